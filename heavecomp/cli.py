@@ -1,0 +1,64 @@
+"""The ``heavecomp`` command line.
+
+Each sub-command lives in ``heavecomp/commands/<name>.py`` and defines
+``add_arguments(parser)`` and ``run(args) -> int``.  Command modules import
+only ``argparse`` at module level so that ``heavecomp --help`` stays fast;
+heavy imports happen inside ``run``.
+
+Bad input (any :class:`heavecomp.errors.InputError`) is printed as one line,
+``heavecomp <command>: error: <message>``, and the exit code is 2.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+
+#: name -> (module, one-line help).  Order is the order shown by --help.
+COMMANDS: dict[str, tuple[str, str]] = {
+    "simulate": ("heavecomp.commands.simulate", "simulate the CMC for a parameter file (exact stick-slip)"),
+    "params": ("heavecomp.commands.params", "write or check a parameter file (built-in sets: paper_a, ...)"),
+}
+
+
+def build_parser() -> tuple[argparse.ArgumentParser, dict]:
+    parser = argparse.ArgumentParser(
+        prog="heavecomp",
+        description="heavecomp: heave compensation of offshore drilling rigs "
+        "(CMC plant, linear analysis, MPC, sim-to-real gap diagnosis).",
+    )
+    from heavecomp import __version__
+
+    parser.add_argument("--version", action="version", version=f"heavecomp {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    modules = {}
+    for name, (modname, helptext) in COMMANDS.items():
+        mod = importlib.import_module(modname)
+        p = sub.add_parser(name, help=helptext, description=(mod.__doc__ or helptext).strip().splitlines()[0])
+        mod.add_arguments(p)
+        modules[name] = mod
+    return parser, modules
+
+
+def main(argv: list[str] | None = None) -> int:
+    from heavecomp.errors import InputError
+
+    parser, modules = build_parser()
+    args = parser.parse_args(argv)
+    if not args.command:
+        parser.print_help()
+        return 2
+    try:
+        return int(modules[args.command].run(args) or 0)
+    except InputError as exc:
+        msg = str(exc).strip().replace("\n", " ")
+        print(f"heavecomp {args.command}: error: {msg}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print(f"heavecomp {args.command}: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

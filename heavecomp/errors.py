@@ -1,0 +1,28 @@
+"""Exceptions for input that a user can fix.
+
+Every error raised for bad user input (parameter files, measured data, CLI
+arguments) derives from :class:`InputError`.  The CLI turns it into a single
+line on stderr and exit code 2; library users catch it like a ``ValueError``.
+"""
+
+from __future__ import annotations
+
+import difflib
+
+
+class InputError(ValueError):
+    """Bad user input: the message is one line and names the offending key/column."""
+
+
+class ParameterError(InputError):
+    """A parameter file or parameter value is invalid."""
+
+
+class DataError(InputError):
+    """Measured data (CSV) is invalid."""
+
+
+def did_you_mean(word: str, choices) -> str:
+    """Return ``" (did you mean 'x'?)"`` for the closest match, or ``""``."""
+    close = difflib.get_close_matches(str(word), [str(c) for c in choices], n=1, cutoff=0.6)
+    return f" (did you mean '{close[0]}'?)" if close else ""

@@ -1,0 +1,289 @@
+"""Parameters of the crown-block mounted compensator (CMC) — the TOML contract.
+
+The table and key names are fixed by ``shared/spec/cmc-reference.md``; this
+module adds nothing to their meaning.  All quantities SI.
+
+Which keys may be omitted (the documented defaults; everything else is required):
+
+- ``[heave]`` as a whole (``simulate`` then needs ``--heave`` data; diagnosis takes
+  heave from the measured run).  ``heave.ramp`` defaults to two periods (sine) or
+  two peak periods (jonswap); ``heave.gamma`` to 3.3; ``heave.seed`` to 0.
+- ``[friction]`` keys not used by the chosen ``model`` (``none`` needs none;
+  ``tangential_velocity`` only for the rotating models).
+- ``drill_string.damping`` and ``formation.damping`` default to 0 N s/m.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Mapping
+
+from heavecomp.errors import ParameterError, did_you_mean
+from heavecomp.params.core import choice, dump_toml, from_table, q, text, to_table
+
+G = 9.81  #: gravity [m/s^2] (contract value)
+P_ATM = 101325.0  #: atmospheric pressure [Pa] (contract value)
+
+FRICTION_MODELS = ("none", "stribeck", "rotating_eq6", "rotating_eq7")
+HEAVE_KINDS = ("sine", "jonswap", "file")
+
+
+@dataclass(frozen=True, kw_only=True)
+class Heave:
+    """``[heave]``: the platform heave input used by ``simulate``."""
+
+    kind: str = choice(HEAVE_KINDS, doc="sine | jonswap | file")
+    amplitude: float = q(None, "m", bounds=(0.0, 50.0), symbol="a", doc="sine amplitude")
+    period: float = q(None, "s", bounds=(0.5, 100.0), symbol="T", doc="sine period")
+    ramp: float = q(None, "s", bounds=(0.0, 1e5), symbol="T_r",
+                    doc="fade-in time; default 2 periods (sine) / 2 peak periods (jonswap)")
+    hs: float = q(None, "m", bounds=(0.0, 30.0), symbol="H_s", doc="significant wave height of the platform heave (jonswap)")
+    tp: float = q(None, "s", bounds=(1.0, 40.0), symbol="T_p", doc="spectral peak period (jonswap)")
+    gamma: float = q(None, "-", bounds=(1.0, 10.0), symbol="gamma", doc="JONSWAP peak enhancement (default 3.3)")
+    seed: int = q(None, "-", bounds=(0, 2**32 - 1), integer=True, doc="random seed of the JONSWAP phases (default 0)")
+    path: str = text(None, doc="CSV with columns t, heave (relative to the parameter file's folder)")
+
+    _REQUIRED = {"sine": ("amplitude", "period"), "jonswap": ("hs", "tp"), "file": ("path",)}
+
+    def __post_init__(self):
+        for key in self._REQUIRED[self.kind]:
+            if getattr(self, key) is None:
+                raise ParameterError(f"heave.{key}: missing required key for kind = \"{self.kind}\"")
+        unused = {"sine": ("hs", "tp", "gamma", "seed", "path"), "jonswap": ("amplitude", "period", "path"),
+                  "file": ("amplitude", "period", "hs", "tp", "ramp", "gamma", "seed")}[self.kind]
+        for key in unused:
+            if getattr(self, key) is not None:
+                raise ParameterError(f"heave.{key}: not used by kind = \"{self.kind}\" (remove it or change heave.kind)")
+        if self.kind == "jonswap":
+            if self.gamma is None:
+                object.__setattr__(self, "gamma", 3.3)
+            if self.seed is None:
+                object.__setattr__(self, "seed", 0)
+        if self.ramp is None and self.kind != "file":
+            object.__setattr__(self, "ramp", 2.0 * (self.period if self.kind == "sine" else self.tp))
+
+
+@dataclass(frozen=True, kw_only=True)
+class Compensator:
+    """``[compensator]``: main cylinder, top mass and gas spring."""
+
+    plunger_diameter: float = q(unit="m", bounds=(0.01, 5.0), open_low=True, symbol="d",
+                                doc="single-acting plunger diameter; area A = pi d^2/4")
+    moving_mass: float = q(unit="kg", bounds=(0.0, 5e6), open_low=True, symbol="M_c",
+                           doc="top mass: crown block, travelling block, top drive, plungers")
+    gas_stiffness: float = q(unit="N/m", bounds=(0.0, 1e9), open_low=True, symbol="k_gas",
+                             doc="gas spring stiffness linearised at the operating point (after force equalizers)")
+    polytropic_index: float = q(unit="-", bounds=(1.0, 1.7), symbol="n",
+                                doc="polytropic index of the gas (1 isothermal, 1.4 adiabatic N2)")
+
+
+@dataclass(frozen=True, kw_only=True)
+class Friction:
+    """``[friction]``: main-cylinder friction (paper A eqs. 4, 6, 7)."""
+
+    model: str = choice(FRICTION_MODELS, doc="none | stribeck | rotating_eq6 | rotating_eq7")
+    static_force: float = q(None, "N", bounds=(0.0, 1e7), symbol="F_S", doc="static (breakaway) friction")
+    coulomb_force: float = q(None, "N", bounds=(0.0, 1e7), symbol="F_C", doc="Coulomb friction")
+    stribeck_velocity: float = q(None, "m/s", bounds=(0.0, 10.0), open_low=True, symbol="v_S",
+                                 doc="Stribeck velocity")
+    viscous_coefficient: float = q(None, "N s/m", bounds=(0.0, 1e9), symbol="C_v", doc="viscous coefficient")
+    pressure_coefficient: float = q(None, "N/Pa", bounds=(0.0, 1.0), symbol="C_p",
+                                    doc="pressure coefficient (200 N/bar = 2e-3 N/Pa)")
+    tangential_velocity: float = q(None, "m/s", bounds=(0.0, 10.0), symbol="v_t",
+                                   doc="piston surface speed from rotation, omega d/2 (rotating models)")
+
+    _LAW_KEYS = ("static_force", "coulomb_force", "stribeck_velocity", "viscous_coefficient",
+                 "pressure_coefficient")
+
+    def __post_init__(self):
+        if self.model == "none":
+            return
+        needed = self._LAW_KEYS + (("tangential_velocity",) if self.model.startswith("rotating") else ())
+        for key in needed:
+            if getattr(self, key) is None:
+                raise ParameterError(f"friction.{key}: missing required key for model = \"{self.model}\"")
+        if not self.model.startswith("rotating") and self.tangential_velocity is not None:
+            raise ParameterError(f"friction.tangential_velocity: not used by model = \"{self.model}\" "
+                                 "(only rotating_eq6 / rotating_eq7)")
+        if self.static_force < self.coulomb_force:
+            raise ParameterError(
+                f"friction.static_force = {self.static_force:g} N is below friction.coulomb_force = "
+                f"{self.coulomb_force:g} N (static friction must be >= Coulomb friction)")
+
+
+@dataclass(frozen=True, kw_only=True)
+class DrillString:
+    """``[drill_string]``: the string as a spring-damper to the lumped lower mass."""
+
+    stiffness: float = q(unit="N/m", bounds=(0.0, 1e10), open_low=True, symbol="k_ds", doc="axial stiffness EA/L")
+    damping: float = q(0.0, "N s/m", bounds=(0.0, 1e9), symbol="c_ds", doc="axial damping (default 0)")
+    lower_mass: float = q(unit="kg", bounds=(0.0, 5e6), open_low=True, symbol="m_b", doc="lumped string + BHA mass")
+
+
+@dataclass(frozen=True, kw_only=True)
+class Formation:
+    """``[formation]``: one-sided bit-rock contact."""
+
+    stiffness: float = q(unit="N/m", bounds=(0.0, 1e10), open_low=True, symbol="k_F", doc="contact stiffness")
+    damping: float = q(0.0, "N s/m", bounds=(0.0, 1e9), symbol="c_F", doc="contact damping (default 0)")
+
+
+@dataclass(frozen=True, kw_only=True)
+class OperatingPoint:
+    """``[operating_point]``."""
+
+    wob_setpoint: float = q(unit="N", bounds=(0.0, 1e8), open_low=True, symbol="W_0", doc="WOB set-point")
+
+
+#: contract tables in file order -> class; optional tables registered by other modules
+TABLES: dict[str, type] = {
+    "heave": Heave,
+    "compensator": Compensator,
+    "friction": Friction,
+    "drill_string": DrillString,
+    "formation": Formation,
+    "operating_point": OperatingPoint,
+}
+#: tables a file may leave out entirely
+OPTIONAL_TABLES: set[str] = {"heave"}
+
+
+@dataclass(frozen=True, kw_only=True)
+class CMCParams:
+    """A complete, validated CMC parameter set (see ``cmc-reference.md``).
+
+    Use :func:`load`, :func:`loads`, :func:`from_dict`, or a named set from
+    :mod:`heavecomp.params.sets`; change with :meth:`replace`.
+    """
+
+    compensator: Compensator
+    friction: Friction
+    drill_string: DrillString
+    formation: Formation
+    operating_point: OperatingPoint
+    heave: Heave | None = None
+    #: folder of the file it was read from (resolves ``heave.path``)
+    base_dir: Path | None = dataclasses.field(default=None, compare=False, repr=False)
+    #: optional extra tables registered in OPTIONAL_EXTRA (e.g. ``[active]``)
+    extra: Mapping[str, Any] = dataclasses.field(default_factory=dict, compare=False)
+
+    def __post_init__(self):
+        g_load = (self.compensator.moving_mass + self.drill_string.lower_mass) * G
+        if self.operating_point.wob_setpoint >= g_load:
+            raise ParameterError(
+                f"operating_point.wob_setpoint = {self.operating_point.wob_setpoint:g} N must be below the "
+                f"suspended weight (M_c + m_b) g = {g_load:g} N (the cylinder pressure would be <= 0)")
+
+    # ---- derived quantities (cmc-reference.md) ---------------------------------
+    @property
+    def area(self) -> float:
+        """Plunger area A = pi d^2 / 4 [m^2]."""
+        return math.pi * self.compensator.plunger_diameter ** 2 / 4.0
+
+    @property
+    def p0(self) -> float:
+        """Operating-point gauge pressure: p_0 A = (M_c + m_b) g - W_0 [Pa]."""
+        c, ds = self.compensator, self.drill_string
+        return ((c.moving_mass + ds.lower_mass) * G - self.operating_point.wob_setpoint) / self.area
+
+    @property
+    def gas_volume(self) -> float:
+        """V_0 from k_gas = n (p_0 + p_atm) A^2 / V_0 [m^3]."""
+        c = self.compensator
+        return c.polytropic_index * (self.p0 + P_ATM) * self.area ** 2 / c.gas_stiffness
+
+    @property
+    def k_eff(self) -> float:
+        """Paper A eq. 14: springs in series, 1/k_eff = 1/k_gas + 1/k_ds + 1/k_F [N/m]."""
+        return 1.0 / (1.0 / self.compensator.gas_stiffness + 1.0 / self.drill_string.stiffness
+                      + 1.0 / self.formation.stiffness)
+
+    def replace(self, **changes: Mapping[str, Any]) -> "CMCParams":
+        """Return a copy with some keys changed, validated like a file.
+
+        ``p.replace(friction={"model": "none"}, drill_string={"stiffness": 208e3})``;
+        a value ``None`` removes that key, a table ``None`` removes the table.
+        Unknown tables or keys raise :class:`ParameterError`.
+        """
+        d = self.to_dict()
+        for tname, upd in changes.items():
+            if tname not in TABLES and tname not in OPTIONAL_EXTRA:
+                raise ParameterError(f"{tname}: unknown table{did_you_mean(tname, list(TABLES) + list(OPTIONAL_EXTRA))}")
+            if upd is None:
+                d.pop(tname, None)
+                continue
+            new = dict(d.get(tname, {}))
+            new.update(upd)
+            d[tname] = {k: v for k, v in new.items() if v is not None}  # None removes a key
+        return from_dict(d, base_dir=self.base_dir)
+
+    def to_dict(self) -> dict[str, dict[str, Any]]:
+        out = {}
+        for tname in TABLES:
+            obj = getattr(self, tname)
+            if obj is not None:
+                out[tname] = to_table(obj)
+        for tname, obj in self.extra.items():
+            out[tname] = to_table(obj) if dataclasses.is_dataclass(obj) else dict(obj)
+        return out
+
+
+#: optional tables other modules add: name -> callable(table_dict) -> object (validated)
+OPTIONAL_EXTRA: dict[str, Any] = {}
+
+
+def from_dict(data: Mapping[str, Any], *, base_dir: Path | None = None) -> CMCParams:
+    """Validate a nested mapping (a parsed TOML file) into :class:`CMCParams`."""
+    for tname, value in data.items():
+        if tname not in TABLES and tname not in OPTIONAL_EXTRA:
+            known = list(TABLES) + list(OPTIONAL_EXTRA)
+            raise ParameterError(f"[{tname}]: unknown table{did_you_mean(tname, known)}; known tables: {', '.join(known)}")
+        if not isinstance(value, Mapping):
+            raise ParameterError(f"{tname}: expected a table [{tname}], got a {type(value).__name__}")
+    kw = {}
+    for tname, cls in TABLES.items():
+        if tname not in data:
+            if tname in OPTIONAL_TABLES:
+                kw[tname] = None
+                continue
+            raise ParameterError(f"[{tname}]: missing required table")
+        kw[tname] = from_table(cls, data[tname], tname)
+    extra = {t: OPTIONAL_EXTRA[t](data[t]) for t in OPTIONAL_EXTRA if t in data}
+    return CMCParams(**kw, base_dir=base_dir, extra=extra)
+
+
+def loads(text_: str, *, base_dir: Path | None = None, source: str = "<string>") -> CMCParams:
+    """Parse TOML text into :class:`CMCParams`."""
+    try:
+        data = tomllib.loads(text_)
+    except tomllib.TOMLDecodeError as exc:
+        raise ParameterError(f"{source}: not valid TOML: {exc}") from None
+    return from_dict(data, base_dir=base_dir)
+
+
+def load(path: str | Path) -> CMCParams:
+    """Read and validate a CMC parameter file."""
+    path = Path(path)
+    try:
+        raw = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise ParameterError(f"{path}: parameter file not found") from None
+    except (IsADirectoryError, PermissionError, UnicodeDecodeError) as exc:
+        raise ParameterError(f"{path}: cannot read parameter file ({type(exc).__name__})") from None
+    return loads(raw, base_dir=path.resolve().parent, source=str(path))
+
+
+def dumps(params: CMCParams, header: str = "") -> str:
+    """TOML text of a parameter set (round-trips through :func:`loads`)."""
+    return dump_toml(params.to_dict(), header=header)
+
+
+def save(params: CMCParams, path: str | Path, header: str = "") -> Path:
+    """Write a parameter set as TOML."""
+    path = Path(path)
+    path.write_text(dumps(params, header), encoding="utf-8")
+    return path

@@ -1,0 +1,167 @@
+"""Parameter machinery: fields that carry unit, bounds and symbol; strict parsing.
+
+A parameter table is a frozen dataclass whose fields are declared with :func:`q`
+(a number with unit and bounds) or :func:`choice` (a string from a fixed set).
+:func:`from_table` builds one from a mapping (a TOML table) and raises
+:class:`~heavecomp.errors.ParameterError` with a one-line message naming the
+key for every problem: unknown key (with a "did you mean"), missing key, wrong
+type, NaN/inf, value out of bounds.  There is no silent default: a field has a
+default only where its metadata documents one.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from typing import Any, Mapping
+
+from heavecomp.errors import ParameterError, did_you_mean
+
+_MISSING = dataclasses.MISSING
+
+
+def q(default=_MISSING, unit: str = "-", *, bounds=(-math.inf, math.inf), symbol: str = "",
+      doc: str = "", open_low: bool = False, integer: bool = False):
+    """A numeric parameter field.
+
+    Parameters
+    ----------
+    default : float, optional
+        Documented default; omit for a required key.
+    unit : str
+        SI unit shown in messages and docs.
+    bounds : (float, float)
+        Physically possible range (inclusive unless ``open_low``).
+    symbol : str
+        Symbol used in the papers (e.g. ``"F_S"``).
+    open_low : bool
+        Lower bound is exclusive (e.g. masses must be > 0).
+    integer : bool
+        Value must be a whole number (e.g. a random seed).
+    """
+    meta = dict(kind="number", unit=unit, bounds=bounds, symbol=symbol, doc=doc,
+                open_low=open_low, integer=integer)
+    if default is _MISSING:
+        return dataclasses.field(metadata=meta)
+    return dataclasses.field(default=default, metadata=meta)
+
+
+def choice(options, default=_MISSING, *, doc: str = ""):
+    """A string parameter restricted to ``options``."""
+    meta = dict(kind="choice", options=tuple(options), doc=doc, unit="", symbol="")
+    if default is _MISSING:
+        return dataclasses.field(metadata=meta)
+    return dataclasses.field(default=default, metadata=meta)
+
+
+def text(default=_MISSING, *, doc: str = ""):
+    """A free string parameter (e.g. a file path)."""
+    meta = dict(kind="text", doc=doc, unit="", symbol="")
+    if default is _MISSING:
+        return dataclasses.field(metadata=meta)
+    return dataclasses.field(default=default, metadata=meta)
+
+
+def _fmt(x) -> str:
+    return f"{x:g}" if isinstance(x, float) else str(x)
+
+
+def check_value(name: str, f: dataclasses.Field, value: Any) -> Any:
+    """Validate one value against its field metadata; return the normalised value."""
+    meta = f.metadata
+    kind = meta.get("kind")
+    if kind == "number":
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise ParameterError(f"{name}: expected a number in {meta['unit']}, got {type(value).__name__} {value!r}")
+        if meta.get("integer"):
+            if float(value) != int(value):
+                raise ParameterError(f"{name}: expected a whole number, got {value!r}")
+            return int(value)
+        value = float(value)
+        if not math.isfinite(value):
+            raise ParameterError(f"{name}: must be finite, got {value}")
+        lo, hi = meta["bounds"]
+        too_low = value <= lo if meta.get("open_low") else value < lo
+        if too_low or value > hi:
+            lo_s = ("(" if meta.get("open_low") else "[") + _fmt(lo)
+            unit = meta["unit"]
+            raise ParameterError(
+                f"{name} = {_fmt(value)} {unit} is outside the possible range {lo_s}, {_fmt(hi)}] {unit}"
+                + (" (wrong unit?)" if unit not in ("-", "") and (value > hi or 0 < value < lo) else ""))
+        return value
+    if kind == "choice":
+        if not isinstance(value, str) or value not in meta["options"]:
+            raise ParameterError(
+                f"{name} = {value!r} is not one of {', '.join(meta['options'])}{did_you_mean(value, meta['options'])}")
+        return value
+    if kind == "text":
+        if not isinstance(value, str):
+            raise ParameterError(f"{name}: expected a string, got {type(value).__name__} {value!r}")
+        return value
+    raise TypeError(f"field {name} has no parameter metadata")  # programming error
+
+
+def from_table(cls, table: Mapping[str, Any] | None, prefix: str, *, required: set[str] | None = None):
+    """Build the dataclass ``cls`` from a TOML table, strictly.
+
+    ``required`` overrides which keys must be present (default: every field
+    without a default).  Keys of ``cls`` that are not in ``required`` and have no
+    default are filled with ``None`` (the caller documents when that is allowed).
+    """
+    table = dict(table or {})
+    fields = {f.name: f for f in dataclasses.fields(cls)}
+    for key in table:
+        if key not in fields:
+            raise ParameterError(f"{prefix}.{key}: unknown key{did_you_mean(key, fields)}; "
+                                 f"known keys: {', '.join(fields)}")
+    if required is None:
+        required = {n for n, f in fields.items()
+                    if f.default is _MISSING and f.default_factory is _MISSING}
+    kwargs = {}
+    for name, f in fields.items():
+        full = f"{prefix}.{name}"
+        if name in table:
+            kwargs[name] = check_value(full, f, table[name])
+        elif name in required:
+            unit = f.metadata.get("unit", "")
+            raise ParameterError(f"{full}: missing required key" + (f" [{unit}]" if unit and unit != "-" else ""))
+        elif f.default is _MISSING:
+            kwargs[name] = None
+    return cls(**kwargs)
+
+
+def to_table(obj) -> dict[str, Any]:
+    """Dataclass -> plain dict (``None`` values dropped), for TOML output."""
+    return {f.name: getattr(obj, f.name) for f in dataclasses.fields(obj) if getattr(obj, f.name) is not None}
+
+
+def describe(cls) -> list[tuple[str, str, str, str, str]]:
+    """(key, unit, symbol, default, doc) rows for documentation."""
+    rows = []
+    for f in dataclasses.fields(cls):
+        m = f.metadata
+        default = "required" if f.default is _MISSING else repr(f.default)
+        rows.append((f.name, m.get("unit", ""), m.get("symbol", ""), default, m.get("doc", "")))
+    return rows
+
+
+def dump_toml(tables: Mapping[str, Mapping[str, Any]], header: str = "") -> str:
+    """Write nested ``{table: {key: value}}`` as TOML (numbers, strings, bools)."""
+    out = [f"# {line}" if line else "#" for line in header.splitlines()] if header else []
+    for tname, table in tables.items():
+        if out:
+            out.append("")
+        out.append(f"[{tname}]")
+        for key, value in table.items():
+            if isinstance(value, bool):
+                s = "true" if value else "false"
+            elif isinstance(value, int):
+                s = str(value)
+            elif isinstance(value, float):
+                s = repr(value)
+            elif isinstance(value, str):
+                s = '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
+            else:
+                raise TypeError(f"cannot write {tname}.{key} of type {type(value).__name__} to TOML")
+            out.append(f"{key} = {s}")
+    return "\n".join(out) + "\n"

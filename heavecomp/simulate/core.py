@@ -1,0 +1,227 @@
+"""Simulate the CMC with exact stick-slip: ``simulate(params, duration) -> SimulationResult``."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import logging
+import math
+import time
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+
+from heavecomp.errors import InputError, ParameterError
+
+log = logging.getLogger(__name__)
+
+CHANNELS = ("t", "heave", "stroke", "pressure", "wob", "stroke_velocity", "friction", "tension",
+            "lower_displacement", "lower_velocity", "stuck", "u_active")
+#: columns written to timeseries.csv (contract columns first)
+CSV_COLUMNS = ("t", "heave", "stroke", "pressure", "wob", "stroke_velocity", "friction", "tension", "stuck")
+
+
+def plant_eigen_rate(params) -> float:
+    """Largest |eigenvalue| [1/s] of the linearised plant (stroke stuck or free),
+    including the steepest friction slope near v = 0 — sets the default step."""
+    from heavecomp.friction.laws import FrictionLaw
+
+    c, ds, fo = params.compensator, params.drill_string, params.formation
+    Mc, mb = c.moving_mass, ds.lower_mass
+    law = FrictionLaw.from_params(params.friction)
+    FS, FC, vS, Cv, Cp, vt = law.FP
+    slope = Cv
+    if law.code in (1, 2) and law.model != "none":  # negative Stribeck slope at 0+
+        slope = max(slope, (FS - FC) / vS)
+    if law.code == 3:
+        slope = max(slope, (FC + (FS - FC) * math.exp(-vt / vS)) / vt + Cv)
+    K = np.array([[c.gas_stiffness + ds.stiffness, -ds.stiffness], [-ds.stiffness, ds.stiffness + fo.stiffness]])
+    C = np.array([[ds.damping + slope, -ds.damping], [-ds.damping, ds.damping + fo.damping]])
+    Minv = np.diag([1 / Mc, 1 / mb])
+    Asys = np.block([[np.zeros((2, 2)), np.eye(2)], [-Minv @ K, -Minv @ C]])
+    lam = np.abs(np.linalg.eigvals(Asys)).max()
+    return float(max(lam, math.sqrt((ds.stiffness + fo.stiffness) / mb), (ds.damping + fo.damping) / mb))
+
+
+def default_dt(params, rate: float | None = None) -> float:
+    """Default RK4 step [s]: h * lambda_max <= 0.25 and at most 10 ms (and a
+    divisor of the output interval 1/rate when ``rate`` is given)."""
+    h = min(0.01, 0.25 / plant_eigen_rate(params))
+    if rate:
+        interval = 1.0 / rate
+        h = interval / math.ceil(interval / h - 1e-9)
+    return h
+
+
+@dataclasses.dataclass
+class SimulationResult:
+    """Named channels of a simulation plus bookkeeping.
+
+    ``res["wob"]`` gives a channel; ``res.metrics()`` the summary statistics;
+    ``res.to_csv(path)`` the contract CSV.  Channels: :data:`CHANNELS`.
+    """
+
+    data: np.ndarray  # (n, len(CHANNELS))
+    params: object
+    dt: float
+    stats: dict
+    heave_info: dict
+    wall_time: float = 0.0
+    stats_start: float = 0.0
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        try:
+            return self.data[:, CHANNELS.index(name)]
+        except ValueError:
+            raise KeyError(f"no channel {name!r}; channels: {', '.join(CHANNELS)}") from None
+
+    @property
+    def t(self) -> np.ndarray:
+        return self["t"]
+
+    def window(self, start: float | None = None) -> np.ndarray:
+        """Boolean mask of samples at t >= start (default: after the fade-in)."""
+        return self.t >= (self.stats_start if start is None else start) - 1e-12
+
+    def metrics(self, start: float | None = None) -> dict:
+        """WOB statistics over t >= start (default: after the heave fade-in) [N, m, -]."""
+        m = self.window(start)
+        w = self["wob"][m]
+        duration = float(self.t[-1])
+        st = self.stats
+        return {
+            "wob_mean": float(np.mean(w)),
+            "wob_std": float(np.std(w)),
+            "wob_min": float(np.min(w)),
+            "wob_max": float(np.max(w)),
+            "wob_p2p": float(np.ptp(w)),
+            "wob_setpoint": float(self.params.operating_point.wob_setpoint),
+            "stick_fraction": float(np.mean(self["stuck"][m])),
+            "stick_fraction_total": st["stuck_time"] / duration if duration > 0 else 0.0,
+            "n_stick": int(st["n_stick"]),
+            "n_breakaway": int(st["n_breakaway"]),
+            "n_reversal": int(st["n_reversal"]),
+            "stroke_max": float(np.max(np.abs(self["stroke"][m]))),
+            "pressure_min": float(np.min(self["pressure"][m])),
+            "pressure_max": float(np.max(self["pressure"][m])),
+            "heave_std": float(np.std(self["heave"][m])),
+            "k_eff_eq14": float(self.params.k_eff),
+            "stats_window": [float(self.t[m][0]), duration],
+            "duration": duration,
+            "dt": self.dt,
+            "friction_model": self.params.friction.model,
+            "wall_time_s": self.wall_time,
+        }
+
+    def to_csv(self, path, columns=CSV_COLUMNS) -> Path:
+        path = Path(path)
+        idx = [CHANNELS.index(c) for c in columns]
+        np.savetxt(path, self.data[:, idx], delimiter=",", header=",".join(columns), comments="", fmt="%.10g")
+        return path
+
+    def to_dict(self) -> dict[str, np.ndarray]:
+        return {c: self.data[:, i] for i, c in enumerate(CHANNELS)}
+
+
+def _friction_vectors(params):
+    from heavecomp.friction.laws import FrictionLaw
+    from heavecomp.plants.cmc import plant_vector
+
+    law = FrictionLaw.from_params(params.friction)
+    return law, plant_vector(params)
+
+
+def simulate(params, duration: float, *, dt: float | None = None, rate: float = 20.0, heave=None,
+             progress: Callable[[float], None] | None = None, stats_start: float | None = None,
+             u_active: float = 0.0) -> SimulationResult:
+    """Simulate the CMC from rest at the operating point with exact stick-slip.
+
+    Parameters
+    ----------
+    params : CMCParams
+        Validated parameter set (:mod:`heavecomp.params`).
+    duration : float [s]
+    dt : float [s], optional
+        RK4 step; default :func:`default_dt`.
+    rate : float [Hz]
+        Output sampling rate (the step is made a divisor of 1/rate).
+    heave : HeaveSamples or (t, z) arrays, optional
+        Overrides ``params.heave`` (e.g. measured heave).
+    progress : callable(fraction), optional
+        Called as the run advances (the CLI draws a bar with it).
+    stats_start : float [s], optional
+        Start of the window for :meth:`SimulationResult.metrics`; default the
+        heave fade-in (``heave.ramp``) or 0.
+    u_active : float [N]
+        Constant active-cylinder force (closed loops use :mod:`heavecomp.controllers`).
+    """
+    from heavecomp.simulate import excitation
+
+    if not (duration > 0 and math.isfinite(duration)):
+        raise InputError(f"--duration must be a positive number of seconds, got {duration}")
+    if not (rate > 0 and math.isfinite(rate)):
+        raise InputError(f"--rate must be a positive number of Hz, got {rate}")
+    h = dt if dt is not None else default_dt(params, rate)
+    if not (h > 0 and math.isfinite(h)):
+        raise InputError(f"--dt must be a positive number of seconds, got {dt}")
+    out_every = max(1, int(round(1.0 / (rate * h))))
+    if dt is not None and abs(out_every * h * rate - 1.0) > 1e-6:
+        log.warning("output interval 1/rate = %g s is not a multiple of dt = %g s; output every %d steps",
+                    1 / rate, h, out_every)
+    n_steps = int(math.ceil(duration / h - 1e-9))
+    sp = 0.5 * h
+    if heave is None:
+        hs = excitation.make_heave(params.heave, n_steps * h, sp, params.base_dir)
+    elif isinstance(heave, excitation.HeaveSamples):
+        if abs(heave.spacing - sp) > 1e-12 * sp:
+            raise ValueError("heave samples must be spaced dt/2")
+        hs = heave
+    else:
+        t_in, z_in = heave
+        hs = excitation.from_series(t_in, z_in, n_steps * h, sp, src="heave")
+    law, PP = _friction_vectors(params)
+    result = run_kernel(law, PP, hs, h, n_steps, out_every, u_active=u_active, progress=progress)
+    data, stats, wall = result
+    if stats_start is None:
+        stats_start = (params.heave.ramp or 0.0) if (heave is None and params.heave is not None) else 0.0
+        stats_start = min(stats_start, 0.5 * duration)
+    return SimulationResult(data=data, params=params, dt=h, stats=stats, heave_info=hs.info,
+                            wall_time=wall, stats_start=stats_start)
+
+
+def run_kernel(law, PP, hs, h, n_steps, out_every, *, u_active=0.0, progress=None, chunk_steps=200_000):
+    """Run the compiled stepper from rest (stuck) at the operating point."""
+    from heavecomp.simulate import _kernel as K
+
+    n_out = n_steps // out_every + 1
+    out = np.empty((n_out, K.NCH))
+    state = np.zeros(4)
+    mode_dir = np.array([float(K.STUCK), 1.0])
+    stats = np.zeros(len(K.STATS))
+    smooth = not law.has_stiction
+    t0 = time.perf_counter()
+    done, pos = 0, 0
+    while done < n_steps:
+        n = min(chunk_steps - chunk_steps % out_every or out_every, n_steps - done)
+        pos = K.advance(state, mode_dir, done * h, n, h, law.code, law.FP, PP, smooth, float(u_active), 0.5 * h,
+                        hs.z, hs.dz, hs.ddz, out, out_every, pos, stats)
+        done += n
+        if progress is not None:
+            progress(done / n_steps)
+    wall = time.perf_counter() - t0
+    return out[:pos], dict(zip(K.STATS, stats.tolist())), wall
+
+
+def write_outputs(res: SimulationResult, out_dir, *, title: str | None = None) -> dict:
+    """Write ``timeseries.csv``, ``metrics.json`` and ``wob.png`` into ``out_dir``."""
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    res.to_csv(out_dir / "timeseries.csv")
+    metrics = res.metrics()
+    metrics["heave"] = {k: v for k, v in res.heave_info.items() if isinstance(v, (int, float, str))}
+    (out_dir / "metrics.json").write_text(json.dumps(metrics, indent=2) + "\n")
+    from heavecomp.report.figures import plot_wob, save
+
+    save(plot_wob({res.params.friction.model: res}, title=title), out_dir / "wob.png")
+    return metrics

@@ -1,0 +1,237 @@
+"""Platform heave inputs: sine with fade-in, JONSWAP irregular sea, measured file.
+
+Every excitation is delivered to the stepper as samples of z_h, dz_h/dt and
+d^2z_h/dt^2 on a uniform grid of spacing ``dt/2`` (the RK4 stage times); the
+stepper interpolates between samples with quintic Hermite polynomials when an
+event falls between them.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from pathlib import Path
+
+import numpy as np
+
+from heavecomp.errors import DataError, ParameterError
+
+G = 9.81
+
+
+@dataclasses.dataclass(frozen=True)
+class HeaveSamples:
+    """z_h, dz_h, ddz_h sampled every ``spacing`` seconds from t = 0."""
+
+    spacing: float
+    z: np.ndarray
+    dz: np.ndarray
+    ddz: np.ndarray
+    info: dict = dataclasses.field(default_factory=dict)
+
+    @property
+    def t(self) -> np.ndarray:
+        return np.arange(self.z.size) * self.spacing
+
+
+def ramp_factor(t, ramp):
+    """Fade-in r(t) = sin^2(pi/2 min(t/T_r, 1)) and its first two derivatives."""
+    t = np.asarray(t, dtype=float)
+    if ramp <= 0:
+        one = np.ones_like(t)
+        return one, 0 * one, 0 * one
+    inside = t < ramp
+    x = np.pi * np.minimum(t / ramp, 1.0)
+    r = np.where(inside, np.sin(x / 2) ** 2, 1.0)
+    dr = np.where(inside, np.pi / (2 * ramp) * np.sin(x), 0.0)
+    ddr = np.where(inside, np.pi ** 2 / (2 * ramp ** 2) * np.cos(x), 0.0)
+    return r, dr, ddr
+
+
+def _apply_ramp(t, z, dz, ddz, ramp):
+    r, dr, ddr = ramp_factor(t, ramp)
+    return r * z, dr * z + r * dz, ddr * z + 2 * dr * dz + r * ddz
+
+
+def sine(amplitude, period, ramp, duration, spacing) -> HeaveSamples:
+    """z_h = r(t) a sin(2 pi t / T) (cmc-reference.md)."""
+    t = np.arange(int(math.ceil(duration / spacing)) + 1) * spacing
+    w = 2 * np.pi / period
+    z, dz, ddz = _apply_ramp(t, amplitude * np.sin(w * t), amplitude * w * np.cos(w * t),
+                             -amplitude * w * w * np.sin(w * t), ramp)
+    return HeaveSamples(spacing, z, dz, ddz, {"kind": "sine", "amplitude": amplitude, "period": period, "ramp": ramp})
+
+
+def jonswap_spectrum(f, hs, tp, gamma=3.3):
+    """One-sided JONSWAP spectral density S(f) [m^2/Hz] scaled to 4 sqrt(m0) = hs.
+
+    DNV-RP-C205 form with sigma = 0.07 (f <= f_p) / 0.09 (f > f_p); the
+    normalisation is done numerically so H_s is exact for any gamma.
+    """
+    f = np.asarray(f, dtype=float)
+    fp = 1.0 / tp
+    out = np.zeros_like(f)
+    pos = f > 0
+    fpos = f[pos]
+    sigma = np.where(fpos <= fp, 0.07, 0.09)
+    shape = fpos ** -5 * np.exp(-1.25 * (fp / fpos) ** 4) * gamma ** np.exp(-((fpos - fp) ** 2) / (2 * sigma ** 2 * fp ** 2))
+    out[pos] = shape
+    # normalise on a fine reference grid (independent of the caller's grid)
+    fr = np.linspace(0.2 * fp, 8 * fp, 20000)
+    sr = np.where(fr <= fp, 0.07, 0.09)
+    ref = fr ** -5 * np.exp(-1.25 * (fp / fr) ** 4) * gamma ** np.exp(-((fr - fp) ** 2) / (2 * sr ** 2 * fp ** 2))
+    m0 = np.trapezoid(ref, fr)
+    return out * (hs / 4.0) ** 2 / m0
+
+
+def jonswap(hs, tp, gamma, seed, ramp, duration, spacing, *, f_cut_factor=6.0) -> HeaveSamples:
+    """Irregular platform heave from a JONSWAP spectrum (random phases, deterministic amplitudes).
+
+    Components sit on the FFT grid f_k = k / T_rep with T_rep >= duration, so
+    the series is synthesised with one inverse FFT per derivative and its
+    variance over T_rep equals the spectrum's m0 exactly (H_s = 4 sqrt(m0)).
+    Components above ``f_cut_factor / T_p`` are dropped (they carry < 0.1 % of
+    the variance and would only add high-frequency acceleration).
+    """
+    from scipy import fft as sfft
+
+    n_need = int(math.ceil(duration / spacing)) + 2
+    n = sfft.next_fast_len(max(n_need, int(math.ceil(4 * tp / spacing))), real=True)
+    T_rep = n * spacing
+    f = np.fft.rfftfreq(n, spacing)
+    S = jonswap_spectrum(f, hs, tp, gamma)
+    S[f > f_cut_factor / tp] = 0.0
+    df = 1.0 / T_rep
+    amp = np.sqrt(2 * S * df)
+    rng = np.random.default_rng(seed)
+    phase = rng.uniform(0, 2 * np.pi, size=f.size)
+    X = amp * np.exp(1j * phase) * n / 2.0  # irfft scaling: a cos(w t + phi)
+    X[0] = 0.0
+    if n % 2 == 0:
+        X[-1] = 0.0
+    w = 2 * np.pi * f
+    z = sfft.irfft(X, n)[:n_need]
+    dz = sfft.irfft(1j * w * X, n)[:n_need]
+    ddz = sfft.irfft(-(w ** 2) * X, n)[:n_need]
+    t = np.arange(n_need) * spacing
+    z, dz, ddz = _apply_ramp(t, z, dz, ddz, ramp)
+    info = {"kind": "jonswap", "hs": hs, "tp": tp, "gamma": gamma, "seed": seed, "ramp": ramp,
+            "repeat_period": T_rep}
+    return HeaveSamples(spacing, z, dz, ddz, info)
+
+
+def spectral_hs_tp(z, dt):
+    """H_s = 4 std(z) and T_p from a smoothed (Welch) spectrum of a heave series."""
+    from scipy.signal import welch
+
+    z = np.asarray(z, dtype=float)
+    nper = min(z.size, int(round(512.0 / dt)))  # ~0.002 Hz resolution
+    f, S = welch(z - z.mean(), fs=1.0 / dt, nperseg=nper)
+    k = int(np.argmax(S[1:])) + 1
+    # parabolic interpolation of the peak
+    if 1 <= k < S.size - 1:
+        a, b, c = S[k - 1], S[k], S[k + 1]
+        den = a - 2 * b + c
+        off = 0.5 * (a - c) / den if den != 0 else 0.0
+        fpk = f[k] + off * (f[1] - f[0])
+    else:
+        fpk = f[k]
+    return 4.0 * float(np.std(z)), 1.0 / float(fpk)
+
+
+def read_heave_csv(path) -> tuple[np.ndarray, np.ndarray]:
+    """Read a heave file: CSV with a header naming columns ``t`` and ``heave``."""
+    path = Path(path)
+    if not path.is_file():
+        raise ParameterError(f"heave.path: file not found: {path}")
+    import csv
+
+    with path.open(newline="") as fh:
+        reader = csv.reader(fh)
+        try:
+            header = [h.strip() for h in next(reader)]
+        except StopIteration:
+            raise DataError(f"{path}: empty heave file") from None
+        for col in ("t", "heave"):
+            if col not in header:
+                raise DataError(f"{path}: missing column '{col}' (header: {', '.join(header)})")
+        it, ih = header.index("t"), header.index("heave")
+        t, z = [], []
+        for row_no, row in enumerate(reader, start=2):
+            if not row:
+                continue
+            try:
+                t.append(float(row[it]))
+                z.append(float(row[ih]))
+            except (ValueError, IndexError):
+                raise DataError(f"{path}: row {row_no}: non-numeric or missing value in 't' or 'heave'") from None
+    t, z = np.asarray(t), np.asarray(z)
+    _check_series(t, z, str(path))
+    return t, z
+
+
+def _check_series(t, z, src):
+    if t.size < 4:
+        raise DataError(f"{src}: column 't': need at least 4 samples, got {t.size}")
+    for name, arr in (("t", t), ("heave", z)):
+        bad = np.flatnonzero(~np.isfinite(arr))
+        if bad.size:
+            raise DataError(f"{src}: column '{name}': non-finite value at data row {bad[0] + 1}")
+    back = np.flatnonzero(np.diff(t) <= 0)
+    if back.size:
+        raise DataError(f"{src}: column 't': time not strictly increasing at data row {back[0] + 2} "
+                        f"({t[back[0]]:g} -> {t[back[0] + 1]:g} s)")
+    if np.max(np.abs(z - z[0])) > 50:
+        raise DataError(f"{src}: column 'heave': excursions over 50 m — is it in metres?")
+
+
+def from_series(t, z, duration, spacing, src="heave") -> HeaveSamples:
+    """Heave from measured samples: cubic spline through (t, z), first sample as reference."""
+    from scipy.interpolate import CubicSpline
+
+    t = np.asarray(t, dtype=float)
+    z = np.asarray(z, dtype=float)
+    _check_series(t, z, src)
+    span = t[-1] - t[0]
+    if duration > span + 1e-9:
+        raise ParameterError(f"duration {duration:g} s exceeds the heave record's span {span:g} s ({src})")
+    cs = CubicSpline(t - t[0], z - z[0])
+    tg = np.arange(int(math.ceil(duration / spacing)) + 1) * spacing
+    tg = np.minimum(tg, span)
+    return HeaveSamples(spacing, cs(tg), cs(tg, 1), cs(tg, 2), {"kind": "file", "source": src, "span": span})
+
+
+def make_heave(heave, duration, spacing, base_dir=None) -> HeaveSamples:
+    """Samples for a :class:`heavecomp.params.cmc.Heave` table."""
+    if heave is None:
+        raise ParameterError("[heave]: missing table (simulate needs a heave input: sine, jonswap or file)")
+    if heave.kind == "sine":
+        return sine(heave.amplitude, heave.period, heave.ramp, duration, spacing)
+    if heave.kind == "jonswap":
+        return jonswap(heave.hs, heave.tp, heave.gamma, heave.seed, heave.ramp, duration, spacing)
+    path = Path(heave.path)
+    if not path.is_absolute() and base_dir is not None:
+        path = Path(base_dir) / path
+    t, z = read_heave_csv(path)
+    return from_series(t, z, duration, spacing, src=str(path))
+
+
+def load_waverider(path, start_hours=0.0):
+    """Buoy heave from the Datawell Waverider CSV in ``shared/data/waverider``.
+
+    Returns ``(t, z)`` with t from 0 [s] and z the sea-surface heave [m]; rows
+    with a bad signal-quality flag or non-finite heave are dropped.
+    """
+    data = np.genfromtxt(path, delimiter=",", names=True)
+    t = data["unix_time_s"]
+    z = data["heave_m"]
+    ok = np.isfinite(t) & np.isfinite(z)
+    if "sig_qual" in data.dtype.names:
+        ok &= data["sig_qual"] == 0
+    t, z = t[ok], z[ok]
+    order = np.argsort(t, kind="stable")
+    t, z = t[order], z[order]
+    keep = np.concatenate([[True], np.diff(t) > 0])
+    t, z = t[keep] - t[0], z[keep]
+    sel = t >= start_hours * 3600
+    return t[sel] - t[sel][0], z[sel]
