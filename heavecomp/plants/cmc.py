@@ -121,9 +121,10 @@ def casadi_model(params, *, eps: float | None = None, sym: str = "SX"):
         Inputs ``x`` (4: s, v, y_b, v_b) and ``u`` (4: z_h, dz_h, ddz_h, u_active);
         outputs ``xdot`` (4) and ``y`` (5: wob, stroke, pressure, tension, friction).
     """
-    import casadi as ca
-
     from heavecomp.friction.laws import FrictionLaw
+    from heavecomp.plants.symbolic import casadi
+
+    ca = casadi()
 
     law = FrictionLaw.from_params(params.friction)
     if law.has_stiction and not (eps and eps > 0):
