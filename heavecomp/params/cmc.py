@@ -9,7 +9,9 @@ Which keys may be omitted (the documented defaults; everything else is required)
   heave from the measured run).  ``heave.ramp`` defaults to two periods (sine) or
   two peak periods (jonswap); ``heave.gamma`` to 3.3; ``heave.seed`` to 0.
 - ``[friction]`` keys not used by the chosen ``model`` (``none`` needs none;
-  ``tangential_velocity`` only for the rotating models).
+  ``tangential_velocity`` only for the rotating models).  Keys given but not
+  used by the model are validated and kept (so one file can be run in every
+  friction regime with ``--friction``), but do not act.
 - ``drill_string.damping`` and ``formation.damping`` default to 0 N s/m.
 """
 
@@ -106,9 +108,6 @@ class Friction:
         for key in needed:
             if getattr(self, key) is None:
                 raise ParameterError(f"friction.{key}: missing required key for model = \"{self.model}\"")
-        if not self.model.startswith("rotating") and self.tangential_velocity is not None:
-            raise ParameterError(f"friction.tangential_velocity: not used by model = \"{self.model}\" "
-                                 "(only rotating_eq6 / rotating_eq7)")
         if self.static_force < self.coulomb_force:
             raise ParameterError(
                 f"friction.static_force = {self.static_force:g} N is below friction.coulomb_force = "

@@ -235,3 +235,31 @@ def load_waverider(path, start_hours=0.0):
     t, z = t[keep] - t[0], z[keep]
     sel = t >= start_hours * 3600
     return t[sel] - t[sel][0], z[sel]
+
+
+def vessel_heave(t, z, natural_period=22.0, damping_ratio=0.15, dt=None):
+    """Platform heave from sea-surface heave through a second-order heave RAO.
+
+    ``H(jw) = w_n^2 / (w_n^2 - w^2 + 2 j zeta w_n w)`` with ``w_n = 2 pi / natural_period``:
+    a generic semi-submersible (heave natural period ~20-25 s), which passes
+    swell, attenuates wind sea (|H| ~ 0.4 at 12 s for the defaults) and adds its
+    phase lag.  An assumption, not a particular vessel — supply the real RAO
+    for a real rig.  The record is first resampled to a uniform grid ``dt``
+    (default: its median sampling interval).
+
+    Returns ``(t_uniform, z_platform)``.
+    """
+    t = np.asarray(t, dtype=float)
+    z = np.asarray(z, dtype=float)
+    if dt is None:
+        dt = float(np.median(np.diff(t)))
+    tu = np.arange(t[0], t[-1] + 1e-9, dt)
+    zu = np.interp(tu, t, z)
+    n = tu.size
+    nf = 2 * n  # zero padding against wrap-around
+    Z = np.fft.rfft(zu - zu.mean(), nf)
+    w = 2 * np.pi * np.fft.rfftfreq(nf, dt)
+    wn = 2 * np.pi / natural_period
+    H = wn ** 2 / (wn ** 2 - w ** 2 + 2j * damping_ratio * wn * w)
+    zp = np.fft.irfft(Z * H, nf)[:n]
+    return tu - tu[0], zp

@@ -1,0 +1,61 @@
+"""Plumbing shared by the scenario scripts: arguments, output folder, metrics and markdown."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import logging
+import math
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def parse_args(argv, name: str, doc: str | None = None, extra=None) -> argparse.Namespace:
+    """``--quick`` and ``--out DIR`` (default ``reports/<name>``) for every scenario."""
+    p = argparse.ArgumentParser(prog=f"scenarios/{name}.py", description=(doc or "").strip().splitlines()[0] if doc else None)
+    p.add_argument("--quick", action="store_true", help="short runs (for tests and a first look)")
+    p.add_argument("--out", default=str(ROOT / "reports" / name), help="output folder (default reports/%(prog)s)")
+    if extra:
+        extra(p)
+    args = p.parse_args(argv)
+    args.out = Path(args.out)
+    args.out.mkdir(parents=True, exist_ok=True)
+    logging.basicConfig(level=logging.INFO, format="%(message)s")
+    return args
+
+
+def _clean(x):
+    if isinstance(x, float) and not math.isfinite(x):
+        return None
+    if isinstance(x, dict):
+        return {k: _clean(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [_clean(v) for v in x]
+    if hasattr(x, "item") and not isinstance(x, (str, bytes)):
+        try:
+            return _clean(x.item())
+        except (ValueError, AttributeError):
+            pass
+    return x
+
+
+def write_metrics(out: Path, metrics: dict) -> Path:
+    path = Path(out) / "metrics.json"
+    path.write_text(json.dumps(_clean(metrics), indent=2) + "\n")
+    return path
+
+
+def md_table(header, rows, fmt="{:.2f}") -> str:
+    """Markdown table; floats formatted with ``fmt``."""
+    def cell(v):
+        return fmt.format(v) if isinstance(v, float) else str(v)
+    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    lines += ["| " + " | ".join(cell(v) for v in r) + " |" for r in rows]
+    return "\n".join(lines)
+
+
+def write_report(out: Path, title: str, sections: list[str]) -> Path:
+    path = Path(out) / "report.md"
+    path.write_text(f"# {title}\n\n" + "\n\n".join(s.strip() for s in sections) + "\n")
+    return path
