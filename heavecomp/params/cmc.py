@@ -286,3 +286,29 @@ def save(params: CMCParams, path: str | Path, header: str = "") -> Path:
     path = Path(path)
     path.write_text(dumps(params, header), encoding="utf-8")
     return path
+
+
+@dataclass(frozen=True, kw_only=True)
+class Active:
+    """``[active]`` (optional): an active cylinder beside the main cylinder.
+
+    It pushes on the top mass with a force u (positive up), limited in size and
+    rate; a controller (:mod:`heavecomp.controllers`) commands it at
+    ``control_rate``.  Files without ``[active]`` are passive rigs; every key has
+    a documented default.
+    """
+
+    u_max: float = q(60e3, "N", bounds=(0.0, 1e8), open_low=True, symbol="u_max",
+                     doc="largest active force magnitude |u| (default 60 kN)")
+    rate_max: float = q(300e3, "N/s", bounds=(0.0, 1e10), open_low=True, symbol="du_max",
+                        doc="largest force rate |du/dt| (default 300 kN/s)")
+    control_rate: float = q(20.0, "Hz", bounds=(0.0, 1e3), open_low=True, symbol="f_c",
+                            doc="controller sample rate; command held between samples (default 20 Hz)")
+
+
+OPTIONAL_EXTRA["active"] = lambda table: from_table(Active, table, "active")
+
+
+def active(params: CMCParams) -> Active:
+    """The ``[active]`` table of ``params``, or its documented defaults when absent."""
+    return params.extra.get("active") or Active()
