@@ -76,7 +76,7 @@ CHANNELS = ("t", "heave", "stroke", "pressure", "wob", "stroke_velocity", "frict
             "lower_displacement", "lower_velocity", "stuck", "u_active")
 NCH = len(CHANNELS)
 #: slots of the ``stats`` array
-STATS = ("stuck_time", "n_stick", "n_breakaway", "n_reversal")
+STATS = ("stuck_time", "n_stick", "n_breakaway", "n_reversal", "n_event_overflow")
 
 
 @_jit
@@ -304,6 +304,15 @@ def advance(state, mode_dir, t0, n_steps, h, code, FP, PP, smooth, u, sp, Z, DZ,
                 stats[2] += 1.0
                 if left <= 0.0:
                     break
+        else:
+            # more than 8 events inside one step (never seen in practice): finish the
+            # step in the current mode without further event checks, and count it
+            if left > 0.0:
+                s, v, yb, vb = rk4(tc, left, s, v, yb, vb, mode, d, smooth, code, FP, PP, u, sp, Z, DZ, DDZ)
+                if mode == STUCK:
+                    v = 0.0
+                    stats[0] += left
+                stats[4] += 1.0
         if (i + 1) % out_every == 0 and pos < out.shape[0]:
             _record(out, pos, t0 + (i + 1) * h, s, v, yb, vb, mode, d, smooth, code, FP, PP, u, sp, Z, DZ, DDZ)
             pos += 1

@@ -102,6 +102,7 @@ class SimulationResult:
             "n_stick": int(st["n_stick"]),
             "n_breakaway": int(st["n_breakaway"]),
             "n_reversal": int(st["n_reversal"]),
+            "n_event_overflow": int(st.get("n_event_overflow", 0)),
             "stroke_max": float(np.max(np.abs(self["stroke"][m]))),
             "pressure_min": float(np.min(self["pressure"][m])),
             "pressure_max": float(np.max(self["pressure"][m])),
