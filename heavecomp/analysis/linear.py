@@ -1,0 +1,302 @@
+"""Operating point and linearisation of the CMC -> ``control.StateSpace``.
+
+The linear model is obtained from the same symbolic equations the rest of the
+toolbox uses (:func:`heavecomp.plants.cmc.casadi_model`, casadi jacobians); no
+equation is restated here.
+
+The nonlinear model is driven by the heave *and its derivatives*,
+``u = [z_h, dz_h, ddz_h, u_active]`` (the stroke is measured relative to the
+moving platform).  Its jacobians give
+
+    dx/dt = A x + B_0 z_h + B_1 dz_h + B_2 ddz_h + B_u u_active
+    y     = C x + D_0 z_h + D_1 dz_h + D_2 ddz_h + D_u u_active
+
+A proper LTI realisation with the heave ``z_h`` as the only disturbance input
+follows from the state shift
+
+    xi = x - N_1 dz_h - N_0 z_h,   N_1 = B_2,   N_0 = B_1 + A B_2
+
+which removes the derivative inputs:
+
+    dxi/dt = A xi + (B_0 + A N_0) z_h + B_u u_active
+    y      = C xi + (D_0 + C N_0) z_h + D_u u_active      (needs C N_1 + D_1 = 0, D_2 = 0)
+
+For the CMC, ``N_1 = [0, -1, 0, 0]`` and ``N_0 = [-1, f_v/M_c, 0, 0]`` with the
+friction slope ``f_v = dF_f/dv``, so ``xi = [y_c, v_c - f_v z_h / M_c, y_b, v_b]``:
+the absolute top-mass coordinates of ``cmc-reference.md`` (exactly, when the
+friction slope is zero).  The outputs wob, stroke, pressure and tension are
+proper; the friction force and the stroke velocity are not (they respond to
+dz_h directly) and are therefore not outputs of the LTI model.
+
+All signals of the returned system are deviations from the operating point
+(:func:`operating_point`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+import math
+
+import numpy as np
+
+from heavecomp.errors import ParameterError
+
+log = logging.getLogger(__name__)
+
+FRICTION_MODES = ("none", "viscous", "sliding")
+#: outputs of the casadi model, in order
+RAW_OUTPUTS = ("wob", "stroke", "pressure", "tension", "friction")
+RAW_INPUTS = ("heave", "heave_velocity", "heave_acceleration", "u_active")
+RAW_STATES = ("stroke", "stroke_velocity", "lower_displacement", "lower_velocity")
+#: outputs of the LTI model
+OUTPUTS = ("wob", "stroke", "pressure", "tension")
+INPUTS = ("heave", "u_active")
+
+
+@dataclasses.dataclass(frozen=True)
+class OperatingPoint:
+    """Where the CMC is linearised.
+
+    Attributes
+    ----------
+    x : ndarray (4,)
+        State ``[s, v, y_b, v_b]`` [m, m/s, m, m/s].
+    u : ndarray (4,)
+        Input ``[z_h, dz_h, ddz_h, u_active]`` [m, m/s, m/s^2, N].
+    y : ndarray (5,)
+        Outputs ``[wob, stroke, pressure, tension, friction]`` [N, m, Pa, N, N].
+    xdot : ndarray (4,)
+        State derivative there; zero at an equilibrium.  While sliding at a
+        constant velocity v0 the friction force F_f(v0) is not balanced
+        (``xdot[1] = -F_f/M_c``): the jacobians describe the dynamics about the
+        sliding motion, the constant force only shifts the mean.
+    equilibrium : bool
+        True when ``xdot`` is zero to rounding.
+    """
+
+    x: np.ndarray
+    u: np.ndarray
+    y: np.ndarray
+    xdot: np.ndarray
+    equilibrium: bool
+    velocity: float = 0.0
+
+    @property
+    def wob(self) -> float:
+        return float(self.y[0])
+
+    @property
+    def pressure(self) -> float:
+        return float(self.y[2])
+
+    @property
+    def tension(self) -> float:
+        return float(self.y[3])
+
+    def as_dict(self) -> dict:
+        """JSON-ready summary (SI units)."""
+        d = {f"x_{n}": float(v) for n, v in zip(RAW_STATES, self.x)}
+        d.update({f"u_{n}": float(v) for n, v in zip(RAW_INPUTS, self.u)})
+        d.update({n: float(v) for n, v in zip(RAW_OUTPUTS, self.y)})
+        d["equilibrium"] = bool(self.equilibrium)
+        d["sliding_velocity"] = float(self.velocity)
+        return d
+
+
+@dataclasses.dataclass(frozen=True)
+class Linearisation:
+    """Full result of :func:`linearise_details`.
+
+    Attributes
+    ----------
+    sys : control.StateSpace
+        Proper LTI model, inputs ``heave`` [m], ``u_active`` [N]; outputs ``wob``
+        [N], ``stroke`` [m], ``pressure`` [Pa], ``tension`` [N] (deviations).
+    op : OperatingPoint
+    A, B, C, D : ndarray
+        Raw jacobians of the casadi model in ``x = [s, v, y_b, v_b]``,
+        ``u = [z_h, dz_h, ddz_h, u_active]`` (outputs :data:`RAW_OUTPUTS`).
+    N0, N1 : ndarray (4,)
+        State shift ``xi = x - N1 dz_h - N0 z_h``.
+    friction_slope : float
+        dF_f/dv at the operating point [N s/m].
+    params : CMCParams
+        The parameter set actually linearised (friction replaced for ``none``/``viscous``).
+    """
+
+    sys: object
+    op: OperatingPoint
+    A: np.ndarray
+    B: np.ndarray
+    C: np.ndarray
+    D: np.ndarray
+    N0: np.ndarray
+    N1: np.ndarray
+    friction_slope: float
+    params: object
+
+    def to_xi(self, x, zh, dzh):
+        """Map raw states ``x`` (deviations) and heave to the LTI state ``xi``."""
+        x = np.asarray(x, dtype=float)
+        return x - np.multiply.outer(np.asarray(dzh, float), self.N1) - np.multiply.outer(np.asarray(zh, float), self.N0)
+
+
+def _friction_params(params, friction: str):
+    """Parameter set with the friction replaced as the linearisation mode asks."""
+    if friction == "none":
+        return params.replace(friction={"model": "none"})
+    if friction == "viscous":
+        cv = params.friction.viscous_coefficient
+        if cv is None:
+            raise ParameterError("friction.viscous_coefficient: needed for the viscous linearisation "
+                                 f"(friction.model = \"{params.friction.model}\" has none)")
+        # eq. 4 with F_S = F_C = C_p = 0 is the viscous law C_v v
+        return params.replace(friction={"model": "stribeck", "static_force": 0.0, "coulomb_force": 0.0,
+                                        "stribeck_velocity": params.friction.stribeck_velocity or 1.0,
+                                        "viscous_coefficient": cv, "pressure_coefficient": 0.0,
+                                        "tangential_velocity": None})
+    if friction == "sliding":
+        if params.friction.model == "none":
+            log.info("sliding linearisation of a frictionless set: same as friction='none'")
+        return params
+    raise ParameterError(f"friction = {friction!r}: must be one of {', '.join(FRICTION_MODES)}")
+
+
+def _eval_model(params, x, u, eps):
+    """Values and jacobians of the casadi model at (x, u)."""
+    from heavecomp.plants.cmc import casadi_model
+    from heavecomp.plants.symbolic import casadi
+
+    ca = casadi()
+    f = casadi_model(params, eps=eps)
+    X = ca.SX.sym("X", 4)
+    U = ca.SX.sym("U", 4)
+    xdot, y = f(X, U)
+    J = ca.Function("J", [X, U], [xdot, y, ca.jacobian(xdot, X), ca.jacobian(xdot, U),
+                                  ca.jacobian(y, X), ca.jacobian(y, U)])
+    return [np.array(v, dtype=float) for v in J(x, u)]
+
+
+def _default_eps(params, velocity):
+    from heavecomp.friction.laws import FrictionLaw
+
+    law = FrictionLaw.from_params(params.friction)
+    if not law.has_stiction:
+        return None
+    # tanh(v0/eps) has slope sech^2(25)/eps ~ 1e-21/eps at v0: the exact law's slope
+    return abs(velocity) / 25.0
+
+
+def operating_point(params, *, velocity: float | None = None, eps: float | None = None) -> OperatingPoint:
+    """The CMC operating point (cmc-reference.md): s = 0, y_b = 0, at rest, WOB = W_0.
+
+    Parameters
+    ----------
+    params : CMCParams
+    velocity : float [m/s], optional
+        Constant stroke (sliding) velocity v0.  The top mass is at rest and the
+        platform moves with dz_h = -v0, so that the stroke velocity is v0.
+    eps : float [m/s], optional
+        Friction regularisation width (default |v0|/25 for laws with stiction).
+
+    Returns
+    -------
+    OperatingPoint
+        ``y`` holds W_0, 0, p_0, T_0 = m_b g - W_0 and the friction force.
+    """
+    v0 = float(velocity or 0.0)
+    if eps is None:
+        eps = _default_eps(params, v0) if v0 != 0.0 else 1e-3
+    x = np.array([0.0, v0, 0.0, 0.0])
+    u = np.array([0.0, -v0, 0.0, 0.0])
+    xdot, y, *_ = _eval_model(params, x, u, eps)
+    xdot, y = xdot.ravel(), y.ravel()
+    scale = params.k_eff * 1e-12 + 1e-9
+    return OperatingPoint(x=x, u=u, y=y, xdot=xdot, equilibrium=bool(np.all(np.abs(xdot) < scale)), velocity=v0)
+
+
+def linearise_details(params, *, friction: str = "none", velocity: float | None = None,
+                      eps: float | None = None) -> Linearisation:
+    """Linearise the CMC; returns the LTI model with the raw jacobians and the state shift.
+
+    See :func:`linearise` for the parameters.
+    """
+    import control as ct
+
+    if friction not in FRICTION_MODES:
+        raise ParameterError(f"friction = {friction!r}: must be one of {', '.join(FRICTION_MODES)}")
+    pl = _friction_params(params, friction)
+    v0 = 0.0
+    if friction == "sliding":
+        if velocity is None or not math.isfinite(velocity) or velocity == 0.0:
+            raise ParameterError("velocity: the sliding linearisation needs a non-zero sliding velocity v0 [m/s]")
+        v0 = float(velocity)
+        if eps is None:
+            eps = _default_eps(pl, v0)
+    elif velocity not in (None, 0.0):
+        raise ParameterError(f"velocity: only used with friction='sliding' (got friction={friction!r})")
+    if eps is not None and not (eps > 0 and math.isfinite(eps)):
+        raise ParameterError(f"eps = {eps!r}: the friction regularisation width must be > 0 m/s")
+
+    op = operating_point(pl, velocity=v0, eps=eps)
+    _, _, A, B, C, D = _eval_model(pl, op.x, op.u, eps)
+    B0, B1, B2, Bu = B[:, 0], B[:, 1], B[:, 2], B[:, 3]
+    N1 = B2.copy()
+    N0 = B1 + A @ B2
+    Bz = B0 + A @ N0
+    idx = [RAW_OUTPUTS.index(o) for o in OUTPUTS]
+    Cz = C[idx]
+    Dz = D[idx, 0] + Cz @ N0
+    Du = D[idx, 3]
+    # the derivative inputs must have disappeared from the chosen outputs
+    improper = np.abs(Cz @ N1 + D[idx, 1]) + np.abs(D[idx, 2])
+    ref = np.abs(Cz).sum(axis=1) + np.abs(D[idx]).sum(axis=1) + 1e-30
+    if np.any(improper > 1e-9 * ref):
+        bad = [OUTPUTS[i] for i in np.nonzero(improper > 1e-9 * ref)[0]]
+        raise RuntimeError(f"outputs {bad} depend on heave derivatives: no proper realisation")
+    MC = pl.compensator.moving_mass
+    friction_slope = float(-A[1, 1] * MC - pl.drill_string.damping)
+    states = ["top_displacement", "top_velocity" if abs(N0[1]) < 1e-15 else "top_velocity_shifted",
+              "lower_displacement", "lower_velocity"]
+    sys = ct.ss(A, np.column_stack([Bz, Bu]), Cz, np.column_stack([Dz, Du]),
+                states=states, inputs=list(INPUTS), outputs=list(OUTPUTS),
+                name=f"cmc_linear_{friction}")
+    return Linearisation(sys=sys, op=op, A=A, B=B, C=C, D=D, N0=N0, N1=N1,
+                         friction_slope=friction_slope, params=pl)
+
+
+def linearise(params, *, friction: str = "none", velocity: float | None = None, eps: float | None = None):
+    """Linearised CMC as a ``control.StateSpace`` with named signals.
+
+    Parameters
+    ----------
+    params : CMCParams
+    friction : {"none", "viscous", "sliding"}
+        ``none``: frictionless; ``viscous``: only the viscous term C_v v of the
+        friction law (paper A eq. 4); ``sliding``: the set's own friction law,
+        linearised about a constant sliding velocity ``velocity`` (slope dF_f/dv
+        at v0 and the pressure term's dF_f/ds = C_p sign(v0) dp/ds).
+    velocity : float [m/s], optional
+        Sliding velocity v0 (``friction="sliding"`` only; non-zero).
+    eps : float [m/s], optional
+        Regularisation width of sign(v) (default |v0|/25, so that tanh(v0/eps) is
+        the exact sign to 1e-21 and the slope is the exact law's).
+
+    Returns
+    -------
+    control.StateSpace
+        States ``top_displacement`` y_c = z_h + s [m], ``top_velocity`` [m/s]
+        (``top_velocity_shifted`` = v_c - f_v z_h/M_c when the friction slope
+        f_v != 0), ``lower_displacement`` y_b [m], ``lower_velocity`` [m/s];
+        inputs ``heave`` z_h [m], ``u_active`` [N]; outputs ``wob`` [N],
+        ``stroke`` [m], ``pressure`` [Pa], ``tension`` [N] — all deviations
+        from :func:`operating_point`.
+
+    Notes
+    -----
+    Frictionless and undamped it is the 2-DOF system ``M ddq + K q = [k_gas, 0] z_h``
+    with ``M = diag(M_c, m_b)``, ``K = [[k_gas + k_ds, -k_ds], [-k_ds, k_ds + k_F]]``;
+    its DC gain heave -> WOB is ``-k_eff`` of paper A eq. 14.
+    """
+    return linearise_details(params, friction=friction, velocity=velocity, eps=eps).sys
