@@ -1,0 +1,235 @@
+"""Seal friction against pressure: fit F_C + C_p dp to steady strokes.
+
+Data: TU Delft pneumatic-cylinder O-ring files (see ``shared/data/README.md``),
+whitespace separated, 7 columns: time [ms], laser [V], pressure [V], force [V],
+position [mm], pressure [bar], force [N].  The friction is, by the authors'
+definition, ``F_f = force - p A`` with ``A = pi 0.0125^2`` m^2 and ``p`` the
+gauge pressure [Pa].
+
+The pressure-dependent Coulomb law is paper A eq. 4 without the velocity terms
+(one speed only, so no Stribeck curve):
+
+    |F_f| = F_C + C_p |dp|                                        (paper A eq. 4)
+
+Steady sliding is selected by velocity (differentiated position): strokes are
+maximal runs of one velocity sign above ``v_min``; the first and last
+``trim`` fraction of each stroke (acceleration, reversal) are dropped and each
+stroke is summarised by its mean friction and pressure, so that the least-squares
+fit works on (nearly) independent points.  A bootstrap over strokes, stratified
+by file, gives a robust uncertainty.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from heavecomp.errors import DataError, ParameterError
+from heavecomp.identification.inverse import least_squares
+
+log = logging.getLogger(__name__)
+
+#: Piston area of the TU Delft actuator, 25 mm bore [m^2].
+BORE_AREA = math.pi * 0.0125 ** 2
+#: Bore diameter [m].
+BORE_DIAMETER = 0.025
+COLUMNS = ("time [ms]", "laser [V]", "pressure [V]", "force [V]", "position [mm]", "pressure [bar]", "force [N]")
+BAR = 1e5
+
+
+@dataclass(frozen=True)
+class SealRecord:
+    """One constant-pressure file: time [s], position [m], gauge pressure [Pa], force [N]."""
+
+    t: np.ndarray
+    x: np.ndarray
+    p: np.ndarray
+    force: np.ndarray
+    name: str = ""
+
+    def friction(self, area: float = BORE_AREA) -> np.ndarray:
+        """F_f = force - p A [N] (authors' definition)."""
+        return self.force - self.p * area
+
+
+def load_seal_csv(path) -> SealRecord:
+    """Read one O-ring file (7 whitespace-separated columns, no header).
+
+    Raises
+    ------
+    DataError
+        Missing file, wrong number of columns, non-numeric or non-finite cells,
+        or a time column (``time [ms]``) that is not strictly increasing.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise DataError(f"{path}: no such file")
+    rows = []
+    with path.open() as fh:
+        for i, line in enumerate(fh, start=1):
+            cells = line.split()
+            if not cells:
+                continue
+            if len(cells) != len(COLUMNS):
+                raise DataError(f"{path.name}: row {i} has {len(cells)} columns, expected {len(COLUMNS)} "
+                                f"({', '.join(COLUMNS)})")
+            try:
+                vals = [float(c) for c in cells]
+            except ValueError:
+                raise DataError(f"{path.name}: row {i} has a non-numeric cell") from None
+            for name, v in zip(COLUMNS, vals):
+                if not math.isfinite(v):
+                    raise DataError(f"{path.name}: column '{name}' is not finite at row {i}")
+            rows.append(vals)
+    if len(rows) < 100:
+        raise DataError(f"{path.name}: only {len(rows)} rows, need at least 100")
+    a = np.asarray(rows)
+    t = a[:, 0] * 1e-3
+    bad = np.flatnonzero(np.diff(t) <= 0)
+    if bad.size:
+        raise DataError(f"{path.name}: column 'time [ms]' is not strictly increasing at row {bad[0] + 2}")
+    return SealRecord(t=t, x=a[:, 4] * 1e-3, p=a[:, 5] * BAR, force=a[:, 6], name=path.name)
+
+
+def velocity(t, x, half_window: int = 10, max_span: float = 0.5) -> np.ndarray:
+    """Velocity [m/s] as the slope over +-``half_window`` samples; NaN where that span
+    exceeds ``max_span`` [s] (a gap in the log) or at the ends."""
+    n = len(t)
+    v = np.full(n, np.nan)
+    k = half_window
+    dt = t[2 * k:] - t[:-2 * k]
+    slope = (x[2 * k:] - x[:-2 * k]) / dt
+    slope[dt > max_span] = np.nan
+    v[k:n - k] = slope
+    return v
+
+
+def strokes(rec: SealRecord, v_min: float = 2e-3, trim: float = 0.2, min_samples: int = 40,
+            area: float = BORE_AREA) -> list[dict]:
+    """Steady-sliding strokes of one file.
+
+    Returns a list of dicts: ``direction`` (+1/-1), ``friction`` mean [N], ``dp`` mean
+    gauge pressure [Pa], ``speed`` mean |v| [m/s], ``n`` samples kept, ``t0``, ``t1`` [s],
+    ``std`` of the friction within the stroke [N], ``file``.
+    """
+    v = velocity(rec.t, rec.x)
+    f = rec.friction(area)
+    s = np.where(np.abs(v) > v_min, np.sign(v), 0.0)
+    s[~np.isfinite(v)] = 0.0
+    out = []
+    i, n = 0, len(s)
+    while i < n:
+        if s[i] == 0:
+            i += 1
+            continue
+        j = i
+        while j < n and s[j] == s[i]:
+            j += 1
+        m = j - i
+        lo, hi = i + int(trim * m), j - int(trim * m)
+        if hi - lo >= min_samples:
+            sl = slice(lo, hi)
+            out.append({"direction": int(s[i]), "friction": float(f[sl].mean()), "std": float(f[sl].std()),
+                        "dp": float(rec.p[sl].mean()), "speed": float(np.abs(v[sl]).mean()),
+                        "n": hi - lo, "t0": float(rec.t[lo]), "t1": float(rec.t[hi - 1]), "file": rec.name})
+        i = j
+    return out
+
+
+def _design(rows, model):
+    dp = np.array([r["dp"] for r in rows])
+    d = np.array([r["direction"] for r in rows], dtype=float)
+    f = np.array([r["friction"] for r in rows])
+    if model == "magnitude":          # |F| = F_C + C_p dp
+        return np.column_stack([np.ones_like(dp), dp]), np.abs(f)
+    if model == "split":              # F = d (F_C + C_p dp) + (F_0 + C_0 dp)
+        return np.column_stack([d, d * dp, np.ones_like(dp), dp]), f
+    raise ParameterError(f"unknown seal model '{model}'")
+
+
+class SealFrictionFit:
+    """Fit |F_f| = F_C + C_p dp over strokes of several constant-pressure files.
+
+    Parameters
+    ----------
+    v_min : float, m/s
+        Speed above which a sample counts as sliding.
+    trim : float
+        Fraction of each stroke dropped at either end (acceleration, reversal).
+    n_boot : int
+        Bootstrap resamples over strokes (stratified by file).
+    seed : int
+        Bootstrap random seed.
+    area : float, m^2
+        Piston area used in F_f = force - p A.
+
+    Attributes
+    ----------
+    strokes_ : list of dict
+        Every steady stroke kept (see :func:`strokes`).
+    fits_ : dict
+        ``pooled`` (both directions, |F|), ``positive``, ``negative`` (one direction
+        each, |F|) and ``split`` (F = d (F_C + C_p dp) + F_0 + C_0 dp: the
+        direction-independent part F_0 + C_0 dp takes sensor offset and any effective
+        area error): each with ``F_C`` [N], ``C_p`` [N/Pa], their least-squares
+        standard errors ``F_C_se``, ``C_p_se``, bootstrap standard deviations
+        ``F_C_boot``, ``C_p_boot`` and 95 % intervals ``C_p_ci95`` [N/Pa], ``rms`` [N],
+        ``n_strokes``.
+    C_p_, C_p_se_ : float
+        Pooled C_p [N/Pa] and its bootstrap standard deviation [N/Pa].
+    """
+
+    def __init__(self, v_min: float = 2e-3, trim: float = 0.2, n_boot: int = 2000, seed: int = 0,
+                 area: float = BORE_AREA):
+        self.v_min, self.trim, self.n_boot, self.seed, self.area = v_min, trim, n_boot, seed, area
+
+    def fit(self, records) -> "SealFrictionFit":
+        rows = []
+        for rec in records:
+            got = strokes(rec, self.v_min, self.trim, area=self.area)
+            if not got:
+                raise DataError(f"{rec.name}: no steady stroke faster than v_min = {self.v_min * 1e3:g} mm/s")
+            rows += got
+        if len({round(r["dp"] / BAR) for r in rows}) < 2:
+            raise DataError("seal friction fit needs files at two or more pressures")
+        self.strokes_ = rows
+        rng = np.random.default_rng(self.seed)
+        files = sorted({r["file"] for r in rows})
+        subsets = {"pooled": rows, "positive": [r for r in rows if r["direction"] > 0],
+                   "negative": [r for r in rows if r["direction"] < 0], "split": rows}
+        self.fits_ = {}
+        for key, sub in subsets.items():
+            model = "split" if key == "split" else "magnitude"
+            X, y = _design(sub, model)
+            res = least_squares(X, y)
+            by_file = [[r for r in sub if r["file"] == f] for f in files]
+            boot = []
+            for _ in range(self.n_boot):
+                pick = [g[i] for g in by_file if g for i in rng.integers(0, len(g), len(g))]
+                Xb, yb = _design(pick, model)
+                boot.append(np.linalg.lstsq(Xb, yb, rcond=None)[0][:2])
+            boot = np.asarray(boot)
+            fit = {"F_C": float(res.theta[0]), "C_p": float(res.theta[1]),
+                   "F_C_se": float(res.stderr[0]), "C_p_se": float(res.stderr[1]),
+                   "F_C_boot": float(boot[:, 0].std(ddof=1)), "C_p_boot": float(boot[:, 1].std(ddof=1)),
+                   "C_p_ci95": [float(x) for x in np.percentile(boot[:, 1], [2.5, 97.5])],
+                   "rms": res.rms, "n_strokes": len(sub)}
+            if model == "split":
+                fit.update({"F_0": float(res.theta[2]), "C_0": float(res.theta[3]),
+                            "F_0_se": float(res.stderr[2]), "C_0_se": float(res.stderr[3])})
+            self.fits_[key] = fit
+        self.C_p_ = self.fits_["pooled"]["C_p"]
+        self.C_p_se_ = self.fits_["pooled"]["C_p_boot"]
+        log.info("seal friction: C_p = %.3f +- %.3f N/bar over %d strokes", self.C_p_ * BAR,
+                 self.C_p_se_ * BAR, len(rows))
+        return self
+
+
+def scale_by_circumference(C_p: float, d_from: float, d_to: float) -> float:
+    """C_p scaled by seal circumference: C_p d_to / d_from (same seal, same contact
+    pressure per unit length; an assumption, not a law)."""
+    return C_p * d_to / d_from
