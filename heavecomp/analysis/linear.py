@@ -300,3 +300,106 @@ def linearise(params, *, friction: str = "none", velocity: float | None = None, 
     its DC gain heave -> WOB is ``-k_eff`` of paper A eq. 14.
     """
     return linearise_details(params, friction=friction, velocity=velocity, eps=eps).sys
+
+
+# ----------------------------------------------------------------------------
+# batched restatement for sweeps (pinned to linearise_details by tests)
+# ----------------------------------------------------------------------------
+def proper_realisation(A, B, C, D):
+    """Remove the heave derivatives from a (batched) jacobian model.
+
+    Parameters
+    ----------
+    A : ndarray (..., n, n)
+    B : ndarray (..., n, 4)
+        Columns ``[z_h, dz_h, ddz_h, u_active]``.
+    C : ndarray (..., p, n)
+    D : ndarray (..., p, 4)
+
+    Returns
+    -------
+    Ap, Bp, Cp, Dp : ndarray
+        Realisation with inputs ``[z_h, u_active]`` (see the module notes:
+        ``N_1 = B_2``, ``N_0 = B_1 + A B_2``, ``B_z = B_0 + A N_0``, ``D_z = D_0 + C N_0``).
+    """
+    A, B, C, D = (np.asarray(m, dtype=float) for m in (A, B, C, D))
+    N0 = B[..., 1] + (A @ B[..., 2:3])[..., 0]
+    Bz = B[..., 0] + (A @ N0[..., None])[..., 0]
+    Dz = D[..., 0] + (C @ N0[..., None])[..., 0]
+    return A, np.stack([Bz, B[..., 3]], axis=-1), C, np.stack([Dz, D[..., 3]], axis=-1)
+
+
+def batch_matrices(*, gas_stiffness, moving_mass, lower_mass, string_stiffness, formation_stiffness,
+                   area, string_damping=0.0, formation_damping=0.0, friction_slope=0.0,
+                   friction_stiffness=0.0):
+    """LTI matrices of the linearised CMC for many parameter sets at once.
+
+    A vectorised restatement of the jacobians of :func:`heavecomp.plants.cmc.casadi_model`
+    at the operating point (pinned to :func:`linearise_details` by
+    ``tests/test_analysis_frequency.py``), for sweeps where a casadi call per
+    variation would dominate.  All arguments broadcast against each other.
+
+    Parameters
+    ----------
+    gas_stiffness : array_like [N/m]
+        k_gas = n (p_0 + p_atm) A^2 / V_0.
+    moving_mass, lower_mass : array_like [kg]
+        M_c, m_b.
+    string_stiffness, string_damping : array_like [N/m], [N s/m]
+        k_ds, c_ds.
+    formation_stiffness, formation_damping : array_like [N/m], [N s/m]
+        k_F, c_F (contact closed).
+    area : array_like [m^2]
+        Plunger area A (pressure output p = -k_gas s / A).
+    friction_slope : array_like [N s/m]
+        dF_f/dv (C_v for the viscous model, an equivalent damping for a describing function).
+    friction_stiffness : array_like [N/m]
+        dF_f/ds (pressure term of eq. 4 while sliding).
+
+    Returns
+    -------
+    A (..., 4, 4), B (..., 4, 2), C (..., 4, 4), D (..., 4, 2) : ndarray
+        States as :func:`linearise`, inputs ``[heave, u_active]``, outputs
+        ``[wob, stroke, pressure, tension]``.
+    """
+    kg, Mc, mb, kd, kF, Ar, cd, cF, fv, fs = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (
+        gas_stiffness, moving_mass, lower_mass, string_stiffness, formation_stiffness, area, string_damping,
+        formation_damping, friction_slope, friction_stiffness)))
+    sh = kg.shape
+    z = np.zeros(sh)
+    one = np.ones(sh)
+    # raw jacobians in x = [s, v, y_b, v_b], u = [z_h, dz_h, ddz_h, u_active]
+    A = np.stack([
+        np.stack([z, one, z, z], -1),
+        np.stack([-(kg + kd + fs) / Mc, -(cd + fv) / Mc, kd / Mc, cd / Mc], -1),
+        np.stack([z, z, z, one], -1),
+        np.stack([kd / mb, cd / mb, -(kd + kF) / mb, -(cd + cF) / mb], -1),
+    ], -2)
+    B = np.stack([
+        np.stack([z, z, z, z], -1),
+        np.stack([-kd / Mc, -cd / Mc, -one, 1.0 / Mc], -1),
+        np.stack([z, z, z, z], -1),
+        np.stack([kd / mb, cd / mb, z, z], -1),
+    ], -2)
+    C = np.stack([
+        np.stack([z, z, -kF, -cF], -1),
+        np.stack([one, z, z, z], -1),
+        np.stack([-kg / Ar, z, z, z], -1),
+        np.stack([kd, cd, -kd, -cd], -1),
+    ], -2)
+    D = np.stack([
+        np.stack([z, z, z, z], -1),
+        np.stack([z, z, z, z], -1),
+        np.stack([z, z, z, z], -1),
+        np.stack([kd, cd, z, z], -1),
+    ], -2)
+    return proper_realisation(A, B, C, D)
+
+
+def batch_matrices_from_params(params, *, friction_slope=0.0, friction_stiffness=0.0):
+    """:func:`batch_matrices` for one :class:`CMCParams` (frictionless unless a slope is given)."""
+    c, ds, fo = params.compensator, params.drill_string, params.formation
+    return batch_matrices(gas_stiffness=c.gas_stiffness, moving_mass=c.moving_mass, lower_mass=ds.lower_mass,
+                          string_stiffness=ds.stiffness, string_damping=ds.damping,
+                          formation_stiffness=fo.stiffness, formation_damping=fo.damping, area=params.area,
+                          friction_slope=friction_slope, friction_stiffness=friction_stiffness)

@@ -1,0 +1,183 @@
+"""Frequency responses of the linearised CMC: transmissibility heave -> WOB,
+effective stiffness k_eff(omega), natural frequencies and damping ratios.
+
+Results are ``control.FrequencyResponseData`` so ``control.bode_plot`` works on
+them directly; :func:`freqresp_batch` evaluates many systems at many
+frequencies at once with numpy (stacked ``(j omega I - A)^-1 B`` solves).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+#: wave band of paper A's argument: periods 5-20 s [rad/s]
+WAVE_BAND = (2 * np.pi / 20.0, 2 * np.pi / 5.0)
+
+
+def freqresp_batch(A, B, C, D, omega):
+    """Frequency response of many state-space systems at many frequencies.
+
+    Parameters
+    ----------
+    A : ndarray (..., n, n)
+    B : ndarray (..., n, m)
+    C : ndarray (..., p, n)
+    D : ndarray (..., p, m)
+        Leading dimensions broadcast (e.g. 100 parameter variations).
+    omega : array_like (nw,) [rad/s]
+
+    Returns
+    -------
+    H : ndarray (..., p, m, nw), complex
+        ``H = C (j omega I - A)^-1 B + D``.
+
+    Notes
+    -----
+    One batched LU solve per (system, frequency) with :func:`numpy.linalg.solve`
+    on stacked matrices; no Python loop.
+    """
+    A, B, C, D = (np.asarray(m) for m in (A, B, C, D))
+    w = np.asarray(omega, dtype=float)
+    n = A.shape[-1]
+    M = (1j * w)[:, None, None] * np.eye(n) - A[..., None, :, :]           # (..., nw, n, n)
+    X = np.linalg.solve(M, np.broadcast_to(B[..., None, :, :], M.shape[:-1] + (B.shape[-1],)))
+    H = C[..., None, :, :] @ X + D[..., None, :, :]                         # (..., nw, p, m)
+    return np.moveaxis(H, -3, -1)
+
+
+def _siso(sys, output, input_):
+    i = list(sys.output_labels).index(output)
+    j = list(sys.input_labels).index(input_)
+    return i, j
+
+
+def frequency_grid(sys=None, n: int = 1000, lo: float = 1e-3, hi: float | None = None) -> np.ndarray:
+    """Log-spaced frequencies [rad/s] from ``lo`` to 10x the fastest pole (or ``hi``)."""
+    if hi is None:
+        hi = 10.0 * max(1.0, float(np.max(np.abs(np.linalg.eigvals(sys.A))))) if sys is not None else 100.0
+    return np.logspace(np.log10(lo), np.log10(hi), n)
+
+
+def effective_stiffness(sys, omega):
+    """Dynamic effective stiffness k_eff(omega) = -WOB(j omega) / z_h(j omega) [N/m].
+
+    Parameters
+    ----------
+    sys : control.StateSpace
+        From :func:`heavecomp.analysis.linear.linearise` (input ``heave``, output ``wob``).
+    omega : array_like [rad/s]
+
+    Returns
+    -------
+    control.FrequencyResponseData
+        Complex, SISO ``heave -> k_eff``.  Its DC value is paper A eq. 14's
+        k_eff = 1/(1/k_gas + 1/k_ds + 1/k_F) (the sign makes it positive: heave
+        up lifts the bit).
+    """
+    import control as ct
+
+    i, j = _siso(sys, "wob", "heave")
+    w = np.asarray(omega, dtype=float)
+    H = freqresp_batch(sys.A, sys.B, sys.C, sys.D, w)[i, j]
+    return ct.frd(-H, w, inputs=["heave"], outputs=["k_eff"], name="k_eff")
+
+
+def transmissibility(sys, omega):
+    """Transmissibility |WOB/heave| normalised by its DC value: T(omega) = k_eff(omega) / k_eff(0) [-].
+
+    Returns
+    -------
+    control.FrequencyResponseData
+        Complex, SISO; |T| > 1 amplifies the heave disturbance of the static
+        estimate (paper A eq. 13), |T| < 1 filters it.
+    """
+    import control as ct
+
+    i, j = _siso(sys, "wob", "heave")
+    w = np.asarray(omega, dtype=float)
+    H = freqresp_batch(sys.A, sys.B, sys.C, sys.D, np.concatenate([[0.0], w]))[i, j]
+    return ct.frd(H[1:] / H[0], w, inputs=["heave"], outputs=["T_wob"], name="transmissibility")
+
+
+def dc_gain(sys, output="wob", input_="heave") -> float:
+    """Static gain of one channel (solve of -A x = B; no inverse of D-only systems)."""
+    i, j = _siso(sys, output, input_)
+    return float((sys.D[i, j] - sys.C[i] @ np.linalg.solve(sys.A, sys.B[:, j])).real)
+
+
+def undamped_natural_frequencies(sys) -> np.ndarray:
+    """Undamped natural frequencies [rad/s, ascending] of a mechanical realisation.
+
+    Requires the states ``[q_1, dq_1, q_2, dq_2]`` layout of
+    :func:`~heavecomp.analysis.linear.linearise` (rows 0 and 2 of A are
+    velocity selectors); then ``-A[[1,3]][:, [0,2]] = M^-1 K`` and
+    omega_i^2 are its eigenvalues (damping and friction slopes dropped).
+    """
+    A = np.asarray(sys.A if hasattr(sys, "A") else sys, dtype=float)
+    pos, vel = [0, 2], [1, 3]
+    sel = np.zeros((2, 4))
+    sel[0, 1] = sel[1, 3] = 1.0
+    if not np.allclose(A[pos], sel):
+        raise ValueError("undamped_natural_frequencies: A is not in [q, dq] mechanical form")
+    K = -A[np.ix_(vel, pos)]
+    lam = np.sort(np.linalg.eigvals(K).real)
+    return np.sqrt(np.maximum(lam, 0.0))
+
+
+def modes(sys) -> dict:
+    """Natural frequencies and damping ratios from the poles.
+
+    Returns
+    -------
+    dict
+        ``natural_frequencies`` [rad/s, ascending]: undamped values
+        (:func:`undamped_natural_frequencies`); ``damped_natural_frequencies``
+        |lambda| of each pole pair [rad/s]; ``damping_ratios`` -Re(lambda)/|lambda|
+        (for an overdamped pair of real poles: -(l1 + l2) / (2 sqrt(l1 l2)));
+        ``poles`` (list of [re, im]).  Pairs are ordered by |lambda|, matched to
+        the undamped frequencies in the same order.
+    """
+    lam = np.linalg.eigvals(np.asarray(sys.A, dtype=float))
+    cplx = lam[lam.imag > 1e-12 * (np.abs(lam) + 1e-300)]
+    real = np.sort(lam[np.abs(lam.imag) <= 1e-12 * (np.abs(lam) + 1e-300)].real)
+    pairs = [(abs(l), -l.real / abs(l)) for l in cplx]
+    for a, b in zip(real[::2], real[1::2]):
+        wn = np.sqrt(a * b) if a * b > 0 else max(abs(a), abs(b))
+        pairs.append((wn, -(a + b) / (2 * wn)))
+    pairs.sort()
+    out = {
+        "damped_natural_frequencies": [float(p[0]) for p in pairs],
+        "damping_ratios": [float(p[1]) for p in pairs],
+        "poles": [[float(l.real), float(l.imag)] for l in sorted(lam, key=lambda l: (abs(l), l.imag))],
+    }
+    try:
+        out["natural_frequencies"] = [float(w) for w in undamped_natural_frequencies(sys)]
+    except ValueError:
+        out["natural_frequencies"] = out["damped_natural_frequencies"]
+    return out
+
+
+def response_table(sys, omega) -> dict[str, np.ndarray]:
+    """Columns of ``frequency_response.csv``: heave -> every output, magnitude and phase.
+
+    Returns
+    -------
+    dict
+        ``omega`` [rad/s], ``frequency`` [Hz], ``period`` [s], ``k_eff_mag`` [N/m],
+        ``k_eff_phase_deg`` [deg], ``transmissibility`` [-] (|k_eff(w)|/k_eff(0)),
+        ``wob_per_heave_mag`` [N/m], ``wob_per_heave_phase_deg`` [deg],
+        ``stroke_per_heave_mag`` [m/m], ``pressure_per_heave_mag`` [Pa/m],
+        ``tension_per_heave_mag`` [N/m] and their phases [deg].
+    """
+    w = np.asarray(omega, dtype=float)
+    j = list(sys.input_labels).index("heave")
+    H = freqresp_batch(sys.A, sys.B, sys.C, sys.D, w)[:, j, :]
+    i = list(sys.output_labels).index("wob")
+    k0 = -dc_gain(sys)
+    cols = {"omega": w, "frequency": w / (2 * np.pi), "period": 2 * np.pi / w,
+            "k_eff_mag": np.abs(H[i]), "k_eff_phase_deg": np.degrees(np.angle(-H[i])),
+            "transmissibility": np.abs(H[i]) / abs(k0)}
+    for k, name in enumerate(sys.output_labels):
+        cols[f"{name}_per_heave_mag"] = np.abs(H[k])
+        cols[f"{name}_per_heave_phase_deg"] = np.degrees(np.angle(H[k]))
+    return cols
