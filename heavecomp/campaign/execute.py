@@ -1,0 +1,294 @@
+"""Run a campaign: local processes by default, or a Dask cluster; resumable.
+
+The unit of work is a *chunk* of ``campaign.chunk_size`` runs, executed by
+:func:`heavecomp.campaign.batch.run_chunk` (one compiled batch call).  The
+parent process is the only writer: each finished chunk is appended to
+``DIR/runs.csv`` (one row per run, key ``run_id``) and flushed to disk, so an
+interrupted campaign loses at most the chunks in flight.  A rerun with the same
+``--out`` reads ``runs.csv``, skips every ``run_id`` already there (a partly
+written last line is discarded) and simulates the rest.  ``DIR/manifest.json``
+holds the campaign's fingerprint; resuming into a folder of a *different*
+campaign is refused.
+
+Executors (no home-made job system):
+
+- ``workers == 1``: in this process;
+- ``workers > 1`` (default: all cores): :class:`concurrent.futures.ProcessPoolExecutor`
+  (``spawn``), one numba thread per process;
+- ``scheduler=ADDRESS`` or ``client=``: :mod:`dask.distributed` (``Client.map`` +
+  ``as_completed``); workers need ``heavecomp`` installed.
+"""
+
+from __future__ import annotations
+
+import csv
+import dataclasses
+import json
+import logging
+import os
+import time
+from pathlib import Path
+
+from heavecomp.errors import InputError, ParameterError
+
+log = logging.getLogger(__name__)
+
+TABLE = "runs.csv"
+MANIFEST = "manifest.json"
+STRING_COLUMNS = ("run_id", "regime", "variant")
+
+
+@dataclasses.dataclass
+class CampaignRun:
+    """What :func:`run_campaign` did: folder, counts, timing."""
+
+    out_dir: Path
+    n_total: int
+    n_skipped: int
+    n_simulated: int
+    wall_time: float
+    executor: str
+    workers: int
+
+    @property
+    def table_path(self) -> Path:
+        return self.out_dir / TABLE
+
+    @property
+    def complete(self) -> bool:
+        return self.n_skipped + self.n_simulated == self.n_total
+
+
+def _check_manifest(campaign, out: Path):
+    man = out / MANIFEST
+    fp = campaign.fingerprint()
+    if man.is_file():
+        try:
+            old = json.loads(man.read_text())
+        except json.JSONDecodeError:
+            raise InputError(f"--out {out}: {MANIFEST} is not valid JSON (remove the folder or choose another --out)") from None
+        if old.get("fingerprint") != fp:
+            raise InputError(f"--out {out}: holds results of a different campaign (fingerprint {old.get('fingerprint')} "
+                             f"!= {fp}); choose another --out")
+    else:
+        out.mkdir(parents=True, exist_ok=True)
+        man.write_text(json.dumps({"schema": 1, "campaign": campaign.settings.name, "fingerprint": fp,
+                                   "n_runs": len(campaign.runs())}, indent=2) + "\n")
+        (out / "campaign.toml").write_text(campaign.source_text)
+
+
+def finished_ids(path: Path) -> tuple[set, list | None]:
+    """run_ids already in ``runs.csv`` and its header; a partial last line is cut off."""
+    if not path.is_file():
+        return set(), None
+    raw = path.read_bytes()
+    if raw and not raw.endswith(b"\n"):
+        cut = raw.rfind(b"\n") + 1
+        log.warning("%s: discarding a partly written last line (interrupted run)", path)
+        with path.open("r+b") as fh:
+            fh.truncate(cut)
+    with path.open(newline="") as fh:
+        reader = csv.reader(fh)
+        header = next(reader, None)
+        if header is None:
+            return set(), None
+        if "run_id" not in header:
+            raise InputError(f"{path}: column 'run_id' missing — not a campaign table")
+        k = header.index("run_id")
+        ids = {row[k] for row in reader if len(row) == len(header)}
+    return ids, header
+
+
+class _Writer:
+    def __init__(self, path: Path, header):
+        self.path = path
+        self.header = header
+
+    def write(self, rows):
+        if not rows:
+            return
+        new = self.header is None
+        if new:
+            self.header = list(rows[0])
+        with self.path.open("a", newline="") as fh:
+            w = csv.DictWriter(fh, fieldnames=self.header, extrasaction="raise")
+            if new:
+                w.writeheader()
+            for r in rows:
+                w.writerow({k: (repr(float(v)) if isinstance(v, float) else v) for k, v in r.items()})
+            fh.flush()
+            os.fsync(fh.fileno())
+
+
+def _init_worker():
+    import numba
+
+    numba.set_num_threads(1)
+
+
+def run_campaign(campaign, out_dir, *, workers: int | None = None, scheduler: str | None = None, client=None,
+                 progress=None, limit: int | None = None) -> CampaignRun:
+    """Simulate every run of ``campaign`` not yet in ``out_dir/runs.csv``.
+
+    Parameters
+    ----------
+    campaign : Campaign
+    out_dir : path
+        Results folder (created).  Rerunning into it resumes.
+    workers : int, optional
+        Local worker processes (default: all cores); ignored with a scheduler.
+    scheduler : str, optional
+        Address of a Dask scheduler (``tcp://host:8786``).
+    client : dask.distributed.Client, optional
+        An existing client (takes precedence over ``scheduler``).
+    progress : callable(done, total), optional
+        Called after each finished chunk with run counts.
+    limit : int, optional
+        Simulate at most this many pending runs (whole chunks) and stop — a
+        deliberately partial campaign (used to test resumption).
+
+    Returns
+    -------
+    CampaignRun
+    """
+    from heavecomp.campaign.batch import run_chunk
+
+    out = Path(out_dir)
+    _check_manifest(campaign, out)
+    runs = campaign.runs()
+    done, header = finished_ids(out / TABLE)
+    pending = [r.run_id for r in runs if r.run_id not in done]
+    n_skip = len(runs) - len(pending)
+    if limit is not None:
+        pending = pending[:max(0, int(limit))]
+    cs = campaign.settings.chunk_size
+    chunks = [pending[i:i + cs] for i in range(0, len(pending), cs)]
+    writer = _Writer(out / TABLE, header)
+    total, count = len(runs), n_skip
+    if n_skip:
+        log.info("resuming: %d of %d runs already in %s", n_skip, total, out / TABLE)
+    if progress:
+        progress(count, total)
+    t0 = time.perf_counter()
+
+    def finished(rows):
+        nonlocal count
+        writer.write(rows)
+        count += len(rows)
+        if progress:
+            progress(count, total)
+
+    if client is not None or scheduler:
+        executor, nw = _run_dask(campaign, chunks, finished, scheduler, client)
+    else:
+        nw = int(workers) if workers else (os.cpu_count() or 1)
+        if nw < 1:
+            raise InputError(f"--workers must be >= 1, got {workers}")
+        nw = min(nw, max(1, len(chunks)))
+        if nw == 1:
+            executor = "in-process"
+            for ch in chunks:
+                finished(run_chunk(campaign, ch, threads=1))
+        else:
+            executor = "processes"
+            import multiprocessing as mp
+            from concurrent.futures import ProcessPoolExecutor, as_completed
+
+            with ProcessPoolExecutor(max_workers=nw, mp_context=mp.get_context("spawn"),
+                                     initializer=_init_worker) as pool:
+                futs = [pool.submit(run_chunk, campaign, ch, 1) for ch in chunks]
+                try:
+                    for f in as_completed(futs):
+                        finished(f.result())
+                except BaseException:
+                    for f in futs:
+                        f.cancel()
+                    raise
+    wall = time.perf_counter() - t0
+    n_sim = count - n_skip
+    log.info("%d runs simulated in %.1f s (%s, %d workers)", n_sim, wall, executor, nw)
+    return CampaignRun(out, total, n_skip, n_sim, wall, executor, nw)
+
+
+def _run_dask(campaign, chunks, finished, scheduler, client):
+    try:
+        from dask.distributed import Client, as_completed
+    except ImportError:
+        raise InputError("--scheduler needs dask.distributed (pip install 'heavecomp[cluster]')") from None
+    from heavecomp.campaign.batch import run_chunk
+
+    own = client is None
+    if own:
+        try:
+            client = Client(scheduler, timeout="15s")
+        except (OSError, TimeoutError, ValueError) as exc:
+            raise InputError(f"--scheduler {scheduler}: cannot connect ({type(exc).__name__}: {exc})") from None
+    try:
+        nw = len(client.scheduler_info().get("workers", {}))
+        fc = client.scatter(campaign, broadcast=True)
+        futs = client.map(run_chunk, [fc] * len(chunks), chunks, [1] * len(chunks), pure=False)
+        for f in as_completed(futs):
+            finished(f.result())
+    finally:
+        if own:
+            client.close()
+    return "dask", nw
+
+
+def read_table(path) -> dict:
+    """``runs.csv`` as columns (numpy arrays; run_id/regime/variant as str)."""
+    import numpy as np
+
+    path = Path(path)
+    if not path.is_file():
+        raise InputError(f"{path}: results table not found")
+    with path.open(newline="") as fh:
+        reader = csv.reader(fh)
+        header = next(reader, None)
+        rows = [r for r in reader if header and len(r) == len(header)]
+    if not header:
+        raise InputError(f"{path}: empty results table")
+    cols = {}
+    for j, name in enumerate(header):
+        vals = [r[j] for r in rows]
+        if name in STRING_COLUMNS:
+            cols[name] = np.array(vals, dtype=object)
+        else:
+            try:
+                cols[name] = np.array([float(v) for v in vals])
+            except ValueError:
+                raise InputError(f"{path}: column '{name}': non-numeric value") from None
+    return cols
+
+
+def export_parquet(table: dict, path) -> Path:
+    """Write the table as Parquet (needs pyarrow)."""
+    try:
+        import pyarrow as pa
+        import pyarrow.parquet as pq
+    except ImportError:
+        raise ParameterError("outputs.format = \"parquet\" needs pyarrow (pip install pyarrow), or use \"csv\"") from None
+    tab = pa.table({k: (list(v) if v.dtype == object else v) for k, v in table.items()})
+    pq.write_table(tab, path)
+    return Path(path)
+
+
+def run_and_report(campaign, out_dir, **kw):
+    """:func:`run_campaign`, then (when every run is in the table) the statistics,
+    ``report.md``, ``metrics.json``, ``statistics.json``, figures and, if asked,
+    ``runs.parquet``.  Returns ``(CampaignRun, statistics dict or None)``."""
+    from heavecomp.campaign import report, stats
+
+    info = run_campaign(campaign, out_dir, **kw)
+    if not info.complete:
+        log.info("campaign incomplete (%d of %d runs); rerun to resume", info.n_skipped + info.n_simulated,
+                 info.n_total)
+        return info, None
+    table = read_table(info.table_path)
+    st = stats.statistics(campaign, table)
+    run_info = {"executor": info.executor, "workers": info.workers, "runs_simulated": info.n_simulated,
+                "runs_resumed": info.n_skipped, "wall_time_s": round(info.wall_time, 2)}
+    report.write_report(info.out_dir, campaign, st, run_info)
+    if campaign.outputs.format == "parquet":
+        export_parquet(table, info.out_dir / "runs.parquet")
+    return info, st
