@@ -14,6 +14,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="RK4 step [s] (default: from the plant's fastest mode, at most 10 ms)")
     p.add_argument("--friction", default=None, metavar="MODEL",
                    help="override friction.model (none | stribeck | rotating_eq6 | rotating_eq7)")
+    p.add_argument("--controller", default="passive", choices=("passive", "pid", "linear-mpc", "nonlinear-mpc"),
+                   help="active-cylinder controller (default passive: no active force); limits from [active]; "
+                        "adds u_active to timeseries.csv and solve times / violations to metrics.json")
 
 
 def run(args) -> int:
@@ -26,10 +29,28 @@ def run(args) -> int:
     params = load(args.params)
     if args.friction:
         params = params.replace(friction={"model": args.friction})
+    if args.controller != "passive":
+        return _run_closed_loop(args, params, Progress)
     bar = Progress(f"simulate {args.duration:g} s")
     res = simulate(params, args.duration, dt=args.dt, rate=args.rate, progress=bar)
     m = write_outputs(res, args.out, title=f"WOB — {Path(args.params).name}, friction: {params.friction.model}")
     print(f"WOB mean {m['wob_mean'] / 1e3:.2f} kN, std {m['wob_std'] / 1e3:.2f} kN, "
           f"peak-to-peak {m['wob_p2p'] / 1e3:.2f} kN, stuck {100 * m['stick_fraction']:.1f} % of the time "
           f"-> {args.out}")
+    return 0
+
+
+def _run_closed_loop(args, params, Progress) -> int:
+    """Active heave compensation: controller in the loop (heavecomp.simulate.closed_loop)."""
+    from pathlib import Path
+
+    from heavecomp.simulate.closed_loop import simulate_closed_loop, write_closed_loop_outputs
+
+    bar = Progress(f"simulate {args.duration:g} s, {args.controller}")
+    res = simulate_closed_loop(params, args.controller, args.duration, dt=args.dt, progress=bar)
+    m = write_closed_loop_outputs(res, args.out, title=f"WOB — {Path(args.params).name}, friction: "
+                                  f"{params.friction.model}, controller: {args.controller}")
+    print(f"WOB std {m['wob_std'] / 1e3:.2f} kN, peak-to-peak {m['wob_p2p'] / 1e3:.2f} kN, "
+          f"|u_active| max {m['u_active_max'] / 1e3:.1f} kN, solve p50/p99 {m['solve_time_ms_p50']:.2f}/"
+          f"{m['solve_time_ms_p99']:.2f} ms, fallbacks {m['fallbacks']} -> {args.out}")
     return 0
