@@ -1,0 +1,254 @@
+"""Loop contract, controller registry, the passive and PID controllers.
+
+Contract (``shared/style/architecture.md``): a controller is built from the
+plant parameters and a frozen config, ``reset()`` clears its memory and
+``step(t, measurement, preview=None) -> u`` returns the commanded active force
+[N] (positive up on the top mass), already within ``|u| <= u_max`` and
+``|u - u_prev| <= rate_max / control_rate``.  ``stats`` counts solver failures
+and fallbacks; ``solve_times`` holds the wall time of each ``step`` [s].
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from heavecomp.errors import InputError, did_you_mean
+
+
+@dataclass(frozen=True)
+class Measurement:
+    """What a rig measures at one control instant (SI, noise included).
+
+    Attributes
+    ----------
+    t : float [s]
+    stroke : float [m]
+    pressure : float [Pa]
+        Main-cylinder gauge pressure.
+    wob : float [N]
+    heave : float [m]
+    u_active : float [N]
+        Active force the actuator applies now (its own load cell / pressure).
+    """
+
+    t: float
+    stroke: float
+    pressure: float
+    wob: float
+    heave: float
+    u_active: float = 0.0
+
+
+@dataclass(frozen=True, kw_only=True)
+class ControllerConfig:
+    """Settings shared by all controllers (frozen).
+
+    Attributes
+    ----------
+    u_max : float [N]
+        Active force limit |u| <= u_max (``[active].u_max``).
+    rate_max : float [N/s]
+        Force rate limit (``[active].rate_max``).
+    control_rate : float [Hz]
+        Controller sample rate; commands are held between samples.
+    horizon : int
+        MPC prediction horizon in control intervals (default 20 = 1 s at 20 Hz).
+    q_wob : float [1/N^2]
+        MPC weight on the WOB error (default 1 per kN^2).
+    r_u : float [1/N^2]
+        MPC weight on the active force.
+    r_du : float [1/N^2]
+        MPC weight on the force change per interval.
+    friction_eps : float [m/s]
+        Regularisation width of the friction model used for feed-forward and the
+        nonlinear MPC.
+    friction_feedforward : bool
+        Linear MPC: add the friction model's force at the predicted stroke
+        velocity v = -dz_h (full compensation) to the disturbance forecast.
+    friction_scale : float
+        Multiplies the controller's friction-model forces (robustness studies:
+        0.7 / 1.3 = a 30 % wrong friction model).
+    gas_stiffness_scale : float
+        Multiplies k_gas in the controller's model (robustness to a wrong gas spring).
+    kp, ki, kd : float
+        PID gains on the WOB error [-, 1/s, s] (u = kp e + ki int e + kd de/dt, e = WOB - W_0).
+    pid_tf : float [s]
+        Time constant of the PID's derivative filter.
+    observer_sigma_d : float [N]
+        Random-walk std per interval of the observer's force disturbance (how fast
+        it follows friction changes).
+    predictor_order : int
+        Order of the AR heave predictor (on 5 Hz block means).
+    predictor_window : float [s]
+        Length of measured heave the AR model is fitted on.
+    """
+
+    u_max: float = 60e3
+    rate_max: float = 300e3
+    control_rate: float = 20.0
+    horizon: int = 20
+    q_wob: float = 1e-6
+    r_u: float = 1e-12
+    r_du: float = 1e-10
+    friction_eps: float = 0.02
+    friction_feedforward: bool = True
+    friction_scale: float = 1.0
+    gas_stiffness_scale: float = 1.0
+    kp: float = 1.0
+    ki: float = 4.0
+    kd: float = 0.0
+    pid_tf: float = 0.2
+    observer_sigma_d: float = 8e3
+    predictor_order: int = 10
+    predictor_window: float = 60.0
+
+    @property
+    def dt(self) -> float:
+        """Control interval 1/control_rate [s]."""
+        return 1.0 / self.control_rate
+
+    @property
+    def du_max(self) -> float:
+        """Largest change of the command per control interval [N]."""
+        return self.rate_max / self.control_rate
+
+    @classmethod
+    def from_params(cls, params, **overrides) -> "ControllerConfig":
+        """Limits and rate from ``params``' ``[active]`` table (or its defaults)."""
+        from heavecomp.params.cmc import active
+
+        a = active(params)
+        kw = dict(u_max=a.u_max, rate_max=a.rate_max, control_rate=a.control_rate)
+        names = {f.name for f in dataclasses.fields(cls)}
+        for k in overrides:
+            if k not in names:
+                raise InputError(f"controller option {k!r}: unknown{did_you_mean(k, names)}")
+        kw.update(overrides)
+        return cls(**kw)
+
+
+def limit(u_cmd: float, u_prev: float, cfg: ControllerConfig) -> float:
+    """Clip a command to |u| <= u_max and |u - u_prev| <= rate_max dt [N]."""
+    du = cfg.du_max
+    u = min(max(u_cmd, u_prev - du), u_prev + du)
+    return float(min(max(u, -cfg.u_max), cfg.u_max))
+
+
+class Controller:
+    """Base class: bookkeeping of solve times, failures and fallbacks."""
+
+    name = "base"
+
+    def __init__(self, params, config: ControllerConfig | None = None):
+        self.params = params
+        self.config = config or ControllerConfig.from_params(params)
+        self.reset()
+
+    def reset(self) -> None:
+        self.u_prev = 0.0
+        self.stats = {"solver_failures": 0, "fallbacks": 0, "saturated_steps": 0}
+        self.solve_times: list[float] = []
+
+    def step(self, t: float, measurement: Measurement, preview=None) -> float:
+        """Commanded active force [N] for the next control interval."""
+        t0 = time.perf_counter()
+        u = self._step(t, measurement, preview)
+        if not math.isfinite(u):
+            self.stats["fallbacks"] += 1
+            u = self.u_prev
+        u_lim = limit(u, self.u_prev, self.config)
+        if abs(u_lim) >= self.config.u_max * (1 - 1e-9):
+            self.stats["saturated_steps"] += 1
+        self.u_prev = u_lim
+        self.solve_times.append(time.perf_counter() - t0)
+        return u_lim
+
+    def _step(self, t, m, preview):  # pragma: no cover - abstract
+        raise NotImplementedError
+
+
+class PassiveController(Controller):
+    """u = 0: the passive CMC."""
+
+    name = "passive"
+
+    def _step(self, t, m, preview):
+        return 0.0
+
+
+class PIDController(Controller):
+    """PID on the WOB error, the baseline a rig would have.
+
+    ``u = kp e + ki int(e) dt + kd de_f/dt`` with ``e = WOB - W_0`` (a WOB above
+    the set-point lifts the top mass), derivative on a first-order filtered error
+    (time constant ``pid_tf``), and conditional-integration anti-windup: the
+    integral stops while the command is at a limit and the error pushes further.
+    No heave preview, no friction model.
+    """
+
+    name = "pid"
+
+    def reset(self):
+        super().reset()
+        self.integral = 0.0
+        self.e_f = None
+
+    def _step(self, t, m, preview):
+        c = self.config
+        e = m.wob - self.params.operating_point.wob_setpoint
+        dt = c.dt
+        if self.e_f is None:
+            self.e_f = e
+        a = dt / (c.pid_tf + dt)
+        e_f_new = self.e_f + a * (e - self.e_f)
+        de = (e_f_new - self.e_f) / dt
+        self.e_f = e_f_new
+        integral = self.integral + c.ki * e * dt
+        u = c.kp * e + integral + c.kd * de
+        u_lim = limit(u, self.u_prev, c)
+        if u_lim == u or np.sign(e) != np.sign(u - u_lim):
+            self.integral = integral  # conditional integration (anti-windup)
+        return u_lim
+
+
+def _linear_mpc(params, config):
+    from heavecomp.controllers.linear_mpc import LinearMPC
+
+    return LinearMPC(params, config)
+
+
+def _nonlinear_mpc(params, config):
+    from heavecomp.controllers.nonlinear_mpc import NonlinearMPC
+
+    return NonlinearMPC(params, config)
+
+
+#: name -> factory(params, config)
+CONTROLLERS = {
+    "passive": PassiveController,
+    "pid": PIDController,
+    "linear-mpc": _linear_mpc,
+    "nonlinear-mpc": _nonlinear_mpc,
+}
+
+
+def make(name: str, params, config: ControllerConfig | None = None, **options) -> Controller:
+    """Build a controller by name (:data:`CONTROLLERS`) or return a given instance.
+
+    ``options`` override :class:`ControllerConfig` fields (limits default to
+    ``params``' ``[active]`` table).
+    """
+    if isinstance(name, Controller):
+        return name
+    if name not in CONTROLLERS:
+        raise InputError(f"--controller {name!r}: not one of {', '.join(CONTROLLERS)}{did_you_mean(name, CONTROLLERS)}")
+    if config is None:
+        config = ControllerConfig.from_params(params, **options)
+    elif options:
+        config = dataclasses.replace(config, **options)
+    return CONTROLLERS[name](params, config)

@@ -1,0 +1,187 @@
+"""Estimation from what a rig measures: heave preview and state/friction observer.
+
+Heave predictor
+---------------
+An autoregressive model AR(p) fitted online by least squares on the measured
+heave.  The 20 Hz samples are first averaged in blocks of ``decimate`` (5 Hz;
+this also averages the sensor noise), the AR model is refitted every second on
+the last ``window`` seconds, iterated forward over the horizon; z_h, dz_h/dt
+and d^2z_h/dt^2 on the control grid (now .. now + N Ts) are the derivatives of a
+least-squares polynomial (degree 4) through the last 2 s of block means and the
+forecast, which smooths the noise before it is differentiated.  Wave heave is a
+narrow-band process, which an AR model predicts well over a fraction of the
+wave period; the closed loop reports the measured prediction error.
+
+Observer
+--------
+A steady-state Kalman filter on the controller's discrete linear model
+(:mod:`heavecomp.controllers.model`) augmented with a constant force
+disturbance d on the top mass (random walk)::
+
+    x+ = Ad x + Bu u + Bw w + Bf (f_ff + d),   d+ = d
+    y  = C x + y0            (stroke, pressure, WOB measured)
+
+``f_ff`` is the friction model's force the controller already accounts for
+(zero when it has none); ``d`` is then the friction the model misses (stiction,
+wrong parameters) plus every other model error.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+class HeavePredictor:
+    """Online AR heave predictor on block means (see module docstring).
+
+    Parameters
+    ----------
+    dt : float [s]
+        Sample interval of the measured heave (the control interval).
+    order : int
+        AR order p on the block means.
+    window : float [s]
+        Fit window.
+    decimate : int
+        Samples per block (default 4: 20 Hz -> 5 Hz).
+    """
+
+    def __init__(self, dt: float, order: int = 10, window: float = 60.0, decimate: int = 4,
+                 past_blocks: int = 10, poly_degree: int = 4):
+        self.dt, self.order, self.window, self.decimate = dt, int(order), float(window), int(decimate)
+        self.past_blocks, self.poly_degree = int(past_blocks), int(poly_degree)
+        self.reset()
+
+    def reset(self):
+        self._buf: list[float] = []
+        self._bt: list[float] = []
+        self.block_t: list[float] = []
+        self.block_z: list[float] = []
+        self.coef_ = None
+        self._since_fit = 0
+        self.z_last = 0.0
+
+    def update(self, t: float, z: float) -> None:
+        """Add one measured heave sample z [m] at time t [s]."""
+        self.z_last = z
+        self._buf.append(z)
+        self._bt.append(t)
+        if len(self._buf) == self.decimate:
+            self.block_t.append(float(np.mean(self._bt)))
+            self.block_z.append(float(np.mean(self._buf)))
+            self._buf, self._bt = [], []
+            self._since_fit += 1
+            nmax = int(self.window / (self.dt * self.decimate)) + self.order + 1
+            if len(self.block_z) > 2 * nmax:
+                del self.block_z[:-nmax], self.block_t[:-nmax]
+            if self._since_fit >= max(1, int(round(1.0 / (self.dt * self.decimate)))) or self.coef_ is None:
+                self._fit()
+
+    def _fit(self):
+        p = self.order
+        z = np.asarray(self.block_z[-int(self.window / (self.dt * self.decimate)):])
+        if z.size < 3 * p + 5:
+            return
+        X = np.column_stack([z[p - i - 1:z.size - i - 1] for i in range(p)] + [np.ones(z.size - p)])
+        coef, *_ = np.linalg.lstsq(X, z[p:], rcond=None)
+        # keep the model stable: a root outside the unit circle (noise, a fit during the
+        # fade-in) would blow up the forecast, so such roots are pulled onto radius 0.999
+        roots = np.roots(np.r_[1.0, -coef[:p]])
+        mag = np.abs(roots)
+        if np.any(mag > 0.999):
+            roots = np.where(mag > 0.999, roots / np.maximum(mag, 1e-12) * 0.999, roots)
+            coef[:p] = -np.real(np.poly(roots))[1:]
+        self.coef_ = coef
+        self._since_fit = 0
+
+    def trajectory(self, t: float, n: int) -> np.ndarray:
+        """Predicted (z, dz, ddz) at t + k dt, k = 0..n, as an (n+1, 3) array [m, m/s, m/s^2]."""
+        times = t + self.dt * np.arange(n + 1)
+        out = np.zeros((n + 1, 3))
+        if self.coef_ is None or len(self.block_z) < self.order + 4:
+            out[:, 0] = self.z_last
+            return out
+        p = self.order
+        Tb = self.dt * self.decimate
+        hist = list(self.block_z[-p:])
+        tb = list(self.block_t[-self.past_blocks:])
+        zb = list(self.block_z[-self.past_blocks:])
+        tnext = self.block_t[-1]
+        while tnext < times[-1] + 2 * Tb:
+            znew = float(np.dot(self.coef_[:p], hist[::-1][:p]) + self.coef_[p])
+            hist.append(znew)
+            hist = hist[-p:]
+            tnext += Tb
+            tb.append(tnext)
+            zb.append(znew)
+        # a least-squares polynomial through the recent block means and the forecast
+        # (not an interpolant: it smooths the measurement noise before differentiating)
+        tau = (np.asarray(tb) - t) / 2.0
+        c = np.polyfit(tau, np.asarray(zb), self.poly_degree)
+        tt = (times - t) / 2.0
+        out[:, 0] = np.polyval(c, tt)
+        out[:, 1] = np.polyval(np.polyder(c, 1), tt) / 2.0
+        out[:, 2] = np.polyval(np.polyder(c, 2), tt) / 4.0
+        return out
+
+
+class DisturbanceObserver:
+    """Steady-state Kalman filter for x = [s, v, y_b, v_b] and the force disturbance d.
+
+    Parameters
+    ----------
+    model : DiscreteModel
+    sigma_y : (3,) array [m, Pa, N]
+        Measurement noise std of stroke, pressure, WOB.
+    sigma_d : float [N]
+        Random-walk std of d per control interval (how fast friction may change).
+    sigma_f : float [N]
+        Unmodelled force noise on the top mass per interval.
+    """
+
+    def __init__(self, model, sigma_y=(1e-3, 5e3, 500.0), sigma_d: float = 8e3, sigma_f: float = 1e3):
+        from scipy.linalg import solve_discrete_are
+
+        self.model = model
+        n = model.Ad.shape[0]
+        A = np.zeros((n + 1, n + 1))
+        A[:n, :n] = model.Ad
+        A[:n, n:] = model.Bf
+        A[n, n] = 1.0
+        # measurements ordered like model.C rows: wob, stroke, pressure
+        C = np.hstack([model.C, np.zeros((3, 1))])
+        sy = np.asarray(sigma_y, dtype=float)
+        R = np.diag([sy[2] ** 2, sy[0] ** 2, sy[1] ** 2])
+        Gf = np.vstack([model.Bf, [[0.0]]])
+        Q = sigma_f ** 2 * (Gf @ Gf.T) + np.diag([1e-10] * n + [sigma_d ** 2])
+        P = solve_discrete_are(A.T, C.T, Q, R)
+        self.L = P @ C.T @ np.linalg.inv(C @ P @ C.T + R)
+        self.A, self.Cm = A, C
+        self.n = n
+        self.reset()
+
+    def reset(self):
+        self.xa = np.zeros(self.n + 1)
+        self._pending = None
+
+    def predict(self, u: float, w: np.ndarray, f_ff: float) -> None:
+        """Time update over one interval with input u [N], heave w = (z, dz, ddz) and friction f_ff [N]."""
+        m = self.model
+        self.xa = self.A @ self.xa
+        self.xa[:self.n] += (m.Bu[:, 0] * u + m.Bw @ w + m.Bf[:, 0] * f_ff)
+
+    def correct(self, y: np.ndarray, w: np.ndarray) -> None:
+        """Measurement update with y = (wob, stroke, pressure) [N, m, Pa]."""
+        m = self.model
+        innov = y - m.y0 - (self.Cm @ self.xa + m.Dw @ w)
+        self.xa = self.xa + self.L @ innov
+
+    @property
+    def x(self) -> np.ndarray:
+        """State estimate (deviation) [m, m/s, m, m/s]."""
+        return self.xa[:self.n]
+
+    @property
+    def d(self) -> float:
+        """Estimated force disturbance on the top mass [N] (acts like friction)."""
+        return float(self.xa[self.n])

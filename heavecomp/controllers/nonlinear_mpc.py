@@ -1,0 +1,176 @@
+"""Nonlinear MPC (casadi + ipopt) on the smooth-friction CMC, warm-started.
+
+Prediction model: :func:`heavecomp.plants.cmc.casadi_model` with the friction
+law of the parameter file (paper A eq. 4/6/7) regularised with width
+``friction_eps`` (``sign(v) -> tanh(v/eps)``), integrated by RK4 with two
+sub-steps per control interval (multiple shooting).  The heave over the horizon
+is the AR preview of :class:`~heavecomp.controllers.estimation.HeavePredictor`;
+the initial state comes from the same Kalman observer as the linear MPC, and the
+part of its disturbance estimate the smooth friction model does not explain is
+added as a constant force over the horizon.
+
+NLP (N intervals, decision variables X_0..X_N, U_0..U_{N-1})::
+
+    min  q_wob sum_k (W(X_k) - W_0)^2 + r_u sum U_k^2 + r_du sum (U_k - U_{k-1})^2
+    s.t. X_0 = x_hat,  X_{k+1} = RK4(X_k, U_k, heave_k),  |U_k| <= u_max,
+         |U_k - U_{k-1}| <= rate_max Ts
+
+The NLP is built once (a casadi ``nlpsol`` with the horizon data as parameters)
+and warm-started from the previous solution shifted by one interval (primal and
+dual).  A failed solve (ipopt status other than success / acceptable) falls back
+to the previous plan shifted (counted in ``solver_failures`` / ``fallbacks``).
+"""
+
+from __future__ import annotations
+
+import logging
+
+import numpy as np
+
+from heavecomp.controllers.linear_mpc import KN, LinearMPC
+
+log = logging.getLogger(__name__)
+
+#: ipopt return statuses accepted as a solution
+_OK = ("Solve_Succeeded", "Solved_To_Acceptable_Level")
+
+
+class NonlinearMPC(LinearMPC):
+    """Nonlinear MPC with casadi/ipopt (see module docstring).
+
+    Re-uses the linear MPC's estimation (heave predictor, Kalman observer) so
+    the two controllers differ only in the prediction model and the solver.
+    """
+
+    name = "nonlinear-mpc"
+    substeps = 2
+
+    def __init__(self, params, config=None):
+        super().__init__(params, config)
+        self._build()
+
+    def _model_params(self):
+        p, c = self.cparams, self.config
+        if p.friction.model == "none" or c.friction_scale == 1.0:
+            return p
+        f = p.friction
+        return p.replace(friction={k: getattr(f, k) * c.friction_scale for k in
+                                   ("static_force", "coulomb_force", "viscous_coefficient", "pressure_coefficient")})
+
+    def _build(self):
+        from heavecomp.plants.cmc import casadi_model
+        from heavecomp.plants.symbolic import casadi
+
+        ca = casadi()
+        cfg, N = self.config, self.N
+        mp = self._model_params()
+        f = casadi_model(mp, eps=cfg.friction_eps)
+        self._f = f
+        W0 = mp.operating_point.wob_setpoint
+        Ts, M = cfg.dt, self.substeps
+        h = Ts / M
+        x = ca.SX.sym("x", 4)
+        uu = ca.SX.sym("u", 4)  # [z, dz, ddz, force]
+        xk = x
+        for _ in range(M):
+            k1 = f(xk, uu)[0]
+            k2 = f(xk + h / 2 * k1, uu)[0]
+            k3 = f(xk + h / 2 * k2, uu)[0]
+            k4 = f(xk + h * k3, uu)[0]
+            xk = xk + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+        F = ca.Function("F", [x, uu], [xk])
+        Y = ca.Function("Y", [x, uu], [f(x, uu)[1][0]])
+
+        X = ca.SX.sym("X", 4, N + 1)
+        U = ca.SX.sym("U", N)              # kN
+        P = ca.SX.sym("P", 4 + 3 * (N + 1) + 2)  # x0, heave (N+1 x 3), d [kN], u_prev [kN]
+        x0 = P[0:4]
+        H = ca.reshape(P[4:4 + 3 * (N + 1)], 3, N + 1)
+        d = P[-2]
+        up = P[-1]
+        g = [X[:, 0] - x0]
+        J = 0
+        qw = cfg.q_wob * KN ** 2
+        ru = cfg.r_u * KN ** 2
+        rdu = cfg.r_du * KN ** 2
+        # state scaling for the defects (m and m/s are small): metres -> millimetres
+        for k in range(N):
+            hk = 0.5 * (H[:, k] + H[:, k + 1])
+            uk = ca.vertcat(hk, (U[k] - d) * KN)
+            g.append((X[:, k + 1] - F(X[:, k], uk)) * 1e3)
+            wob = Y(X[:, k + 1], ca.vertcat(H[:, k + 1], 0))
+            J += qw * ((wob - W0) / KN) ** 2 + ru * U[k] ** 2
+            du = U[k] - (up if k == 0 else U[k - 1])
+            J += rdu * du ** 2
+            g.append(du)
+        g[0] = g[0] * 1e3
+        w = ca.vertcat(ca.vec(X), U)
+        nlp = {"x": w, "f": J, "g": ca.vertcat(*g), "p": P}
+        opts = {"ipopt.print_level": 0, "print_time": False, "ipopt.max_iter": 40, "ipopt.tol": 1e-6,
+                "ipopt.acceptable_tol": 1e-3, "ipopt.acceptable_iter": 3, "ipopt.warm_start_init_point": "yes",
+                "ipopt.mu_init": 1e-3, "ipopt.sb": "yes", "ipopt.linear_solver": "mumps"}
+        self.solver = ca.nlpsol("nmpc", "ipopt", nlp, opts)
+        nx = 4 * (N + 1)
+        umax, dumax = cfg.u_max / KN, cfg.du_max / KN
+        self._lbx = np.r_[-np.inf * np.ones(nx), -umax * np.ones(N)]
+        self._ubx = np.r_[np.inf * np.ones(nx), umax * np.ones(N)]
+        ng = 4 + N * 5
+        lbg, ubg = np.zeros(ng), np.zeros(ng)
+        for k in range(N):
+            i = 4 + 5 * k + 4
+            lbg[i], ubg[i] = -dumax, dumax
+        self._lbg, self._ubg = lbg, ubg
+        self._nx = nx
+        self._w0 = None
+        self._lam_x = None
+        self._lam_g = None
+        self._fric = ca.Function("fric", [x, uu], [f(x, uu)[1][4]])
+
+    def reset(self):
+        super().reset()
+        self._w0 = None
+
+    def _step(self, t, meas, preview):
+        H, fff = self._estimate(t, meas, preview)
+        self._last = (meas.u_active, H[0].copy(), float(fff[0]))
+        N = self.N
+        xh = self.observer.x.copy()
+        # the friction the observer attributes to the top mass minus what the smooth model predicts now
+        f_model = float(self._fric(xh, np.r_[H[0], 0.0]))
+        d_res = self.observer.d + float(fff[0]) - f_model
+        lim = 2.0 * (self.law.FP[0] + self.law.FP[4] * abs(meas.pressure)) + 5e3
+        d_res = float(np.clip(d_res, -lim, lim))
+        P = np.r_[xh, H.ravel(), d_res / KN, self.u_prev / KN]
+        if self._w0 is None:
+            X0 = np.tile(xh[:, None], (1, N + 1))
+            w0 = np.r_[X0.ravel(order="F"), np.full(N, self.u_prev / KN)]
+            args = {}
+        else:
+            w0 = self._w0
+            args = {"lam_x0": self._lam_x, "lam_g0": self._lam_g}
+        try:
+            sol = self.solver(x0=w0, p=P, lbx=self._lbx, ubx=self._ubx, lbg=self._lbg, ubg=self._ubg, **args)
+            status = self.solver.stats().get("return_status", "")
+            wsol = np.array(sol["x"]).ravel()
+            ok = status in _OK and np.all(np.isfinite(wsol))
+        except RuntimeError as exc:  # casadi raises on evaluation errors
+            status, ok = f"error: {exc}", False
+        if ok:
+            Xs = wsol[:self._nx].reshape(4, N + 1, order="F")
+            Us = wsol[self._nx:]
+            # warm start: shift the plan one interval
+            Xn = np.hstack([Xs[:, 1:], Xs[:, -1:]])
+            Un = np.r_[Us[1:], Us[-1]]
+            self._w0 = np.r_[Xn.ravel(order="F"), Un]
+            self._lam_x = np.array(sol["lam_x"]).ravel()
+            self._lam_g = np.array(sol["lam_g"]).ravel()
+            self.plan = Us * KN
+            return float(self.plan[0])
+        self.stats["solver_failures"] += 1
+        self.stats["fallbacks"] += 1
+        self._w0 = None
+        log.warning("nonlinear MPC: ipopt status %r at t = %.2f s; using the shifted previous plan", status, t)
+        if self.plan is not None and self.plan.size > 1:
+            self.plan = np.r_[self.plan[1:], self.plan[-1]]
+            return float(self.plan[0])
+        return self.u_prev

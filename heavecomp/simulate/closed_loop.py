@@ -1,0 +1,258 @@
+"""Closed-loop simulation: the exact stick-slip CMC with an active cylinder and a controller.
+
+The plant is the foundation's compiled stepper (:func:`heavecomp.simulate._kernel.advance`),
+called one RK4 step at a time so that the active force can change between
+steps.  Per control interval (``[active].control_rate``, 20 Hz by default):
+
+1. the rig's measurements (stroke, pressure, WOB, heave; Gaussian noise,
+   seeded) and the actuator's force are handed to ``controller.step``;
+2. the command is held for the interval (sample-and-hold) and clipped to
+   ``|u| <= u_max``;
+3. the actuator follows the command at most at ``rate_max``: before each RK4
+   step of size h its force moves towards the command by at most
+   ``rate_max h`` and is constant within the step (the stepper holds u
+   constant within a call).
+
+The realised force trace is checked afterwards against both limits; the
+counts are in the metrics (``violations_u_max``, ``violations_rate``).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import logging
+import math
+import time
+from pathlib import Path
+
+import numpy as np
+
+from heavecomp.simulate.core import CHANNELS, CSV_COLUMNS, SimulationResult, default_dt
+
+log = logging.getLogger(__name__)
+
+#: timeseries.csv columns of a closed-loop run
+CL_CSV_COLUMNS = CSV_COLUMNS + ("u_active",)
+
+
+@dataclasses.dataclass(frozen=True)
+class Noise:
+    """Measurement noise std (Gaussian, white at the control rate).
+
+    Attributes
+    ----------
+    stroke : float [m]
+    pressure : float [Pa]
+    wob : float [N]
+    heave : float [m]
+    seed : int
+    """
+
+    stroke: float = 1e-3
+    pressure: float = 5e3
+    wob: float = 500.0
+    heave: float = 5e-3
+    seed: int = 0
+
+
+@dataclasses.dataclass
+class ClosedLoopResult(SimulationResult):
+    """A :class:`SimulationResult` (20 Hz rows) plus the controller's bookkeeping."""
+
+    controller: str = "passive"
+    control: dict = dataclasses.field(default_factory=dict)
+
+    def metrics(self, start: float | None = None) -> dict:
+        """Plant metrics plus ``u_active_max``, solve-time percentiles [ms], limit
+        violations, solver failures, fallbacks and the heave-preview error."""
+        m = super().metrics(start)
+        w = self.window(start)
+        u = self["u_active"]
+        m.update(self.control)
+        m["controller"] = self.controller
+        m["u_active_max"] = float(np.max(np.abs(u))) if u.size else 0.0
+        m["u_active_rms"] = float(np.sqrt(np.mean(u[w] ** 2))) if np.any(w) else 0.0
+        return m
+
+    def to_csv(self, path, columns=CL_CSV_COLUMNS) -> Path:
+        return super().to_csv(path, columns)
+
+
+def _percentile_ms(x, q):
+    return float(np.percentile(np.asarray(x) * 1e3, q)) if len(x) else 0.0
+
+
+def simulate_closed_loop(params, controller="passive", duration: float = 120.0, *, dt: float | None = None,
+                         heave=None, noise: Noise | None = Noise(), preview: str = "predicted",
+                         stats_start: float | None = None, progress=None, **options) -> ClosedLoopResult:
+    """Simulate the CMC with an active cylinder under ``controller``.
+
+    Parameters
+    ----------
+    params : CMCParams
+        Plant parameters; ``[active]`` gives u_max, rate_max and the control rate.
+    controller : str or Controller
+        ``passive``, ``pid``, ``linear-mpc``, ``nonlinear-mpc`` or an instance.
+    duration : float [s]
+    dt : float [s], optional
+        RK4 step (default: the plant's, made a divisor of the control interval).
+    heave : HeaveSamples or (t, z), optional
+        Overrides ``params.heave``.
+    noise : Noise or None
+        Measurement noise (None: exact measurements).
+    preview : {"predicted", "perfect"}
+        ``predicted``: the controller predicts heave from its measurements (AR);
+        ``perfect``: it is given the true future heave (an upper bound).
+    options
+        :class:`~heavecomp.controllers.ControllerConfig` overrides (when
+        ``controller`` is a name).
+
+    Returns
+    -------
+    ClosedLoopResult
+        Rows at the control rate; ``metrics()`` has ``wob_std``, ``wob_p2p``,
+        ``u_active_max``, ``solve_time_ms_p50``/``_p99``, ``violations_*``,
+        ``solver_failures``, ``fallbacks``, ``preview_rmse_m``.
+    """
+    from heavecomp.controllers import Measurement, make
+    from heavecomp.errors import InputError
+    from heavecomp.friction.laws import FrictionLaw
+    from heavecomp.params.cmc import active
+    from heavecomp.plants.cmc import plant_vector
+    from heavecomp.simulate import _kernel as K
+    from heavecomp.simulate import excitation
+
+    if not (duration > 0 and math.isfinite(duration)):
+        raise InputError(f"--duration must be a positive number of seconds, got {duration}")
+    if preview not in ("predicted", "perfect"):
+        raise InputError(f"preview {preview!r}: not one of predicted, perfect")
+    act = active(params)
+    ctrl = make(controller, params, **options)
+    cfg = ctrl.config
+    Tc = 1.0 / act.control_rate
+    h = dt if dt is not None else default_dt(params, act.control_rate)
+    if not (h > 0 and math.isfinite(h)):
+        raise InputError(f"--dt must be a positive number of seconds, got {dt}")
+    n_sub = max(1, int(round(Tc / h)))
+    h = Tc / n_sub
+    n_ctrl = int(math.ceil(duration / Tc - 1e-9))
+    sp = 0.5 * h
+    horizon_t = (cfg.horizon + 2) * Tc
+    if heave is None:
+        hs = excitation.make_heave(params.heave, n_ctrl * Tc + horizon_t, sp, params.base_dir)
+    elif isinstance(heave, excitation.HeaveSamples):
+        hs = heave
+    else:
+        t_in, z_in = heave
+        hs = excitation.from_series(t_in, z_in, n_ctrl * Tc + horizon_t, sp, src="heave")
+    law = FrictionLaw.from_params(params.friction)
+    PP = plant_vector(params)
+    smooth = not law.has_stiction
+    rng = np.random.default_rng(noise.seed if noise else 0)
+    sig = np.array([noise.stroke, noise.pressure, noise.wob, noise.heave]) if noise else np.zeros(4)
+
+    state = np.zeros(4)
+    mode_dir = np.array([float(K.STUCK), 1.0])
+    stats = np.zeros(len(K.STATS))
+    rows = np.empty((n_ctrl + 1, K.NCH))
+    rec = np.empty((1, K.NCH))
+    none_out = np.empty((0, K.NCH))
+    u_trace = np.empty(n_ctrl * n_sub + 1)
+    u_trace[0] = 0.0
+    u = 0.0
+    du_step = act.rate_max * h
+    previews = []
+    ctrl.reset()
+    t_wall = time.perf_counter()
+    for k in range(n_ctrl + 1):
+        t = k * Tc
+        K.advance(state, mode_dir, t, 0, h, law.code, law.FP, PP, smooth, u, sp, hs.z, hs.dz, hs.ddz,
+                  rec, 1, 0, stats)
+        rows[k] = rec[0]
+        if k == n_ctrl:
+            break
+        noisy = rec[0, [2, 3, 4, 1]] + sig * rng.standard_normal(4)
+        meas = Measurement(t=t, stroke=noisy[0], pressure=noisy[1], wob=noisy[2], heave=noisy[3], u_active=u)
+        pv = None
+        if preview == "perfect":
+            tt = t + Tc * np.arange(cfg.horizon + 1)
+            pv = np.array([K.heave_at(ti, sp, hs.z, hs.dz, hs.ddz) for ti in tt])
+        try:
+            u_cmd = float(ctrl.step(t, meas, pv))
+        except Exception as exc:  # a controller must never stop the run
+            log.warning("controller %s raised %s at t = %.2f s; holding the last command", ctrl.name, exc, t)
+            ctrl.stats["fallbacks"] = ctrl.stats.get("fallbacks", 0) + 1
+            u_cmd = ctrl.u_prev
+        if not math.isfinite(u_cmd):
+            ctrl.stats["fallbacks"] = ctrl.stats.get("fallbacks", 0) + 1
+            u_cmd = 0.0
+        u_cmd = min(max(u_cmd, -act.u_max), act.u_max)
+        lp = getattr(ctrl, "last_preview", None)
+        if lp is not None and preview == "predicted":
+            previews.append(lp)
+        for j in range(n_sub):
+            u = u + min(max(u_cmd - u, -du_step), du_step)
+            u_trace[k * n_sub + j + 1] = u
+            K.advance(state, mode_dir, t + j * h, 1, h, law.code, law.FP, PP, smooth, u, sp, hs.z, hs.dz,
+                      hs.ddz, none_out, 1, 0, stats)
+        if progress is not None and k % 200 == 0:
+            progress(k / n_ctrl)
+    wall = time.perf_counter() - t_wall
+    if progress is not None:
+        progress(1.0)
+
+    tol = 1e-6
+    du = np.diff(u_trace) / h
+    st = ctrl.solve_times
+    control = {
+        "u_max": act.u_max, "rate_max": act.rate_max, "control_rate": act.control_rate,
+        "violations_u_max": int(np.sum(np.abs(u_trace) > act.u_max * (1 + tol))),
+        "violations_rate": int(np.sum(np.abs(du) > act.rate_max * (1 + tol))),
+        "solve_time_ms_p50": _percentile_ms(st, 50), "solve_time_ms_p99": _percentile_ms(st, 99),
+        "solve_time_ms_max": _percentile_ms(st, 100), "n_control_steps": len(st),
+        "solver_failures": int(ctrl.stats.get("solver_failures", 0)),
+        "fallbacks": int(ctrl.stats.get("fallbacks", 0)),
+        "saturated_steps": int(ctrl.stats.get("saturated_steps", 0)),
+        "preview": preview,
+        "noise": dataclasses.asdict(noise) if noise else None,
+    }
+    control.update(_preview_error(previews, hs, sp, Tc, K))
+    if stats_start is None:
+        stats_start = (params.heave.ramp or 0.0) if (heave is None and params.heave is not None) else 0.0
+        stats_start = min(stats_start, 0.5 * duration)
+    return ClosedLoopResult(data=rows, params=params, dt=h, stats=dict(zip(K.STATS, stats.tolist())),
+                            heave_info=hs.info, wall_time=wall, stats_start=stats_start,
+                            controller=ctrl.name, control=control)
+
+
+def _preview_error(previews, hs, sp, Tc, K) -> dict:
+    """RMS error of the heave preview at each horizon step, after the first 30 s [m]."""
+    errs = []
+    for t0, z in previews:
+        if t0 < 30.0:
+            continue
+        tt = t0 + Tc * np.arange(z.size)
+        true = np.array([K.heave_at(ti, sp, hs.z, hs.dz, hs.ddz)[0] for ti in tt])
+        errs.append(z - true)
+    if not errs:
+        return {}
+    E = np.array(errs)
+    rms = np.sqrt(np.mean(E ** 2, axis=0))
+    return {"preview_predictor": "AR(p) on 5 Hz block means, refitted every 1 s",
+            "preview_rmse_m": [float(x) for x in rms],
+            "preview_rmse_end_m": float(rms[-1]), "preview_horizon_s": float(Tc * (z.size - 1))}
+
+
+def write_closed_loop_outputs(res: ClosedLoopResult, out_dir, *, title: str | None = None) -> dict:
+    """Write ``timeseries.csv`` (with ``u_active``), ``metrics.json`` and ``wob.png``."""
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    res.to_csv(out_dir / "timeseries.csv")
+    metrics = res.metrics()
+    metrics["heave"] = {k: v for k, v in res.heave_info.items() if isinstance(v, (int, float, str))}
+    (out_dir / "metrics.json").write_text(json.dumps(metrics, indent=2) + "\n")
+    from heavecomp.report.figures import plot_wob, save
+
+    save(plot_wob({res.controller: res}, title=title), out_dir / "wob.png")
+    return metrics
