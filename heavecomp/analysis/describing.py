@@ -125,7 +125,7 @@ def describing_response(params, heave_amplitude: float, omega: float, *, n: int 
     DFResult
     """
     from heavecomp.friction.laws import FrictionLaw
-    from heavecomp.plants.cmc import plant_vector
+    from heavecomp.plants.cmc import A as A_IDX, V0 as V0_IDX, plant_vector
 
     a, w = float(heave_amplitude), float(omega)
     if not (a > 0 and w > 0 and math.isfinite(a) and math.isfinite(w)):
@@ -141,7 +141,9 @@ def describing_response(params, heave_amplitude: float, omega: float, *, n: int 
         return Ts, Z, c, k
 
     # balance h(S) = log(a |Ts(S)|) - log S: a stable sliding solution is where h crosses 0 downwards
-    S_grid = a * np.logspace(-6, 1, 300) * max(1.0, float(np.abs(Gsz)))
+    # stroke amplitudes up to where the gas volume V_0 + A s would vanish
+    S_max = min(10.0 * a * max(1.0, float(np.abs(Gsz))), 0.95 * PP[V0_IDX] / PP[A_IDX])
+    S_grid = np.logspace(np.log10(S_max) - 7, np.log10(S_max), 300)
     Ts, _, _, _ = closed(S_grid)
     h = np.log(a * np.abs(Ts)) - np.log(S_grid)
     down = np.nonzero((h[:-1] > 0) & (h[1:] <= 0))[0]
