@@ -1,0 +1,117 @@
+"""Figures for the real-data identification (each returns a matplotlib Figure;
+save with :func:`heavecomp.report.figures.save`)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from heavecomp.plants.axis import BASE_NAMES, EMPS_PUBLISHED, EMPS_UNITS
+
+
+def _plt():
+    from heavecomp.report.figures import _plt as plt
+
+    return plt()
+
+
+def emps_overlay(t, measured, model_before, model_after, label_after: str):
+    """Measured vs model force on the held-out part."""
+    plt = _plt()
+    fig, (ax, axr) = plt.subplots(2, 1, figsize=(10, 5.6), sharex=True, gridspec_kw={"height_ratios": [2, 1]})
+    ax.plot(t, measured, color="0.2", lw=1.2, label="measured F = g_tau v_ir")
+    ax.plot(t, model_before, color="tab:blue", lw=0.9, label="EMPS model (M, F_v, F_c, offset)")
+    ax.plot(t, model_after, color="tab:red", lw=0.9, ls="--", label=f"+ {label_after}")
+    ax.set_ylabel("motor force F [N]")
+    ax.legend(fontsize=8, loc="upper right")
+    ax.grid(alpha=0.3)
+    ax.set_title("EMPS held-out part: the inverse model follows the force; the residual is a few N", fontsize=10)
+    axr.plot(t, measured - model_before, color="tab:blue", lw=0.8, label="residual, EMPS model")
+    axr.plot(t, measured - model_after, color="tab:red", lw=0.8, label="residual, augmented")
+    axr.set_ylabel("residual [N]")
+    axr.set_xlabel("time t [s]")
+    axr.legend(fontsize=8, loc="upper right")
+    axr.grid(alpha=0.3)
+    fig.tight_layout()
+    return fig
+
+
+def emps_residual_map(v, q, r_before, r_after, where_before, where_after):
+    """Residual vs velocity and vs position, with the per-bin rms before/after."""
+    plt = _plt()
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.4), sharey=True)
+    for ax, x, key, scale, unit in ((axes[0], v, "velocity", 1e3, "velocity q' [mm/s]"),
+                                    (axes[1], q, "position", 1e3, "position q [mm]")):
+        ax.plot(x * scale, r_before, ".", ms=2, color="tab:blue", alpha=0.35, label="residual, EMPS model")
+        ax.plot(x * scale, r_after, ".", ms=2, color="tab:red", alpha=0.35, label="residual, augmented")
+        for w, c, lab in ((where_before, "tab:blue", "bin rms before"), (where_after, "tab:red", "bin rms after")):
+            mids = [0.5 * (b["lo"] + b["hi"]) * scale for b in w[key] if b["n"]]
+            ax.plot(mids, [b["rms"] for b in w[key] if b["n"]], "o-", color=c, lw=1.5, label=lab)
+        ax.axhline(0, color="0.5", lw=0.6)
+        ax.set_xlabel(unit)
+        ax.grid(alpha=0.3)
+    axes[0].set_ylabel("force residual [N]")
+    axes[0].legend(fontsize=7)
+    d = where_before["direction"]
+    vb = max((b for b in where_before["velocity"] if b["n"]), key=lambda b: b["rms"])
+    qb = max((b for b in where_before["position"] if b["n"]), key=lambda b: b["rms"])
+    fig.suptitle(f"Where the held-out residual lives: {d['negative']['share']:.0%} of it in the negative direction "
+                 f"({d['positive']['share']:.0%} positive); largest bin rms at v = {vb['lo'] * 1e3:.0f}.."
+                 f"{vb['hi'] * 1e3:.0f} mm/s and q = {qb['lo'] * 1e3:.0f}..{qb['hi'] * 1e3:.0f} mm", fontsize=10)
+    fig.tight_layout()
+    return fig
+
+
+def emps_cutoff_sensitivity(sens: dict):
+    """Estimates vs Butterworth cut-off, as % deviation from the published values.
+
+    ``sens``: label -> output of :func:`heavecomp.identification.inverse.cutoff_sensitivity`.
+    """
+    plt = _plt()
+    fig, axes = plt.subplots(2, 2, figsize=(10, 6.4), sharex=True)
+    for ax, k in zip(axes.ravel(), BASE_NAMES):
+        for label, s in sens.items():
+            dev = 100.0 * (np.asarray(s[k]) / EMPS_PUBLISHED[k] - 1.0)
+            ax.semilogx(s["cutoff"], dev, "o-", ms=3, label=label)
+        ax.axhspan(-2, 2, color="tab:green", alpha=0.12, label="within 2 %")
+        ax.axhline(0, color="0.4", lw=0.6)
+        ax.set_title(f"{k} (published {EMPS_PUBLISHED[k]:g} {EMPS_UNITS[k]})", fontsize=9)
+        ax.set_ylabel("deviation [%]")
+        ax.grid(alpha=0.3, which="both")
+    for ax in axes[1]:
+        ax.set_xlabel("Butterworth cut-off of q [Hz]")
+    axes[0, 0].legend(fontsize=7)
+    fig.suptitle("EMPS estimates vs position-filter cut-off: on the published values once the cut-off "
+                 "is above the decimation band", fontsize=10)
+    fig.tight_layout()
+    return fig
+
+
+def seal_friction_vs_pressure(strokes: list, fits: dict):
+    """Per-stroke friction vs gauge pressure, per direction, with the fitted lines."""
+    plt = _plt()
+    fig, ax = plt.subplots(figsize=(8, 5))
+    bar = 1e5
+    for d, c, lab in ((1, "tab:red", "positive stroke"), (-1, "tab:blue", "negative stroke")):
+        rows = [r for r in strokes if r["direction"] == d]
+        ax.plot([r["dp"] / bar for r in rows], [abs(r["friction"]) for r in rows], "o", ms=4, color=c,
+                alpha=0.6, label=f"|F_f| per {lab}")
+        key = "positive" if d > 0 else "negative"
+        f = fits[key]
+        x = np.linspace(0, 7.5, 20)
+        ax.plot(x, f["F_C"] + f["C_p"] * x * bar, color=c, lw=1, ls=":",
+                label=f"{key}: F_C = {f['F_C']:.2f} N, C_p = {f['C_p'] * bar:.3f} N/bar")
+    f = fits["split"]
+    x = np.linspace(0, 7.5, 20)
+    ax.plot(x, f["F_C"] + f["C_p"] * x * bar, "k-", lw=1.8,
+            label=f"direction-symmetric part: F_C = {f['F_C']:.2f} N, C_p = {f['C_p'] * bar:.3f} N/bar "
+                  f"(+- {f['C_p_boot'] * bar:.3f} strokes, +- {fits['file_means']['C_p_se'] * bar:.3f} files)")
+    ax.set_xlabel("chamber gauge pressure dp [bar]")
+    ax.set_ylabel("seal friction |F_f| = |force - p A| [N]")
+    ax.set_xlim(0, 7.5)
+    ax.set_ylim(bottom=0)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7, loc="upper left")
+    ax.set_title("O-ring friction grows with pressure (paper A eq. 4, F_C + C_p dp), "
+                 "much more in the positive direction", fontsize=10)
+    fig.tight_layout()
+    return fig

@@ -1,0 +1,102 @@
+"""The two real-data studies as functions returning plain results (metrics + objects
+for figures), so that the scenarios stay thin and tests can call them directly."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from heavecomp.identification.inverse import AxisRegression, InverseModelLS, cutoff_sensitivity
+from heavecomp.identification.residual import ResidualDiagnoser
+from heavecomp.identification.seal import BAR, BORE_DIAMETER, SealFrictionFit, scale_by_circumference
+from heavecomp.plants.axis import BASE_NAMES, EMPS_PUBLISHED
+
+#: Paper A main-cylinder friction: C_p = 200 N/bar for a 0.72 m plunger.
+PAPER_A_CP = 200.0 / BAR
+PAPER_A_DIAMETER = 0.72
+
+
+def emps_study(record, cutoff: float = 50.0, order: int = 4, decimate: int = 10, t_split: float = 15.0,
+               sensitivity_cutoffs=(10, 15, 20, 30, 40, 50, 70, 100, 150, 200),
+               sensitivity_decimations=(10, 1), edge: float = 0.1) -> dict:
+    """Identify the EMPS model on the whole record (benchmark check), its cut-off
+    sensitivity, and diagnose the residual on the held-out part ``t >= t_split``
+    (``edge`` [s] at both ends of the record, filter edge transients, left out of the diagnosis).
+
+    Returns ``{"metrics": dict, "estimator": InverseModelLS, "diagnoser": ResidualDiagnoser,
+    "sensitivity": {label: dict}}``.
+    """
+    est = InverseModelLS(cutoff, order, decimate).fit(record)
+    rel = {k: est.params_[k] / EMPS_PUBLISHED[k] - 1.0 for k in BASE_NAMES}
+    sens = {f"decimate {nd} (parallel filter {0.4 * record.fs / nd:.0f} Hz)" if nd > 1 else "no decimation":
+            cutoff_sensitivity(record, sensitivity_cutoffs, decimate=nd, order=order)
+            for nd in sensitivity_decimations}
+    reg = est.regression_
+    t0, t1 = float(record.t[0]) + edge, float(record.t[-1]) - edge
+    diag = ResidualDiagnoser(fit_window=(t0, t_split), validate_window=(t_split, t1)).fit(reg)
+    base = diag.baseline_["parameters"]
+    metrics = {
+        "record": {"name": record.name, "samples": len(record), "fs_Hz": record.fs,
+                   "duration_s": float(record.t[-1] - record.t[0])},
+        "settings": {"butterworth_cutoff_Hz": cutoff, "butterworth_order": order,
+                     "forward_backward": True, "decimate": decimate,
+                     "parallel_filter_cutoff_Hz": 0.4 * record.fs / decimate if decimate > 1 else None,
+                     "derivative": "central differences of the filtered position"},
+        "published": dict(EMPS_PUBLISHED),
+        "identified_whole_record": est.params_,
+        "stderr_whole_record": est.stderr_,
+        "relative_error": rel,
+        "max_abs_relative_error": max(abs(v) for v in rel.values()),
+        "rms_whole_record_N": est.rms_,
+        "sensitivity": sens,
+        "split": {"fit": [t0, t_split], "validate": [t_split, t1],
+                  "note": f"the first and last {edge:g} s (filter edge transients) are left out"},
+        "baseline_fit_part": diag.baseline_,
+        "asymmetric_coulomb_equivalent": {"coulomb_positive": base["coulomb"] + base["offset"],
+                                          "coulomb_negative": base["coulomb"] - base["offset"]},
+        "where": diag.where_,
+        "candidates": diag.results_,
+        "best_single": diag.best_["effect"] if diag.best_ else "none",
+        "selection": diag.selection_,
+        "where_after_selection": diag.where_after_,
+    }
+    return {"metrics": metrics, "estimator": est, "diagnoser": diag, "sensitivity": sens}
+
+
+def seal_study(records, n_boot: int = 2000, seed: int = 0) -> dict:
+    """Fit F_C + C_p dp over the O-ring files; compare with paper A scaled by circumference.
+
+    Returns ``{"metrics": dict, "fit": SealFrictionFit}``.
+    """
+    fit = SealFrictionFit(n_boot=n_boot, seed=seed).fit(records)
+    per_file = {}
+    for rec in records:
+        rows = [r for r in fit.strokes_ if r["file"] == rec.name]
+        per_file[rec.name] = {
+            "dp_bar": float(np.mean([r["dp"] for r in rows]) / BAR),
+            "strokes_positive": sum(r["direction"] > 0 for r in rows),
+            "strokes_negative": sum(r["direction"] < 0 for r in rows),
+            "friction_positive_N": float(np.mean([r["friction"] for r in rows if r["direction"] > 0])),
+            "friction_negative_N": float(np.mean([r["friction"] for r in rows if r["direction"] < 0])),
+            "speed_positive_mm_s": float(np.mean([r["speed"] for r in rows if r["direction"] > 0]) * 1e3),
+            "speed_negative_mm_s": float(np.mean([r["speed"] for r in rows if r["direction"] < 0]) * 1e3),
+        }
+    fits = {k: {**f, "C_p_N_per_bar": f["C_p"] * BAR, "C_p_se_N_per_bar": f["C_p_se"] * BAR,
+                "C_p_boot_N_per_bar": None if f["C_p_boot"] is None else f["C_p_boot"] * BAR}
+            for k, f in fit.fits_.items()}
+    scaled = scale_by_circumference(PAPER_A_CP, PAPER_A_DIAMETER, BORE_DIAMETER)
+    metrics = {
+        "settings": {"v_min_m_s": fit.v_min, "trim": fit.trim, "n_boot": n_boot, "area_m2": fit.area,
+                     "velocity": "slope over +-10 samples (0.2 s)"},
+        "files": per_file,
+        "fits": fits,
+        "C_p_N_per_Pa": fit.C_p_, "C_p_uncertainty_N_per_Pa": fit.C_p_se_,
+        "C_p_N_per_bar": fit.C_p_ * BAR, "C_p_uncertainty_N_per_bar": fit.C_p_se_ * BAR,
+        "F_C_N": fit.F_C_,
+        "headline_fit": "split",
+        "paper_a": {"C_p_N_per_bar": PAPER_A_CP * BAR, "plunger_diameter_m": PAPER_A_DIAMETER,
+                    "scaled_to_bore_N_per_bar": scaled * BAR,
+                    "ratio_measured_to_scaled": fit.C_p_ / scaled if scaled else math.nan},
+    }
+    return {"metrics": metrics, "fit": fit}
