@@ -56,3 +56,23 @@ def test_wob_history_converges_with_fourth_order(model):
                 ref.stats["n_stick"], ref.stats["n_breakaway"], ref.stats["n_reversal"])
         # the total stuck time converges as well (event times located, not snapped to the grid)
         assert abs(stats[1]["stuck_time"] - ref.stats["stuck_time"]) < 1e-4
+
+
+@pytest.mark.xfail(strict=True, reason="BUG/limit: bit lift-off and touchdown (W = max(0, k_F pen - c_F v_b) "
+                   "switching at pen = 0, with a force jump c_F |v_b| at touchdown) are not located inside "
+                   "the step, so RK4 drops to order <= 1 and the default 10 ms step errs by ~1 kN rms")
+def test_wob_history_converges_through_bit_lift_off():
+    """3 m heave without friction: the bit leaves the formation every wave period
+    (WOB = 0 for ~0.3 s).  The convergence should stay high as for stick-slip; today the
+    error is erratic (order ~-0.5...3.5) and ~1 kN rms at the default step."""
+    p = paper_a("none").replace(heave={"amplitude": 3.0})
+    ref = simulate(p, T, dt=DT_REF, rate=RATE)
+    assert np.count_nonzero(ref["wob"] == 0.0) > 20  # the bit really lifts off
+    errs = []
+    for dt in DTS:
+        e = simulate(p, T, dt=dt, rate=RATE)["wob"] - ref["wob"]
+        errs.append(float(np.sqrt(np.mean(e ** 2))))
+    errs = np.array(errs)
+    orders = np.log2(errs[:-1] / errs[1:])
+    print(f"lift-off: rms WOB error {['%.3g' % e for e in errs]} N, observed orders {np.round(orders, 2)}")
+    assert errs[1] < 1.0 and np.all(orders >= 3.5)
