@@ -1,0 +1,285 @@
+"""Frequency-response figures and the ``heavecomp analyse`` outputs.
+
+Compute first (:mod:`heavecomp.analysis.linear`, :mod:`~heavecomp.analysis.frequency`,
+:mod:`~heavecomp.analysis.sweeps`, :mod:`~heavecomp.analysis.describing`), then draw:
+every ``*_figure`` function takes computed data and returns a matplotlib Figure
+(save it with :func:`heavecomp.report.figures.save`).
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import math
+from pathlib import Path
+
+import numpy as np
+
+from heavecomp.analysis.frequency import WAVE_BAND
+
+log = logging.getLogger(__name__)
+
+
+def _plt():
+    from heavecomp.report.figures import _plt as plt_
+
+    return plt_()
+
+
+def _band(ax, axis="x"):
+    lo, hi = WAVE_BAND
+    (ax.axvspan if axis == "x" else ax.axhspan)(lo, hi, color="tab:blue", alpha=0.12,
+                                                  label="wave band (periods 5-20 s)")
+
+
+def bode_figure(curves: dict, *, natural_frequencies=(), k_eff_eq14: float | None = None, title: str = ""):
+    """Bode plot of k_eff(omega) = -WOB/heave for several models.
+
+    Parameters
+    ----------
+    curves : dict
+        label -> (omega [rad/s], complex k_eff(omega) [N/m]).
+    natural_frequencies : sequence [rad/s]
+        Marked as vertical lines.
+    k_eff_eq14 : float [N/m], optional
+        Paper A eq. 14, drawn as a horizontal line.
+    """
+    plt = _plt()
+    fig, (am, ap) = plt.subplots(2, 1, figsize=(8, 6), sharex=True, gridspec_kw={"height_ratios": [2, 1]})
+    for label, (w, k) in curves.items():
+        am.loglog(w, np.abs(k) / 1e3, lw=1.4, label=label)
+        ap.semilogx(w, np.degrees(np.unwrap(np.angle(k))), lw=1.2)
+    _band(am)
+    _band(ap)
+    if k_eff_eq14 is not None:
+        am.axhline(k_eff_eq14 / 1e3, color="k", ls="--", lw=0.8, label=f"eq. 14 k_eff = {k_eff_eq14 / 1e3:.2f} kN/m")
+    for i, wn in enumerate(natural_frequencies):
+        for ax in (am, ap):
+            ax.axvline(wn, color="tab:red", ls=":", lw=1, label=("natural frequencies" if i == 0 and ax is am else None))
+    am.set_ylabel("|k_eff(w)| = |WOB/heave| [kN/m]")
+    ap.set_ylabel("phase of k_eff [deg]")
+    ap.set_xlabel("angular frequency w [rad/s]")
+    am.set_title(title or "Heave -> WOB: the static gain (eq. 14) holds through the wave band; resonances lie above it",
+                 fontsize=10)
+    am.legend(fontsize=7, loc="lower left")
+    for ax in (am, ap):
+        ax.grid(alpha=0.3, which="both")
+    fig.tight_layout()
+    return fig
+
+
+def map_figure(m: dict, *, marker=None, title: str = ""):
+    """Lowest and second natural period over (string length, formation stiffness).
+
+    Parameters
+    ----------
+    m : dict
+        From :func:`heavecomp.analysis.sweeps.eigenfrequency_map`.
+    marker : (length [m], k_F [N/m]), optional
+        A point to mark (e.g. the paper-A set).
+    """
+    plt = _plt()
+    L, kF = m["lengths"], m["formation_stiffness"]
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.6), sharey=True)
+    levels = [1, 2, 3, 5, 8, 12, 20, 40]
+    for k, ax in enumerate(axes):
+        T = 2 * np.pi / m["omega"][..., k]
+        cs = ax.contour(L, kF / 1e3, T.T, levels=levels, colors="0.3", linewidths=0.8)
+        ax.clabel(cs, fmt="%g s", fontsize=7)
+        band = ((T >= 5.0) & (T <= 20.0)).T.astype(float)
+        ax.contourf(L, kF / 1e3, band, levels=[0.5, 1.5], colors=["tab:blue"], alpha=0.25)
+        ax.set_yscale("log")
+        ax.set_xlabel("drill-string length L [m]")
+        ax.set_title(f"{'lower' if k == 0 else 'upper'} natural period T_{k + 1} [s]"
+                     " (shaded: inside the 5-20 s wave band)", fontsize=9)
+        if marker is not None:
+            ax.plot(marker[0], marker[1] / 1e3, "r*", ms=12, label="paper-A set")
+            ax.legend(fontsize=8, loc="lower right")
+        ax.grid(alpha=0.3)
+    axes[0].set_ylabel("formation stiffness k_F [kN/m]")
+    fig.suptitle(title or "Where do the CMC's eigenfrequencies meet the waves? Soft formations bring the "
+                 "lower mode into the wave band", fontsize=10)
+    fig.tight_layout()
+    return fig
+
+
+def transmissibility_map_figure(m: dict, period_index: int, *, marker=None):
+    """|k_eff(omega)|/k_eff(0) at one wave period over (L, k_F) (frictionless)."""
+    plt = _plt()
+    L, kF = m["lengths"], m["formation_stiffness"]
+    T = m["wave_periods"][period_index]
+    tr = m["transmissibility"][..., period_index]
+    fig, ax = plt.subplots(figsize=(6.5, 4.6))
+    pc = ax.pcolormesh(L, kF / 1e3, np.log10(tr.T), cmap="RdBu_r", vmin=-1, vmax=1, shading="auto")
+    cb = fig.colorbar(pc, ax=ax)
+    cb.set_label("log10 transmissibility |k_eff(w)| / k_eff(0) [-]")
+    cs = ax.contour(L, kF / 1e3, tr.T, levels=[0.5, 1.1, 2, 5], colors="k", linewidths=0.7)
+    ax.clabel(cs, fmt="%g", fontsize=7)
+    if marker is not None:
+        ax.plot(marker[0], marker[1] / 1e3, "k*", ms=12, label="paper-A set")
+        ax.legend(fontsize=8)
+    ax.set_yscale("log")
+    ax.set_xlabel("drill-string length L [m]")
+    ax.set_ylabel("formation stiffness k_F [kN/m]")
+    ax.set_title(f"Heave -> WOB at a {T:g} s wave: red amplifies (resonance), blue filters", fontsize=10)
+    fig.tight_layout()
+    return fig
+
+
+def df_figure(rows: list[dict], *, title: str = ""):
+    """WOB first-harmonic amplitude vs heave amplitude: describing function, simulator, linear."""
+    plt = _plt()
+    frictions = sorted({r["friction"] for r in rows})
+    fig, axes = plt.subplots(1, len(frictions), figsize=(5.2 * len(frictions), 4.2), sharey=True, squeeze=False)
+    for ax, fr in zip(axes[0], frictions):
+        sub = [r for r in rows if r["friction"] == fr]
+        for j, T in enumerate(sorted({r["period"] for r in sub})):
+            rr = sorted((r for r in sub if r["period"] == T), key=lambda r: r["amplitude"])
+            a = np.array([r["amplitude"] for r in rr])
+            col = f"C{j}"
+            ax.plot(a, [r["wob_df"] / 1e3 for r in rr], "-", color=col, label=f"describing function, T = {T:g} s")
+            ax.plot(a, [r["wob_sim"] / 1e3 for r in rr], "o", color=col, ms=5, label=f"simulator, T = {T:g} s")
+            ax.plot(a, [r["wob_linear"] / 1e3 for r in rr], ":", color=col, lw=1)
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel("heave amplitude a [m]")
+        ax.set_title(f"friction: {fr} (dotted: frictionless linear)", fontsize=9)
+        ax.grid(alpha=0.3, which="both")
+    axes[0][0].set_ylabel("WOB first-harmonic amplitude [kN]")
+    axes[0][0].legend(fontsize=7)
+    fig.suptitle(title or "Amplitude-dependent heave -> WOB: friction stiffens the compensator at small heave",
+                 fontsize=10)
+    fig.tight_layout()
+    return fig
+
+
+def _clean(x):
+    from heavecomp.report.scenario import _clean as c
+
+    return c(x)
+
+
+def analyse(params, *, n_points: int = 1000, omega_min: float = 1e-3, omega_max: float | None = None,
+            sliding_velocity: float | None = None) -> dict:
+    """Everything ``heavecomp analyse`` reports for one parameter set (no files).
+
+    Returns
+    -------
+    dict
+        ``summary`` (the analysis.json content), ``table`` (CSV columns of the
+        frictionless model), ``curves`` (label -> (omega, k_eff(omega))).
+    """
+    from heavecomp.analysis.frequency import dc_gain, frequency_grid, modes, response_table
+    from heavecomp.analysis.linear import linearise_details
+
+    L0 = linearise_details(params, friction="none")
+    sys = L0.sys
+    w = frequency_grid(sys, n_points, omega_min, omega_max)
+    table = response_table(sys, w)
+    md = modes(sys)
+    k_dc = -dc_gain(sys)
+    lo, hi = WAVE_BAND
+    summary = {
+        "k_eff_dc": k_dc,
+        "k_eff_eq14": params.k_eff,
+        "dc_gain_heave_to_wob": -k_dc,
+        "natural_frequencies": md["natural_frequencies"],
+        "natural_periods": [2 * math.pi / x for x in md["natural_frequencies"]],
+        "damping_ratios": md["damping_ratios"],
+        "damped_natural_frequencies": md["damped_natural_frequencies"],
+        "poles": md["poles"],
+        "wave_band_rad_s": [lo, hi],
+        "modes_in_wave_band": [bool(lo <= x <= hi) for x in md["natural_frequencies"]],
+        "peak_k_eff": float(np.max(table["k_eff_mag"])),
+        "peak_omega": float(w[np.argmax(table["k_eff_mag"])]),
+        "transmissibility_at_wave_periods": {
+            f"{T:g}": float(np.interp(2 * math.pi / T, w, table["transmissibility"])) for T in (5, 8, 12, 16, 20)},
+        "operating_point": L0.op.as_dict(),
+        "linearisation": "frictionless (friction='none'); outputs are deviations from the operating point",
+        "frequency_points": int(len(w)),
+        "friction_model": params.friction.model,
+    }
+    curves = {"frictionless": (w, -(table["wob_per_heave_mag"] * np.exp(1j * np.radians(table["wob_per_heave_phase_deg"]))))}
+    if params.friction.viscous_coefficient is not None:
+        Lv = linearise_details(params, friction="viscous")
+        mv = modes(Lv.sys)
+        tv = response_table(Lv.sys, w)
+        summary["viscous"] = {"viscous_coefficient": params.friction.viscous_coefficient,
+                              "natural_frequencies": mv["natural_frequencies"],
+                              "damping_ratios": mv["damping_ratios"], "k_eff_dc": -dc_gain(Lv.sys)}
+        curves[f"viscous C_v = {params.friction.viscous_coefficient / 1e3:g} kN s/m"] = (
+            w, -(tv["wob_per_heave_mag"] * np.exp(1j * np.radians(tv["wob_per_heave_phase_deg"]))))
+    if sliding_velocity is not None and params.friction.model != "none":
+        Ls = linearise_details(params, friction="sliding", velocity=sliding_velocity)
+        ms = modes(Ls.sys)
+        ts = response_table(Ls.sys, w)
+        summary["sliding"] = {"velocity": sliding_velocity, "friction_slope": Ls.friction_slope,
+                              "natural_frequencies": ms["natural_frequencies"],
+                              "damping_ratios": ms["damping_ratios"], "k_eff_dc": -dc_gain(Ls.sys)}
+        curves[f"sliding at {sliding_velocity:g} m/s"] = (
+            w, -(ts["wob_per_heave_mag"] * np.exp(1j * np.radians(ts["wob_per_heave_phase_deg"]))))
+    return {"summary": summary, "table": table, "curves": curves}
+
+
+def write_analysis(params, out, *, source: str = "", **kw) -> dict:
+    """Write ``analysis.json``, ``frequency_response.csv``, ``bode.png`` and ``report.md`` into ``out``.
+
+    Returns the analysis.json content.
+    """
+    from heavecomp.report.figures import save
+
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    res = analyse(params, **kw)
+    s, table = res["summary"], res["table"]
+    (out / "analysis.json").write_text(json.dumps(_clean(s), indent=2) + "\n")
+    cols = list(table)
+    np.savetxt(out / "frequency_response.csv", np.column_stack([table[c] for c in cols]), delimiter=",",
+               header=",".join(cols), comments="", fmt="%.10g")
+    save(bode_figure(res["curves"], natural_frequencies=s["natural_frequencies"], k_eff_eq14=params.k_eff,
+                     title=f"Heave -> WOB {source}: |k_eff(w)| with the wave band and the natural frequencies"),
+         out / "bode.png", dpi=100)
+    (out / "report.md").write_text(report_markdown(s, source))
+    log.info("analysis written to %s", out)
+    return s
+
+
+def report_markdown(s: dict, source: str = "") -> str:
+    """Markdown frequency-response report from an analysis.json dict."""
+    wn = ", ".join(f"{x:.3f}" for x in s["natural_frequencies"])
+    Tn = ", ".join(f"{x:.2f}" for x in s["natural_periods"])
+    z = ", ".join(f"{x:.4f}" for x in s["damping_ratios"])
+    inband = any(s["modes_in_wave_band"])
+    lines = [
+        f"# Frequency response heave -> WOB {source}".rstrip(),
+        "",
+        "Linearised CMC (frictionless, about the operating point s = 0, WOB = W_0), from the same casadi "
+        "equations the simulator uses (`heavecomp.analysis.linear`).",
+        "",
+        "| quantity | value |",
+        "|---|---|",
+        f"| k_eff_dc (DC gain heave -> WOB, sign flipped) | {s['k_eff_dc'] / 1e3:.3f} kN/m |",
+        f"| paper A eq. 14 k_eff | {s['k_eff_eq14'] / 1e3:.3f} kN/m |",
+        f"| natural frequencies (undamped) | {wn} rad/s |",
+        f"| natural periods | {Tn} s |",
+        f"| damping ratios | {z} |",
+        f"| peak |k_eff(w)| | {s['peak_k_eff'] / 1e3:.1f} kN/m at {s['peak_omega']:.3f} rad/s |",
+        "",
+        "Transmissibility |k_eff(w)|/k_eff(0) at wave periods: "
+        + ", ".join(f"{k} s: {v:.3f}" for k, v in s["transmissibility_at_wave_periods"].items()) + ".",
+        "",
+        ("A natural frequency lies **inside** the wave band (periods 5-20 s): waves excite a resonance."
+         if inband else
+         "Both natural frequencies lie **above** the wave band (periods 5-20 s): the heave reaches the bit "
+         "quasi-statically (WOB ~ k_eff z_h, paper A eqs. 13-14) and cylinder-force disturbances are not filtered."),
+        "",
+        "![Bode plot](bode.png)",
+        "",
+    ]
+    for key, label in (("viscous", "viscous friction only"), ("sliding", "sliding linearisation")):
+        if key in s:
+            v = s[key]
+            lines.append(f"With {label}: natural frequencies "
+                         + ", ".join(f"{x:.3f}" for x in v["natural_frequencies"]) + " rad/s, damping ratios "
+                         + ", ".join(f"{x:.4f}" for x in v["damping_ratios"]) + ".")
+    return "\n".join(lines) + "\n"

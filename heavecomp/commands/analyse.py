@@ -1,0 +1,54 @@
+"""Linear analysis of the CMC: k_eff_dc, natural frequencies, damping ratios and the heave -> WOB frequency response.
+
+Writes DIR/analysis.json, DIR/frequency_response.csv, DIR/bode.png and DIR/report.md.
+"""
+
+from __future__ import annotations
+
+import argparse
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("params", metavar="PARAMS.toml", help="CMC parameter file (cmc-reference.md contract)")
+    p.add_argument("--out", required=True, metavar="DIR", help="output folder")
+    p.add_argument("--points", type=int, default=1000, metavar="N",
+                   help="number of log-spaced frequencies (default 1000)")
+    p.add_argument("--omega-min", type=float, default=1e-3, metavar="RAD_S",
+                   help="lowest angular frequency [rad/s] (default 1e-3)")
+    p.add_argument("--omega-max", type=float, default=None, metavar="RAD_S",
+                   help="highest angular frequency [rad/s] (default 10x the fastest pole)")
+    p.add_argument("--sliding-velocity", type=float, default=None, metavar="M_S",
+                   help="also linearise the file's friction law about this constant stroke velocity [m/s]")
+
+
+def _check(args):
+    import math
+
+    from heavecomp.errors import InputError
+
+    if not (2 <= args.points <= 1_000_000):
+        raise InputError(f"--points must be between 2 and 1000000, got {args.points}")
+    if not (args.omega_min > 0 and math.isfinite(args.omega_min)):
+        raise InputError(f"--omega-min must be a positive number of rad/s, got {args.omega_min}")
+    if args.omega_max is not None and not (math.isfinite(args.omega_max) and args.omega_max > args.omega_min):
+        raise InputError(f"--omega-max must be a finite number of rad/s above --omega-min, got {args.omega_max}")
+    v = args.sliding_velocity
+    if v is not None and not (math.isfinite(v) and v != 0.0):
+        raise InputError(f"--sliding-velocity must be a non-zero number of m/s, got {v}")
+
+
+def run(args) -> int:
+    from pathlib import Path
+
+    from heavecomp.analysis.report import write_analysis
+    from heavecomp.params import load
+
+    _check(args)
+    params = load(args.params)
+    s = write_analysis(params, args.out, source=f"({Path(args.params).name})", n_points=args.points,
+                       omega_min=args.omega_min, omega_max=args.omega_max, sliding_velocity=args.sliding_velocity)
+    wn = ", ".join(f"{x:.3f}" for x in s["natural_frequencies"])
+    zeta = ", ".join(f"{x:.4f}" for x in s["damping_ratios"])
+    print(f"k_eff_dc {s['k_eff_dc'] / 1e3:.3f} kN/m (eq. 14: {s['k_eff_eq14'] / 1e3:.3f}), natural frequencies "
+          f"{wn} rad/s, damping ratios {zeta} -> {args.out}")
+    return 0
