@@ -243,3 +243,21 @@ def test_friction_only_dissipates(model):
     both = (res["stuck"][1:] == 1.0) & (res["stuck"][:-1] == 1.0)
     if both.any():
         assert np.all(np.diff(heat_seal)[both] == 0.0)
+
+
+@pytest.mark.parametrize("sign", [1.0, -1.0])
+def test_active_force_step_below_limit_holds_above_breaks_loose(sign):
+    """No heave; a constant active-cylinder force u on the top mass from t = 0.  At the
+    operating point p_0 A - M_c g - T_0 = 0, so the holding force is u itself: at 90 %
+    of the static limit nothing moves and the friction equals u; at 110 % the plunger
+    breaks loose at once in the direction of u."""
+    p = paper_a("stribeck")
+    lim = float(FrictionLaw.from_params(p.friction).static_limit(p.p0))
+    still = (np.linspace(0.0, 31.0, 32), np.zeros(32))
+    held = simulate(p, 30.0, heave=still, u_active=sign * 0.9 * lim)
+    assert np.all(held["stroke"] == 0.0) and np.all(held["stuck"] == 1.0)
+    np.testing.assert_allclose(held["friction"], sign * 0.9 * lim, rtol=1e-12)
+    np.testing.assert_allclose(held["wob"], p.operating_point.wob_setpoint, rtol=1e-12)
+    moved = simulate(p, 30.0, heave=still, u_active=sign * 1.1 * lim)
+    assert moved["stuck"][1] == 0.0 and moved.stats["n_breakaway"] >= 1
+    assert sign * moved["stroke"][1] > 0
