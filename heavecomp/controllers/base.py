@@ -94,16 +94,16 @@ class ControllerConfig:
     horizon: int = 20
     q_wob: float = 1e-6
     r_u: float = 1e-12
-    r_du: float = 1e-10
+    r_du: float = 3e-7
     friction_eps: float = 0.02
     friction_feedforward: bool = True
     friction_scale: float = 1.0
     gas_stiffness_scale: float = 1.0
-    kp: float = 1.0
-    ki: float = 4.0
+    kp: float = 0.5
+    ki: float = 0.3
     kd: float = 0.0
     pid_tf: float = 0.2
-    observer_sigma_d: float = 8e3
+    observer_sigma_d: float = 1e3
     predictor_order: int = 10
     predictor_window: float = 60.0
 

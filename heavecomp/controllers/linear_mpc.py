@@ -147,7 +147,7 @@ class LinearMPC(Controller):
         q[0] -= 2.0 * self.rdu * u_prev
         l, u = self._bounds(u_prev)
         self.solver.update(q=q, l=l, u=u)
-        res = self.solver.solve()
+        res = self.solver.solve(raise_error=False)
         status = str(getattr(res.info, "status", "")).lower()
         if status == "solved" and np.all(np.isfinite(res.x)):
             self.plan = res.x * KN
