@@ -1,0 +1,21 @@
+"""Sim-to-real gap diagnosis of the CMC (issue 4): measured runs, replay, where, which effect, how far.
+
+>>> from heavecomp.diagnosis import GapDiagnoser, load_run      # doctest: +SKIP
+>>> run = load_run("run.csv", nominal)                           # doctest: +SKIP
+>>> d = GapDiagnoser(nominal, split=0.67).fit(run)               # doctest: +SKIP
+>>> d.verdict_, d.candidates_, d.where_, d.to_json()             # doctest: +SKIP
+
+Heavy modules (numba, scipy) load on first use.
+"""
+
+__all__ = ["GapDiagnoser", "load_run", "check_run", "MeasuredRun"]
+
+
+def __getattr__(name):
+    if name == "GapDiagnoser":
+        from heavecomp.diagnosis.estimator import GapDiagnoser
+        return GapDiagnoser
+    if name in ("load_run", "check_run", "MeasuredRun"):
+        from heavecomp.diagnosis import data
+        return getattr(data, name)
+    raise AttributeError(name)

@@ -1,0 +1,280 @@
+"""Measured runs: load and check the CSV contract, derive heave velocity/acceleration.
+
+Contract: ``shared/spec/diagnosis-contract.md`` — columns ``t`` [s], ``heave`` [m],
+``stroke`` [m], ``pressure`` [Pa], ``wob`` [N]; other columns are carried along.
+
+Treatments (documented in ``docs/diagnosis.md``):
+
+- missing column, non-numeric cell, ``t`` not finite / not strictly increasing:
+  :class:`~heavecomp.errors.DataError` naming the column (and row);
+- dropouts (empty / NaN cells): a channel more than ``MAX_MISSING`` missing is an
+  error; otherwise heave gaps are interpolated linearly for the replay input and
+  missing samples of stroke/pressure/wob are excluded from the residuals;
+- non-uniform sampling: the replay uses the actual times; spectra and filters
+  work on a uniform resampling at the median interval;
+- wrong units: magnitudes are compared with the nominal operating point
+  (pressure with p_0, WOB with W_0, stroke with heave); a channel off by a
+  unit factor (bar, kPa, MPa; kN, tonnes; mm) is an error naming the column and
+  the likely unit — never converted silently.
+"""
+
+from __future__ import annotations
+
+import csv
+import dataclasses
+import math
+from pathlib import Path
+
+import numpy as np
+
+from heavecomp.errors import DataError
+
+REQUIRED = ("t", "heave", "stroke", "pressure", "wob")
+CHANNELS = ("wob", "stroke", "pressure")
+UNITS = {"t": "s", "heave": "m", "stroke": "m", "pressure": "Pa", "wob": "N"}
+MAX_MISSING = 0.2  #: largest tolerated fraction of missing samples per column
+MAX_GAP = 2.0      #: longest heave dropout bridged by interpolation [s]
+HEAVE_CUTOFF = 0.8  #: zero-phase FIR low-pass cut-off for the heave [Hz] (paper B's method; waves < 0.7 Hz)
+TAPS_PER_CUTOFF = 4.0  #: FIR length in periods of the cut-off (Hamming window)
+
+
+@dataclasses.dataclass
+class MeasuredRun:
+    """A checked measured run: arrays per column (NaN where missing) and notes."""
+
+    t: np.ndarray
+    columns: dict
+    source: str = "<array>"
+    warnings: list = dataclasses.field(default_factory=list)
+
+    def __getitem__(self, name):
+        if name == "t":
+            return self.t
+        return self.columns[name]
+
+    @property
+    def duration(self) -> float:
+        return float(self.t[-1] - self.t[0])
+
+    @property
+    def dt(self) -> float:
+        """Median sampling interval [s]."""
+        return float(np.median(np.diff(self.t)))
+
+    @property
+    def uniform(self) -> bool:
+        d = np.diff(self.t)
+        return bool(np.ptp(d) <= 1e-6 * np.median(d))
+
+
+def load_run(path, params=None) -> MeasuredRun:
+    """Read and check a measured-run CSV (contract columns, SI).
+
+    Parameters
+    ----------
+    path : str or Path
+    params : CMCParams, optional
+        Nominal parameters; when given, the channel magnitudes are checked
+        against the operating point (wrong-unit detection).
+
+    Raises
+    ------
+    DataError
+        One line naming the column (and row) for every problem.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise DataError(f"{path}: file not found")
+    with path.open(newline="") as fh:
+        reader = csv.reader(fh)
+        try:
+            header = [h.strip() for h in next(reader)]
+        except StopIteration:
+            raise DataError(f"{path}: empty file (expected a header with columns {', '.join(REQUIRED)})") from None
+        for col in REQUIRED:
+            if col not in header:
+                raise DataError(f"{path}: missing column '{col}' (header: {', '.join(header)})")
+        rows = []
+        for row_no, row in enumerate(reader, start=2):
+            if not row or all(not c.strip() for c in row):
+                continue
+            if len(row) < len(header):
+                row = row + [""] * (len(header) - len(row))
+            vals = []
+            for name, cell in zip(header, row):
+                cell = cell.strip()
+                if cell == "" or cell.lower() in ("nan", "na", "null"):
+                    vals.append(math.nan)
+                    continue
+                try:
+                    vals.append(float(cell))
+                except ValueError:
+                    if name in REQUIRED:
+                        raise DataError(f"{path}: column '{name}', row {row_no}: not a number: {cell!r}") from None
+                    vals.append(math.nan)
+            rows.append(vals)
+    if not rows:
+        raise DataError(f"{path}: column 't': no data rows")
+    arr = np.array(rows, dtype=float)
+    cols = {h: arr[:, i] for i, h in enumerate(header) if h != "t"}
+    return check_run(arr[:, header.index("t")], cols, params=params, source=str(path))
+
+
+def check_run(t, columns: dict, *, params=None, source="<array>") -> MeasuredRun:
+    """Check arrays against the contract (see the module docstring); returns a :class:`MeasuredRun`."""
+    t = np.asarray(t, dtype=float)
+    columns = {k: np.asarray(v, dtype=float) for k, v in columns.items()}
+    for col in REQUIRED[1:]:
+        if col not in columns:
+            raise DataError(f"{source}: missing column '{col}'")
+    if t.size < 50:
+        raise DataError(f"{source}: column 't': need at least 50 samples, got {t.size}")
+    bad = np.flatnonzero(~np.isfinite(t))
+    if bad.size:
+        raise DataError(f"{source}: column 't', row {bad[0] + 2}: missing or non-finite time")
+    back = np.flatnonzero(np.diff(t) <= 0)
+    if back.size:
+        i = back[0]
+        raise DataError(f"{source}: column 't', row {i + 3}: time not strictly increasing "
+                        f"({t[i]:g} -> {t[i + 1]:g} s; duplicate or backwards)")
+    warnings = []
+    for col in REQUIRED[1:]:
+        miss = ~np.isfinite(columns[col])
+        frac = float(miss.mean())
+        if frac > MAX_MISSING:
+            raise DataError(f"{source}: column '{col}': {100 * frac:.0f} % of samples missing "
+                            f"(at most {100 * MAX_MISSING:.0f} % tolerated)")
+        if miss.any():
+            warnings.append(f"column '{col}': {int(miss.sum())} missing samples "
+                            + ("interpolated in the replay input" if col == "heave" else "excluded from the residuals"))
+    z = columns["heave"]
+    miss = ~np.isfinite(z)
+    if miss.any():
+        gaps = _runs(miss)
+        for a, b in gaps:
+            lo = t[max(a - 1, 0)]
+            hi = t[min(b, t.size - 1)]
+            if hi - lo > MAX_GAP:
+                raise DataError(f"{source}: column 'heave', row {a + 2}: dropout of {hi - lo:.3g} s "
+                                f"(longest bridged gap {MAX_GAP:g} s)")
+    d = np.diff(t)
+    if np.ptp(d) > 1e-6 * np.median(d):
+        warnings.append(f"non-uniform sampling (intervals {d.min():.4g}..{d.max():.4g} s): replay uses the "
+                        "actual times, spectra a uniform resampling")
+    run = MeasuredRun(t=t - t[0], columns=columns, source=source, warnings=warnings)
+    if params is not None:
+        check_units(run, params)
+    return run
+
+
+def _runs(mask):
+    """(start, stop) index pairs of True runs."""
+    m = np.concatenate([[False], mask, [False]]).astype(int)
+    dm = np.diff(m)
+    return list(zip(np.flatnonzero(dm == 1), np.flatnonzero(dm == -1)))
+
+
+def check_units(run: MeasuredRun, params) -> None:
+    """Compare channel magnitudes with the nominal operating point; DataError naming the likely unit.
+
+    Pressure: the mean gauge pressure should be near p_0 (cmc-reference.md);
+    WOB: its mean near W_0; stroke: its spread comparable to the heave's.
+    """
+    src = run.source
+    p0 = params.p0
+    W0 = params.operating_point.wob_setpoint
+    pm = float(np.nanmean(run["pressure"]))
+    for factor, unit in ((1e-5, "bar"), (1e-3, "kPa"), (1e-6, "MPa"), (1.45038e-4, "psi")):
+        if abs(pm / (p0 * factor) - 1.0) < 0.5:
+            raise DataError(f"{src}: column 'pressure': mean {pm:.4g} looks like {unit}, expected Pa "
+                            f"(nominal p_0 = {p0:.4g} Pa); convert the column to Pa")
+    if not (0.2 * p0 < pm < 5 * p0):
+        raise DataError(f"{src}: column 'pressure': mean {pm:.4g} Pa is far from the nominal p_0 = {p0:.4g} Pa "
+                        "(wrong unit, absolute pressure of another rig, or wrong parameter file?)")
+    wm = float(np.nanmean(run["wob"]))
+    for factor, unit in ((1e-3, "kN"), (1.0 / 9810.0, "tonnes"), (1.0 / 4448.22, "kip")):
+        if abs(wm / (W0 * factor) - 1.0) < 0.5:
+            raise DataError(f"{src}: column 'wob': mean {wm:.4g} looks like {unit}, expected N "
+                            f"(nominal W_0 = {W0:.4g} N); convert the column to N")
+    if not (0.05 * W0 < wm < 20 * W0):
+        raise DataError(f"{src}: column 'wob': mean {wm:.4g} N is far from the nominal W_0 = {W0:.4g} N "
+                        "(wrong unit or wrong parameter file?)")
+    sz = float(np.nanstd(run["heave"]))
+    ss = float(np.nanstd(run["stroke"]))
+    if sz > 0 and ss > 100 * sz and ss > 1.0:
+        raise DataError(f"{src}: column 'stroke': spread {ss:.4g} is {ss / sz:.0f} x the heave's — looks like mm, "
+                        "expected m; convert the column to m")
+    if ss > 0 and sz > 100 * ss and sz > 1.0:
+        raise DataError(f"{src}: column 'heave': spread {sz:.4g} is {sz / ss:.0f} x the stroke's — looks like mm, "
+                        "expected m; convert the column to m")
+
+
+def fill_gaps(t, y):
+    """Linear interpolation over NaN samples (for the replay input)."""
+    ok = np.isfinite(y)
+    if ok.all():
+        return y
+    return np.interp(t, t[ok], y[ok])
+
+
+def uniform(t, y, dt=None):
+    """Resample (t, y) to a uniform grid of spacing ``dt`` (default: median interval); NaNs bridged."""
+    dt = float(np.median(np.diff(t))) if dt is None else dt
+    tu = np.arange(t[0], t[-1] + 1e-9 * dt, dt)
+    return tu, np.interp(tu, t, fill_gaps(t, y))
+
+
+def zero_phase_lowpass(y, dt, cutoff=HEAVE_CUTOFF):
+    """FIR low-pass run forward and backward (scipy ``filtfilt``): no phase shift (paper B).
+
+    Hamming-window FIR with TAPS_PER_CUTOFF periods of the cut-off in its length.
+    """
+    from scipy.signal import filtfilt, firwin
+
+    fs = 1.0 / dt
+    if cutoff >= 0.45 * fs:
+        return y
+    ntaps = int(TAPS_PER_CUTOFF * fs / cutoff) | 1
+    ntaps = min(ntaps, (y.size - 1) // 3 - 1) | 1
+    b = firwin(ntaps, cutoff, fs=fs)
+    return filtfilt(b, [1.0], y)
+
+
+def heave_samples(run: MeasuredRun, h: float, n_steps: int, cutoff=HEAVE_CUTOFF):
+    """Heave input for the replay: gap-filled, uniformly resampled, zero-phase FIR low-passed
+    (``cutoff`` [Hz]), then a cubic spline gives z_h, dz_h, ddz_h on the stepper grid (h/2).
+
+    The first sample is the operating point's heave reference (cmc-reference.md).
+    """
+    from scipy.interpolate import CubicSpline
+
+    from heavecomp.simulate.excitation import HeaveSamples
+
+    tu, zu = uniform(run.t, run["heave"])
+    zf = zero_phase_lowpass(zu, tu[1] - tu[0], cutoff)
+    cs = CubicSpline(tu, zf - zf[0])
+    sp = 0.5 * h
+    tg = np.minimum(np.arange(2 * n_steps + 2) * sp, tu[-1])
+    return HeaveSamples(sp, cs(tg), cs(tg, 1), cs(tg, 2), {"kind": "measured", "cutoff_hz": cutoff})
+
+
+def derivative_zero_phase(t, y, cutoff):
+    """Velocity and acceleration of a channel by zero-phase FIR filtering and spline differentiation,
+    returned at the original times ``t``."""
+    from scipy.interpolate import CubicSpline
+
+    tu, yu = uniform(t, y)
+    yf = zero_phase_lowpass(yu, tu[1] - tu[0], cutoff)
+    cs = CubicSpline(tu, yf)
+    return cs(t, 1), cs(t, 2)
+
+
+def noise_floor(y, t=None) -> float:
+    """Measurement-noise standard deviation from second differences (robust: median absolute
+    deviation), sigma ~ 1.4826 MAD(d2 y) / sqrt(6) for white noise on a smooth signal."""
+    y = np.asarray(y, dtype=float)
+    if t is not None:
+        _, y = uniform(t, y)
+    y = y[np.isfinite(y)]
+    d2 = np.diff(y, 2)
+    return float(1.4826 * np.median(np.abs(d2 - np.median(d2))) / math.sqrt(6.0))

@@ -1,0 +1,105 @@
+"""Where the gap lies: by friction regime, by frequency band, by time segment."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+REGIMES = ("stuck", "breakaway", "sliding_accelerating", "sliding_decelerating")
+BANDS = ("below_wave", "wave", "resonance", "above")
+BREAKAWAY_WINDOW = 0.3  #: s after a stuck -> sliding transition counted as "breakaway"
+SEGMENT_LENGTH = 5.0    #: s, window of the rolling residual power for "segments"
+
+
+def eigenfrequencies(params) -> list[float]:
+    """Undamped eigenfrequencies [Hz] of the linearised frictionless CMC: sliding (2 DOF:
+    top mass on the gas spring, lower mass on string and formation) and stuck (lower mass on
+    k_ds + k_F)."""
+    c, ds, fo = params.compensator, params.drill_string, params.formation
+    K = np.array([[c.gas_stiffness + ds.stiffness, -ds.stiffness], [-ds.stiffness, ds.stiffness + fo.stiffness]])
+    M = np.diag([c.moving_mass, ds.lower_mass])
+    lam = np.linalg.eigvals(np.linalg.solve(M, K)).real
+    f = sorted(float(np.sqrt(max(x, 0.0)) / (2 * np.pi)) for x in lam)
+    f.append(float(np.sqrt((ds.stiffness + fo.stiffness) / ds.lower_mass) / (2 * np.pi)))
+    return f
+
+
+def wave_band(t, z) -> tuple[float, float]:
+    """Frequencies [Hz] holding the central 90 % of the heave variance (5 %..95 %)."""
+    from heavecomp.diagnosis.data import uniform
+    from scipy.signal import welch
+
+    tu, zu = uniform(t, z)
+    dt = tu[1] - tu[0]
+    f, S = welch(zu - zu.mean(), fs=1 / dt, nperseg=min(zu.size, int(256 / dt)))
+    cum = np.cumsum(S)
+    cum /= cum[-1]
+    return float(f[np.searchsorted(cum, 0.05)]), float(f[np.searchsorted(cum, 0.95)])
+
+
+def band_edges(run, params):
+    lo, hi = wave_band(run.t, run["heave"])
+    fe = eigenfrequencies(params)
+    res = [max(0.7 * min(f for f in fe if f > hi) if any(f > hi for f in fe) else hi, hi), 1.3 * max(fe)]
+    return {"below_wave": [0.0, lo], "wave": [lo, hi], "resonance": res, "above": [res[1], math.inf]}
+
+
+def residual_spectrum(t, r):
+    """Welch PSD of a residual [unit^2/Hz] on a uniform resampling (dropouts bridged)."""
+    from heavecomp.diagnosis.data import uniform
+    from scipy.signal import welch
+
+    tu, ru = uniform(t, r)
+    dt = tu[1] - tu[0]
+    return welch(ru - ru.mean(), fs=1 / dt, nperseg=min(ru.size, int(128 / dt)))
+
+
+def locate(run, nom, params, mask, channel="wob") -> dict:
+    """Shares of the squared residual by regime and band, and the worst segments.
+
+    Regimes come from the replayed nominal model (noise-free): stuck; breakaway
+    (the first ``BREAKAWAY_WINDOW`` s after a stuck -> sliding transition); sliding
+    with |v| growing (v a > 0) or shrinking.
+    """
+    t = run.t
+    y = run[channel]
+    ok = mask & np.isfinite(y)
+    r = np.where(ok, nom[channel] - np.where(np.isfinite(y), y, 0.0), np.nan)
+    r2 = np.where(ok, r * r, 0.0)
+    stuck = nom["stuck"] > 0.5
+    v = nom["stroke_velocity"]
+    a = np.gradient(v, t)
+    start = np.flatnonzero(stuck[:-1] & ~stuck[1:]) + 1
+    brk = np.zeros_like(stuck)
+    for i in start:
+        brk |= (t >= t[i]) & (t < t[i] + BREAKAWAY_WINDOW)
+    brk &= ~stuck
+    acc = ~stuck & ~brk & (v * a > 0)
+    dec = ~stuck & ~brk & ~acc
+    tot = r2.sum() or 1.0
+    regimes = {k: float(r2[m].sum() / tot) for k, m in zip(REGIMES, (stuck, brk, acc, dec))}
+    regimes_time = {k: float(np.mean(m[ok])) for k, m in zip(REGIMES, (stuck, brk, acc, dec))}
+    edges = band_edges(run, params)
+    f, S = residual_spectrum(t[ok], r[ok])
+    Stot = S.sum() or 1.0
+    bands = {}
+    for k in BANDS:
+        lo, hi = edges[k]
+        bands[k] = float(S[(f >= lo) & (f < hi)].sum() / Stot)
+    # worst segments: rolling mean square over SEGMENT_LENGTH, top 3 disjoint windows
+    dt = float(np.median(np.diff(t)))
+    n = max(1, int(SEGMENT_LENGTH / dt))
+    power = np.convolve(r2, np.ones(n) / n, mode="same")
+    segs = []
+    order = np.argsort(power)[::-1]
+    for i in order:
+        c = t[i]
+        if any(abs(c - 0.5 * (s0 + s1)) < SEGMENT_LENGTH for s0, s1 in segs):
+            continue
+        segs.append([float(max(c - 0.5 * SEGMENT_LENGTH, 0.0)), float(min(c + 0.5 * SEGMENT_LENGTH, t[-1]))])
+        if len(segs) == 3:
+            break
+    return {"regimes": regimes, "bands": bands, "segments": segs, "regime_time_share": regimes_time,
+            "band_edges_hz": {k: [float(x) if math.isfinite(x) else None for x in e] for k, e in edges.items()},
+            "eigenfrequencies_hz": eigenfrequencies(params), "channel": channel}
