@@ -30,6 +30,7 @@ import argparse
 import json
 import os
 import platform
+import resource
 import shutil
 import statistics
 import subprocess
@@ -55,10 +56,18 @@ open(sys.argv[3] + '/metrics.json', 'w').write(json.dumps(r.metrics()))
 """
 
 
+CPU = []  # CPU seconds (user + sys) of each timed child, in call order
+
+
 def timed(cmd, env=None) -> float:
+    """Wall-clock seconds of one whole process; its CPU seconds are appended to CPU."""
+    r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
     subprocess.run(cmd, check=True, env=env, stdout=subprocess.DEVNULL)
-    return time.perf_counter() - t0
+    wall = time.perf_counter() - t0
+    r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    CPU.append(r1.ru_utime - r0.ru_utime + r1.ru_stime - r0.ru_stime)
+    return wall
 
 
 def rms_error(t, wob, ref_t, ref_wob, start):
@@ -115,17 +124,21 @@ def main(argv=None) -> int:
         cmd = [hc, "simulate", str(pfile), "--duration", f"{T:g}", "--out", str(out)]
         print("heavecomp simulate: cold run (empty numba cache) ...", flush=True)
         cold = timed(cmd, env)
-        warm = [timed(cmd, env) for _ in range(a.repeat)]
+        cold_cpu = CPU[-1]
+        warm, warm_cpu, nofig, nofig_cpu = [], [], [], []
+        nofig_cmd = [sys.executable, "-c", NOFIG, str(pfile), f"{T:g}", str(work)]
+
+        def heavecomp_round():
+            warm.append(timed(cmd, env))
+            warm_cpu.append(CPU[-1])
+            nofig.append(timed(nofig_cmd, env))
+            nofig_cpu.append(CPU[-1])
+
+        print("heavecomp simulate: warm runs ...", flush=True)
+        heavecomp_round()
         csv = np.loadtxt(out / "timeseries.csv", delimiter=",", skiprows=1, usecols=(0, 4))
         hm = json.loads((out / "metrics.json").read_text())
         err = rms_error(csv[:, 0], csv[:, 1], ref_t, ref_w, start)
-        nofig = [timed([sys.executable, "-c", NOFIG, str(pfile), f"{T:g}", str(work)], env) for _ in range(a.repeat)]
-        res["heavecomp"] = {"command": " ".join(["heavecomp", "simulate", "paper_a.toml", "--duration", f"{T:g}",
-                                                 "--out", "DIR"]),
-                            "dt": hm["dt"], "wall_cold_s": cold, "wall_warm_s": warm,
-                            "wall_warm_median_s": statistics.median(warm), "in_process_kernel_s": hm["wall_time_s"],
-                            "wob_rms_error_N": err[0], "wob_max_error_N": err[1],
-                            "wall_no_figure_median_s": statistics.median(nofig), "wall_no_figure_s": nofig}
 
         # ---- peer, whole process ----------------------------------------------------------
         peer = []
@@ -141,17 +154,34 @@ def main(argv=None) -> int:
                 continue
             d = np.load(f)
             e = rms_error(d["t"], d["wob"], ref_t, ref_w, start)
-            peer.append({"eps": eps, "rtol": rtol, "atol": atol, "wall_s": [wall], "wob_rms_error_N": e[0],
+            peer.append({"eps": eps, "rtol": rtol, "atol": atol, "wall_s": [wall], "cpu_s": [CPU[-1]],
+                         "wob_rms_error_N": e[0],
                          "wob_max_error_N": e[1], "nfev": int(d["nfev"]), "njev": int(d["njev"]),
                          "in_process_solve_s": float(d["solve_time"]), "cmd": pcmd})
         ok = [r for r in peer if "failed" not in r and r["wob_rms_error_N"] <= TARGET_RMS]
-        chosen = min(ok, key=lambda r: r["wall_s"][0]) if ok else None
-        if chosen is not None:
-            chosen["wall_s"] += [timed(chosen["cmd"]) for _ in range(a.repeat - 1)]
+        chosen = min(ok, key=lambda r: r["cpu_s"][0]) if ok else None  # CPU time: less load noise
+        # remaining repetitions interleaved (heavecomp, peer, heavecomp, ...) so that a change
+        # of machine load hits both sides alike
+        print("interleaved repetitions ...", flush=True)
+        for _ in range(a.repeat - 1):
+            heavecomp_round()
+            if chosen is not None:
+                chosen["wall_s"].append(timed(chosen["cmd"]))
+                chosen["cpu_s"].append(CPU[-1])
         for r in peer:
             r.pop("cmd", None)
             if "wall_s" in r:
                 r["wall_median_s"] = statistics.median(r["wall_s"])
+                r["cpu_median_s"] = statistics.median(r["cpu_s"])
+        res["heavecomp"] = {"command": " ".join(["heavecomp", "simulate", "paper_a.toml", "--duration", f"{T:g}",
+                                                 "--out", "DIR"]),
+                            "dt": hm["dt"], "wall_cold_s": cold, "cpu_cold_s": cold_cpu,
+                            "wall_warm_s": warm, "cpu_warm_s": warm_cpu,
+                            "wall_warm_median_s": statistics.median(warm), "cpu_warm_median_s": statistics.median(warm_cpu),
+                            "in_process_kernel_s": hm["wall_time_s"],
+                            "wob_rms_error_N": err[0], "wob_max_error_N": err[1],
+                            "wall_no_figure_s": nofig, "wall_no_figure_median_s": statistics.median(nofig),
+                            "cpu_no_figure_median_s": statistics.median(nofig_cpu)}
         res["peer"] = {"solver": "scipy.integrate.solve_ivp(method='LSODA'), friction sign -> tanh(v/eps)",
                        "settings": peer, "chosen": None if chosen is None else
                        {k: chosen[k] for k in ("eps", "rtol", "atol")}}
@@ -159,6 +189,7 @@ def main(argv=None) -> int:
         if chosen is not None:
             res["ratio_peer_over_heavecomp"] = {
                 "whole_process_warm": chosen["wall_median_s"] / hcw,
+                "whole_process_warm_cpu_time": chosen["cpu_median_s"] / res["heavecomp"]["cpu_warm_median_s"],
                 "whole_process_cold": chosen["wall_median_s"] / cold,
                 "whole_process_no_figure": chosen["wall_median_s"] / res["heavecomp"]["wall_no_figure_median_s"],
                 "in_process_solver": chosen["in_process_solve_s"] / res["heavecomp"]["in_process_kernel_s"],
@@ -170,18 +201,19 @@ def main(argv=None) -> int:
     Path(a.out).write_text(json.dumps(res, indent=2) + "\n")
     h = res["heavecomp"]
     print(f"\n{T:g} s of the paper-A stribeck case, reference dt 1 ms (vs 0.5 ms: {res['reference']['rms_diff_vs_0.5ms_N']:.2g} N rms)")
-    print(f"{'':34s} {'wall [s]':>10s} {'WOB rms err [N]':>16s} {'max err [N]':>12s}")
-    print(f"{'heavecomp simulate (warm, median)':34s} {h['wall_warm_median_s']:10.2f} {h['wob_rms_error_N']:16.3g} "
-          f"{h['wob_max_error_N']:12.3g}")
-    print(f"{'heavecomp simulate (cold cache)':34s} {h['wall_cold_s']:10.2f}")
-    print(f"{'heavecomp, same run without PNG':34s} {h['wall_no_figure_median_s']:10.2f}")
+    print(f"{'':34s} {'wall [s]':>10s} {'CPU [s]':>8s} {'WOB rms err [N]':>16s} {'max err [N]':>12s}")
+    print(f"{'heavecomp simulate (warm, median)':34s} {h['wall_warm_median_s']:10.2f} {h['cpu_warm_median_s']:8.2f} "
+          f"{h['wob_rms_error_N']:16.3g} {h['wob_max_error_N']:12.3g}")
+    print(f"{'heavecomp simulate (cold cache)':34s} {h['wall_cold_s']:10.2f} {h['cpu_cold_s']:8.2f}")
+    print(f"{'heavecomp, same run without PNG':34s} {h['wall_no_figure_median_s']:10.2f} {h['cpu_no_figure_median_s']:8.2f}")
     for r in res["peer"]["settings"]:
         name = f"LSODA eps={r['eps']:g} rtol={r['rtol']:g}"
         if "failed" in r:
             print(f"{name:34s} failed")
         else:
             mark = " <- chosen" if chosen is r else ""
-            print(f"{name:34s} {r['wall_median_s']:10.2f} {r['wob_rms_error_N']:16.3g} {r['wob_max_error_N']:12.3g}{mark}")
+            print(f"{name:34s} {r['wall_median_s']:10.2f} {r['cpu_median_s']:8.2f} {r['wob_rms_error_N']:16.3g} "
+                  f"{r['wob_max_error_N']:12.3g}{mark}")
     if "ratio_peer_over_heavecomp" in res:
         print("ratio peer / heavecomp: " + ", ".join(f"{k} {v:.1f}x" for k, v in res["ratio_peer_over_heavecomp"].items()))
     else:
