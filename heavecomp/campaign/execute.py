@@ -36,6 +36,7 @@ log = logging.getLogger(__name__)
 TABLE = "runs.csv"
 MANIFEST = "manifest.json"
 STRING_COLUMNS = ("run_id", "regime", "variant")
+CONNECT_TIMEOUT = "15s"  #: how long to wait for a Dask scheduler
 
 
 @dataclasses.dataclass
@@ -220,7 +221,7 @@ def _run_dask(campaign, chunks, finished, scheduler, client):
     own = client is None
     if own:
         try:
-            client = Client(scheduler, timeout="15s")
+            client = Client(scheduler, timeout=CONNECT_TIMEOUT)
         except (OSError, TimeoutError, ValueError) as exc:
             raise InputError(f"--scheduler {scheduler}: cannot connect ({type(exc).__name__}: {exc})") from None
     try:

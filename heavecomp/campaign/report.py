@@ -119,10 +119,10 @@ def write_report(out_dir, campaign, st: dict, run_info=None) -> Path:
     figs = []
     if campaign.outputs.figures:
         save(plot_long_term(st), out / "exceedance_long_term.png", dpi=100)
-        save(plot_short_term(st), out / "exceedance_short_term.png", dpi=90)
+        save(plot_short_term(st), out / "exceedance_short_term.png", dpi=80)
         save(plot_band_maps(st, campaign), out / "band_by_sea_state.png", dpi=90)
         figs = ["exceedance_long_term.png", "exceedance_short_term.png", "band_by_sea_state.png"]
-    (out / "statistics.json").write_text(json.dumps(_clean(st)) + "\n")
+    (out / "statistics.json").write_text(json.dumps(_clean(st, digits=5)) + "\n")
     m = summary(st)
     if run_info is not None:
         m["execution"] = run_info
@@ -165,13 +165,16 @@ def write_report(out_dir, campaign, st: dict, run_info=None) -> Path:
     return path
 
 
-def _clean(x):
-    if isinstance(x, float) and not math.isfinite(x):
-        return None
-    if isinstance(x, dict):
-        return {k: _clean(v) for k, v in x.items()}
-    if isinstance(x, (list, tuple)):
-        return [_clean(v) for v in x]
+def _clean(x, digits=None):
+    """JSON-safe: nan/inf -> null, numpy scalars -> python; optionally round to ``digits`` significant digits."""
     if isinstance(x, np.generic):
-        return _clean(x.item())
+        x = x.item()
+    if isinstance(x, float):
+        if not math.isfinite(x):
+            return None
+        return float(f"{x:.{digits}g}") if digits else x
+    if isinstance(x, dict):
+        return {k: _clean(v, digits) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [_clean(v, digits) for v in x]
     return x

@@ -141,8 +141,9 @@ def statistics(campaign, table: dict) -> dict:
             wpk = pn * nu
             lt_abs = pn @ Qa
             lt = {
-                "frac_outside_band": float(pn @ [s["frac_outside_band"] for s in states]),
-                "p_leave_exposure": float(pn @ [s["p_leave_exposure"] for s in states]),
+                # probabilities: clip the last-ulp rounding of the weighted sums into [0, 1]
+                "frac_outside_band": float(np.clip(pn @ [s["frac_outside_band"] for s in states], 0.0, 1.0)),
+                "p_leave_exposure": float(np.clip(pn @ [s["p_leave_exposure"] for s in states], 0.0, 1.0)),
                 "band_exits_per_hour": float(pn @ [s["band_exits_per_hour"] for s in states]),
                 "wob_std_rms": float(math.sqrt(pn @ np.square([s["wob_std"] for s in states]))),
                 "stick_fraction": float(pn @ [s["stick_fraction"] for s in states]),
