@@ -25,6 +25,22 @@ def build(quick: bool = False, path=DATA) -> dict:
     return emps_study(load_emps(path), sensitivity_cutoffs=cutoffs)
 
 
+def _findings(m: dict) -> str:
+    b, eq = m["baseline_fit_part"]["parameters"], m["asymmetric_coulomb_equivalent"]
+    lines = [f"Base model on the fit part: offset {b['offset']:.2f} N + F_c sign(v) is the same as an asymmetric "
+             f"Coulomb force F_c+ = {eq['coulomb_positive']:.2f} N, F_c- = {eq['coulomb_negative']:.2f} N (with "
+             f"the axis moving the two cannot be told apart, so asymmetric Coulomb is not a separate candidate)."]
+    if "asymmetric_viscous_split" in m:
+        a = m["asymmetric_viscous_split"]
+        lines.append(f"Best single effect: asymmetric viscous friction, F_v+ = {a['viscous_positive']:.1f} N s/m, "
+                     f"F_v- = {a['viscous_negative']:.1f} N s/m; with it the offset falls to {a['offset']:.2f} N "
+                     f"(F_c = {a['coulomb']:.2f} N): the published offset mostly stands in for a direction-dependent "
+                     f"viscous term.")
+    else:
+        lines.append(f"Best single effect: {m['best_single']}.")
+    return " ".join(lines)
+
+
 def main(argv=None) -> int:
     args = parse_args(argv, "emps_identification", __doc__,
                       extra=lambda p: p.add_argument("--data", default=str(DATA), help="DATA_EMPS.mat"))
@@ -33,10 +49,10 @@ def main(argv=None) -> int:
     reg, mv = diag.reg_, diag.mv_
     after = " + ".join(diag.selection_[-1]["effects"]) if diag.selection_ else "none"
     save(plots.emps_overlay(reg.t_d[mv], reg.force_d[mv], reg.force_d[mv] - diag.residual_before_,
-                            reg.force_d[mv] - diag.residual_after_, after), args.out / "overlay.png")
+                            reg.force_d[mv] - diag.residual_after_, after), args.out / "overlay.png", dpi=90)
     save(plots.emps_residual_map(reg.dq_d[mv], reg.q_d[mv], diag.residual_before_, diag.residual_after_,
-                                 diag.where_, diag.where_after_), args.out / "residual_map.png")
-    save(plots.emps_cutoff_sensitivity(res["sensitivity"]), args.out / "cutoff_sensitivity.png")
+                                 diag.where_, diag.where_after_), args.out / "residual_map.png", dpi=90)
+    save(plots.emps_cutoff_sensitivity(res["sensitivity"]), args.out / "cutoff_sensitivity.png", dpi=90)
     write_metrics(args.out, m)
     pub, got, se = m["published"], m["identified_whole_record"], m["stderr_whole_record"]
     w, sel = m["where"], m["selection"]
@@ -54,7 +70,14 @@ def main(argv=None) -> int:
         md_table(["candidate", "k", "held-out rms [N]", "shrink", "score (BIC-like)"],
                  [(c["effect"], c["n_parameters"], c["rms_after"], c["shrink"], c["score"])
                   for c in m["candidates"]], fmt="{:.3f}"),
-        "Forward selection: " + "; ".join(f"{' + '.join(s['effects'])}: shrink {s['shrink']:.3f}" for s in sel),
+        "Candidate parameters (fitted on the fit part; SI: N, N s/m, m/s, m, s):\n\n" + md_table(
+            ["candidate", "parameters"],
+            [(c["effect"], ", ".join(f"{k} = {v:.4g}" for k, v in c["parameters"].items() if not k.startswith("base_")))
+             for c in m["candidates"]]),
+        "Forward selection (each step chosen by the BIC of the fit part, its shrink measured on the "
+        "held-out part): "
+        + "; ".join(f"{' + '.join(s['effects'])}: shrink {s['shrink']:.3f}" for s in sel),
+        _findings(m),
         "![overlay](overlay.png)",
     ])
     return 0

@@ -32,7 +32,7 @@ def main(argv=None) -> int:
                       extra=lambda p: p.add_argument("--data", default=str(DATA), help="folder of the O-ring files"))
     res = build(args.quick, args.data)
     m, fit = res["metrics"], res["fit"]
-    save(plots.seal_friction_vs_pressure(fit.strokes_, fit.fits_), args.out / "friction_vs_pressure.png")
+    save(plots.seal_friction_vs_pressure(fit.strokes_, fit.fits_), args.out / "friction_vs_pressure.png", dpi=90)
     write_metrics(args.out, m)
     pa = m["paper_a"]
     write_report(args.out, "Seal friction vs pressure (O-ring, 25 mm bore)", [

@@ -12,7 +12,9 @@ search on the fit part) and scored on the held-out part:
 
 with ``n_v`` held-out samples and ``k`` extra parameters (linear + shape); a
 negative score means the candidate earns its parameters.  A greedy forward
-selection then adds candidates while the score keeps falling.
+selection then adds candidates while the BIC **of the fit part**
+(n_f ln(RSS_f/RSS_f0) + k ln n_f) keeps falling, so that the held-out part is
+used only to report each step's shrink, never to choose.
 """
 
 from __future__ import annotations
@@ -172,7 +174,7 @@ class ResidualDiagnoser:
     dead_band : float, m/s
         |v| below this counts as near rest in the localisation.
     forward_selection : bool
-        Also add candidates greedily while the held-out score falls.
+        Also add candidates greedily while the fit-part BIC falls.
 
     Attributes
     ----------
@@ -186,7 +188,8 @@ class ResidualDiagnoser:
     best_ : dict or None
         The best candidate if it earns its parameters (score < 0), else None.
     selection_ : list of dict
-        Forward-selection steps: ``effects`` so far, ``rms_after``, ``shrink``, ``score``.
+        Forward-selection steps (chosen by the fit-part BIC ``bic_fit``): ``effects`` so far,
+        held-out ``rms_after``, ``shrink`` and ``score``.
     where_after_ : dict
         :func:`localise` of the held-out residual after the forward selection.
     """
@@ -262,23 +265,26 @@ class ResidualDiagnoser:
         self.selection_ = []
         chosen, cols, k_tot, current = [], [], 0, 0.0
         rv_sel = rv0
+        n_f = int(self.mf_.sum())
         while self.forward_selection:
             step = None
             for name, (c_cols, k) in self._chosen.items():
                 if name in chosen:
                     continue
                 res, rv = self._solve(cols + c_cols)
-                score, rms = self._score(rv, k_tot + k)
-                if step is None or score < step[1]:
-                    step = (name, score, rms, c_cols, k, rv, res)
+                bic = n_f * math.log(res.rss / res0.rss) + (k_tot + k) * math.log(n_f)   # fit part only
+                if step is None or bic < step[1]:
+                    step = (name, bic, c_cols, k, rv, res)
             if step is None or step[1] >= current:
                 break
-            name, current, rms, c_cols, k, rv_sel, res = step
+            name, current, c_cols, k, rv_sel, res = step
             chosen.append(name)
             cols += c_cols
             k_tot += k
-            self.selection_.append({"effects": list(chosen), "rms_after": rms, "shrink": 1.0 - rms / rms0,
-                                    "score": current, "theta": [float(x) for x in res.theta]})
+            score, rms = self._score(rv_sel, k_tot)
+            self.selection_.append({"effects": list(chosen), "bic_fit": current, "rms_after": rms,
+                                    "shrink": 1.0 - rms / rms0, "score": score,
+                                    "theta": [float(x) for x in res.theta]})
         self.residual_after_ = rv_sel
         self.where_after_ = localise(rv_sel, reg.dq_d[mv], reg.q_d[mv], reg.ddq_d[mv], self.dead_band)
         log.info("residual diagnosis: best single %s (shrink %.3f); forward selection %s",

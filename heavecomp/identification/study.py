@@ -58,9 +58,15 @@ def emps_study(record, cutoff: float = 50.0, order: int = 4, decimate: int = 10,
         "where": diag.where_,
         "candidates": diag.results_,
         "best_single": diag.best_["effect"] if diag.best_ else "none",
+        "best_single_parameters": diag.best_["parameters"] if diag.best_ else {},
         "selection": diag.selection_,
         "where_after_selection": diag.where_after_,
     }
+    if diag.best_ and diag.best_["effect"] == "asymmetric_viscous":
+        p = diag.best_["parameters"]
+        metrics["asymmetric_viscous_split"] = {"viscous_negative": p["base_viscous"],
+                                               "viscous_positive": p["base_viscous"] + p["viscous_asymmetry"],
+                                               "offset": p["base_offset"], "coulomb": p["base_coulomb"]}
     return {"metrics": metrics, "estimator": est, "diagnoser": diag, "sensitivity": sens}
 
 
