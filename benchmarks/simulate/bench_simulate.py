@@ -58,6 +58,32 @@ open(sys.argv[3] + '/metrics.json', 'w').write(json.dumps(r.metrics()))
 
 CPU = []  # CPU seconds (user + sys) of each timed child, in call order
 
+# where the whole process spends its time: the CLI's steps, timed one by one (warm cache)
+PHASES = """
+import time, json, sys
+t0 = time.perf_counter(); T = {}
+def lap(name):
+    global t0
+    t = time.perf_counter(); T[name] = t - t0; t0 = t
+import numpy
+from heavecomp.params import load
+from heavecomp.simulate import simulate, write_outputs
+from heavecomp.simulate.core import SimulationResult
+lap("imports (numpy, heavecomp)")
+p = load(sys.argv[1]); lap("read parameters")
+from heavecomp.simulate import _kernel
+lap("import numba + kernel module")
+simulate(p, 0.1); lap("load machine code from numba cache (1st call)")
+r = simulate(p, float(sys.argv[2])); lap("simulate()")
+T["  of which the stepper loop"] = r.wall_time
+r.to_csv(sys.argv[3] + "/ts.csv"); lap("write timeseries.csv")
+json.dumps(r.metrics()); lap("metrics")
+from heavecomp.report.figures import plot_wob, save
+fig = plot_wob({p.friction.model: r}); lap("import matplotlib + draw WOB figure")
+save(fig, sys.argv[3] + "/wob.png"); lap("render + write wob.png")
+print(json.dumps(T))
+"""
+
 
 def timed(cmd, env=None) -> float:
     """Wall-clock seconds of one whole process; its CPU seconds are appended to CPU."""
@@ -140,6 +166,10 @@ def main(argv=None) -> int:
         hm = json.loads((out / "metrics.json").read_text())
         err = rms_error(csv[:, 0], csv[:, 1], ref_t, ref_w, start)
 
+        ph = subprocess.run([sys.executable, "-c", PHASES, str(pfile), f"{T:g}", str(work)], check=True, env=env,
+                            capture_output=True, text=True)
+        phases = json.loads(ph.stdout.strip().splitlines()[-1])
+
         # ---- peer, whole process ----------------------------------------------------------
         peer = []
         for eps, rtol, atol in PEER_SETTINGS:
@@ -181,7 +211,8 @@ def main(argv=None) -> int:
                             "in_process_kernel_s": hm["wall_time_s"],
                             "wob_rms_error_N": err[0], "wob_max_error_N": err[1],
                             "wall_no_figure_s": nofig, "wall_no_figure_median_s": statistics.median(nofig),
-                            "cpu_no_figure_median_s": statistics.median(nofig_cpu)}
+                            "cpu_no_figure_median_s": statistics.median(nofig_cpu),
+                            "phases_s": phases}
         res["peer"] = {"solver": "scipy.integrate.solve_ivp(method='LSODA'), friction sign -> tanh(v/eps)",
                        "settings": peer, "chosen": None if chosen is None else
                        {k: chosen[k] for k in ("eps", "rtol", "atol")}}
@@ -206,6 +237,9 @@ def main(argv=None) -> int:
           f"{h['wob_rms_error_N']:16.3g} {h['wob_max_error_N']:12.3g}")
     print(f"{'heavecomp simulate (cold cache)':34s} {h['wall_cold_s']:10.2f} {h['cpu_cold_s']:8.2f}")
     print(f"{'heavecomp, same run without PNG':34s} {h['wall_no_figure_median_s']:10.2f} {h['cpu_no_figure_median_s']:8.2f}")
+    print("heavecomp simulate, where the time goes (one warm run, in-process; + interpreter start-up):")
+    for k, v in h["phases_s"].items():
+        print(f"    {k:48s} {v:6.2f} s")
     for r in res["peer"]["settings"]:
         name = f"LSODA eps={r['eps']:g} rtol={r['rtol']:g}"
         if "failed" in r:
