@@ -257,12 +257,14 @@ def influence(p, factors=(0.5, 0.71, 1.0, 1.41, 2.0), *, convention: str = "pape
 # the CMC main cylinder through the same lens
 # ----------------------------------------------------------------------------------------------
 def cmc_stick_map(params, amplitudes, periods, models=("stribeck", "rotating_eq6", "rotating_eq7"), *,
-                  n_periods: float = 4.0, rate: float = 10.0) -> dict:
+                  n_periods: float = 4.0, rate: float = 10.0, tangential_velocity: float = 0.05) -> dict:
     """Stick fraction, stick count and mean stick duration of the CMC main cylinder over
     heave amplitude x period, for each friction model (foundation simulator, exact stick).
 
     Statistics are taken after the heave fade-in (``ramp`` = one period) over ``n_periods``.
-    Returns {model: {"stick_fraction", "n_stick_per_period", "mean_stick_s", "stroke_max"}}
+    ``tangential_velocity`` [m/s] is used for the rotating models when ``params``
+    has none (paper A: v_t = omega d / 2 ~ 0.05 m/s).
+    Returns {model: {"stick_fraction", "n_stick_per_period", "mean_stick_s", "stroke_p2p"}}
     with arrays (len(periods), len(amplitudes)), plus the axes.
     """
     from heavecomp.simulate import simulate
@@ -276,7 +278,10 @@ def cmc_stick_map(params, amplitudes, periods, models=("stribeck", "rotating_eq6
         smax = np.empty_like(sf)
         for i, per in enumerate(T):
             for j, amp in enumerate(A):
-                q = params.replace(friction={"model": m},
+                fr = {"model": m}
+                if m.startswith("rotating") and params.friction.tangential_velocity is None:
+                    fr["tangential_velocity"] = tangential_velocity
+                q = params.replace(friction=fr,
                                    heave={"kind": "sine", "amplitude": float(amp), "period": float(per),
                                           "ramp": float(per)})
                 res = simulate(q, (n_periods + 1) * per, rate=rate)

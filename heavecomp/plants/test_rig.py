@@ -176,7 +176,10 @@ def run(p: RigParams, *, rotation: bool, cycles: float = 1.0, fs: float = 100.0,
 
 
 def fit_quadrants(v, F, quadrant, *, v_min: float = 1e-4) -> list[QuadrantFriction]:
-    """Least-squares eq. 4 fit (C_p = 0) per quadrant to a measured friction-velocity loop."""
+    """Least-squares eq. 4 fit (C_p = 0) per quadrant to a measured friction-velocity loop.
+
+    Bounded: F_C >= 0, F_S - F_C >= 0, C_v >= 0, 0.1 mm/s <= v_S <= 50 mm/s.
+    """
     from scipy.optimize import least_squares
 
     out = []
@@ -185,11 +188,14 @@ def fit_quadrants(v, F, quadrant, *, v_min: float = 1e-4) -> list[QuadrantFricti
         s, f = np.abs(v[m]), np.abs(F[m])
 
         def res(th):
-            FS, FC, lvS, Cv = th
-            return FC + (FS - FC) * np.exp(-s / np.exp(lvS)) + Cv * s - f
+            FC, dF, lvS, Cv = th
+            return FC + dF * np.exp(-s / np.exp(lvS)) + Cv * s - f
 
-        x0 = [f.max(), np.median(f), math.log(0.005), 1000.0]
-        r = least_squares(res, x0, x_scale=[100, 100, 1, 1000])
-        FS, FC, lvS, Cv = r.x
+        x0 = [np.median(f), max(f.max() - np.median(f), 1.0), math.log(0.005), 1000.0]
+        lb = [0.0, 0.0, math.log(1e-4), 0.0]
+        ub = [np.inf, np.inf, math.log(0.05), np.inf]
+        r = least_squares(res, x0, bounds=(lb, ub), x_scale=[100, 100, 1, 1000])
+        FC, dF, lvS, Cv = r.x
+        FS = FC + dF
         out.append(QuadrantFriction(float(FS), float(FC), float(math.exp(lvS)), float(Cv)))
     return out
