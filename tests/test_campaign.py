@@ -141,7 +141,6 @@ def test_resume_into_other_campaign_refused(tiny, tmp_path):
 
 
 # ---------------------------------------------------------------- Dask
-@pytest.mark.slow
 def test_tiny_campaign_on_local_dask_cluster(tiny, tmp_path):
     distributed = pytest.importorskip("distributed")
     from heavecomp.campaign.execute import run_campaign
@@ -273,3 +272,19 @@ def test_default_campaign_is_documented_illustrative_platform_heave():
     assert "illustrative" in c.scatter.note and "platform" in c.scatter.note
     assert sum(p for *_, p in c.scatter.cells()) == pytest.approx(1.0)
     assert c.regimes == ("none", "rotating_eq7", "stribeck")
+
+
+def test_parquet_export_and_relative_band(tmp_path):
+    pytest.importorskip("pyarrow")
+    import pyarrow.parquet as pq
+
+    from heavecomp.campaign.execute import read_table, run_and_report
+
+    camp = spec.loads(TINY.replace("duration = 90.0", "duration = 40.0").replace("tolerance = 20e3", "relative = 0.1")
+                      .replace("[outputs]", "[outputs]\nformat = \"parquet\""))
+    info, st = run_and_report(camp, tmp_path, workers=1)
+    tab = pq.read_table(tmp_path / "runs.parquet")
+    csv_tab = read_table(info.table_path)
+    assert tab.num_rows == len(camp.runs()) == csv_tab["run_id"].size
+    assert np.array_equal(np.sort(tab.column("wob_std").to_numpy()), np.sort(csv_tab["wob_std"]))
+    assert st["band_half_width"] == pytest.approx(0.1 * 98.1e3)  # 10 % of the paper-A set-point

@@ -208,8 +208,6 @@ def simulate_batch(campaign, runs, *, threads: int | None = None, base=None) -> 
     """
     if not runs:
         return []
-    if threads is not None:
-        nb.set_num_threads(max(1, min(int(threads), nb.config.NUMBA_NUM_THREADS)))
     t0 = time.perf_counter()
     a = prepare(campaign, runs, base=base)
     t_prep = time.perf_counter() - t0
@@ -219,9 +217,15 @@ def simulate_batch(campaign, runs, *, threads: int | None = None, base=None) -> 
     hist = np.zeros((n, o.bins + 2), dtype=np.int64)
     phist = np.zeros((n, o.bins // 2 + 1), dtype=np.int64)
     stats = np.zeros((n, 4))
-    _batch(a["codes"], a["FPs"], a["PPs"], a["smooth"], a["hsteps"], a["nsteps"], a["out_every"], a["t_stat"],
-          a["W0"], a["half"], a["Zs"], a["DZs"], a["DDZs"], float(o.deviation_max), int(o.bins), acc, hist, phist,
-          stats)
+    prev = nb.get_num_threads()
+    if threads is not None:  # for this call only: numba's thread count is process-global
+        nb.set_num_threads(max(1, min(int(threads), nb.config.NUMBA_NUM_THREADS)))
+    try:
+        _batch(a["codes"], a["FPs"], a["PPs"], a["smooth"], a["hsteps"], a["nsteps"], a["out_every"], a["t_stat"],
+               a["W0"], a["half"], a["Zs"], a["DZs"], a["DDZs"], float(o.deviation_max), int(o.bins), acc, hist,
+               phist, stats)
+    finally:
+        nb.set_num_threads(prev)
     wall = time.perf_counter() - t0
     log.debug("batch of %d runs: %.2f s (heave synthesis %.2f s)", n, wall, t_prep)
     dev_cols, pk_cols = hist_columns(o.bins)
