@@ -56,30 +56,71 @@ class HeavePredictor:
         self._buf: list[float] = []
         self._bt: list[float] = []
         self.block_t: list[float] = []
-        self.block_z: list[float] = []
+        self.block_z: list[float] = []   # raw block means
+        self.block_f: list[float] = []   # Kalman-filtered block means
         self.coef_ = None
+        self.noise_var_ = None           # estimated sensor noise variance of one sample [m^2]
+        self._raw = []
+        self._d2 = None
         self._since_fit = 0
         self.z_last = 0.0
+        self._xs = None                  # filtered AR state [z_n, z_{n-1}, ...]
+        self._P = None
 
     def update(self, t: float, z: float) -> None:
         """Add one measured heave sample z [m] at time t [s]."""
         self.z_last = z
+        self._raw = (self._raw + [z])[-3:]
+        if len(self._raw) == 3:
+            # second differences of the raw samples: 6 sigma^2 for white noise (the wave's
+            # own second difference at 20 Hz is ~1e-3 m, negligible)
+            d2 = (self._raw[2] - 2 * self._raw[1] + self._raw[0]) ** 2 / 6.0
+            self._d2 = d2 if self._d2 is None else 0.995 * self._d2 + 0.005 * d2
+            self.noise_var_ = self._d2
         self._buf.append(z)
         self._bt.append(t)
         if len(self._buf) == self.decimate:
             self.block_t.append(float(np.mean(self._bt)))
-            self.block_z.append(float(np.mean(self._buf)))
+            zb = float(np.mean(self._buf))
+            self.block_z.append(zb)
+            self.block_f.append(self._filter(zb))
             self._buf, self._bt = [], []
             self._since_fit += 1
             nmax = int(self.window / (self.dt * self.decimate)) + self.order + 1
             if len(self.block_z) > 2 * nmax:
-                del self.block_z[:-nmax], self.block_t[:-nmax]
+                del self.block_z[:-nmax], self.block_t[:-nmax], self.block_f[:-nmax]
             if self._since_fit >= max(1, int(round(1.0 / (self.dt * self.decimate)))) or self.coef_ is None:
                 self._fit()
 
+    def _filter(self, zb: float) -> float:
+        """Kalman filter of the block means with the AR model in companion form."""
+        if self.coef_ is None:
+            return zb
+        p = self.order
+        a, c0 = self.coef_[:p], self.coef_[p]
+        r = (self.noise_var_ or 0.0) / self.decimate + 1e-12
+        if self._xs is None:
+            self._xs = np.asarray(self.block_z[-p:][::-1], dtype=float) if len(self.block_z) >= p else np.full(p, zb)
+            self._P = np.eye(p) * r
+        F = np.zeros((p, p))
+        F[0] = a
+        F[1:, :-1] = np.eye(p - 1)
+        xs = F @ self._xs
+        xs[0] += c0
+        P = F @ self._P @ F.T
+        P[0, 0] += self.q_
+        S = P[0, 0] + r
+        K = P[:, 0] / S
+        xs = xs + K * (zb - xs[0])
+        self._P = P - np.outer(K, P[0, :])
+        self._xs = xs
+        return float(xs[0])
+
     def _fit(self):
         p = self.order
-        z = np.asarray(self.block_z[-int(self.window / (self.dt * self.decimate)):])
+        nwin = int(self.window / (self.dt * self.decimate))
+        src = self.block_f if self.coef_ is not None else self.block_z
+        z = np.asarray(src[-nwin:])
         if z.size < 3 * p + 5:
             return
         X = np.column_stack([z[p - i - 1:z.size - i - 1] for i in range(p)] + [np.ones(z.size - p)])
@@ -91,6 +132,8 @@ class HeavePredictor:
         if np.any(mag > 0.999):
             roots = np.where(mag > 0.999, roots / np.maximum(mag, 1e-12) * 0.999, roots)
             coef[:p] = -np.real(np.poly(roots))[1:]
+        resid = z[p:] - X @ coef
+        self.q_ = max(float(np.var(resid)), 1e-10)  # innovation variance of the AR model [m^2]
         self.coef_ = coef
         self._since_fit = 0
 
@@ -103,9 +146,10 @@ class HeavePredictor:
             return out
         p = self.order
         Tb = self.dt * self.decimate
-        hist = list(self.block_z[-p:])
+        src = self.block_f
+        hist = list(src[-p:])
         tb = list(self.block_t[-self.past_blocks:])
-        zb = list(self.block_z[-self.past_blocks:])
+        zb = list(src[-self.past_blocks:])
         tnext = self.block_t[-1]
         while tnext < times[-1] + 2 * Tb:
             znew = float(np.dot(self.coef_[:p], hist[::-1][:p]) + self.coef_[p])
