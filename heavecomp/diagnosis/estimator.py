@@ -91,6 +91,16 @@ class GapDiagnoser:
     progress : callable(fraction, message), optional
     second : int
         How many runner-up candidates to try jointly with the best (0: none).
+    segment : float [s] or None
+        Multiple-shooting segment length: the replay restarts from the measured state every
+        ``segment`` seconds, so one early stick-slip event does not decide the rest of the run
+        (exact stiction makes long open-loop replays drift).  None: one open-loop replay.
+    reinit : float [s]
+        Start of each restarted segment left out of the residuals.
+    stuck_speed : float [m/s]
+        A segment starts stuck when the measured stroke speed is below this.
+    grid : int
+        Points per axis of the coarse start grid for candidates with <= 2 parameters.
 
     Attributes (after ``fit``)
     --------------------------
@@ -104,7 +114,8 @@ class GapDiagnoser:
     """
 
     def __init__(self, nominal, candidates=None, *, split=0.67, settle=None, penalty=0.03, min_explained=0.5,
-                 none_ratio=1.2, max_nfev=40, decimate=2, n_jobs=2, progress=None, second=2):
+                 none_ratio=1.2, max_nfev=40, decimate=2, n_jobs=2, progress=None, second=2, segment=None,
+                 reinit=1.5, stuck_speed=2e-3, grid=7):
         self.nominal = nominal
         names = list(CANDIDATES) if candidates is None else list(candidates)
         for n in names:
@@ -122,6 +133,10 @@ class GapDiagnoser:
         self.n_jobs = max(1, int(n_jobs))
         self.progress = progress
         self.second = second
+        self.segment = segment
+        self.reinit = reinit
+        self.stuck_speed = stuck_speed
+        self.grid = int(grid)
 
     # ------------------------------------------------------------------ replay
     def _setup(self, run):
@@ -132,12 +147,50 @@ class GapDiagnoser:
         n_steps = int(math.ceil(run.t[-1] / h - 1e-9))
         hs = heave_samples(run, h, n_steps)
         code, FP, PP = _vectors(self.nominal)
-        return Replay(run.t, h, n_steps, hs, code, FP, PP)
+        rp = Replay(run.t, h, n_steps, hs, code, FP, PP)
+        rp.bounds, rp.starts, rp.reinit = [(0, n_steps)], [None], np.zeros(run.t.size, bool)
+        if self.segment:
+            rp.bounds, rp.starts, rp.reinit = self._segments(run, h, n_steps, PP)
+        return rp
+
+    def _segments(self, run, h, n_steps, PP):
+        """Multiple shooting: segments of ``segment`` s, each started from the measured state
+        (stroke and its zero-phase derivative; lower mass from the low-passed WOB through the
+        formation spring, y_b = delta_0 - W/k_F, v_b = -dW/dt / k_F).  The first ``reinit`` s of
+        every restarted segment are left out of the residuals."""
+        from heavecomp.diagnosis.data import derivative_zero_phase, fill_gaps, uniform, zero_phase_lowpass
+        from heavecomp.plants.cmc import D0, KF
+
+        t = run.t
+        L = self.segment
+        n_seg = max(1, int(math.floor(t[-1] / L)))
+        bounds, starts = [], []
+        tu, su = uniform(t, run["stroke"])
+        sf = zero_phase_lowpass(su, tu[1] - tu[0], 1.0)
+        vs, _ = derivative_zero_phase(t, run["stroke"], 1.0)
+        wf_u = zero_phase_lowpass(uniform(t, run["wob"])[1], tu[1] - tu[0], 3.0)
+        dw, _ = derivative_zero_phase(t, run["wob"], 3.0)
+        reinit = np.zeros(t.size, bool)
+        for k in range(n_seg):
+            i0 = int(round(k * L / h))
+            i1 = n_steps if k == n_seg - 1 else int(round((k + 1) * L / h))
+            bounds.append((i0, i1))
+            if k == 0:
+                starts.append(None)
+                continue
+            tk = i0 * h
+            s = float(np.interp(tk, tu, sf))
+            v = float(np.interp(tk, t, vs))
+            W = float(np.interp(tk, tu, wf_u))
+            stuck = abs(v) < self.stuck_speed
+            starts.append((s, v, PP[D0] - W / PP[KF], -float(np.interp(tk, t, dw)) / PP[KF], stuck))
+            reinit |= (t >= tk) & (t < tk + self.reinit)
+        return bounds, starts, reinit
 
     def simulate(self, config, t_end=None):
         """Model channels at the run's times (up to ``t_end``) for a configuration
         ``[(effect name, values), ...]`` (empty: the nominal model)."""
-        from heavecomp.diagnosis.stepper import CHANNELS as SC, run_fx
+        from heavecomp.diagnosis.stepper import CHANNELS as SC, run_fx, run_segments
 
         rp = self._rp
         code, FP, PP = rp.code, rp.FP, rp.PP
@@ -152,7 +205,10 @@ class GapDiagnoser:
             else:
                 shift = (values["channel"], values["delay"])
         n = rp.n_steps if t_end is None else min(rp.n_steps, int(math.ceil(t_end / rp.h)) + 2)
-        out = run_fx(code, FP, PP, EP, rp.hs, rp.h, n, 1)
+        if self.segment:
+            out = run_segments(code, FP, PP, EP, rp.hs, rp.h, rp.bounds, rp.starts, n + 1)
+        else:
+            out = run_fx(code, FP, PP, EP, rp.hs, rp.h, n, 1)
         tg = out[:, 0]
         t = rp.t if t_end is None else rp.t[rp.t <= tg[-1]]
         res = {}
@@ -225,7 +281,18 @@ class GapDiagnoser:
                 pred = self.simulate(list(fixed) + [(name, cls.from_x(x))], t_end)
                 return self._resid_vec(pred)
 
-            r = least_squares(fun, x0, bounds=(lo, hi), diff_step=0.02, max_nfev=self.max_nfev, x_scale=1.0,
+            # stick-slip makes the cost rough: start from the best of a coarse grid (<= 2 parameters)
+            k = x0.size
+            if k <= 2 and start is None:
+                axes = [np.linspace(lo[i] + 0.1 * (hi[i] - lo[i]), hi[i] - 0.1 * (hi[i] - lo[i]),
+                                    self.grid if k == 1 else max(3, self.grid // 2)) for i in range(k)]
+                pts = np.array(np.meshgrid(*axes)).reshape(k, -1).T
+                costs = [float(np.sum(fun(x) ** 2)) for x in pts]
+                c0 = float(np.sum(fun(x0) ** 2))
+                if min(costs) < c0:
+                    x0 = pts[int(np.argmin(costs))]
+
+            r = least_squares(fun, x0, bounds=(lo, hi), diff_step=0.03, max_nfev=self.max_nfev, x_scale=1.0,
                               xtol=1e-3, ftol=1e-4, gtol=1e-6)
             values = cls.from_x(r.x)
             sigma = self._sigma(cls, r)
@@ -272,9 +339,10 @@ class GapDiagnoser:
         self.warnings_ = list(run.warnings)
         self._y = {c: run[c] for c in CH}
         t = run.t
-        self._fitmask = (t >= settle) & (t < t_split)
-        self._valmask = t >= t_split
-        allmask = t >= settle
+        keep = ~self._rp.reinit
+        self._fitmask = (t >= settle) & (t < t_split) & keep
+        self._valmask = (t >= t_split) & keep
+        allmask = (t >= settle) & keep
         self.noise_floor_ = {c: noise_floor(run[c], run.t if not run.uniform else None) for c in CH}
         self._report(0.02, "replaying the nominal model")
         nom = self.simulate([])
@@ -359,8 +427,11 @@ class GapDiagnoser:
         gap_ratio = max(self.gap_["channels"][c]["rms_validate"] / max(self.noise_floor_[c], 1e-30) for c in CH)
         runner = rows[1] if len(rows) > 1 else None
         margin = best["score"] - runner["score"] if runner else 1.0
+        # the verdict's shrink is on the channel with the largest gap relative to its noise floor
+        # (wob unless the gap is elsewhere, e.g. a delayed stroke sensor)
+        ch = max(CH, key=lambda c: self.gap_["channels"][c]["rms_validate"] / max(self.noise_floor_[c], 1e-30))
         v = {"effect": best["effect"], "confidence": "low", "parameters": best["parameters"],
-             "shrink": best["shrink"], "uncertainty": best["uncertainty"], "explained": best["explained"],
+             "shrink": best["channels"][ch]["shrink"], "shrink_channel": ch, "uncertainty": best["uncertainty"], "explained": best["explained"],
              "gap_to_noise": gap_ratio, "margin": margin}
         if gap_ratio <= self.none_ratio:
             v.update(effect="none", parameters={}, shrink=0.0, uncertainty={},

@@ -322,3 +322,34 @@ def simulate_fx(params, duration, EP=None, *, rate=50.0, heave=None, dt=None):
     res = {c: data[:, i] for i, c in enumerate(CHANNELS)}
     res["wall_time"] = time.perf_counter() - t0
     return res
+
+
+def run_segments(code, FP, PP, EP, hs, h, bounds, starts, n_out):
+    """Multiple-shooting replay: segment k covers grid steps ``bounds[k]`` = (i0, i1) and starts
+    from the state ``starts[k]`` = (s, v, y_b, v_b, stuck) estimated from the measurement
+    (``None``: rest at the operating point).  Memory states restart from their steady values
+    at that velocity (theta = 1, w = |v|, E = (F_S - F_C) e^{-|v|/v_S}, tau = 0).
+
+    Returns the output rows on the stepper grid (row i at t = i h), shape (n_out, NCH).
+    """
+    FP = np.asarray(FP, dtype=float)
+    PP = np.asarray(PP, dtype=float)
+    EP = np.asarray(EP, dtype=float)
+    out = np.empty((n_out, NCH))
+    for (i0, i1), st in zip(bounds, starts):
+        if i0 >= n_out - 1:
+            break
+        i1 = min(i1, n_out - 1)
+        X0 = initial_state(FP, EP)
+        mode_dir = np.array([float(STUCK), 1.0])
+        if st is not None:
+            s, v, yb, vb, stuck = st
+            X0[0], X0[2], X0[3] = s, yb, vb
+            if not stuck:
+                X0[1] = v
+                mode_dir[:] = (float(SLIDING), 1.0 if v > 0 else -1.0)
+            X0[5] = abs(X0[1])
+            X0[6] = (FP[0] - FP[1]) * math.exp(-abs(X0[1]) / FP[2]) if FP[2] > 0 else 0.0
+        advance_fx(X0, mode_dir, i0 * h, i1 - i0, h, int(code), FP, PP, EP, 0.0, 0.5 * h, hs.z, hs.dz, hs.ddz,
+                   out[i0:], 1, 0)
+    return out

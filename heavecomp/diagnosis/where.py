@@ -41,7 +41,7 @@ def wave_band(t, z) -> tuple[float, float]:
 def band_edges(run, params):
     lo, hi = wave_band(run.t, run["heave"])
     fe = eigenfrequencies(params)
-    res = [max(0.7 * min(f for f in fe if f > hi) if any(f > hi for f in fe) else hi, hi), 1.3 * max(fe)]
+    res = [hi, max(1.3 * max(fe), 1.5 * hi)]  # contiguous: wave | resonance (up to 1.3 x the top mode) | above
     return {"below_wave": [0.0, lo], "wave": [lo, hi], "resonance": res, "above": [res[1], math.inf]}
 
 

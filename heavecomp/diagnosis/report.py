@@ -1,0 +1,178 @@
+"""Diagnosis outputs: ``diagnosis.json`` (contract schema 1), ``report.md`` and the figures."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+
+CH_UNITS = {"wob": ("kN", 1e-3), "stroke": ("mm", 1e3), "pressure": ("kPa", 1e-3)}
+
+
+def _clean(x):
+    if isinstance(x, float) and not math.isfinite(x):
+        return None
+    if isinstance(x, dict):
+        return {str(k): _clean(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [_clean(v) for v in x]
+    if isinstance(x, (np.floating, np.integer, np.bool_)):
+        return _clean(x.item())
+    return x
+
+
+def write_json(diag, path) -> Path:
+    path = Path(path)
+    path.write_text(json.dumps(_clean(diag.to_json()), indent=2) + "\n")
+    return path
+
+
+def fig_where(diag):
+    """Residual over stroke velocity x acceleration (nominal replay), coloured by |WOB residual|."""
+    from heavecomp.report.figures import _plt
+
+    plt = _plt()
+    tr = diag.traces_
+    t = tr["t"]
+    v = tr["stroke_velocity"]
+    a = np.gradient(v, t)
+    r = tr["nominal"]["wob"] - tr["measured"]["wob"]
+    ok = np.isfinite(r) & (t >= diag.split_["settle"])
+    fig, (ax, axb) = plt.subplots(1, 2, figsize=(11, 4.2), gridspec_kw={"width_ratios": [1.6, 1]})
+    order = np.argsort(np.abs(r[ok]))
+    sc = ax.scatter(v[ok][order] * 1e3, a[ok][order], c=np.abs(r[ok][order]) / 1e3, s=3, cmap="viridis")
+    fig.colorbar(sc, ax=ax, label="|WOB residual| [kN]")
+    ax.set_xlabel("stroke velocity v [mm/s]")
+    ax.set_ylabel("stroke acceleration [m/s²]")
+    ax.set_title("Where: WOB residual over (v, dv/dt) of the nominal replay", fontsize=10)
+    ax.grid(alpha=0.3)
+    w = diag.where_
+    keys = list(w["regimes"]) + list(w["bands"])
+    vals = [w["regimes"][k] for k in w["regimes"]] + [w["bands"][k] for k in w["bands"]]
+    cols = ["tab:red"] * len(w["regimes"]) + ["tab:blue"] * len(w["bands"])
+    axb.barh(range(len(keys)), vals, color=cols)
+    axb.set_yticks(range(len(keys)), [k.replace("_", " ") for k in keys], fontsize=8)
+    axb.invert_yaxis()
+    axb.set_xlabel("share of squared WOB residual [-]")
+    axb.set_title("by regime (red) and frequency band (blue)", fontsize=10)
+    axb.grid(alpha=0.3, axis="x")
+    fig.tight_layout()
+    return fig
+
+
+def fig_spectra(diag):
+    """Residual spectra per channel before (nominal) and after (best candidate), with the band edges."""
+    from heavecomp.diagnosis.where import residual_spectrum
+    from heavecomp.report.figures import _plt
+
+    plt = _plt()
+    tr = diag.traces_
+    t = tr["t"]
+    fig, axs = plt.subplots(1, 3, figsize=(13, 3.8))
+    for ax, c in zip(axs, ("wob", "stroke", "pressure")):
+        unit, sc = CH_UNITS[c]
+        y = tr["measured"][c]
+        ok = np.isfinite(y) & (t >= diag.split_["settle"])
+        for label, key, col in (("nominal", "nominal", "tab:red"), (f"with {tr['best_effect']}", "best", "tab:green")):
+            f, S = residual_spectrum(t[ok], (tr[key][c][ok] - y[ok]) * sc)
+            ax.loglog(f[1:], S[1:], color=col, lw=1, label=label)
+        for k, (lo, hi) in diag.where_["band_edges_hz"].items():
+            if lo:
+                ax.axvline(lo, color="0.6", lw=0.6, ls="--")
+        ax.set_xlabel("frequency [Hz]")
+        ax.set_ylabel(f"residual PSD [{unit}²/Hz]")
+        ax.set_title(f"{c} residual spectrum", fontsize=10)
+        ax.grid(alpha=0.3, which="both")
+        ax.legend(fontsize=7)
+    fig.suptitle("Residual spectra (dashed: band edges below-wave | wave | resonance | above)", fontsize=10)
+    fig.tight_layout()
+    return fig
+
+
+def fig_overlay(diag, span=40.0):
+    """Measured vs nominal vs best candidate on held-out data around the worst held-out segment."""
+    from heavecomp.report.figures import _plt
+
+    plt = _plt()
+    tr = diag.traces_
+    t = tr["t"]
+    t0 = diag.split_["validate"][0]
+    segs = [s for s in diag.where_["segments"] if s[0] >= t0] or [[t0, t0 + span]]
+    c0 = 0.5 * (segs[0][0] + segs[0][1])
+    lo = max(t0, c0 - span / 2)
+    hi = min(t[-1], lo + span)
+    m = (t >= lo) & (t <= hi)
+    fig, axs = plt.subplots(3, 1, figsize=(11, 7.5), sharex=True)
+    for ax, c in zip(axs, ("wob", "stroke", "pressure")):
+        unit, sc = CH_UNITS[c]
+        ax.plot(t[m], tr["measured"][c][m] * sc, color="0.4", lw=0.8, label="measured")
+        ax.plot(t[m], tr["nominal"][c][m] * sc, color="tab:red", lw=1.1, label="nominal replay")
+        ax.plot(t[m], tr["best"][c][m] * sc, color="tab:green", lw=1.1, ls="--", label=f"with {tr['best_effect']}")
+        ax.set_ylabel(f"{c} [{unit}]")
+        ax.grid(alpha=0.3)
+    axs[0].legend(fontsize=8, loc="upper right")
+    axs[-1].set_xlabel("time t [s]")
+    axs[0].set_title("Before/after on held-out data: the fitted effect closes the gap where the nominal misses",
+                     fontsize=10)
+    fig.tight_layout()
+    return fig
+
+
+def write_report(diag, out_dir, *, title="Sim-to-real gap diagnosis") -> dict:
+    """Write diagnosis.json, report.md and where.png / spectra.png / overlay.png into ``out_dir``."""
+    from heavecomp.report.figures import save
+    from heavecomp.report.scenario import md_table
+
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    write_json(diag, out / "diagnosis.json")
+    save(fig_where(diag), out / "where.png", dpi=90)
+    save(fig_spectra(diag), out / "spectra.png", dpi=90)
+    save(fig_overlay(diag), out / "overlay.png", dpi=90)
+    v = diag.verdict_
+    g = diag.gap_
+    lines = [f"# {title}", "",
+             f"**Verdict: `{v['effect']}`** (confidence {v['confidence']}); held-out shrink of the "
+             f"{v.get('shrink_channel', 'wob')} residual {v['shrink']:.2f}."]
+    if v.get("note"):
+        lines.append(f"\n{v['note']}.")
+    if v.get("parameters"):
+        unc = v.get("uncertainty", {})
+        lines.append("\nFitted parameters: " + ", ".join(
+            f"{k} = {val:.4g}" + (f" ± {unc[k]:.2g}" if isinstance(unc.get(k), float) and math.isfinite(unc[k]) else "")
+            if isinstance(val, float) else f"{k} = {val}" for k, val in v["parameters"].items()) + ".")
+    if v.get("second_effect"):
+        se = v["second_effect"]
+        lines.append(f"\nSecond effect: `{se['effect']}` adds {100 * se['added_explained']:.0f} % of the held-out "
+                     f"gap when fitted jointly with the first.")
+    for w in getattr(diag, "warnings_", []):
+        lines.append(f"\n> data: {w}")
+    lines += ["", "## Gap (nominal replay vs measurement, after the settling window)", "",
+              md_table(["channel", "rms", "nrmse", "rms held-out", "noise floor"],
+                       [[c, f"{g['channels'][c]['rms']:.4g}", f"{g['channels'][c]['nrmse']:.3f}",
+                         f"{g['channels'][c]['rms_validate']:.4g}", f"{g['channels'][c]['noise_floor']:.4g}"]
+                        for c in ("wob", "stroke", "pressure")]),
+              "", "## Where", "",
+              "Share of the squared WOB residual by regime: " + ", ".join(
+                  f"{k.replace('_', ' ')} {100 * x:.0f} %" for k, x in diag.where_["regimes"].items()) + ".",
+              "By band: " + ", ".join(f"{k.replace('_', ' ')} {100 * x:.0f} %" for k, x in diag.where_["bands"].items())
+              + f" (eigenfrequencies {', '.join(f'{f:.2f}' for f in diag.where_['eigenfrequencies_hz'])} Hz).",
+              "Largest in: " + ", ".join(f"{a:.1f}-{b:.1f} s" for a, b in diag.where_["segments"]) + ".",
+              "", "![where](where.png)", "", "![spectra](spectra.png)", "",
+              "## Which: every candidate, fitted on the fit part, scored on the held-out part", "",
+              md_table(["effect", "explained", "score", "wob rms before", "wob rms after", "wob shrink",
+                        "stroke shrink", "pressure shrink", "parameters"],
+                       [[c["effect"], f"{c['explained']:.2f}", f"{c['score']:.2f}", f"{c['rms_before']:.4g}",
+                         f"{c['rms_after']:.4g}", f"{c['channels']['wob']['shrink']:.2f}",
+                         f"{c['channels']['stroke']['shrink']:.2f}", f"{c['channels']['pressure']['shrink']:.2f}",
+                         ", ".join(f"{k}={val:.3g}" if isinstance(val, float) else f"{k}={val}"
+                                   for k, val in c["parameters"].items())]
+                        for c in diag.candidates_]),
+              "", f"Split: fit {diag.split_['fit'][0]:.0f}-{diag.split_['fit'][1]:.0f} s, held out "
+                  f"{diag.split_['validate'][0]:.0f}-{diag.split_['validate'][1]:.0f} s; first "
+                  f"{diag.split_['settle']:.0f} s excluded (start-up). Run time {diag.wall_time_:.1f} s.",
+              "", "## Before / after", "", "![overlay](overlay.png)", ""]
+    (out / "report.md").write_text("\n".join(lines))
+    return diag.to_json()
