@@ -80,6 +80,8 @@ class AxisRegression:
     """
 
     def __init__(self, record: AxisRecord, cutoff: float = 50.0, order: int = 4, decimate: int = 10):
+        if int(decimate) < 1 or int(decimate) != decimate:
+            raise ParameterError(f"decimate must be a positive integer, got {decimate}")
         self.record = record
         self.fs = record.fs
         self.cutoff, self.order, self.factor = float(cutoff), int(order), int(decimate)

@@ -104,7 +104,8 @@ def seal_friction_vs_pressure(strokes: list, fits: dict):
     x = np.linspace(0, 7.5, 20)
     ax.plot(x, f["F_C"] + f["C_p"] * x * bar, "k-", lw=1.8,
             label=f"direction-symmetric part: F_C = {f['F_C']:.2f} N, C_p = {f['C_p'] * bar:.3f} N/bar "
-                  f"(+- {f['C_p_boot'] * bar:.3f} strokes, +- {fits['file_means']['C_p_se'] * bar:.3f} files)")
+                  f"(+- {f['C_p_boot'] * bar:.3f} strokes" + (f", +- {fits['file_means']['C_p_se'] * bar:.3f} files)"
+                                                              if "file_means" in fits else ")"))
     ax.set_xlabel("chamber gauge pressure dp [bar]")
     ax.set_ylabel("seal friction |F_f| = |force - p A| [N]")
     ax.set_xlim(0, 7.5)

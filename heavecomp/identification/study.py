@@ -70,12 +70,13 @@ def emps_study(record, cutoff: float = 50.0, order: int = 4, decimate: int = 10,
     return {"metrics": metrics, "estimator": est, "diagnoser": diag, "sensitivity": sens}
 
 
-def seal_study(records, n_boot: int = 2000, seed: int = 0) -> dict:
+def seal_study(records, n_boot: int = 2000, seed: int = 0, fit: SealFrictionFit | None = None) -> dict:
     """Fit F_C + C_p dp over the O-ring files; compare with paper A scaled by circumference.
 
-    Returns ``{"metrics": dict, "fit": SealFrictionFit}``.
+    Returns ``{"metrics": dict, "fit": SealFrictionFit}``; pass ``fit`` (unfitted) to
+    change its settings.
     """
-    fit = SealFrictionFit(n_boot=n_boot, seed=seed).fit(records)
+    fit = (fit or SealFrictionFit(n_boot=n_boot, seed=seed)).fit(records)
     per_file = {}
     for rec in records:
         rows = [r for r in fit.strokes_ if r["file"] == rec.name]
@@ -93,7 +94,7 @@ def seal_study(records, n_boot: int = 2000, seed: int = 0) -> dict:
             for k, f in fit.fits_.items()}
     scaled = scale_by_circumference(PAPER_A_CP, PAPER_A_DIAMETER, BORE_DIAMETER)
     metrics = {
-        "settings": {"v_min_m_s": fit.v_min, "trim": fit.trim, "n_boot": n_boot, "area_m2": fit.area,
+        "settings": {"v_min_m_s": fit.v_min, "trim": fit.trim, "n_boot": fit.n_boot, "area_m2": fit.area,
                      "velocity": "slope over +-10 samples (0.2 s)"},
         "files": per_file,
         "fits": fits,
