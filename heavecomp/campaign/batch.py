@@ -136,7 +136,6 @@ def prepare(campaign, runs, base=None):
     """Per-run arrays for the compiled driver (parameters, steps, heave samples)."""
     from heavecomp.friction.laws import FrictionLaw
     from heavecomp.plants.cmc import plant_vector
-    from heavecomp.simulate import excitation
     from heavecomp.simulate.core import default_dt
 
     s = campaign.settings
@@ -154,6 +153,7 @@ def prepare(campaign, runs, base=None):
     half = np.zeros(n)
     heaves = []
     cache = {}
+    spectra = {}
     for i, run in enumerate(runs):
         p = campaign.params_for(run, base=base)
         key = (run.regime, run.variant)
@@ -171,7 +171,8 @@ def prepare(campaign, runs, base=None):
         t_stat[i] = min(p.heave.ramp, 0.5 * s.duration)
         W0[i] = p.operating_point.wob_setpoint
         half[i] = campaign.band.half_width(W0[i])
-        heaves.append(excitation.jonswap(run.hs, run.tp, s.gamma, run.seed, p.heave.ramp, nsteps[i] * h, 0.5 * h))
+        heaves.append(jonswap_samples(run.hs, run.tp, s.gamma, run.seed, p.heave.ramp, nsteps[i] * h, 0.5 * h,
+                                      spectra))
     m = max(hv.z.size for hv in heaves)
     Zs, DZs, DDZs = (np.empty((n, m)) for _ in range(3))
     for i, hv in enumerate(heaves):
@@ -180,6 +181,46 @@ def prepare(campaign, runs, base=None):
             arr[i, src.size:] = src[-1]  # never reached: padding to a common length only
     return dict(codes=codes, FPs=FPs, PPs=PPs, smooth=smooth, hsteps=hsteps, nsteps=nsteps, out_every=out_every,
                 t_stat=t_stat, W0=W0, half=half, Zs=Zs, DZs=DZs, DDZs=DDZs)
+
+
+def jonswap_samples(hs, tp, gamma, seed, ramp, duration, spacing, spectra=None):
+    """:func:`heavecomp.simulate.excitation.jonswap`, bit for bit, for many runs.
+
+    Two savings, no change in the numbers (pinned by ``tests/test_campaign.py``):
+    the amplitude spectrum is computed once per (H_s, T_p, gamma, grid) and kept in
+    ``spectra`` (a dict) across runs; the fade-in is applied only on t < ramp
+    (beyond it r = 1, r' = r'' = 0, so the product is the identity).
+    """
+    from scipy import fft as sfft
+
+    from heavecomp.simulate import excitation
+
+    n_need = int(math.ceil(duration / spacing)) + 2
+    n = sfft.next_fast_len(max(n_need, int(math.ceil(4 * tp / spacing))), real=True)
+    f = np.fft.rfftfreq(n, spacing)
+    key = (hs, tp, gamma, n, spacing)
+    amp = None if spectra is None else spectra.get(key)
+    if amp is None:
+        S = excitation.jonswap_spectrum(f, hs, tp, gamma)
+        S[f > 6.0 / tp] = 0.0
+        amp = np.sqrt(2 * S * (1.0 / (n * spacing)))
+        if spectra is not None:
+            spectra[key] = amp
+    rng = np.random.default_rng(seed)
+    phase = rng.uniform(0, 2 * np.pi, size=f.size)
+    X = amp * np.exp(1j * phase) * n / 2.0
+    X[0] = 0.0
+    if n % 2 == 0:
+        X[-1] = 0.0
+    w = 2 * np.pi * f
+    z = sfft.irfft(X, n)[:n_need]
+    dz = sfft.irfft(1j * w * X, n)[:n_need]
+    ddz = sfft.irfft(-(w ** 2) * X, n)[:n_need]
+    k = min(n_need, int(math.ceil(ramp / spacing)) + 1)
+    t = np.arange(k) * spacing
+    z[:k], dz[:k], ddz[:k] = excitation._apply_ramp(t, z[:k], dz[:k], ddz[:k], ramp)
+    return excitation.HeaveSamples(spacing, z, dz, ddz, {"kind": "jonswap", "hs": hs, "tp": tp, "gamma": gamma,
+                                                         "seed": seed, "ramp": ramp, "repeat_period": n * spacing})
 
 
 def hist_columns(nbins: int) -> tuple[list[str], list[str]]:
