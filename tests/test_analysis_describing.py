@@ -71,3 +71,18 @@ def test_df_predicts_a_stuck_cylinder_exactly(pa):
     r = compare_with_simulation(pa, [0.02], [12.0])[0]
     assert r["df_stuck"] and r["stick_fraction"] == 1.0
     assert r["rel_error"] == pytest.approx(0.0, abs=1e-3)
+
+
+def test_describing_transmissibility_limits(pa):
+    """Frictionless: the linear k_eff(w) exactly; with eq. 4 friction: |k_eff(w; a)| falls towards the
+    frictionless curve as the heave amplitude grows (in the wave band)."""
+    from heavecomp.analysis.describing import describing_transmissibility
+    from heavecomp.analysis.frequency import effective_stiffness
+    from heavecomp.analysis.linear import linearise
+
+    w = np.array([0.4, 0.8, 1.2])
+    p0 = pa.replace(friction={"model": "none"})
+    lin = np.asarray(effective_stiffness(linearise(p0), w).frdata).ravel()
+    np.testing.assert_allclose(np.asarray(describing_transmissibility(p0, 1.0, w).frdata).ravel(), lin, rtol=1e-12)
+    k = [np.abs(np.asarray(describing_transmissibility(pa, a, w, n=512).frdata).ravel()) for a in (0.2, 1.0, 5.0)]
+    assert np.all(k[0] > k[1]) and np.all(k[1] > k[2]) and np.all(k[2] > np.abs(lin))

@@ -143,7 +143,7 @@ def describing_response(params, heave_amplitude: float, omega: float, *, n: int 
     # balance h(S) = log(a |Ts(S)|) - log S: a stable sliding solution is where h crosses 0 downwards
     # stroke amplitudes up to where the gas volume V_0 + A s would vanish
     S_max = min(10.0 * a * max(1.0, float(np.abs(Gsz))), 0.95 * PP[V0_IDX] / PP[A_IDX])
-    S_grid = np.logspace(np.log10(S_max) - 7, np.log10(S_max), 300)
+    S_grid = np.logspace(np.log10(S_max) - 7, np.log10(S_max), 150)
     Ts, _, _, _ = closed(S_grid)
     h = np.log(a * np.abs(Ts)) - np.log(S_grid)
     down = np.nonzero((h[:-1] > 0) & (h[1:] <= 0))[0]
@@ -237,3 +237,29 @@ def compare_with_simulation(params, amplitudes, periods, **sim_kw) -> list[dict]
                          "stroke_sim": sim["stroke_amplitude"], "c_eq": df.c_eq,
                          "stick_fraction": sim["stick_fraction"], "df_stuck": df.stuck})
     return rows
+
+
+def describing_transmissibility(params, heave_amplitude: float, omega, *, n: int = 1024):
+    """Amplitude-dependent effective stiffness k_eff(omega; a) = -WOB_1/heave [N/m] as an FRD.
+
+    Parameters
+    ----------
+    params : CMCParams
+    heave_amplitude : float [m]
+        Heave amplitude a of the sine the describing function is balanced for.
+    omega : array_like [rad/s]
+
+    Returns
+    -------
+    control.FrequencyResponseData
+        SISO ``heave -> k_eff``; at each frequency the first-harmonic WOB per
+        metre of heave with the friction replaced by its describing function
+        (:func:`describing_response`).  For ``friction.model = "none"`` it is
+        :func:`heavecomp.analysis.frequency.effective_stiffness`.
+    """
+    import control as ct
+
+    w = np.asarray(omega, dtype=float)
+    r = [describing_response(params, heave_amplitude, wi, n=n) for wi in w]
+    H = np.array([x.k_eff * np.exp(1j * np.radians(x.wob_phase_deg)) for x in r])
+    return ct.frd(-H, w, inputs=["heave"], outputs=["k_eff"], name=f"k_eff_df_a{heave_amplitude * 1e3:.0f}mm")
