@@ -118,7 +118,7 @@ def linearise(p, position: float | None = None, convention: str = "paper") -> Li
     F_eq = A * (p.supply_abs - Pb)
     D = (p.stick_static_force - (F_eq - c * u0)) / (M * u0 * wn)
     T_f = math.sqrt(M * Vb / (Pb * A * A))
-    lin = Linearisation(u0, Pb, x, a, b, c, g, wn, zeta, D, T_f, convention)
+    lin = Linearisation(*(float(v) for v in (u0, Pb, x, a, b, c, g, wn, zeta, D, T_f)), convention)
     object.__setattr__(lin, "_A", np.array([[-c / M, -A / M], [b, -a]]))
     return lin
 

@@ -75,7 +75,7 @@ def critical_curve(zetas) -> np.ndarray:
 
 def predicts_stick_slip(zeta: float, D: float) -> bool:
     """True above the critical curve."""
-    return D > critical_D(zeta)
+    return bool(D > critical_D(zeta))
 
 
 # ----------------------------------------------------------------------------------------------
@@ -102,7 +102,7 @@ def nonlinear_sticks(p, position=None, periods: float = 8.0) -> bool:
     lin = PL.linearise(p, position)
     res = PS.simulate(p, window(lin, periods), state=restart_state(p, position), moved=True, stop_at_stick=True,
                       rate=100.0)
-    return res["stats"]["n_stick"] >= 1
+    return bool(res["stats"]["n_stick"] >= 1)
 
 
 # ----------------------------------------------------------------------------------------------

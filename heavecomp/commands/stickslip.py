@@ -1,0 +1,83 @@
+"""Stick-slip analysis of paper B's pneumatic meter-out cylinder: linearisation, critical curve, simulation, map."""
+
+from __future__ import annotations
+
+import argparse
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("params", metavar="PARAMS.toml|default",
+                   help="[pneumatic] parameter file, or 'default' for the documented default cylinder")
+    p.add_argument("--dump", action="store_true", help="print the (validated) parameters as TOML and exit")
+    p.add_argument("--duration", type=float, default=None, metavar="S",
+                   help="also simulate S seconds from paper B's start (exact stick-slip)")
+    p.add_argument("--map", type=int, default=None, metavar="N",
+                   help="classify an N x N grid (viscous coefficient x friction drop) by the critical curve "
+                        "and by simulation; print the agreement")
+    p.add_argument("--convention", choices=("paper", "full"), default="paper",
+                   help="linearisation: neglect the volume change (paper B) or keep it (full Jacobian)")
+    p.add_argument("--out", default=None, metavar="DIR", help="write metrics.json (and timeseries.csv) here")
+
+
+def run(args) -> int:
+    import json
+    import math
+    import sys
+    from pathlib import Path
+
+    import numpy as np
+
+    from heavecomp.analysis import pneumatic_linear as PL
+    from heavecomp.analysis import stickslip as SS
+    from heavecomp.errors import InputError, ParameterError
+    from heavecomp.plants import pneumatic as pn
+
+    if args.params == "default":
+        p = pn.default()
+    else:
+        if not Path(args.params).exists():
+            raise ParameterError(f"{args.params}: no such parameter file (or use 'default')")
+        p = pn.load(args.params)
+    if args.dump:
+        sys.stdout.write(pn.dumps(p))
+        return 0
+    if args.duration is not None and not (args.duration > 0 and math.isfinite(args.duration)):
+        raise InputError(f"--duration must be a positive number of seconds, got {args.duration}")
+    if args.map is not None and not (2 <= args.map <= 200):
+        raise InputError(f"--map must be a grid size between 2 and 200, got {args.map}")
+    lin = PL.linearise(p, convention=args.convention)
+    Dcr = SS.critical_D(lin.zeta)
+    mv = SS.minimum_velocity(p, convention=args.convention, nonlinear=False)
+    m = {"linearisation": lin.as_dict(), "critical_D": Dcr, "stick_slip_predicted": bool(lin.D > Dcr),
+         "minimum_velocity_linear_m_s": mv["linear_u0"], "minimum_velocity_exhaust_area_m2": mv["linear_exhaust_area"]}
+    print(f"u_0 = {lin.u0 * 1e3:.2f} mm/s, omega_n = {lin.omega_n:.2f} rad/s, zeta* = {lin.zeta:.3f}, "
+          f"D* = {lin.D:.3f}, D*_cr = {Dcr:.3f} -> {'STICK-SLIP' if lin.D > Dcr else 'no stick-slip'} after a stick; "
+          f"minimum equilibrium velocity {mv['linear_u0'] * 1e3:.2f} mm/s")
+    out = Path(args.out) if args.out else None
+    if out:
+        out.mkdir(parents=True, exist_ok=True)
+    if args.duration is not None:
+        from heavecomp.analysis import pneumatic_sim as PS
+
+        r = PS.simulate(p, args.duration, rate=1000.0)
+        m["simulation"] = r["stats"]
+        st = r["stats"]
+        print(f"simulation {args.duration:g} s: breakaway {st['t_first_breakaway']:.3f} s, sticks {int(st['n_stick'])}, "
+              f"first stick {st['t_first_stick']:.3f} s, restart {st['t_second_breakaway']:.3f} s")
+        if out:
+            cols = [c for c in PS.CHANNELS]
+            np.savetxt(out / "timeseries.csv", np.column_stack([r[c] for c in cols]), delimiter=",",
+                       header=",".join(cols), comments="", fmt="%.10g")
+    if args.map is not None:
+        n = args.map
+        g = SS.grid_map(p, "viscous_coefficient", np.geomspace(8.0, 250.0, n), "friction_drop",
+                        np.geomspace(1.0, 120.0, n), convention=args.convention)
+        m["map"] = {"n": n, "agreement": g["agreement"], "stick_slip_nonlinear": int(g["nonlinear"].sum()),
+                    "stick_slip_linear": int(g["linear"].sum())}
+        print(f"map {n}x{n}: critical curve and simulation agree on {100 * g['agreement']:.1f} % of the points")
+    if out:
+        from heavecomp.report.scenario import write_metrics
+
+        write_metrics(out, m)
+        print(f"-> {out}")
+    return 0
