@@ -129,8 +129,8 @@ def localise(r, v, q, a, dead_band: float = 0.005, n_velocity: int = 10, n_posit
     -------
     dict
         ``direction`` (positive / negative / near_rest), ``motion`` (accelerating:
-        v a > 0, decelerating: v a < 0, while moving), ``velocity`` and ``position``
-        bins; each entry has ``n``, ``mean`` [N], ``rms`` [N] and ``share`` of the
+        v a > 0, decelerating: v a < 0, while moving), ``acceleration`` (sign of a),
+        ``velocity`` and ``position`` bins; each entry has ``n``, ``mean`` [N], ``rms`` [N] and ``share`` of the
         total squared residual.  Also ``rms`` (total) [N].
     """
     r, v, q, a = (np.asarray(x, dtype=float) for x in (r, v, q, a))
@@ -142,6 +142,7 @@ def localise(r, v, q, a, dead_band: float = 0.005, n_velocity: int = 10, n_posit
                         "near_rest": _bin_stats(r, ~moving, total)}
     out["motion"] = {"accelerating": _bin_stats(r, moving & (v * a > 0), total),
                      "decelerating": _bin_stats(r, moving & (v * a < 0), total)}
+    out["acceleration"] = {"positive": _bin_stats(r, a > 0, total), "negative": _bin_stats(r, a < 0, total)}
     vmax = float(np.max(np.abs(v)))
     edges = np.linspace(-vmax, vmax, n_velocity + 1)
     idx = np.clip(np.searchsorted(edges, v, side="right") - 1, 0, n_velocity - 1)
