@@ -24,7 +24,10 @@ def emps_overlay(t, measured, model_before, model_after, label_after: str):
     ax.set_ylabel("motor force F [N]")
     ax.legend(fontsize=8, loc="upper right")
     ax.grid(alpha=0.3)
-    ax.set_title("EMPS held-out part: the inverse model follows the force; the residual is a few N", fontsize=10)
+    rb = float(np.sqrt(np.mean((measured - model_before) ** 2)))
+    ra = float(np.sqrt(np.mean((measured - model_after) ** 2)))
+    ax.set_title(f"EMPS held-out part: the inverse model follows the force; residual rms {rb:.2f} N, "
+                 f"{ra:.2f} N with the added effects", fontsize=10)
     axr.plot(t, measured - model_before, color="tab:blue", lw=0.8, label="residual, EMPS model")
     axr.plot(t, measured - model_after, color="tab:red", lw=0.8, label="residual, augmented")
     axr.set_ylabel("residual [N]")
