@@ -31,7 +31,11 @@ def run(args) -> int:
     params = load(args.params)
     cands = None
     if args.candidates:
+        from heavecomp.effects import get
+
         cands = [c.strip() for c in args.candidates.split(",") if c.strip()]
+        for c in cands:
+            get(c)  # unknown names fail before any work
     if args.jobs < 1:
         raise InputError(f"--jobs must be >= 1, got {args.jobs}")
     run_ = load_run(args.run, params)
