@@ -105,3 +105,16 @@ def test_bad_modes_raise_one_line_errors(pa):
         linearise(pa, friction="dry")
     with pytest.raises(ParameterError, match="^friction.viscous_coefficient"):
         linearise(paper_a("none"), friction="viscous")
+
+
+def test_sliding_operating_point_carries_the_law_friction(pa):
+    """About a constant stroke velocity the friction force is the exact law's, unbalanced (not an equilibrium)."""
+    from heavecomp.friction.laws import FrictionLaw
+
+    v0 = 0.04
+    op = operating_point(pa, velocity=v0, eps=v0 / 25)
+    F = float(FrictionLaw.from_params(pa.friction).force(v0, pa.p0))
+    assert op.y[4] == pytest.approx(F, rel=1e-12)
+    assert not op.equilibrium
+    assert op.xdot[1] == pytest.approx(-F / pa.compensator.moving_mass, rel=1e-9)
+    assert op.u[1] == -v0  # platform moves, top mass at rest
