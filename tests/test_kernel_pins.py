@@ -162,3 +162,24 @@ def test_smooth_model_approaches_exact_stick_slip_as_eps_shrinks():
     # each decade of eps cuts the error by at least 4x (observed ~8x), and eps = 1e-5 is within 50 N
     assert errs[0] > 4 * errs[1] > 16 * errs[2]
     assert errs[2] < 50.0
+
+
+def test_advance_in_pieces_equals_one_call():
+    """``K.advance`` may be called repeatedly (once per control interval): the mode and
+    direction carried in ``mode_dir`` make the result independent of where the run is
+    cut, also when a cut falls inside a stick phase."""
+    from heavecomp.simulate.core import _friction_vectors, run_kernel
+    from heavecomp.simulate.excitation import make_heave
+
+    p = paper_a("stribeck")
+    h, T, out_every = 0.01, 60.0, 5
+    n = int(round(T / h))
+    hs = make_heave(p.heave, n * h, 0.5 * h)
+    law, PP = _friction_vectors(p)
+    whole, st_whole, _ = run_kernel(law, PP, hs, h, n, out_every)
+    # 0.1 s pieces (a control interval); 600 cuts, many of them while stuck
+    parts, st_parts, _ = run_kernel(law, PP, hs, h, n, out_every, chunk_steps=10)
+    assert whole.shape == parts.shape
+    assert np.count_nonzero(whole[:, K.CHANNELS.index("stuck")]) > 50
+    np.testing.assert_allclose(parts, whole, rtol=1e-9, atol=1e-9)
+    assert st_parts["n_stick"] == st_whole["n_stick"] and st_parts["n_breakaway"] == st_whole["n_breakaway"]
