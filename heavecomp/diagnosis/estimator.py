@@ -14,8 +14,11 @@ Method
    parameters, decimated residual) on the *fit* part [settle, t_split] and
    scored on the held-out part [t_split, end].  All channels enter, each
    weighted by 1/rms_before_c^2 on the fit part.
-4. Explained share of the held-out gap above the noise floor
-   ``e = (J_before - J_after) / (J_before - J_noise)`` with ``J = sum_c w_c mse_c``;
+4. Explained share of the held-out gap above the noise floor, per channel
+   ``e_c = (mse_before - mse_after) / (mse_before - sigma_c^2)``, averaged with the
+   channels' gap-over-noise as weights (:meth:`GapDiagnoser._explained`); the noise
+   floor sigma_c adds the output noise, the effect of the heave noise and of the heave
+   pre-processing on the replay;
    score = e - ``penalty`` * (number of parameters).  Verdict: ``none`` when
    J_before <= ``none_ratio``^2 J_noise; ``inconclusive`` when the best e <
    ``min_explained``; else the best score, with a confidence from e and the
@@ -234,6 +237,19 @@ class GapDiagnoser:
     def _J(self, mse):
         return sum(self._w[c] * mse[c] for c in CH)
 
+    def _explained(self, mse_b, mse_a):
+        """Explained share of the held-out gap above the noise floor: per channel
+        e_c = (mse_b - mse_a) / max(mse_b - sigma_c^2, 0.1 mse_b), averaged with weights
+        g_c = max(mse_b / sigma_c^2 - 1, 0) (the channel with the largest gap over its noise counts most)."""
+        num = den = 0.0
+        for c in CH:
+            f2 = max(self.noise_floor_[c] ** 2, 1e-30)
+            g = max(mse_b[c] / f2 - 1.0, 0.0)
+            e = (mse_b[c] - mse_a[c]) / max(mse_b[c] - f2, 0.1 * mse_b[c], 1e-300)
+            num += g * e
+            den += g
+        return num / den if den > 0 else 0.0
+
     def _resid_vec(self, pred):
         m = self._fitmask[: pred["wob"].size]
         parts = []
@@ -355,7 +371,7 @@ class GapDiagnoser:
         mse_b = self._mse(nom, self._valmask)
         J_b = self._J(mse_b)
         J_n = sum(self._w[c] * self.noise_floor_[c] ** 2 for c in CH)
-        self._Jb, self._Jn = J_b, J_n
+        self._Jb, self._Jn, self._mse_b = J_b, J_n, mse_b
         # ---- where (on everything after the settling window, nominal residual)
         self.gap_ = {"channels": {}}
         for c in CH:
@@ -393,8 +409,7 @@ class GapDiagnoser:
             fitted = results[n]
             pred = self.simulate([(n, fitted["values"])])
             mse_a = self._mse(pred, self._valmask)
-            J_a = self._J(mse_a)
-            expl = (J_b - J_a) / max(J_b - J_n, 0.1 * J_b)
+            expl = self._explained(mse_b, mse_a)
             k = get(n).n_params()
             rows.append({"effect": n, "parameters": self._public(n, fitted["values"]),
                          "uncertainty": fitted["sigma"],
@@ -470,8 +485,7 @@ class GapDiagnoser:
             start = r["_values"] if get(r["effect"]).kind != "output" else None
             fitted = self._fit_candidate(r["effect"], start=start, fixed=fixed)
             pred = self.simulate(fixed + [(r["effect"], fitted["values"])])
-            J_a = self._J(self._mse(pred, self._valmask))
-            expl = (self._Jb - J_a) / max(self._Jb - self._Jn, 0.1 * self._Jb)
+            expl = self._explained(self._mse_b, self._mse(pred, self._valmask))
             gain = expl - best["explained"] - self.penalty * get(r["effect"]).n_params()
             if gain > 0.1 and (out is None or gain > out["added_explained"]):
                 mse_a = self._mse(pred, self._valmask)
@@ -486,6 +500,8 @@ class GapDiagnoser:
         (second-difference estimate); rms difference per channel [SI]."""
         from heavecomp.diagnosis.data import MeasuredRun, heave_samples, noise_floor
 
+        from heavecomp.diagnosis.data import HEAVE_CUTOFF
+
         sz = noise_floor(run["heave"], run.t if not run.uniform else None)
         rng = np.random.default_rng(12345)
         pert = MeasuredRun(run.t, {"heave": run["heave"] + rng.normal(0.0, sz, run.t.size)}, run.source)
@@ -493,10 +509,14 @@ class GapDiagnoser:
         try:
             self._rp.hs = heave_samples(pert, self._rp.h, self._rp.n_steps)
             alt = self.simulate([])
+            # sensitivity to the heave pre-processing: cut-off 1.5 x higher
+            self._rp.hs = heave_samples(run, self._rp.h, self._rp.n_steps, cutoff=1.5 * HEAVE_CUTOFF)
+            alt2 = self.simulate([])
         finally:
             self._rp.hs = saved
         self.heave_noise_ = sz
-        return {c: float(np.sqrt(np.mean((alt[c][mask] - nom[c][mask]) ** 2))) for c in CH}
+        return {c: float(np.sqrt(np.mean((alt[c][mask] - nom[c][mask]) ** 2)
+                                 + np.mean((alt2[c][mask] - nom[c][mask]) ** 2))) for c in CH}
 
     def _report(self, frac, msg):
         log.info("diagnose: %s", msg)
