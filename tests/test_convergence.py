@@ -76,3 +76,23 @@ def test_wob_history_converges_through_bit_lift_off():
     orders = np.log2(errs[:-1] / errs[1:])
     print(f"lift-off: rms WOB error {['%.3g' % e for e in errs]} N, observed orders {np.round(orders, 2)}")
     assert errs[1] < 1.0 and np.all(orders >= 3.5)
+
+
+@pytest.mark.xfail(strict=True, reason="BUG: the sin^2 fade-in has a jump in d2r/dt2 at t = T_r (-pi^2/(2 T_r^2) -> 0); "
+                   "when z(T_r) != 0 (any JONSWAP run, a sine whose ramp is not a multiple of T/2) the heave "
+                   "acceleration jumps there, the step across T_r sees one sample for both sides and the "
+                   "WOB error becomes first order (0.4-0.6 N rms at 10 ms)")
+@pytest.mark.parametrize("heave", [{"ramp": 27.0},
+                                   {"kind": "jonswap", "hs": 2.0, "tp": 12.0, "amplitude": None, "period": None}],
+                         ids=["sine ramp 27 s", "jonswap"])
+def test_wob_history_converges_through_the_end_of_the_fade_in(heave):
+    p = paper_a("none").replace(heave=heave)
+    ref = simulate(p, T, dt=DT_REF, rate=RATE)
+    errs = []
+    for dt in DTS:
+        e = simulate(p, T, dt=dt, rate=RATE)["wob"] - ref["wob"]
+        errs.append(float(np.sqrt(np.mean(e ** 2))))
+    errs = np.array(errs)
+    orders = np.log2(errs[:-1] / errs[1:])
+    print(f"fade-in {heave}: rms WOB error {['%.3g' % e for e in errs]} N, observed orders {np.round(orders, 2)}")
+    assert np.all(orders >= 3.5)
