@@ -176,3 +176,46 @@ def write_report(diag, out_dir, *, title="Sim-to-real gap diagnosis") -> dict:
               "", "## Before / after", "", "![overlay](overlay.png)", ""]
     (out / "report.md").write_text("\n".join(lines))
     return diag.to_json()
+
+
+def fig_confusion(summary):
+    """Confusion matrix of the withheld-effect benchmark (rows: withheld effect, columns: verdict)."""
+    from heavecomp.report.figures import _plt
+
+    plt = _plt()
+    cm = summary["confusion"]
+    truths = list(cm)
+    verdicts = list(next(iter(cm.values())))
+    M = np.array([[cm[t][v] for v in verdicts] for t in truths], dtype=float)
+    fig, ax = plt.subplots(figsize=(9, 6))
+    ax.imshow(M, cmap="Blues")
+    for i in range(M.shape[0]):
+        for j in range(M.shape[1]):
+            if M[i, j]:
+                ax.text(j, i, int(M[i, j]), ha="center", va="center", color="k", fontsize=9)
+    ax.set_xticks(range(len(verdicts)), verdicts, rotation=40, ha="right", fontsize=8)
+    ax.set_yticks(range(len(truths)), truths, fontsize=8)
+    ax.set_xlabel("verdict of the diagnosis [-]")
+    ax.set_ylabel("withheld effect (dominant) [-]")
+    ax.set_title(f"Withheld-effect benchmark: {summary['n_runs']} runs, accuracy {100 * summary['accuracy']:.0f} % "
+                 "(diagonal = correct)", fontsize=10)
+    fig.tight_layout()
+    return fig
+
+
+def fig_shrink(rows):
+    """Held-out shrink of the verdict per benchmark run, coloured by correctness."""
+    from heavecomp.report.figures import _plt
+
+    plt = _plt()
+    fig, ax = plt.subplots(figsize=(10, 4))
+    labels = [r["truth"] + (f"+{r['truth_second']}" if r["truth_second"] else "") for r in rows]
+    vals = [r["shrink"] for r in rows]
+    cols = ["tab:green" if r["correct"] else "tab:red" for r in rows]
+    ax.bar(range(len(rows)), vals, color=cols)
+    ax.set_xticks(range(len(rows)), labels, rotation=60, ha="right", fontsize=7)
+    ax.set_ylabel("held-out shrink 1 - rms_after/rms_before [-]")
+    ax.set_title("How far the gap shrinks on held-out data (green: verdict names the withheld effect)", fontsize=10)
+    ax.grid(alpha=0.3, axis="y")
+    fig.tight_layout()
+    return fig
