@@ -76,9 +76,11 @@ def main(argv=None) -> int:
         + (f"; nonlinear simulation {mv['nonlinear_u0'] * 1e3:.1f} mm/s "
            f"(S_e = {mv['nonlinear_exhaust_area'] * 1e6:.3f} mm^2)." if "nonlinear_u0" in mv else "."),
         "![influence](influence.png)",
-        "Each variable scaled 0.5..2 (paper B Fig. 6): a larger friction drop or bore moves the point into the "
-        "stick-slip region; a larger viscous coefficient C or exhaust area S_e moves it out; supply pressure, "
-        "load mass and stroke act mainly through zeta*.",
+        "Each variable scaled 0.5..2 (paper B Fig. 6); D*/D*_cr at x0.5 -> x2 (above 1 = stick-slip):",
+        md_table(["variable", "x0.5", "x1", "x2", "doubling it"],
+                 [(v, *(d / SS.critical_D(z) for d, z in zip(r["D"][::2], r["zeta"][::2])),
+                   "more stick-slip" if r["D"][-1] / SS.critical_D(r["zeta"][-1]) > r["D"][2] / SS.critical_D(r["zeta"][2])
+                   else "less stick-slip") for v, r in res["influence"].items()]),
     ])
     return 0
 

@@ -137,7 +137,7 @@ def run(state, t_end, h, PP, FPB, moved, stop_at_stick, out, out_every):
     for i in range(n_steps + 1):
         if i % out_every == 0 and pos < nout:
             if mode == STUCK:
-                Ff = drive_force(Pa, Pb, PP)
+                Ff = _push(drive_force(Pa, Pb, PP), x, L)  # a cover takes the rest
             else:
                 Ff = d * branch_magnitude(d * v, peak, FPB)
             out[pos, 0] = t
@@ -239,20 +239,24 @@ def run_many(states, t_ends, h, PPs, FPBs, moved, stop_at_stick):
     return res
 
 
-def default_step(p) -> float:
-    """RK4 step [s]: resolves the charging chamber's fastest pressure mode and the
-    mechanical mode with margin (h * lambda <= 0.3), at most 0.2 ms."""
+def default_step(p, position: float = 0.0) -> float:
+    """RK4 step [s]: h * lambda <= 0.3 for the fastest linear mode, at most 1 ms.
+
+    Modes: the charging chamber's pressure at its steepest flow slope (pressure
+    ratio 0.995) with the chamber volume at ``position`` [m] (the smallest volume
+    the run will see when the piston moves forward from there; 0 = start cover),
+    the pneumatic spring of that chamber, and the steepest friction slope.
+    """
     PP = p.plant_vector()
     A, k, R, T = p.area, p.kappa, p.gas_constant, p.temperature
-    Va0 = PP[_pn.I_VA0]
+    Va = PP[_pn.I_VA0] + A * position
     Ps = p.supply_abs
-    # slope of the supply flow at the laminar ratio (steepest point of the orifice law)
     dP = Ps * (1 - _pn.LAMINAR_RATIO)
     G = float(_pn.orifice_flow(Ps, Ps - dP, p.supply_area, T, k, R))
-    lam_p = k * R * T * (G / dP) / Va0
-    lam_m = np.sqrt(k * Ps * A * A / (p.mass * Va0))
+    lam_p = k * R * T * (G / dP) / Va
+    lam_m = np.sqrt(k * Ps * A * A / (p.mass * Va))
     lam_f = (p.viscous_coefficient + 2 * (p.start_static_force - p.coulomb_force) / p.critical_velocity) / p.mass
-    return float(min(2e-4, 0.3 / max(lam_p, lam_m, lam_f)))
+    return float(min(1e-3, 0.3 / max(lam_p, lam_m, lam_f)))
 
 
 def simulate(p, duration: float, *, h: float | None = None, rate: float = 1000.0, state=None, moved=False,

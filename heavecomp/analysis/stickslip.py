@@ -149,7 +149,7 @@ def grid_map(p, var_x: str, xs, var_y: str, ys, *, convention: str = "paper", po
             t_ends.append(window(lin, periods))
             PPs.append(q.plant_vector())
             FPBs.append(q.friction.FPB)
-            steps.append(PS.default_step(q))
+            steps.append(PS.default_step(q, states[-1][0]))
     hh = h or min(steps)
     args = (np.array(states), np.array(t_ends), hh, np.array(PPs), np.array(FPBs), 1, 1)
     if parallel:
