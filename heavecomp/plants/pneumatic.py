@@ -48,7 +48,6 @@ give u_0 of several tenths of a m/s.  The default S_e = 0.12 mm^2.
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from dataclasses import dataclass
 
