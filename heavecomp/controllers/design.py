@@ -1,0 +1,151 @@
+"""Controller-design experiments: compare controllers, sweep horizon/weights/actuator, robustness.
+
+Compute functions return plain dicts of metrics (and results for figures);
+figure functions take them and return matplotlib figures (save with
+:func:`heavecomp.report.figures.save`).  Used by ``scenarios/controller_design.py``.
+"""
+
+from __future__ import annotations
+
+import logging
+
+import numpy as np
+
+from heavecomp.params import paper_a
+
+log = logging.getLogger(__name__)
+
+#: seas of the study: paper A's sine (1 m, 12 s) and the irregular sea of scenarios/irregular_sea.py
+SEAS = {
+    "sine": None,
+    "jonswap": {"kind": "jonswap", "hs": 2.0, "tp": 12.0, "gamma": 3.3, "seed": 7, "amplitude": None,
+                "period": None, "ramp": 60.0},
+}
+REGIMES = ("none", "rotating_eq7", "stribeck")
+CONTROLLERS = ("passive", "pid", "linear-mpc", "nonlinear-mpc")
+#: metrics kept per run
+KEYS = ("wob_std", "wob_p2p", "u_active_max", "u_active_rms", "solve_time_ms_p50", "solve_time_ms_p99",
+        "violations_u_max", "violations_rate", "solver_failures", "fallbacks", "saturated_steps",
+        "preview_rmse_end_m", "heave_std", "stick_fraction")
+
+
+def case_params(regime: str, sea: str, active: dict | None = None):
+    """Paper A parameters for a friction regime and a sea (optionally another [active] table)."""
+    p = paper_a(regime)
+    if SEAS[sea] is not None:
+        p = p.replace(heave=SEAS[sea])
+    if active:
+        p = p.replace(active=active)
+    return p
+
+
+def run_case(regime: str, sea: str, controller: str, duration: float, *, active=None, keep=False, **options):
+    """One closed-loop run; returns its metrics (and the result when ``keep``)."""
+    from heavecomp.simulate.closed_loop import simulate_closed_loop
+
+    p = case_params(regime, sea, active)
+    res = simulate_closed_loop(p, controller, duration, **({} if controller == "passive" else options))
+    m = res.metrics()
+    out = {k: m.get(k) for k in KEYS}
+    log.info("%-13s %-12s %-7s %s: WOB std %.2f kN, |u| max %.1f kN, p99 %.2f ms", controller, regime, sea,
+             options or "", m["wob_std"] / 1e3, m["u_active_max"] / 1e3, m["solve_time_ms_p99"])
+    return (out, res) if keep else out
+
+
+def compare(regimes, seas, controllers, durations: dict, options: dict | None = None):
+    """Metrics table[sea][regime][controller] and the results of the first sea's runs (for figures)."""
+    table, kept = {}, {}
+    for sea in seas:
+        table[sea] = {}
+        for reg in regimes:
+            table[sea][reg] = {}
+            for c in controllers:
+                m, res = run_case(reg, sea, c, durations[sea], keep=True, **(options or {}).get(c, {}))
+                table[sea][reg][c] = m
+                kept[(sea, reg, c)] = res
+    return table, kept
+
+
+def sweep(regime, sea, controller, duration, name, values, **fixed):
+    """Metrics for each value of one option (``name`` is a ControllerConfig field or ``u_max``/``rate_max``)."""
+    rows = []
+    for v in values:
+        if name in ("u_max", "rate_max"):
+            m = run_case(regime, sea, controller, duration, active={name: v}, **fixed)
+        else:
+            m = run_case(regime, sea, controller, duration, **{name: v}, **fixed)
+        rows.append({"value": v, **m})
+    return rows
+
+
+# ------------------------------------------------------------------ figures
+def plot_wob_controllers(results: dict, window, *, title: str):
+    """WOB and active force over time for several controllers (label -> ClosedLoopResult)."""
+    from heavecomp.report.figures import _plt
+
+    plt = _plt()
+    fig, (ax, axu) = plt.subplots(2, 1, figsize=(10, 6.2), sharex=True, gridspec_kw={"height_ratios": [3, 2]})
+    colors = {"passive": "tab:red", "pid": "tab:orange", "linear-mpc": "tab:blue", "nonlinear-mpc": "tab:green"}
+    for label, res in results.items():
+        t = res.t
+        m = (t >= window[0]) & (t <= window[1])
+        ax.plot(t[m], res["wob"][m] / 1e3, lw=1.2, color=colors.get(label), label=label)
+        axu.plot(t[m], res["u_active"][m] / 1e3, lw=1.0, color=colors.get(label), label=label)
+    first = next(iter(results.values()))
+    u_max = first.control["u_max"]
+    for s in (-1, 1):
+        axu.axhline(s * u_max / 1e3, color="0.5", ls="--", lw=0.8)
+    ax.axhline(first.params.operating_point.wob_setpoint / 1e3, color="0.5", lw=0.8)
+    ax.set_ylabel("WOB [kN]")
+    axu.set_ylabel("active force u [kN]")
+    axu.set_xlabel("time t [s]")
+    ax.set_title(title, fontsize=10)
+    ax.legend(fontsize=8, loc="upper right")
+    ax.grid(alpha=0.3)
+    axu.grid(alpha=0.3)
+    fig.tight_layout()
+    return fig
+
+
+def plot_std_table(table: dict, sea: str, *, title: str):
+    """Grouped bars: WOB std per friction regime and controller."""
+    from heavecomp.report.figures import REGIME_LABELS, _plt
+
+    plt = _plt()
+    fig, ax = plt.subplots(figsize=(9, 4.2))
+    regs = list(table[sea])
+    ctrls = list(table[sea][regs[0]])
+    w = 0.8 / len(ctrls)
+    x = np.arange(len(regs))
+    for i, c in enumerate(ctrls):
+        vals = [table[sea][r][c]["wob_std"] / 1e3 for r in regs]
+        bars = ax.bar(x - 0.4 + (i + 0.5) * w, vals, w, label=c)
+        ax.bar_label(bars, fmt="%.1f", fontsize=7)
+    ax.set_xticks(x, [REGIME_LABELS.get(r, r) for r in regs], fontsize=8)
+    ax.set_ylabel("WOB standard deviation [kN]")
+    ax.set_title(title, fontsize=10)
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3, axis="y")
+    fig.tight_layout()
+    return fig
+
+
+def plot_sweeps(sweeps: dict, passive_std: float, *, title: str):
+    """One panel per swept option: WOB std (left axis) against the option value."""
+    from heavecomp.report.figures import _plt
+
+    plt = _plt()
+    n = len(sweeps)
+    fig, axes = plt.subplots(1, n, figsize=(3.3 * n, 3.6), squeeze=False)
+    for ax, (label, (unit, rows)) in zip(axes[0], sweeps.items()):
+        for ctrl, rr in rows.items():
+            ax.plot([r["value"] for r in rr], [r["wob_std"] / 1e3 for r in rr], "o-", label=ctrl)
+        ax.axhline(0.2 * passive_std / 1e3, color="k", ls="--", lw=0.8, label="goal: 20 % of passive")
+        ax.set_xlabel(f"{label} [{unit}]")
+        ax.set_ylabel("WOB std [kN]")
+        ax.grid(alpha=0.3)
+        ax.set_ylim(bottom=0)
+    axes[0][0].legend(fontsize=7)
+    fig.suptitle(title, fontsize=10)
+    fig.tight_layout()
+    return fig
