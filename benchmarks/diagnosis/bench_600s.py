@@ -1,0 +1,49 @@
+"""Speed of the gap diagnosis: a 600 s run at 50 Hz, all eight candidates, both cores.
+
+Goal (issue 4): <= 120 s on a 2-core machine.  Peers: the budget itself, and the
+foundation's ``simulate()`` of the same 600 s (how many nominal simulations the whole
+diagnosis costs).  Usage::
+
+    python benchmarks/diagnosis/bench_600s.py [--effect dwell_stiction] [--jobs 2]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--effect", default="flow_loss")
+    ap.add_argument("--jobs", type=int, default=2)
+    ap.add_argument("--duration", type=float, default=600.0)
+    args = ap.parse_args(argv)
+
+    from heavecomp.diagnosis.estimator import GapDiagnoser
+    from heavecomp.diagnosis.generator import generate
+    from heavecomp.simulate import simulate
+
+    tr = generate(args.effect, seed=11, duration=args.duration, rate=50.0)
+    run = tr.to_run()
+    simulate(tr.nominal, 10.0, rate=50.0)  # compile / load caches outside the timing
+    GapDiagnoser(tr.nominal, ["flow_loss"], n_jobs=1, second=0).fit(generate("none", duration=30.0).to_run())
+    t0 = time.perf_counter()
+    sim = simulate(tr.nominal, args.duration, rate=50.0)
+    t_sim = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    d = GapDiagnoser(tr.nominal, n_jobs=args.jobs,
+                     progress=lambda f, m: print(f"  [{time.perf_counter() - t0:6.1f} s] {m}", file=sys.stderr)).fit(run)
+    t_diag = time.perf_counter() - t0
+    out = {"duration_s": args.duration, "rate_hz": 50.0, "n_samples": int(run.t.size), "candidates": 8,
+           "jobs": args.jobs, "diagnosis_wall_s": t_diag, "budget_s": 120.0, "ratio_to_budget": t_diag / 120.0,
+           "foundation_simulate_600s_wall_s": t_sim, "diagnosis_in_foundation_simulations": t_diag / t_sim,
+           "withheld": args.effect, "verdict": d.verdict_["effect"], "shrink": d.verdict_["shrink"]}
+    print(json.dumps(out, indent=2))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

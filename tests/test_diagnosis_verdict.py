@@ -1,0 +1,70 @@
+"""Verdicts end to end: the quick withheld-effect benchmark (scenario), the CLI on a generated run with
+dropouts and jittered sampling, and the Python API's contract fields."""
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+CONTRACT_EFFECTS = {"friction_lag", "dwell_stiction", "pressure_friction", "gas_heat_transfer", "flow_loss",
+                    "string_damping", "sensor_delay", "parameter_mismatch", "none", "inconclusive"}
+
+
+@pytest.mark.slow
+def test_withheld_effects_scenario_quick(tmp_path):
+    r = subprocess.run([sys.executable, str(ROOT / "scenarios" / "withheld_effects.py"), "--quick", "--out",
+                        str(tmp_path)], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr[-2000:]
+    m = json.loads((tmp_path / "metrics.json").read_text())
+    runs = {x["truth"]: x for x in m["runs"]}
+    # no effect -> the gap is at the noise floor
+    assert runs["none"]["verdict"] == "none"
+    # a withheld orifice loss is named and the held-out gap really shrinks
+    assert runs["flow_loss"]["verdict"] == "flow_loss"
+    assert runs["flow_loss"]["shrink"] > 0.2
+    assert runs["flow_loss"]["fitted_parameters"]["resistance"] > 0
+    s = m["summary"]
+    assert s["accuracy"] == pytest.approx(sum(x["correct"] for x in m["runs"]) / len(m["runs"]))
+    assert sum(sum(r.values()) for r in s["confusion"].values()) == len(m["runs"])
+    assert (tmp_path / "confusion.png").stat().st_size > 5000 and (tmp_path / "report.md").is_file()
+
+
+def test_cli_diagnose_contract_json(tmp_path):
+    from heavecomp.diagnosis.generator import generate
+    from heavecomp.params import dumps
+
+    tr = generate("sensor_delay", seed=5, duration=90.0, jitter=True, dropouts=True)
+    f = tr.to_csv(tmp_path / "run.csv")
+    toml = tmp_path / "nom.toml"
+    toml.write_text(dumps(tr.nominal))
+    r = subprocess.run([sys.executable, "-m", "heavecomp.cli", "diagnose", str(f), "--params", str(toml), "--out",
+                        str(tmp_path / "out"), "--candidates", "sensor_delay,flow_loss,string_damping"],
+                       capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr[-2000:]
+    d = json.loads((tmp_path / "out" / "diagnosis.json").read_text())
+    assert d["schema"] == 1
+    v = d["verdict"]
+    assert {"effect", "confidence", "parameters", "shrink"} <= set(v)
+    assert v["effect"] in CONTRACT_EFFECTS and v["confidence"] in ("high", "medium", "low")
+    # the lagged channel is found and the delay is of the order of the generated sensor lag
+    lag = tr.truth["parameters"]["sensor_delay"]
+    assert v["effect"] == "sensor_delay" and v["parameters"]["channel"] == lag["channel"]
+    assert 0.5 * lag["lag_time"] < v["parameters"]["delay"] < 1.5 * lag["lag_time"]
+    assert v["shrink"] > 0.3
+    g = d["gap"]
+    assert set(g["channels"]) == {"wob", "stroke", "pressure"}
+    assert all({"rms", "nrmse"} <= set(g["channels"][c]) for c in g["channels"])
+    assert set(g["where"]["regimes"]) == {"stuck", "breakaway", "sliding_accelerating", "sliding_decelerating"}
+    assert set(g["where"]["bands"]) == {"below_wave", "wave", "resonance", "above"}
+    assert sum(g["where"]["regimes"].values()) == pytest.approx(1.0, abs=1e-6)
+    assert sum(g["where"]["bands"].values()) == pytest.approx(1.0, abs=0.02)
+    assert [c["score"] for c in d["candidates"]] == sorted((c["score"] for c in d["candidates"]), reverse=True)
+    for c in d["candidates"]:
+        assert {"effect", "parameters", "rms_before", "rms_after", "shrink", "score"} <= set(c)
+    assert d["split"]["fit"][1] == pytest.approx(d["split"]["validate"][0])
+    assert any("non-uniform" in w for w in d["warnings"]) and any("missing" in w for w in d["warnings"])
+    for name in ("report.md", "where.png", "spectra.png", "overlay.png"):
+        assert (tmp_path / "out" / name).is_file()
