@@ -39,6 +39,8 @@ def test_unknown_controller_and_option_are_input_errors():
         make("lqr", paper_a())
     with pytest.raises(InputError, match="controller option 'horizn': unknown .*'horizon'"):
         make("pid", paper_a(), horizn=5)
+    with pytest.raises(InputError, match="controller option nlp_solver = 'cvx': not one of sqp, ipopt"):
+        make("nonlinear-mpc", paper_a(), nlp_solver="cvx")
 
 
 # ---------------------------------------------------------------- linear model

@@ -6,8 +6,10 @@
    optimal-control helper) on the same regulation QP (same discrete model, horizon, quadratic
    cost on WOB and force, force bounds) from the same initial states.  Ours: osqp set up once,
    linear term updated, warm-started.
-3. Nonlinear MPC vs a do-mpc-style setup that builds a fresh ``casadi.Opti`` problem each step
-   (same NLP, ipopt, cold start).
+3. Nonlinear MPC (prebuilt nlpsol, warm-started; SQP + qrqp by default, ipopt as option) vs a
+   do-mpc-style setup that builds a fresh ``casadi.Opti`` problem each step (same NLP, ipopt,
+   cold start).  The peer's instances are the parameter vectors the ipopt controller saw in a
+   closed-loop run.
 
 Usage: python benchmarks/mpc/bench_mpc.py [--quick]   (writes benchmarks/mpc/results.json)
 """
@@ -29,8 +31,8 @@ def in_loop(duration):
     from heavecomp.simulate.closed_loop import simulate_closed_loop
 
     out = {}
-    for c in ("linear-mpc", "nonlinear-mpc"):
-        m = simulate_closed_loop(paper_a("stribeck"), c, duration).metrics()
+    for c, opts in (("linear-mpc", {}), ("nonlinear-mpc", {}), ("nonlinear-mpc-ipopt", {"nlp_solver": "ipopt"})):
+        m = simulate_closed_loop(paper_a("stribeck"), c.replace("-ipopt", ""), duration, **opts).metrics()
         out[c] = {k: m[k] for k in ("solve_time_ms_p50", "solve_time_ms_p99", "solve_time_ms_max",
                                     "n_control_steps", "solver_failures", "wob_std")}
     return out
@@ -104,7 +106,7 @@ def nonlinear_vs_fresh_opti(n_peer):
 
     ca = casadi()
     p = paper_a("stribeck")
-    ctrl = make("nonlinear-mpc", p)
+    ctrl = make("nonlinear-mpc", p, nlp_solver="ipopt")
     inst = []
     orig_solver = ctrl.solver
 
@@ -188,7 +190,9 @@ def main(argv=None):
     t_nl, ok = nonlinear_vs_fresh_opti(5 if quick else 20)
     il = res["in_loop"]["nonlinear-mpc"]
     res["nonlinear"] = {
-        "ours_step_ms": {"p50": il["solve_time_ms_p50"], "p99": il["solve_time_ms_p99"]},
+        "ours_step_ms": {"p50": il["solve_time_ms_p50"], "p99": il["solve_time_ms_p99"], "solver": "sqpmethod+qrqp"},
+        "ours_ipopt_step_ms": {"p50": res["in_loop"]["nonlinear-mpc-ipopt"]["solve_time_ms_p50"],
+                               "p99": res["in_loop"]["nonlinear-mpc-ipopt"]["solve_time_ms_p99"]},
         "peer_fresh_opti_ms": {"p50": pct(t_nl, 50), "p99": pct(t_nl, 99), "n": len(t_nl), "solved": ok},
         "ratio_p50_peer_over_ours": pct(t_nl, 50) / il["solve_time_ms_p50"],
     }

@@ -82,6 +82,10 @@ class ControllerConfig:
     observer_sigma_d : float [N]
         Random-walk std per interval of the observer's force disturbance (how fast
         it follows friction changes).
+    nlp_solver : {"sqp", "ipopt"}
+        Nonlinear MPC solver: casadi sqpmethod + qrqp (default) or ipopt.
+    sqp_iterations : int
+        Largest number of SQP iterations per control step.
     predictor_order : int
         Order of the AR heave predictor (on 5 Hz block means).
     predictor_window : float [s]
@@ -104,6 +108,8 @@ class ControllerConfig:
     kd: float = 0.0
     pid_tf: float = 0.2
     observer_sigma_d: float = 1e3
+    nlp_solver: str = "sqp"
+    sqp_iterations: int = 3
     predictor_order: int = 10
     predictor_window: float = 60.0
 
@@ -129,6 +135,8 @@ class ControllerConfig:
             if k not in names:
                 raise InputError(f"controller option {k!r}: unknown{did_you_mean(k, names)}")
         kw.update(overrides)
+        if kw.get("nlp_solver", "sqp") not in ("sqp", "ipopt"):
+            raise InputError(f"controller option nlp_solver = {kw['nlp_solver']!r}: not one of sqp, ipopt")
         return cls(**kw)
 
 

@@ -1,4 +1,4 @@
-"""Nonlinear MPC (casadi + ipopt) on the smooth-friction CMC, warm-started.
+"""Nonlinear MPC (casadi: SQP with qrqp, or ipopt) on the smooth-friction CMC, warm-started.
 
 Prediction model: :func:`heavecomp.plants.cmc.casadi_model` with the friction
 law of the parameter file (paper A eq. 4/6/7) regularised with width
@@ -17,8 +17,14 @@ NLP (N intervals, decision variables X_0..X_N, U_0..U_{N-1})::
 
 The NLP is built once (a casadi ``nlpsol`` with the horizon data as parameters)
 and warm-started from the previous solution shifted by one interval (primal and
-dual).  A failed solve (ipopt status other than success / acceptable) falls back
-to the previous plan shifted (counted in ``solver_failures`` / ``fallbacks``).
+dual).  Solver (``ControllerConfig.nlp_solver``): ``"sqp"`` (default) —
+casadi's ``sqpmethod`` with the exact Hessian and the active-set QP solver
+``qrqp``, at most ``sqp_iterations`` (3) iterations per step (a real-time-iteration
+scheme: from the shifted warm start it usually converges within them); or
+``"ipopt"`` (interior point, up to 40 iterations).  A failed solve (an
+exception, a status other than success / acceptable / iteration limit for SQP,
+a non-finite iterate) falls back to the previous plan shifted (counted in
+``solver_failures`` / ``fallbacks``).
 """
 
 from __future__ import annotations
@@ -106,10 +112,21 @@ class NonlinearMPC(LinearMPC):
         g[0] = g[0] * 1e3
         w = ca.vertcat(ca.vec(X), U)
         nlp = {"x": w, "f": J, "g": ca.vertcat(*g), "p": P}
-        opts = {"ipopt.print_level": 0, "print_time": False, "ipopt.max_iter": 40, "ipopt.tol": 1e-6,
-                "ipopt.acceptable_tol": 1e-3, "ipopt.acceptable_iter": 3, "ipopt.warm_start_init_point": "yes",
-                "ipopt.mu_init": 1e-3, "ipopt.sb": "yes", "ipopt.linear_solver": "mumps"}
-        self.solver = ca.nlpsol("nmpc", "ipopt", nlp, opts)
+        if cfg.nlp_solver == "ipopt":
+            opts = {"ipopt.print_level": 0, "print_time": False, "ipopt.max_iter": 40, "ipopt.tol": 1e-6,
+                    "ipopt.acceptable_tol": 1e-3, "ipopt.acceptable_iter": 3,
+                    "ipopt.warm_start_init_point": "yes", "ipopt.mu_init": 1e-3, "ipopt.sb": "yes"}
+            self.solver = ca.nlpsol("nmpc", "ipopt", nlp, opts)
+            self._ok = _OK
+        else:  # "sqp": sequential QP (exact Hessian, casadi's active-set qrqp), a few warm iterations
+            opts = {"qpsol": "qrqp", "qpsol_options": {"print_iter": False, "print_header": False,
+                                                       "error_on_fail": False},
+                    "max_iter": cfg.sqp_iterations, "print_header": False, "print_iteration": False,
+                    "print_status": False, "print_time": False, "error_on_fail": False}
+            self.solver = ca.nlpsol("nmpc", "sqpmethod", nlp, opts)
+            # real-time iteration: the iterate after max_iter warm SQP steps is used
+            # (input bounds and rate limits are linear, so every QP iterate satisfies them)
+            self._ok = _OK + ("Maximum_Iterations_Exceeded", "SOLVER_RET_LIMITED")
         nx = 4 * (N + 1)
         umax, dumax = cfg.u_max / KN, cfg.du_max / KN
         self._lbx = np.r_[-np.inf * np.ones(nx), -umax * np.ones(N)]
@@ -152,7 +169,7 @@ class NonlinearMPC(LinearMPC):
             sol = self.solver(x0=w0, p=P, lbx=self._lbx, ubx=self._ubx, lbg=self._lbg, ubg=self._ubg, **args)
             status = self.solver.stats().get("return_status", "")
             wsol = np.array(sol["x"]).ravel()
-            ok = status in _OK and np.all(np.isfinite(wsol))
+            ok = status in self._ok and np.all(np.isfinite(wsol))
         except RuntimeError as exc:  # casadi raises on evaluation errors
             status, ok = f"error: {exc}", False
         if ok:
