@@ -134,21 +134,31 @@ def plot_influence(inf, zc, Dc):
 
 
 def plot_cmc_map(m, breakout):
-    """Stick fraction of the CMC main cylinder over heave amplitude x period, one panel per law."""
+    """CMC main cylinder over heave amplitude x period, one column per friction law:
+    fraction of time stuck (top) and mean duration of one stick (bottom)."""
     plt = _plt()
     models = [k for k in m if k not in ("amplitudes", "periods")]
-    fig, axs = plt.subplots(1, len(models), figsize=(4.6 * len(models), 4.2), sharey=True)
+    fig, axs = plt.subplots(2, len(models), figsize=(4.6 * len(models), 7.6), sharey=True, sharex=True,
+                            squeeze=False)
     A, T = m["amplitudes"], m["periods"]
-    for ax, mod in zip(np.atleast_1d(axs), models):
-        im = ax.pcolormesh(A, T, m[mod]["stick_fraction"], vmin=0, vmax=1, cmap="viridis", shading="nearest")
-        ax.plot(breakout[mod], T, "w--", lw=1.5, label="breakout estimate (zero stroke to the left)")
-        ax.set_xscale("log")
-        ax.set_xlabel("heave amplitude [m]")
-        ax.set_title(mod, fontsize=10)
-        ax.legend(fontsize=7, loc="upper right")
-    np.atleast_1d(axs)[0].set_ylabel("heave period [s]")
-    fig.colorbar(im, ax=axs, label="fraction of time stuck [-]")
-    fig.suptitle("CMC main cylinder: stuck fraction; rotation (eq. 7) shrinks the zero-stroke region", fontsize=11)
+    vmax_d = max(float(np.max(np.where(m[k]["stick_fraction"] < 0.999, m[k]["mean_stick_s"], 0))) for k in models)
+    for c, mod in enumerate(models):
+        top, bot = axs[0, c], axs[1, c]
+        im = top.pcolormesh(A, T, m[mod]["stick_fraction"], vmin=0, vmax=1, cmap="viridis", shading="nearest")
+        dur = np.where(m[mod]["stick_fraction"] < 0.999, m[mod]["mean_stick_s"], np.nan)
+        im2 = bot.pcolormesh(A, T, dur, vmin=0, vmax=max(vmax_d, 1e-3), cmap="magma", shading="nearest")
+        for ax in (top, bot):
+            ax.plot(breakout[mod], T, "w--", lw=1.5, label="breakout estimate (zero stroke to the left)")
+            ax.set_xscale("log")
+        top.set_title(mod, fontsize=10)
+        top.legend(fontsize=7, loc="lower right")
+        bot.set_xlabel("heave amplitude [m]")
+    axs[0, 0].set_ylabel("heave period [s]")
+    axs[1, 0].set_ylabel("heave period [s]")
+    fig.colorbar(im, ax=axs[0, :], label="fraction of time stuck [-]")
+    fig.colorbar(im2, ax=axs[1, :], label="mean duration of one stick [s] (blank: never slides)")
+    fig.suptitle("CMC main cylinder: where it sticks and for how long; rotation (eq. 6, eq. 7) shrinks "
+                 "the zero-stroke region", fontsize=11)
     return fig
 
 
