@@ -78,7 +78,10 @@ def discharge_conductance(p, Pb: float) -> float:
     r = p.atmosphere / Pb
     bcr = critical_ratio(k)
     if r > LAMINAR_RATIO:
-        raise ValueError("equilibrium pressure ratio is in the laminar end zone")
+        from heavecomp.errors import ParameterError
+
+        raise ParameterError("pneumatic.supply_pressure: the equilibrium exhaust pressure ratio is above 0.995 "
+                             "(supply too low to linearise the exhaust flow)")
     if r <= bcr:
         psi = math.sqrt(bcr ** (2 / k) - bcr ** ((k + 1) / k))
         return p.exhaust_area * K * psi
