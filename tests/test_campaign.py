@@ -236,6 +236,17 @@ def test_variants_grid_and_sample():
     assert len(g.variants) == 6 and len(g.runs()) == 6 * len(spec.loads(TINY).runs())
     p = g.params_for(next(r for r in g.runs() if r.variant == "v005"))
     assert (p.drill_string.stiffness, p.formation.stiffness) == (2.08e6, 2e5)
+    # the variant reaches the plant: the batch row of a softer formation equals simulate() with that k_F
+    from heavecomp.campaign.batch import simulate_batch
+    from heavecomp.simulate import simulate
+
+    pick = [r for r in g.runs() if r.regime == "none" and r.sea_state == 1 and r.variant in ("v003", "v005")][:2]
+    rows = {row["variant"]: row for row in simulate_batch(g, pick)}
+    assert rows["v005"]["formation.stiffness"] == 2e5 and rows["v003"]["formation.stiffness"] == 1e6
+    for run in pick:
+        ref = simulate(g.params_for(run), g.settings.duration).metrics()["wob_std"]
+        assert rows[run.variant]["wob_std"] == pytest.approx(ref, rel=1e-10)
+    assert abs(rows["v005"]["wob_std"] / rows["v003"]["wob_std"] - 1) > 0.02
     s = spec.loads(TINY + '\n[variations]\nmode = "sample"\nn = 5\nseed = 1\n[variations.sample]\n'
                    '"friction.static_force" = [15e3, 30e3]\n')
     vals = [dict(v.overrides)["friction.static_force"] for v in s.variants]

@@ -43,10 +43,19 @@ def plot_long_term(st: dict, *, title=None):
     return fig
 
 
+def _panel_groups(st, max_panels=4):
+    """Groups drawn as panels: all, or (many variants) the regimes of the first variant."""
+    groups = list(st["groups"].items())
+    if len(groups) <= max_panels:
+        return groups, ""
+    first = groups[0][1]["variant"]
+    return [(k, g) for k, g in groups if g["variant"] == first], f" (variant {first} only; all in statistics.json)"
+
+
 def plot_short_term(st: dict, *, title=None):
     """Short-term P(|dW| > x) per sea state, one panel per regime, coloured by H_s."""
     plt = _plt()
-    groups = list(st["groups"].items())
+    groups, note = _panel_groups(st)
     fig, axes = plt.subplots(1, len(groups), figsize=(4.2 * len(groups), 4), sharey=True, squeeze=False)
     x = np.asarray(st["x_abs"]) / 1e3
     hs_all = sorted({s["hs"] for _, g in groups for s in g["short_term"]})
@@ -64,14 +73,14 @@ def plot_short_term(st: dict, *, title=None):
     sm = plt.cm.ScalarMappable(cmap=cmap, norm=plt.Normalize(min(hs_all), max(hs_all)))
     fig.colorbar(sm, ax=axes[0].tolist(), label="platform heave H_s [m]")
     fig.suptitle(title or "Short-term WOB exceedance per sea state (one line per H_s x T_p cell): "
-                 "H_s sets the tail", fontsize=10)
+                 "H_s sets the tail" + note, fontsize=10)
     return fig
 
 
 def plot_band_maps(st: dict, campaign, *, title=None):
     """Fraction of time outside the tolerance band on the H_s x T_p grid, per regime."""
     plt = _plt()
-    groups = list(st["groups"].items())
+    groups, note = _panel_groups(st)
     hs, tp = campaign.scatter.hs, campaign.scatter.tp
     fig, axes = plt.subplots(1, len(groups), figsize=(3.8 * len(groups), 3.6), squeeze=False)
     for ax, (key, g) in zip(axes[0], groups):
@@ -91,8 +100,8 @@ def plot_band_maps(st: dict, campaign, *, title=None):
         ax.set_title(REGIME_LABELS.get(g["regime"], g["regime"]) + f" [{g['variant']}]", fontsize=8)
     axes[0][0].set_ylabel("platform heave H_s [m]")
     fig.colorbar(im, ax=axes[0].tolist(), label="time outside the band [-] (cells: %)")
-    fig.suptitle(title or f"Share of time with WOB outside W0 +- {st['band_half_width'] / 1e3:.0f} kN per sea state",
-                 fontsize=10)
+    fig.suptitle(title or f"Share of time with WOB outside W0 +- {st['band_half_width'] / 1e3:.0f} kN per sea state"
+                 + note, fontsize=10)
     return fig
 
 
@@ -147,6 +156,7 @@ def write_report(out_dir, campaign, st: dict, run_info=None) -> Path:
             f"| regime | variant | RMS WOB std [kN] | time outside band [%] | P(leave band within {T:g} s) | "
             "band exits per hour | dW exceeded 1 % of time [kN] | dW exceeded 0.1 % of time [kN] | stuck [%] |",
             "|---|---|---|---|---|---|---|---|---|", *rows, "",
+            *_variant_lines(campaign),
             "## Method", "",
             "Each run is the exact stick-slip simulation of `heavecomp.simulate` (same stepper, step and JONSWAP "
             "heave; the batch path is tested against single runs). WOB is sampled at "
@@ -163,6 +173,18 @@ def write_report(out_dir, campaign, st: dict, run_info=None) -> Path:
     path = out / "report.md"
     path.write_text("\n".join(text))
     return path
+
+
+def _variant_lines(campaign):
+    if len(campaign.variants) <= 1 and not campaign.variants[0].overrides:
+        return []
+    keys = list(dict(campaign.variants[0].overrides))
+    lines = ["## Variants", "", "| variant | " + " | ".join(f"`{k}`" for k in keys) + " |",
+             "|---|" + "---|" * len(keys)]
+    for v in campaign.variants:
+        d = dict(v.overrides)
+        lines.append(f"| {v.name} | " + " | ".join(f"{d[k]:.6g}" for k in keys) + " |")
+    return lines + [""]
 
 
 def _clean(x, digits=None):

@@ -153,6 +153,7 @@ def statistics(campaign, table: dict) -> dict:
                 "dev_exceeded_1e-2": level_at(x_abs, lt_abs, 1e-2),
                 "dev_exceeded_1e-3": level_at(x_abs, lt_abs, 1e-3),
                 "probability_covered": float(p.sum()),
+                "band_half_width": float(np.max(table["band_half_width"][sel])),
             }
             groups[f"{reg}/{var.name}"] = {"regime": reg, "variant": var.name, "short_term": states, "long_term": lt}
     effect = {}
