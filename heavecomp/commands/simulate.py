@@ -44,12 +44,14 @@ def _run_closed_loop(args, params, Progress) -> int:
     """Active heave compensation: controller in the loop (heavecomp.simulate.closed_loop)."""
     from pathlib import Path
 
-    from heavecomp.simulate.closed_loop import simulate_closed_loop, write_closed_loop_outputs
+    from heavecomp.params.cmc import active
+    from heavecomp.simulate.closed_loop import output_every, simulate_closed_loop, write_closed_loop_outputs
 
+    output_every(args.rate, active(params).control_rate)  # bad --rate fails before the run
     bar = Progress(f"simulate {args.duration:g} s, {args.controller}")
     res = simulate_closed_loop(params, args.controller, args.duration, dt=args.dt, progress=bar)
     m = write_closed_loop_outputs(res, args.out, title=f"WOB — {Path(args.params).name}, friction: "
-                                  f"{params.friction.model}, controller: {args.controller}")
+                                  f"{params.friction.model}, controller: {args.controller}", rate=args.rate)
     print(f"WOB std {m['wob_std'] / 1e3:.2f} kN, peak-to-peak {m['wob_p2p'] / 1e3:.2f} kN, "
           f"|u_active| max {m['u_active_max'] / 1e3:.1f} kN, solve p50/p99 {m['solve_time_ms_p50']:.2f}/"
           f"{m['solve_time_ms_p99']:.2f} ms, fallbacks {m['fallbacks']} -> {args.out}")
