@@ -130,3 +130,15 @@ def test_cli_bad_active_table_exits_2_with_one_line(tmp_path):
     assert r.returncode == 2
     assert r.stderr.strip() == ("heavecomp simulate: error: active.u_max = -1 N is outside the possible "
                                 "range (0, 1e+08] N")
+
+
+def test_cli_closed_loop_rate_must_divide_the_control_rate(tmp_path):
+    f = tmp_path / "p.toml"
+    f.write_text(dumps(paper_a()))
+    r = subprocess.run([sys.executable, "-m", "heavecomp.cli", "simulate", str(f), "--duration", "10",
+                        "--out", str(tmp_path / "o"), "--controller", "pid", "--rate", "7"],
+                       capture_output=True, text=True)
+    assert r.returncode == 2
+    assert r.stderr.strip() == ("heavecomp simulate: error: --rate 7 Hz: a closed-loop run writes at the control "
+                                "rate [active].control_rate = 20 Hz or an integer fraction of it")
+    assert not (tmp_path / "o").exists()  # checked before simulating

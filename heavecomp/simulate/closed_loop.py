@@ -75,8 +75,16 @@ class ClosedLoopResult(SimulationResult):
         m["u_active_rms"] = float(np.sqrt(np.mean(u[w] ** 2))) if np.any(w) else 0.0
         return m
 
-    def to_csv(self, path, columns=CL_CSV_COLUMNS) -> Path:
-        return super().to_csv(path, columns)
+    def to_csv(self, path, columns=CL_CSV_COLUMNS, every: int = 1) -> Path:
+        """Write the CSV with every ``every``-th row (rows are at the control rate)."""
+        if every == 1:
+            return super().to_csv(path, columns)
+        full = self.data
+        try:
+            self.data = full[::every]
+            return super().to_csv(path, columns)
+        finally:
+            self.data = full
 
 
 def _percentile_ms(x, q):
@@ -244,11 +252,28 @@ def _preview_error(previews, hs, sp, Tc, K) -> dict:
             "preview_rmse_end_m": float(rms[-1]), "preview_horizon_s": float(Tc * (z.size - 1))}
 
 
-def write_closed_loop_outputs(res: ClosedLoopResult, out_dir, *, title: str | None = None) -> dict:
-    """Write ``timeseries.csv`` (with ``u_active``), ``metrics.json`` and ``wob.png``."""
+def output_every(rate: float | None, control_rate: float) -> int:
+    """Rows per written row for an output ``rate`` [Hz] (None: the control rate)."""
+    from heavecomp.errors import InputError
+
+    if rate is None:
+        return 1
+    ratio = control_rate / rate if rate > 0 else math.inf
+    every = int(round(ratio)) if math.isfinite(ratio) else 0
+    if not (every >= 1 and abs(ratio - every) < 1e-9):
+        raise InputError(f"--rate {rate:g} Hz: a closed-loop run writes at the control rate "
+                         f"[active].control_rate = {control_rate:g} Hz or an integer fraction of it")
+    return every
+
+
+def write_closed_loop_outputs(res: ClosedLoopResult, out_dir, *, title: str | None = None,
+                              rate: float | None = None) -> dict:
+    """Write ``timeseries.csv`` (with ``u_active``; at ``rate`` [Hz], which must divide
+    the control rate; default the control rate), ``metrics.json`` and ``wob.png``."""
+    every = output_every(rate, res.control["control_rate"])
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
-    res.to_csv(out_dir / "timeseries.csv")
+    res.to_csv(out_dir / "timeseries.csv", every=every)
     metrics = res.metrics()
     metrics["heave"] = {k: v for k, v in res.heave_info.items() if isinstance(v, (int, float, str))}
     (out_dir / "metrics.json").write_text(json.dumps(metrics, indent=2) + "\n")
