@@ -18,7 +18,11 @@ probabilities p_s (the fraction of time the rig spends in them):
 Cycle peaks (max |dW| between zero up-crossings of dW) are pooled the same
 way; their long-term distribution weights each sea state by p_s nu_s, with
 nu_s its mean cycle rate (cycles per second), as for long-term wave-height
-statistics.
+statistics.  The most probable largest deviation within the exposure T is the
+level x with Q_peak,LT(x) = 1 / (nu_LT T), nu_LT = sum_s p_s nu_s (independent
+peaks assumed; ``nan`` when the histogram range does not reach that level).
+It is not extrapolated beyond the largest simulated peak, so with few seeds
+and an exposure much longer than the simulated time it is a lower bound.
 
 Tolerance band |dW| <= b: per sea state the fraction of time outside, the rate
 of band exits lambda_s (inside -> outside transitions of the sampled WOB per
@@ -154,7 +158,13 @@ def statistics(campaign, table: dict) -> dict:
                 "dev_exceeded_1e-3": level_at(x_abs, lt_abs, 1e-3),
                 "probability_covered": float(p.sum()),
                 "band_half_width": float(np.max(table["band_half_width"][sel])),
+                "cycle_rate": float(pn @ nu),
             }
+            # most probable largest |dW| in the exposure T: the level exceeded by one of the nu T cycle peaks
+            # expected in T (long-term peak distribution; independent peaks assumed)
+            n_exp = lt["cycle_rate"] * T
+            lt["dev_max_in_exposure"] = (level_at(x_abs, lt["exceed_peak"], 1.0 / n_exp)
+                                         if lt["exceed_peak"] and n_exp > 1 else math.nan)
             groups[f"{reg}/{var.name}"] = {"regime": reg, "variant": var.name, "short_term": states, "long_term": lt}
     effect = {}
     for var in campaign.variants:
