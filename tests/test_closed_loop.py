@@ -142,3 +142,14 @@ def test_cli_closed_loop_rate_must_divide_the_control_rate(tmp_path):
     assert r.stderr.strip() == ("heavecomp simulate: error: --rate 7 Hz: a closed-loop run writes at the control "
                                 "rate [active].control_rate = 20 Hz or an integer fraction of it")
     assert not (tmp_path / "o").exists()  # checked before simulating
+
+
+def test_pid_is_stable_without_friction():
+    """No friction = least damping of the top-mass mode: the default PID must not slowly diverge."""
+    p = paper_a("none")
+    res = simulate_closed_loop(p, "pid", 300.0)
+    w, t = res["wob"], res.t
+    early = np.std(w[(t >= 100) & (t < 200)])
+    late = np.std(w[t >= 200])
+    assert late < 1.1 * early
+    assert res.metrics()["wob_std"] < simulate_closed_loop(p, "passive", 300.0).metrics()["wob_std"]

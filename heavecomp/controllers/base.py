@@ -105,7 +105,7 @@ class ControllerConfig:
     gas_stiffness_scale: float = 1.0
     kp: float = 0.5
     ki: float = 0.3
-    kd: float = 0.0
+    kd: float = 0.2
     pid_tf: float = 0.2
     observer_sigma_d: float = 1e3
     nlp_solver: str = "sqp"

@@ -154,7 +154,8 @@ class LinearMPC(Controller):
             return float(self.plan[0])
         self.stats["solver_failures"] += 1
         self.stats["fallbacks"] += 1
-        log.warning("linear MPC: osqp status %r at t = %.2f s; using the shifted previous plan", status, t)
+        (log.warning if self.stats["solver_failures"] <= 5 else log.debug)(
+            "linear MPC: osqp status %r at t = %.2f s; using the shifted previous plan", status, t)
         if self.plan is not None and self.plan.size > 1:
             self.plan = np.r_[self.plan[1:], self.plan[-1]]
             return float(self.plan[0])

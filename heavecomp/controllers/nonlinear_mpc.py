@@ -126,7 +126,9 @@ class NonlinearMPC(LinearMPC):
             self.solver = ca.nlpsol("nmpc", "sqpmethod", nlp, opts)
             # real-time iteration: the iterate after max_iter warm SQP steps is used
             # (input bounds and rate limits are linear, so every QP iterate satisfies them)
-            self._ok = _OK + ("Maximum_Iterations_Exceeded", "SOLVER_RET_LIMITED")
+            # "Search_Direction_Becomes_Too_Small": the SQP step is negligible (converged/stalled)
+            self._ok = _OK + ("Maximum_Iterations_Exceeded", "SOLVER_RET_LIMITED",
+                              "Search_Direction_Becomes_Too_Small")
         nx = 4 * (N + 1)
         umax, dumax = cfg.u_max / KN, cfg.du_max / KN
         self._lbx = np.r_[-np.inf * np.ones(nx), -umax * np.ones(N)]
@@ -186,7 +188,9 @@ class NonlinearMPC(LinearMPC):
         self.stats["solver_failures"] += 1
         self.stats["fallbacks"] += 1
         self._w0 = None
-        log.warning("nonlinear MPC: ipopt status %r at t = %.2f s; using the shifted previous plan", status, t)
+        (log.warning if self.stats["solver_failures"] <= 5 else log.debug)(
+            "nonlinear MPC: %s status %r at t = %.2f s; using the shifted previous plan",
+            self.config.nlp_solver, status, t)
         if self.plan is not None and self.plan.size > 1:
             self.plan = np.r_[self.plan[1:], self.plan[-1]]
             return float(self.plan[0])
