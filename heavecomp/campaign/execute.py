@@ -121,10 +121,21 @@ class _Writer:
             os.fsync(fh.fileno())
 
 
-def _init_worker():
+def _init_worker(parent_pid: int):
+    """Pool worker set-up: one numba thread; exit if the parent dies (e.g. killed by SIGTERM/SIGKILL),
+    instead of lingering as an orphan blocked on the task queue."""
+    import threading
+
     import numba
 
     numba.set_num_threads(1)
+
+    def watch():
+        while os.getppid() == parent_pid:
+            time.sleep(0.5)
+        os._exit(1)
+
+    threading.Thread(target=watch, daemon=True).start()
 
 
 def run_campaign(campaign, out_dir, *, workers: int | None = None, scheduler: str | None = None, client=None,
@@ -196,7 +207,7 @@ def run_campaign(campaign, out_dir, *, workers: int | None = None, scheduler: st
             from concurrent.futures import ProcessPoolExecutor, as_completed
 
             with ProcessPoolExecutor(max_workers=nw, mp_context=mp.get_context("spawn"),
-                                     initializer=_init_worker) as pool:
+                                     initializer=_init_worker, initargs=(os.getpid(),)) as pool:
                 futs = [pool.submit(run_chunk, campaign, ch, 1) for ch in chunks]
                 try:
                     for f in as_completed(futs):
