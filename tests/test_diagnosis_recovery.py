@@ -41,7 +41,7 @@ def _planted(name, values, *, amplitude_hs=2.5, seed=4, params=None):
 
 
 CASES = [
-    ("friction_lag", {"lag_time": 0.5}, 0.3),
+    ("friction_lag", {"lag_time": 3.0, "drop_time": 0.1}, 0.35),
     ("dwell_stiction", {"gain": 1e4, "exponent": 0.5}, 0.3),  # calm sea (H_s 1 m): long dwells
     ("pressure_friction", {"extra_pressure_coefficient": 3e-3}, 0.15),
     ("gas_heat_transfer", {"effective_index": 1.15, "loss_coefficient": 5e4}, 0.15),
@@ -57,7 +57,9 @@ def test_candidate_recovers_planted_parameters(name, values, rtol):
     d = GapDiagnoser(nominal, [name], n_jobs=1, second=0, settle=10.0).fit(run)
     got = d.candidates_[0]["parameters"]
     for k, v in values.items():
-        if isinstance(v, str):
+        if k == "drop_time":  # only weakly identifiable below the dynamics' time scale: must come out fast
+            assert got[k] < 0.3
+        elif isinstance(v, str):
             assert got[k] == v
         else:
             assert got[k] == pytest.approx(v, rel=rtol), (k, got[k], v)

@@ -301,20 +301,50 @@ class GapDiagnoser:
             k = x0.size
             if k <= 2 and start is None:
                 axes = [np.linspace(lo[i] + 0.1 * (hi[i] - lo[i]), hi[i] - 0.1 * (hi[i] - lo[i]),
-                                    self.grid if k == 1 else max(3, self.grid // 2)) for i in range(k)]
+                                    self.grid if k == 1 else max(3, (self.grid + 3) // 2)) for i in range(k)]
                 pts = np.array(np.meshgrid(*axes)).reshape(k, -1).T
                 costs = [float(np.sum(fun(x) ** 2)) for x in pts]
                 c0 = float(np.sum(fun(x0) ** 2))
                 if min(costs) < c0:
                     x0 = pts[int(np.argmin(costs))]
 
-            r = least_squares(fun, x0, bounds=(lo, hi), diff_step=0.03, max_nfev=self.max_nfev, x_scale=1.0,
-                              xtol=1e-3, ftol=1e-4, gtol=1e-6)
+            if k <= 2:
+                r = self._nelder_mead(fun, x0, lo, hi)
+            else:
+                r = least_squares(fun, x0, bounds=(lo, hi), diff_step=0.03, max_nfev=self.max_nfev, x_scale=1.0,
+                                  xtol=1e-3, ftol=1e-4, gtol=1e-6)
             values = cls.from_x(r.x)
             sigma = self._sigma(cls, r)
             out = {"values": values, "sigma": sigma, "nfev": int(r.nfev), "cost": float(2 * r.cost)}
         out["wall_time"] = time.perf_counter() - t0
         return out
+
+    def _nelder_mead(self, fun, x0, lo, hi):
+        """Derivative-free refinement (Nelder-Mead on the clipped parameters; stick-slip costs are
+        piecewise smooth, so finite-difference gradients mislead), then a forward-difference
+        Jacobian at the optimum for the uncertainty.  Returns an object like least_squares'."""
+        import types
+
+        from scipy.optimize import minimize
+
+        def cost(x):
+            r = fun(np.clip(x, lo, hi))
+            return float(r @ r)
+
+        step = 0.08 * (hi - lo)
+        simplex = np.vstack([x0] + [x0 + np.where(np.arange(x0.size) == i, np.where(x0 + step <= hi, step, -step), 0.0)
+                                    for i in range(x0.size)])
+        res = minimize(cost, x0, method="Nelder-Mead",
+                       options={"initial_simplex": simplex, "maxfev": self.max_nfev, "xatol": 1e-3, "fatol": 1e-4})
+        x = np.clip(res.x, lo, hi)
+        f0 = fun(x)
+        J = np.empty((f0.size, x.size))
+        for i in range(x.size):
+            dx = 0.02 * (hi[i] - lo[i]) * (1 if x[i] + 0.02 * (hi[i] - lo[i]) <= hi[i] else -1)
+            xi = x.copy()
+            xi[i] += dx
+            J[:, i] = (fun(xi) - f0) / dx
+        return types.SimpleNamespace(x=x, fun=f0, jac=J, nfev=int(res.nfev) + x.size + 1, cost=0.5 * float(f0 @ f0))
 
     @staticmethod
     def _sigma(cls, r):

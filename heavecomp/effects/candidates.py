@@ -84,16 +84,19 @@ class Candidate:
 # ---------------------------------------------------------------------------
 @dataclass(frozen=True)
 class FrictionLagParams:
-    lag_time: float = q(0.3, "s", bounds=(0.01, 30.0), symbol="T_E",
-                        doc="time constant of the lagged Stribeck excess force")
+    lag_time: float = q(1.0, "s", bounds=(0.01, 100.0), symbol="T_E",
+                        doc="recovery time of the Stribeck excess force (rising towards its steady value)")
+    drop_time: float = q(0.05, "s", bounds=(0.001, 10.0), symbol="T_drop",
+                         doc="relaxation time of the Stribeck excess force while it falls")
 
 
 class FrictionLag(Candidate):
     """``friction_lag``: frictional memory.
 
     The Stribeck excess (F_S - F_C) e^{-|v|/v_S} of paper A eq. 4 is replaced by a
-    state E that follows it with a first-order lag, dE/dt = ((F_S-F_C) e^{-|v|/v_S} - E)/T_E
-    (:func:`heavecomp.effects.terms.lag_rates`).  Accelerating, E stays high
+    state E that follows it with an asymmetric first-order memory,
+    dE/dt = ((F_S-F_C) e^{-|v|/v_S} - E)/T with T = T_E while E rises and T_drop while
+    it falls (:func:`heavecomp.effects.terms.lag_rates`).  Accelerating, E stays high
     (Stribeck-like); decelerating, it stays low (viscous-like) — the hysteresis of
     paper A Fig. 7.  The static limit at rest is F_C + E + C_p|p|.
     """
@@ -101,12 +104,13 @@ class FrictionLag(Candidate):
     name = "friction_lag"
     Params = FrictionLagParams
     states = ("E",)
-    log = ("lag_time",)
+    log = ("lag_time", "drop_time")
     term = "friction_magnitude_fx, lag_rates"
 
     @classmethod
     def write_ep(cls, values, EP):
         EP[T.LAG_T_CAND] = values["lag_time"]
+        EP[T.LAG_TDOWN_CAND] = values["drop_time"]
 
 
 @dataclass(frozen=True)

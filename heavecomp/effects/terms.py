@@ -17,8 +17,9 @@ Pairs (truth law -> fitted candidate law):
 ============================  ===========================================  =============================================
 effect                        generator (truth)                            candidate (fitted)
 ============================  ===========================================  =============================================
-friction_lag                  Stribeck curve evaluated at a first-order    first-order lag of the Stribeck *excess force*
-                              lagged *speed* w, dw/dt = (|v| - w)/T_w      E, dE/dt = ((F_S-F_C) e^{-|v|/v_S} - E)/T_E
+friction_lag                  Stribeck curve evaluated at a first-order    asymmetric memory of the Stribeck *excess force*
+                              lagged *speed* w, dw/dt = (|v| - w)/T_w      E, dE/dt = ((F_S-F_C) e^{-|v|/v_S} - E)/T,
+                                                                           T = T_E rising, T_drop falling
 dwell_stiction                dF (1 - exp(-tau/tau_d)), tau = dwell time   power law a tau^beta
 pressure_friction             k max(p - p_th, 0) (energised seal)           dC_p |p| (linear in pressure)
 gas_heat_transfer             thermal state theta = T/T_0, adiabatic        effective polytropic index n_eff plus a
@@ -53,7 +54,8 @@ FLOW_K_TRUTH = 13      # Pa s^2/m^2  K (truth)
 FLOW_R_CAND = 14       # Pa s/m R (candidate)
 SD_CQ_TRUTH = 15       # N s^2/m^2  c_q (truth)
 SD_C_CAND = 16         # N s/m  c (candidate)
-N_EP = 17
+LAG_TDOWN_CAND = 17    # s      T_drop, relaxation time while the excess falls (candidate)
+N_EP = 18
 
 
 def zero_ep() -> np.ndarray:
@@ -140,12 +142,18 @@ def dwell_gain(tau, EP):
 def lag_rates(v, w, el, FP, EP):
     """(dw/dt, dE/dt) of the friction memory states [m/s^2, N/s].
 
-    Truth: dw/dt = (|v| - w)/T_w.  Candidate: dE/dt = ((F_S-F_C) e^{-|v|/v_S} - E)/T_E.
+    Truth: dw/dt = (|v| - w)/T_w (the Stribeck curve sees a lagged speed).
+    Candidate: the Stribeck excess force E relaxes towards its steady value with an
+    asymmetric memory, dE/dt = ((F_S-F_C) e^{-|v|/v_S} - E)/T, T = T_E (recovery, target
+    above E) or T_drop (target below E; T_drop = T_E when not set).
     """
     tw = EP[LAG_T_TRUTH] + (EP[LAG_T_TRUTH] <= 0.0)
     te = EP[LAG_T_CAND] + (EP[LAG_T_CAND] <= 0.0)
+    td = EP[LAG_TDOWN_CAND] + (EP[LAG_TDOWN_CAND] <= 0.0) * te
     dw = (np.abs(v) - w) / tw * (EP[LAG_T_TRUTH] > 0.0)
-    de = ((FP[0] - FP[1]) * np.exp(-np.abs(v) / FP[2]) - el) / te * (EP[LAG_T_CAND] > 0.0)
+    target = (FP[0] - FP[1]) * np.exp(-np.abs(v) / FP[2])
+    up = target > el
+    de = (target - el) / (te * up + td * (1.0 - up)) * (EP[LAG_T_CAND] > 0.0)
     return dw, de
 
 
