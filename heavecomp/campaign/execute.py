@@ -111,6 +111,9 @@ class _Writer:
         new = self.header is None
         if new:
             self.header = list(rows[0])
+        elif set(rows[0]) != set(self.header):
+            raise InputError(f"{self.path}: its columns differ from this heavecomp version's table "
+                             "(written by another version?); choose another --out")
         with self.path.open("a", newline="") as fh:
             w = csv.DictWriter(fh, fieldnames=self.header, extrasaction="raise")
             if new:
