@@ -107,7 +107,7 @@ class ControllerConfig:
     ki: float = 0.3
     kd: float = 0.2
     pid_tf: float = 0.2
-    observer_sigma_d: float = 1e3
+    observer_sigma_d: float = 300.0
     nlp_solver: str = "sqp"
     sqp_iterations: int = 3
     predictor_order: int = 10
