@@ -49,8 +49,15 @@ def ramp_factor(t, ramp):
 
 
 def _apply_ramp(t, z, dz, ddz, ramp):
-    r, dr, ddr = ramp_factor(t, ramp)
-    return r * z, dr * z + r * dz, ddr * z + 2 * dr * dz + r * ddz
+    """Fade in (z, dz, ddz) by r(t); only the samples with t < ramp change."""
+    n = int(np.searchsorted(t, ramp)) if ramp > 0 else 0
+    if n == 0:
+        return z, dz, ddz
+    z, dz, ddz = z.copy(), dz.copy(), ddz.copy()
+    r, dr, ddr = ramp_factor(t[:n], ramp)
+    z0, d0, a0 = z[:n].copy(), dz[:n].copy(), ddz[:n].copy()
+    z[:n], dz[:n], ddz[:n] = r * z0, dr * z0 + r * d0, ddr * z0 + 2 * dr * d0 + r * a0
+    return z, dz, ddz
 
 
 def sine(amplitude, period, ramp, duration, spacing) -> HeaveSamples:
