@@ -3,7 +3,7 @@
 Paper A's CMC (full static friction eq. 4, reduced static friction eq. 7, no friction) under paper A's
 sine (1 m, 12 s) and a JONSWAP sea (H_s 2 m, T_p 12 s), with the rig's measurements noisy (stroke 1 mm,
 pressure 5 kPa, WOB 0.5 kN, heave 5 mm) and the heave preview predicted online (AR model): passive vs PID
-vs linear MPC (osqp) vs nonlinear MPC (casadi/ipopt); effect of horizon, weights and actuator size;
+vs linear MPC (osqp) vs nonlinear MPC (casadi SQP + qrqp); effect of horizon, weights and actuator size;
 robustness to a +-30 % wrong friction model and a wrong gas stiffness.
 """
 
@@ -46,7 +46,9 @@ def main(argv=None) -> int:
     save(D.plot_wob_controllers({c: kept[("sine", "stribeck", c)] for c in D.CONTROLLERS}, (T - 36, T),
                                 title="Full static friction, paper A sine: MPC holds the WOB where passive and PID "
                                       "let gas spring and friction through"), args.out / "wob_controllers.png", dpi=100)
-    sections = []
+    sections = ["## Findings", "\n".join(D.findings(table, r["sweeps"], r["robust"])),
+                "Solve times here are wall-clock inside the loop on a shared 2-core machine; see "
+                "`benchmarks/mpc/README.md` for the dedicated measurement and the peer comparison."]
     for sea in table:
         save(D.plot_std_table(table, sea, title=f"WOB std per friction regime and controller ({sea})"),
              args.out / f"wob_std_{sea}.png", dpi=100)

@@ -178,7 +178,7 @@ def main(argv=None):
     from heavecomp.params import paper_a
 
     ctrl0 = make("linear-mpc", paper_a("stribeck"), r_du=0.0)  # python-control has no force-rate cost
-    t_o, u_o, t_p, u_p = linear_vs_python_control(ctrl0, X0, 10 if quick else 40)
+    t_o, u_o, t_p, u_p = linear_vs_python_control(ctrl0, X0, 5 if quick else 15)
     res["linear"] = {
         "ours_osqp_ms": {"p50": pct(t_o, 50), "p99": pct(t_o, 99), "n": len(t_o)},
         "peer_python_control_solve_ocp_ms": {"p50": pct(t_p, 50), "p99": pct(t_p, 99), "n": len(t_p)},

@@ -79,6 +79,37 @@ def sweep(regime, sea, controller, duration, name, values, **fixed):
 
 
 # ------------------------------------------------------------------ figures
+def findings(table: dict, sweeps: dict, robust: dict) -> list[str]:
+    """Plain-language findings computed from the metrics (no numbers typed in)."""
+    out = []
+    for sea in table:
+        st = table[sea]["stribeck"]
+        pas = st["passive"]["wob_std"]
+        parts = [f"{c} {100 * st[c]['wob_std'] / pas:.0f} %" for c in st if c != "passive"]
+        ok = all(st[c]["wob_std"] <= 0.2 * pas for c in ("linear-mpc", "nonlinear-mpc") if c in st)
+        prev = st.get("linear-mpc", {}).get("preview_rmse_end_m")
+        out.append(f"- {sea}, full static friction: WOB std relative to passive ({pas / 1e3:.1f} kN): "
+                   + ", ".join(parts) + f" — the 20 % goal is {'met' if ok else 'NOT met'} by the MPCs"
+                   + (f" (heave preview RMSE 1 s ahead: {prev * 100:.1f} cm)." if prev is not None else "."))
+    if "u_max" in sweeps:
+        rows = sweeps["u_max"][1]["linear-mpc"]
+        pas = table["sine"]["stribeck"]["passive"]["wob_std"]
+        good = [r["value"] for r in rows if r["wob_std"] <= 0.2 * pas]
+        out.append(f"- Actuator size (sine, full static friction): the smallest u_max tried that meets the goal is "
+                   + (f"{min(good) / 1e3:.0f} kN" if good else "none of those tried") + "; WOB std "
+                   + ", ".join(f"{r['wob_std'] / 1e3:.1f} kN at {r['value'] / 1e3:.0f} kN" for r in rows) + ".")
+    worst = max(((c, k, m["wob_std"]) for c, d in robust.items() for k, m in d.items()), key=lambda x: x[2],
+                default=None)
+    if worst:
+        out.append(f"- Robustness: the worst model error tried is {worst[1]} for {worst[0]} "
+                   f"({worst[2] / 1e3:.1f} kN WOB std).")
+    viol = sum(m["violations_u_max"] + m["violations_rate"] for sea in table for reg in table[sea]
+               for m in table[sea][reg].values())
+    fb = sum(m["fallbacks"] for sea in table for reg in table[sea] for m in table[sea][reg].values())
+    out.append(f"- Limit violations over all runs of the table: {viol}; solver fallbacks: {fb}.")
+    return out
+
+
 def plot_wob_controllers(results: dict, window, *, title: str):
     """WOB and active force over time for several controllers (label -> ClosedLoopResult)."""
     from heavecomp.report.figures import _plt
@@ -142,6 +173,8 @@ def plot_sweeps(sweeps: dict, passive_std: float, *, title: str):
             ax.plot([r["value"] for r in rr], [r["wob_std"] / 1e3 for r in rr], "o-", label=ctrl)
         ax.axhline(0.2 * passive_std / 1e3, color="k", ls="--", lw=0.8, label="goal: 20 % of passive")
         ax.set_xlabel(f"{label} [{unit}]")
+        if "weight" in label:
+            ax.set_xscale("log")
         ax.set_ylabel("WOB std [kN]")
         ax.grid(alpha=0.3)
         ax.set_ylim(bottom=0)
