@@ -123,8 +123,9 @@ def test_zero_phase_filter_has_no_lag():
     y = np.sin(2 * np.pi * 0.1 * t)
     f = zero_phase_lowpass(y + np.random.default_rng(2).normal(0, 0.05, t.size), dt, 0.8)
     mid = slice(2000, -2000)
-    lag = np.argmax(np.correlate(f[mid], y[mid], "full")) - (f[mid].size - 1)
-    assert lag == 0 and np.std(f[mid] - y[mid]) < 0.02
+    lags = np.arange(-10, 11)
+    corr = [np.dot(f[2000 + k:-2000 + k], y[mid]) for k in lags]
+    assert lags[int(np.argmax(corr))] == 0 and np.std(f[mid] - y[mid]) < 0.02
 
 
 def test_cli_bad_input_exit_2_one_line(tmp_path):

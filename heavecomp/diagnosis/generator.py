@@ -193,7 +193,7 @@ def generate(effects, *, seed=0, duration=300.0, rate=50.0, param_set="paper_a",
     for c, s in NOISE.items():
         cols[c] = cols[c] + rng.normal(0.0, s, t.size)
     if jitter:
-        tj = t + rng.uniform(-0.3, 0.3, t.size) * dt
+        tj = t + rng.uniform(-0.3, 0.3, t.size) * (t[1] - t[0])
         tj[0] = 0.0
         cols = {c: np.interp(tj, t, y) for c, y in cols.items()}
         t = tj
