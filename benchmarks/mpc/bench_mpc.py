@@ -94,6 +94,7 @@ def linear_vs_python_control(ctrl, X0, n_peer):
         t_peer.append(time.perf_counter() - t0)
         n_ok += bool(r.success)
         u_peer.append(float(np.atleast_2d(r.inputs)[0, 0]) * 1e3)
+    linear_vs_python_control.n_success = n_ok
     return t_ours, u_ours, t_peer, u_peer
 
 
@@ -110,11 +111,17 @@ def nonlinear_vs_fresh_opti(n_peer):
     inst = []
     orig_solver = ctrl.solver
 
-    def spy(**kw):
-        inst.append({k: np.array(v) for k, v in kw.items() if k in ("p",)})
-        return orig_solver(**kw)
+    class Spy:
+        """Records the NLP parameter vectors the controller solves in the loop."""
 
-    ctrl.solver = spy
+        def __call__(self, **kw):
+            inst.append({"p": np.array(kw["p"])})
+            return orig_solver(**kw)
+
+        def stats(self):
+            return orig_solver.stats()
+
+    ctrl.solver = Spy()
     simulate_closed_loop(p, ctrl, 24.0 + n_peer * 0.05 * 4)
     ctrl.solver = orig_solver
     inst = inst[-n_peer * 4::4]
@@ -181,7 +188,8 @@ def main(argv=None):
     t_o, u_o, t_p, u_p = linear_vs_python_control(ctrl0, X0, 5 if quick else 15)
     res["linear"] = {
         "ours_osqp_ms": {"p50": pct(t_o, 50), "p99": pct(t_o, 99), "n": len(t_o)},
-        "peer_python_control_solve_ocp_ms": {"p50": pct(t_p, 50), "p99": pct(t_p, 99), "n": len(t_p)},
+        "peer_python_control_solve_ocp_ms": {"p50": pct(t_p, 50), "p99": pct(t_p, 99), "n": len(t_p),
+                                             "success": linear_vs_python_control.n_success},
         "ratio_p50_peer_over_ours": pct(t_p, 50) / pct(t_o, 50),
         "problem": "regulation QP, N = 20, cost q_wob WOB^2 + r_u u^2, |u| <= u_max (no rate limits)",
         "first_move_rms_difference_N": float(np.sqrt(np.mean((np.array(u_o[:len(u_p)]) - np.array(u_p)) ** 2))),
