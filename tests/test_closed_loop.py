@@ -153,3 +153,18 @@ def test_pid_is_stable_without_friction():
     late = np.std(w[t >= 200])
     assert late < 1.1 * early
     assert res.metrics()["wob_std"] < simulate_closed_loop(p, "passive", 300.0).metrics()["wob_std"]
+
+
+def test_measured_heave_record_covering_just_the_run_is_enough():
+    """A heave record as long as the run works (the predictor needs no future data);
+    the perfect-preview study option needs the horizon beyond the end and says so."""
+    from heavecomp.errors import ParameterError
+
+    t = np.arange(0.0, 30.0 + 1e-9, 0.1)
+    z = 0.5 * np.sin(2 * np.pi * t / 10.0) * np.minimum(t / 10.0, 1.0)
+    p = paper_a("stribeck")
+    res = simulate_closed_loop(p, "linear-mpc", 30.0, heave=(t, z))
+    assert res.t[-1] == pytest.approx(30.0)
+    np.testing.assert_allclose(res["heave"], np.interp(res.t, t, z), atol=2e-3)
+    with pytest.raises(ParameterError, match="exceeds the heave record's span 30 s"):
+        simulate_closed_loop(p, "linear-mpc", 30.0, heave=(t, z), preview="perfect")
