@@ -143,6 +143,8 @@ def simulate_closed_loop(params, controller="passive", duration: float = 120.0, 
     if not (h > 0 and math.isfinite(h)):
         raise InputError(f"--dt must be a positive number of seconds, got {dt}")
     n_sub = max(1, int(round(Tc / h)))
+    if dt is not None and abs(n_sub * dt - Tc) > 1e-9 * Tc:
+        log.warning("dt = %g s does not divide the control interval %g s; using %g s", dt, Tc, Tc / n_sub)
     h = Tc / n_sub
     n_ctrl = int(math.ceil(duration / Tc - 1e-9))
     sp = 0.5 * h
