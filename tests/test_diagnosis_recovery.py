@@ -12,7 +12,7 @@ from heavecomp.diagnosis.stepper import CHANNELS as SC, run_fx
 from heavecomp.effects import get, terms as T
 from heavecomp.params import paper_a
 from heavecomp.simulate import excitation
-from heavecomp.simulate.core import default_dt
+from heavecomp.diagnosis.stepper import replay_dt
 
 DUR = 90.0
 
@@ -24,7 +24,7 @@ def _planted(name, values, *, amplitude_hs=2.5, seed=4, params=None):
     cls = get(name)
     if cls.kind == "plant":
         cls.write_ep(values, EP)
-    h = default_dt(truth, 50.0)
+    h = replay_dt(truth, 50.0)
     n = int(math.ceil(DUR / h))
     hs = excitation.jonswap(amplitude_hs, 10.0, 3.3, seed, 20.0, n * h, 0.5 * h)
     code, FP, PP = _vectors(truth)
@@ -41,7 +41,7 @@ def _planted(name, values, *, amplitude_hs=2.5, seed=4, params=None):
 
 
 CASES = [
-    ("friction_lag", {"lag_time": 3.0, "drop_time": 0.1}, 0.35),
+    ("friction_lag", {"lag_time": 0.5, "drop_time": 0.5}, 0.3),
     ("dwell_stiction", {"gain": 1e4, "exponent": 0.5}, 0.3),  # calm sea (H_s 1 m): long dwells
     ("pressure_friction", {"extra_pressure_coefficient": 3e-3}, 0.15),
     ("gas_heat_transfer", {"effective_index": 1.15, "loss_coefficient": 5e4}, 0.15),
@@ -57,9 +57,7 @@ def test_candidate_recovers_planted_parameters(name, values, rtol):
     d = GapDiagnoser(nominal, [name], n_jobs=1, second=0, settle=10.0).fit(run)
     got = d.candidates_[0]["parameters"]
     for k, v in values.items():
-        if k == "drop_time":  # only weakly identifiable below the dynamics' time scale: must come out fast
-            assert got[k] < 0.3
-        elif isinstance(v, str):
+        if isinstance(v, str):
             assert got[k] == v
         else:
             assert got[k] == pytest.approx(v, rel=rtol), (k, got[k], v)

@@ -13,8 +13,8 @@ from heavecomp.simulate import simulate
 @pytest.mark.parametrize("model", ["stribeck", "rotating_eq7", "none"])
 def test_no_effect_reproduces_foundation_simulate(model):
     p = paper_a(model)
-    ref = simulate(p, 120.0, rate=50.0)
-    fx = simulate_fx(p, 120.0, rate=50.0)
+    ref = simulate(p, 120.0, rate=50.0, dt=0.01)  # same explicit step for both
+    fx = simulate_fx(p, 120.0, rate=50.0, dt=0.01)
     assert fx["t"].shape == ref["t"].shape
     scale = np.std(ref["wob"])
     assert np.max(np.abs(fx["wob"] - ref["wob"])) < 1e-6 * scale

@@ -146,9 +146,9 @@ class GapDiagnoser:
     # ------------------------------------------------------------------ replay
     def _setup(self, run):
         from heavecomp.diagnosis.data import heave_samples
-        from heavecomp.simulate.core import default_dt
+        from heavecomp.diagnosis.stepper import replay_dt
 
-        h = default_dt(self.nominal)
+        h = replay_dt(self.nominal)
         n_steps = int(math.ceil(run.t[-1] / h - 1e-9))
         hs = heave_samples(run, h, n_steps)
         code, FP, PP = _vectors(self.nominal)
@@ -259,7 +259,11 @@ class GapDiagnoser:
             y = self._y[c][: m.size]
             ok = m & np.isfinite(y)
             parts.append((pred[c][ok] - y[ok])[:: self.decimate] * math.sqrt(self._w[c]))
-        return np.concatenate(parts)
+        r = np.concatenate(parts)
+        bad = ~np.isfinite(r)
+        if bad.any():  # a diverged simulation: a large, finite penalty keeps the optimisers working
+            r[bad] = 1e3
+        return r
 
     # --------------------------------------------------------------- fitting
     def _fit_candidate(self, name, start=None, fixed=()):
@@ -447,6 +451,9 @@ class GapDiagnoser:
             expl_pert = self._explained(self._mse_b_pert, self._mse(self._with_hs(self._hs_pert, [(n, fitted["values"])]),
                                                                     self._valmask))
             expl = min(expl_plain, expl_pert)
+            if not math.isfinite(expl):  # the fitted model diverged on held-out data
+                log.warning("diagnose: %s diverged on the held-out data", n)
+                expl = -10.0
             k = get(n).n_params()
             rows.append({"effect": n, "parameters": self._public(n, fitted["values"]),
                          "uncertainty": fitted["sigma"],
@@ -480,9 +487,10 @@ class GapDiagnoser:
         gap_ratio = max(self.gap_["channels"][c]["rms_validate"] / max(self.noise_floor_[c], 1e-30) for c in CH)
         runner = rows[1] if len(rows) > 1 else None
         margin = best["score"] - runner["score"] if runner else 1.0
-        # the verdict's shrink is on the channel with the largest gap relative to its noise floor
-        # (wob unless the gap is elsewhere, e.g. a delayed stroke sensor)
-        ch = max(CH, key=lambda c: self.gap_["channels"][c]["rms_validate"] / max(self.noise_floor_[c], 1e-30))
+        # the verdict's shrink is on wob (the primary channel) unless wob is at its noise floor and
+        # the gap is elsewhere (e.g. a delayed stroke sensor): then the channel with the largest gap
+        ratio = {c: self.gap_["channels"][c]["rms_validate"] / max(self.noise_floor_[c], 1e-30) for c in CH}
+        ch = "wob" if ratio["wob"] > self.none_ratio else max(CH, key=ratio.get)
         v = {"effect": best["effect"], "confidence": "low", "parameters": best["parameters"],
              "shrink": best["channels"][ch]["shrink"], "shrink_channel": ch, "uncertainty": best["uncertainty"], "explained": best["explained"],
              "gap_to_noise": gap_ratio, "margin": margin}
@@ -523,7 +531,11 @@ class GapDiagnoser:
             start = r["_values"] if get(r["effect"]).kind != "output" else None
             fitted = self._fit_candidate(r["effect"], start=start, fixed=fixed)
             pred = self.simulate(fixed + [(r["effect"], fitted["values"])])
-            expl = self._explained(self._mse_b, self._mse(pred, self._valmask))
+            cfg = fixed + [(r["effect"], fitted["values"])]
+            expl = min(self._explained(self._mse_b, self._mse(pred, self._valmask)),
+                       self._explained(self._mse_b_pert, self._mse(self._with_hs(self._hs_pert, cfg), self._valmask)))
+            if not math.isfinite(expl):
+                continue
             gain = expl - best["explained"] - self.penalty * get(r["effect"]).n_params()
             if gain > 0.1 and (out is None or gain > out["added_explained"]):
                 mse_a = self._mse(pred, self._valmask)

@@ -138,7 +138,7 @@ def generate(effects, *, seed=0, duration=300.0, rate=50.0, param_set="paper_a",
     from heavecomp.diagnosis.stepper import CHANNELS as SC, run_fx
     from heavecomp.diagnosis.estimator import _vectors
     from heavecomp.simulate import excitation
-    from heavecomp.simulate.core import default_dt
+    from heavecomp.diagnosis.stepper import replay_dt
 
     effects = (effects,) if isinstance(effects, str) else tuple(effects)
     rng = np.random.default_rng(seed)
@@ -153,7 +153,7 @@ def generate(effects, *, seed=0, duration=300.0, rate=50.0, param_set="paper_a",
         parts.append((e, EPe, extra))
     hsig, tp = rng.uniform(1.5, 3.0), rng.uniform(9.0, 13.0)
     truth["sea"] = {"hs": hsig, "tp": tp}
-    h = default_dt(nominal, rate)
+    h = replay_dt(nominal, rate)
     out_every = max(1, int(round(1.0 / (rate * h))))
     n_steps = int(math.ceil(duration / h - 1e-9))
     hs = excitation.jonswap(hsig, tp, 3.3, int(rng.integers(2**31)), 2 * tp, n_steps * h, 0.5 * h)

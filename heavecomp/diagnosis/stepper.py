@@ -298,6 +298,24 @@ def run_fx(code, FP, PP, EP, hs, h, n_steps, out_every=1, *, u_active=0.0, progr
     return out[:pos]
 
 
+def replay_dt(params, rate: float | None = None) -> float:
+    """RK4 step of the diagnosis [s]: h * lambda_max <= 0.25 and at most 10 ms (a divisor of the
+    output interval 1/rate when ``rate`` is given).
+
+    Fixed here (not the simulator's default step, which may trade accuracy for speed): replay,
+    candidates and the withheld-effect generator must all integrate on a step whose error is far
+    below the measurement noise, or the discretisation error itself shows up as a gap.
+    ``lambda_max`` is :func:`heavecomp.simulate.core.plant_eigen_rate`.
+    """
+    from heavecomp.simulate.core import plant_eigen_rate
+
+    h = min(0.01, 0.25 / plant_eigen_rate(params))
+    if rate:
+        interval = 1.0 / rate
+        h = interval / math.ceil(interval / h - 1e-9)
+    return h
+
+
 def simulate_fx(params, duration, EP=None, *, rate=50.0, heave=None, dt=None):
     """Convenience: simulate ``params`` with effects ``EP`` (default none) for ``duration`` [s].
 
@@ -306,9 +324,7 @@ def simulate_fx(params, duration, EP=None, *, rate=50.0, heave=None, dt=None):
     from heavecomp.friction.laws import FrictionLaw
     from heavecomp.plants.cmc import plant_vector
     from heavecomp.simulate import excitation
-    from heavecomp.simulate.core import default_dt
-
-    h = dt if dt is not None else default_dt(params, rate)
+    h = dt if dt is not None else replay_dt(params, rate)
     out_every = max(1, int(round(1.0 / (rate * h))))
     n_steps = int(math.ceil(duration / h - 1e-9))
     if heave is None:

@@ -205,7 +205,7 @@ class FlowLoss(Candidate):
 
 @dataclass(frozen=True)
 class StringDampingParams:
-    damping: float = q(3e4, "N s/m", bounds=(10.0, 1e7), symbol="c", doc="extra drill-string damping")
+    damping: float = q(3e4, "N s/m", bounds=(10.0, 2e6), symbol="c", doc="extra drill-string damping")
 
 
 class StringDamping(Candidate):
