@@ -68,3 +68,18 @@ def test_cli_diagnose_contract_json(tmp_path):
     assert any("non-uniform" in w for w in d["warnings"]) and any("missing" in w for w in d["warnings"])
     for name in ("report.md", "where.png", "spectra.png", "overlay.png"):
         assert (tmp_path / "out" / name).is_file()
+
+
+def test_diagnosis_example_scenario_quick(tmp_path):
+    """Withheld quadratic string drag: the linear-dashpot candidate fits a positive damping that
+    shrinks the held-out WOB residual, and the report files are written."""
+    r = subprocess.run([sys.executable, str(ROOT / "scenarios" / "diagnosis_example.py"), "--quick", "--out",
+                        str(tmp_path)], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr[-2000:]
+    m = json.loads((tmp_path / "metrics.json").read_text())
+    sd = next(c for c in m["candidates"] if c["effect"] == "string_damping")
+    assert sd["parameters"]["damping"] > 1e3
+    assert sd["channels"]["wob"]["rms_after"] < sd["channels"]["wob"]["rms_before"]
+    assert m["verdict"]["effect"] in CONTRACT_EFFECTS
+    d = json.loads((tmp_path / "diagnosis.json").read_text())
+    assert d["schema"] == 1 and (tmp_path / "overlay.png").is_file()
