@@ -163,7 +163,7 @@ class GapDiagnoser:
         (stroke and its zero-phase derivative; lower mass from the low-passed WOB through the
         formation spring, y_b = delta_0 - W/k_F, v_b = -dW/dt / k_F).  The first ``reinit`` s of
         every restarted segment are left out of the residuals."""
-        from heavecomp.diagnosis.data import derivative_zero_phase, fill_gaps, uniform, zero_phase_lowpass
+        from heavecomp.diagnosis.data import derivative_zero_phase, uniform, zero_phase_lowpass
         from heavecomp.plants.cmc import D0, KF
 
         t = run.t
