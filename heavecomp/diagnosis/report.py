@@ -104,7 +104,14 @@ def fig_overlay(diag, span=40.0):
     lo = max(t0, c0 - span / 2)
     hi = min(t[-1], lo + span)
     m = (t >= lo) & (t <= hi)
-    fig, axs = plt.subplots(3, 1, figsize=(11, 7.5), sharex=True)
+    fig, axs = plt.subplots(4, 1, figsize=(11, 9), sharex=True)
+    ax = axs[3]
+    yw = tr["measured"]["wob"][m]
+    ax.plot(t[m], (tr["nominal"]["wob"][m] - yw) / 1e3, color="tab:red", lw=1.0, label="nominal − measured")
+    ax.plot(t[m], (tr["best"]["wob"][m] - yw) / 1e3, color="tab:green", lw=1.0, label=f"with {tr['best_effect']} − measured")
+    ax.set_ylabel("WOB residual [kN]")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8, loc="upper right")
     for ax, c in zip(axs, ("wob", "stroke", "pressure")):
         unit, sc = CH_UNITS[c]
         ax.plot(t[m], tr["measured"][c][m] * sc, color="0.4", lw=0.8, label="measured")
