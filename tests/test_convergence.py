@@ -102,18 +102,21 @@ def test_wob_history_converges_through_the_end_of_the_fade_in(heave):
                                     {"friction": {"stribeck_velocity": 0.001}}],
                          ids=["paper_a", "light BHA (2 t)", "steep Stribeck (v_S = 1 mm/s)"])
 def test_default_step_follows_the_fastest_mode_and_is_accurate(change):
-    """default_dt: h <= 10 ms, h lambda_max <= 0.25, a divisor of the output interval —
-    and with it the WOB is within 1 N rms of a run at h/4 (no lift-off in these cases)."""
+    """default_dt: h <= 50 ms, h lambda_max <= 0.6, a divisor of the output interval —
+    and with it the WOB is within 50 N rms of a run at h/4 (a quarter of issue 2's 0.2 kN
+    accuracy budget; no lift-off in these cases)."""
     from heavecomp.simulate import default_dt
     from heavecomp.simulate.core import plant_eigen_rate
 
     p = paper_a("stribeck").replace(**change)
     h = default_dt(p, 20.0)
-    assert h <= 0.01 + 1e-15
-    assert h * plant_eigen_rate(p) <= 0.25 + 1e-12
+    assert h <= 0.05 + 1e-15
+    assert h * plant_eigen_rate(p) <= 0.6 + 1e-12
     k = 0.05 / h
     assert abs(k - round(k)) < 1e-9
     r = simulate(p, T)
     ref = simulate(p, T, dt=h / 4)
     assert r.dt == h and np.min(ref["wob"]) > 0
-    assert np.sqrt(np.mean((r["wob"] - ref["wob"]) ** 2)) < 1.0
+    err = np.sqrt(np.mean((r["wob"] - ref["wob"]) ** 2))
+    print(f"default dt {h * 1e3:.2f} ms: rms WOB error vs h/4 {err:.2f} N")
+    assert err < 50.0

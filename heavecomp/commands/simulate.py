@@ -11,7 +11,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--out", required=True, metavar="DIR", help="output folder")
     p.add_argument("--rate", type=float, default=20.0, metavar="HZ", help="output sample rate [Hz] (default 20)")
     p.add_argument("--dt", type=float, default=None, metavar="S",
-                   help="RK4 step [s] (default: from the plant's fastest mode, at most 10 ms)")
+                   help="RK4 step [s] (default: h * fastest plant rate <= 0.6, at most 50 ms)")
     p.add_argument("--friction", default=None, metavar="MODEL",
                    help="override friction.model (none | stribeck | rotating_eq6 | rotating_eq7)")
     p.add_argument("--controller", default="passive", choices=("passive", "pid", "linear-mpc", "nonlinear-mpc"),
@@ -24,6 +24,7 @@ def run(args) -> int:
 
     from heavecomp.commands._progress import Progress
     from heavecomp.params import load
+    from heavecomp.report.background import BackgroundFigure
     from heavecomp.simulate import simulate, write_outputs
 
     params = load(args.params)
@@ -32,8 +33,14 @@ def run(args) -> int:
     if args.controller != "passive":
         return _run_closed_loop(args, params, Progress)
     bar = Progress(f"simulate {args.duration:g} s")
-    res = simulate(params, args.duration, dt=args.dt, rate=args.rate, progress=bar)
-    m = write_outputs(res, args.out, title=f"WOB — {Path(args.params).name}, friction: {params.friction.model}")
+    figure = BackgroundFigure()  # imports matplotlib in parallel with the simulation
+    try:
+        res = simulate(params, args.duration, dt=args.dt, rate=args.rate, progress=bar)
+    except BaseException:
+        figure.cancel()
+        raise
+    m = write_outputs(res, args.out, title=f"WOB — {Path(args.params).name}, friction: {params.friction.model}",
+                      figure=figure)
     print(f"WOB mean {m['wob_mean'] / 1e3:.2f} kN, std {m['wob_std'] / 1e3:.2f} kN, "
           f"peak-to-peak {m['wob_p2p'] / 1e3:.2f} kN, stuck {100 * m['stick_fraction']:.1f} % of the time "
           f"-> {args.out}")

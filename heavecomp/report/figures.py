@@ -25,13 +25,33 @@ def _plt():
     return plt
 
 
-def save(fig, path, dpi: int = 110) -> Path:
-    """Save and close a figure."""
+def pyplot():
+    """matplotlib.pyplot with the non-interactive Agg backend (unless one is already chosen)."""
+    return _plt()
+
+
+def save(fig, path, dpi: int = 110, tight: bool = True) -> Path:
+    """Save and close a figure (``tight=False`` skips the extra layout pass of bbox_inches="tight")."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=dpi, bbox_inches="tight")
+    fig.savefig(path, dpi=dpi, bbox_inches="tight" if tight else None)
     _plt().close(fig)
     return path
+
+
+def envelope(t, y, max_points: int = 4000):
+    """Min/max envelope of a long series for plotting: at most ``max_points`` points that draw
+    exactly the same band as the full series at figure resolution (short series pass through)."""
+    t = np.asarray(t)
+    y = np.asarray(y)
+    if t.size <= max_points:
+        return t, y
+    nb = max_points // 2
+    edges = np.linspace(0, t.size, nb + 1).astype(int)
+    idx_min = np.array([a + np.argmin(y[a:b]) for a, b in zip(edges[:-1], edges[1:])])
+    idx_max = np.array([a + np.argmax(y[a:b]) for a, b in zip(edges[:-1], edges[1:])])
+    idx = np.sort(np.concatenate([idx_min, idx_max]))
+    return t[idx], y[idx]
 
 
 def plot_wob(results: dict, *, title: str | None = None, static_estimate: bool = True, window=None):
@@ -43,23 +63,70 @@ def plot_wob(results: dict, *, title: str | None = None, static_estimate: bool =
     for label, res in results.items():
         t = res["t"]
         m = slice(None) if window is None else (t >= window[0]) & (t <= window[1])
-        ax.plot(t[m], res["wob"][m] / 1e3, color=REGIME_COLORS.get(label), lw=1.3,
+        ax.plot(*envelope(t[m], res["wob"][m] / 1e3), color=REGIME_COLORS.get(label), lw=1.3 if t[m].size < 4000 else 0.6,
                 label=REGIME_LABELS.get(label, label))
     t = first["t"]
     m = slice(None) if window is None else (t >= window[0]) & (t <= window[1])
     p = first.params
     if static_estimate:
-        ax.plot(t[m], (p.operating_point.wob_setpoint - p.k_eff * first["heave"][m]) / 1e3, "k--", lw=1,
+        ax.plot(*envelope(t[m], (p.operating_point.wob_setpoint - p.k_eff * first["heave"][m]) / 1e3), "k--", lw=1,
                 label=f"static estimate W0 - k_eff z_h (eq. 13-14, k_eff = {p.k_eff / 1e3:.1f} kN/m)")
     ax.axhline(p.operating_point.wob_setpoint / 1e3, color="0.6", lw=0.8)
     ax.set_ylabel("WOB [kN]")
     ax.legend(loc="upper right", fontsize=8)
     ax.set_title(title or "Weight on bit: friction in the main cylinder reaches the bit almost unfiltered")
     ax.grid(alpha=0.3)
-    axh.plot(t[m], first["heave"][m], color="tab:blue", lw=1)
+    axh.plot(*envelope(t[m], first["heave"][m]), color="tab:blue", lw=1 if t[m].size < 4000 else 0.6)
     axh.set_ylabel("heave z_h [m]")
     axh.set_xlabel("time t [s]")
     axh.grid(alpha=0.3)
+    fig.tight_layout()
+    return fig
+
+
+def plot_wob_run(res, *, title: str | None = None, zoom: float | None = None):
+    """One run at a glance: the WOB band over the whole run (min/max per bin) and a zoom on
+    its last seconds with the static estimate of eqs. 13-14 and the heave."""
+    plt = _plt()
+    t, w, z = res["t"], res["wob"] / 1e3, res["heave"]
+    p = res.params
+    if zoom is None:
+        period = (p.heave.period if p.heave is not None and p.heave.kind == "sine" else
+                  p.heave.tp if p.heave is not None and p.heave.kind == "jonswap" else 12.0)
+        zoom = min(t[-1], 5 * period)
+    fig = plt.figure(figsize=(9.5, 7))
+    gs = fig.add_gridspec(3, 1, height_ratios=[2, 2.4, 1])
+    ax0 = fig.add_subplot(gs[0])
+    nb = min(600, max(1, t.size // 4))
+    k = t.size // nb
+    tb = t[: nb * k].reshape(nb, k)
+    wb = w[: nb * k].reshape(nb, k)
+    ax0.fill_between(tb.mean(1), wb.min(1), wb.max(1), color="tab:red", alpha=0.35, lw=0, label="WOB min-max")
+    ax0.plot(tb.mean(1), wb.mean(1), color="tab:red", lw=0.8, label="WOB mean")
+    ax0.axhline(p.operating_point.wob_setpoint / 1e3, color="0.4", lw=0.8, ls=":", label="set-point W0")
+    ax0.axvspan(t[-1] - zoom, t[-1], color="0.85", zorder=0)
+    ax0.set_xlabel("time t [s]")
+    ax0.set_ylabel("WOB [kN]")
+    ax0.legend(loc="upper right", fontsize=8, ncol=3)
+    ax0.grid(alpha=0.3)
+    ax0.set_title(title or "Weight on bit over the run (band) and its last wave periods (zoom, shaded)")
+    m = t >= t[-1] - zoom
+    ax1 = fig.add_subplot(gs[1])
+    ax1.plot(t[m], w[m], color="tab:red", lw=1.2, label=f"WOB, friction {p.friction.model}")
+    ax1.plot(t[m], (p.operating_point.wob_setpoint - p.k_eff * z[m]) / 1e3, "k--", lw=1,
+             label=f"static estimate W0 - k_eff z_h (eqs. 13-14, k_eff = {p.k_eff / 1e3:.1f} kN/m)")
+    st = res["stuck"][m] > 0.5
+    if st.any():
+        ax1.fill_between(t[m], w[m].min(), w[m].max(), where=st, color="tab:blue", alpha=0.12, lw=0,
+                         label="cylinder stuck")
+    ax1.set_ylabel("WOB [kN]")
+    ax1.legend(loc="upper right", fontsize=8)
+    ax1.grid(alpha=0.3)
+    ax2 = fig.add_subplot(gs[2], sharex=ax1)
+    ax2.plot(t[m], z[m], color="tab:blue", lw=1)
+    ax2.set_ylabel("heave z_h [m]")
+    ax2.set_xlabel("time t [s]")
+    ax2.grid(alpha=0.3)
     fig.tight_layout()
     return fig
 

@@ -68,15 +68,7 @@ stroke_accel = _compile(_cmc.stroke_accel)
 sliding_friction = _compile(_cmc.sliding_friction)
 static_limit = _compile(_cmc.static_limit)
 
-STUCK = 0
-SLIDING = 1
-
-#: output channels, in column order of the ``out`` array
-CHANNELS = ("t", "heave", "stroke", "pressure", "wob", "stroke_velocity", "friction", "tension",
-            "lower_displacement", "lower_velocity", "stuck", "u_active")
-NCH = len(CHANNELS)
-#: slots of the ``stats`` array
-STATS = ("stuck_time", "n_stick", "n_breakaway", "n_reversal", "n_event_overflow")
+from heavecomp.simulate.layout import CHANNELS, NCH, SLIDING, STATS, STUCK  # noqa: E402,F401
 
 
 @_jit

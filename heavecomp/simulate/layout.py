@@ -1,0 +1,26 @@
+"""Array layout shared by the compiled steppers and their callers (no numba import here)."""
+
+STUCK = 0
+SLIDING = 1
+
+#: output channels, in column order of the stepper's ``out`` array
+CHANNELS = ("t", "heave", "stroke", "pressure", "wob", "stroke_velocity", "friction", "tension",
+            "lower_displacement", "lower_velocity", "stuck", "u_active")
+NCH = len(CHANNELS)
+#: slots of the ``stats`` array
+STATS = ("stuck_time", "n_stick", "n_breakaway", "n_reversal", "n_event_overflow")
+
+#: files whose source the compiled stepper is built from (the AOT build is keyed to them)
+KERNEL_SOURCES = ("friction/laws.py", "plants/cmc.py", "simulate/_kernel.py")
+
+
+def source_hash() -> int:
+    """63-bit hash of the stepper's source files (friction laws, CMC equations, kernel)."""
+    import hashlib
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    h = hashlib.sha256()
+    for rel in KERNEL_SOURCES:
+        h.update((root / rel).read_bytes())
+    return int(h.hexdigest()[:15], 16)

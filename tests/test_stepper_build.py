@@ -1,0 +1,93 @@
+"""The ahead-of-time stepper is the JIT stepper (same source, same numbers), is never used
+stale, and the CLI's background figure gives the same file with and without fork."""
+
+import os
+
+import numpy as np
+import pytest
+
+from heavecomp.params import paper_a
+from heavecomp.simulate import core, simulate
+
+
+@pytest.fixture
+def fresh_stepper(monkeypatch):
+    monkeypatch.setattr(core, "_STEPPER", None)
+    yield
+    core._STEPPER = None
+
+
+def _run(model, monkeypatch, jit):
+    core._STEPPER = None
+    if jit:
+        monkeypatch.setenv("HEAVECOMP_JIT", "1")
+    else:
+        monkeypatch.delenv("HEAVECOMP_JIT", raising=False)
+    res = simulate(paper_a(model), 180.0)
+    return res, core.stepper()
+
+
+def test_aot_was_built_and_is_used(fresh_stepper, monkeypatch):
+    # setup.py builds it with numba.pycc (needs a C compiler, present on CI); if this fails the
+    # install printed why and every process pays numba's ~0.4 s start-up
+    from heavecomp.simulate import _cmc_aot
+    from heavecomp.simulate.layout import source_hash
+
+    assert _cmc_aot.source_hash() == source_hash()
+    _, fn = _run("stribeck", monkeypatch, jit=False)
+    assert fn is _cmc_aot.advance
+
+
+@pytest.mark.parametrize("model", ["none", "stribeck", "rotating_eq6", "rotating_eq7"])
+def test_aot_equals_jit_bit_for_bit(model, fresh_stepper, monkeypatch):
+    a, fa = _run(model, monkeypatch, jit=False)
+    b, fb = _run(model, monkeypatch, jit=True)
+    assert fa is not fb
+    np.testing.assert_array_equal(a.data, b.data)
+    assert a.stats == b.stats
+
+
+def test_stale_build_falls_back_to_jit(fresh_stepper, monkeypatch):
+    from heavecomp.simulate import _kernel, layout
+
+    monkeypatch.delenv("HEAVECOMP_JIT", raising=False)
+    monkeypatch.setattr(layout, "source_hash", lambda: -1)  # as if cmc.py had been edited
+    assert core.stepper() is _kernel.advance
+
+
+@pytest.mark.parametrize("fork", [True, False])
+def test_background_figure(tmp_path, monkeypatch, fork):
+    from heavecomp.report.background import BackgroundFigure
+    from heavecomp.report.figures import plot_wob_run
+
+    if not fork:
+        monkeypatch.setenv("HEAVECOMP_NO_FORK", "1")
+    fig = BackgroundFigure()
+    assert (fig._proc is not None) == (fork and os.name == "posix" and os.uname().sysname == "Linux")
+    res = simulate(paper_a(), 60.0)
+    fig.draw(plot_wob_run, res, path=tmp_path / "w.png", save_kwargs={"tight": False})
+    fig.wait()
+    png = (tmp_path / "w.png").read_bytes()
+    assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 20_000
+
+
+def test_background_figure_job_that_cannot_reach_the_child_is_drawn_inline(tmp_path):
+    # a local function cannot be pickled to the child: the figure must still be written
+    from heavecomp.report.background import BackgroundFigure
+
+    calls = []
+
+    def bad_then_good(x):
+        import matplotlib.pyplot as plt
+
+        assert os.getpid() == parent
+        calls.append(x)
+        fig, ax = plt.subplots()
+        ax.plot([0, 1], [0, x])
+        return fig
+
+    parent = os.getpid()
+    fig = BackgroundFigure()
+    fig.draw(bad_then_good, 2.0, path=tmp_path / "f.png")
+    fig.wait()
+    assert (tmp_path / "f.png").is_file() and calls == [2.0]
