@@ -17,12 +17,12 @@ import sys
 
 #: name -> (module, one-line help).  Order is the order shown by --help.
 COMMANDS: dict[str, tuple[str, str]] = {
-    "simulate": ("heavecomp.commands.simulate", "simulate the CMC for a parameter file (exact stick-slip)"),
+    "simulate": ("heavecomp.commands.simulate", "simulate the CMC for a parameter file (exact stick-slip; --controller for active compensation)"),
     "params": ("heavecomp.commands.params", "write or check a parameter file (built-in sets: paper_a, ...)"),
-    "stickslip": ("heavecomp.commands.stickslip", "paper B pneumatic cylinder: stick-slip analysis, simulation, map"),
-    "diagnose": ("heavecomp.commands.diagnose", "sim-to-real gap diagnosis of a measured run (which unmodelled effect)"),
     "analyse": ("heavecomp.commands.analyse", "linear analysis: k_eff_dc, natural frequencies, heave -> WOB frequency response"),
+    "diagnose": ("heavecomp.commands.diagnose", "sim-to-real gap diagnosis of a measured run (which unmodelled effect)"),
     "campaign": ("heavecomp.commands.campaign", "run a sea-state campaign: WOB exceedance over a scatter diagram"),
+    "stickslip": ("heavecomp.commands.stickslip", "paper B pneumatic cylinder: stick-slip analysis, simulation, map"),
     "identify": ("heavecomp.commands.identify", "identify from measured data: EMPS axis (+ residual diagnosis) or seal friction vs pressure"),
 }
 

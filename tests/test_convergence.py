@@ -58,13 +58,10 @@ def test_wob_history_converges_with_fourth_order(model):
         assert abs(stats[1]["stuck_time"] - ref.stats["stuck_time"]) < 1e-4
 
 
-@pytest.mark.xfail(strict=True, reason="BUG/limit: bit lift-off and touchdown (W = max(0, k_F pen - c_F v_b) "
-                   "switching at pen = 0, with a force jump c_F |v_b| at touchdown) are not located inside "
-                   "the step, so RK4 drops to order <= 1 and the default 10 ms step errs by ~1 kN rms")
 def test_wob_history_converges_through_bit_lift_off():
     """3 m heave without friction: the bit leaves the formation every wave period
-    (WOB = 0 for ~0.3 s).  The convergence should stay high as for stick-slip; today the
-    error is erratic (order ~-0.5...3.5) and ~1 kN rms at the default step."""
+    (WOB = 0 for ~0.3 s).  Lift-off and touchdown are located as events with the contact
+    state held through each sub-step, so the order stays 4 (it was erratic, ~1 kN rms)."""
     p = paper_a("none").replace(heave={"amplitude": 3.0})
     ref = simulate(p, T, dt=DT_REF, rate=RATE)
     assert np.count_nonzero(ref["wob"] == 0.0) > 20  # the bit really lifts off
@@ -78,10 +75,6 @@ def test_wob_history_converges_through_bit_lift_off():
     assert errs[1] < 1.0 and np.all(orders >= 3.5)
 
 
-@pytest.mark.xfail(strict=True, reason="BUG: the sin^2 fade-in has a jump in d2r/dt2 at t = T_r (-pi^2/(2 T_r^2) -> 0); "
-                   "when z(T_r) != 0 (any JONSWAP run, a sine whose ramp is not a multiple of T/2) the heave "
-                   "acceleration jumps there, the step across T_r sees one sample for both sides and the "
-                   "WOB error becomes first order (0.4-0.6 N rms at 10 ms)")
 @pytest.mark.parametrize("heave", [{"ramp": 27.0},
                                    {"kind": "jonswap", "hs": 2.0, "tp": 12.0, "amplitude": None, "period": None}],
                          ids=["sine ramp 27 s", "jonswap"])

@@ -79,7 +79,10 @@ def test_kernel_rhs_equals_casadi_model_away_from_zero_velocity(model):
         xdot, y = np.asarray(xdot).ravel(), np.asarray(y).ravel()
         Z, DZ, DDZ = np.array([zh, zh]), np.array([dzh, dzh]), np.array([ddzh, ddzh])
         # heave samples are constant, so heave_at(0) returns them exactly
-        k = K.rhs(0.0, s, v, yb, vb, K.SLIDING, float(np.sign(v)), smooth, law.code, law.FP, PP, u, 1.0, Z, DZ, DDZ)
+        cm = 1.0 if K.contact_switch(yb, vb, PP) > 0 else 0.0  # the stepper's contact state here
+        # held contact state = the clamped law wherever they agree (physics once)
+        assert _close(K.lower_accel_contact(s, v, yb, vb, zh, dzh, cm, PP), cmc.lower_accel(s, v, yb, vb, zh, dzh, PP), 1.0)
+        k = K.rhs(0.0, s, v, yb, vb, K.SLIDING, float(np.sign(v)), cm, smooth, law.code, law.FP, PP, u, 1.0, Z, DZ, DDZ)
         assert k[0] == v and k[2] == vb
         assert _close(k[1], xdot[1], 1.0)
         assert _close(k[3], xdot[3], 1.0)
@@ -93,7 +96,7 @@ def test_kernel_rhs_equals_casadi_model_away_from_zero_velocity(model):
         hold = K.hold(0.0, s, v, yb, vb, u, PP, 1.0, Z, DZ, DDZ)
         assert _close(hold, PP[cmc.MC] * xdot[1] + y[4], 1e5)
         # stuck mode: stroke frozen, lower mass as in the model
-        k0 = K.rhs(0.0, s, 0.0, yb, vb, K.STUCK, 1.0, smooth, law.code, law.FP, PP, u, 1.0, Z, DZ, DDZ)
+        k0 = K.rhs(0.0, s, 0.0, yb, vb, K.STUCK, 1.0, cm, smooth, law.code, law.FP, PP, u, 1.0, Z, DZ, DDZ)
         assert k0[0] == 0.0 and k0[1] == 0.0
         assert _close(k0[3], K.lower_accel(s, 0.0, yb, vb, zh, dzh, PP), 1.0)
 

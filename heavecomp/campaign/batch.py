@@ -46,8 +46,11 @@ NACC = len(ACC)
 
 @nb.njit(parallel=True, cache=True)
 def _batch(codes, FPs, PPs, smooth, hsteps, nsteps, out_every, t_stat, W0, half, Zs, DZs, DDZs,
-           dev_max, nbins, acc, hist, phist, stats):
-    """Parallel driver: ``prange`` over runs, each stepping ``K.advance`` block by block."""
+           kink_step, ddz_left, dev_max, nbins, acc, hist, phist, stats):
+    """Parallel driver: ``prange`` over runs, each stepping ``K.advance`` block by block.
+
+    As in :func:`heavecomp.simulate.core.run_kernel`, the steps up to the end of the
+    fade-in (``kink_step``, -1 if none) see the left-limit heave acceleration there."""
     nrun = codes.shape[0]
     nbp = nbins // 2
     for r in nb.prange(nrun):
@@ -57,7 +60,7 @@ def _batch(codes, FPs, PPs, smooth, hsteps, nsteps, out_every, t_stat, W0, half,
         out = np.empty((BLOCK + 1, K.NCH))
         state = np.zeros(4)
         mode_dir = np.array([float(K.STUCK), 1.0])
-        st = np.zeros(4)
+        st = np.zeros(K.NSTATS)
         a = acc[r]
         a[3] = np.inf
         a[4] = -np.inf
@@ -69,11 +72,21 @@ def _batch(codes, FPs, PPs, smooth, hsteps, nsteps, out_every, t_stat, W0, half,
         peak = 0.0
         done = 0
         total = nsteps[r]
+        k1 = kink_step[r]
+        ddl = DDZs[r][:2 * k1 + 1].copy() if k1 > 0 else DDZs[r][:1].copy()
+        if k1 > 0:
+            ddl[2 * k1] = ddz_left[r]
         while done < total:
             n = min(BLOCK * oe, total - done)
+            if done < k1 < done + n:
+                n = k1 - done
             start = 0 if done == 0 else 1
-            pos = K.advance(state, mode_dir, done * h, n, h, codes[r], FPs[r], PPs[r], smooth[r], 0.0, sp,
-                          Zs[r], DZs[r], DDZs[r], out, oe, start, st)
+            if done < k1:
+                pos = K.advance(state, mode_dir, done * h, n, h, codes[r], FPs[r], PPs[r], smooth[r], 0.0, sp,
+                                Zs[r][:2 * k1 + 1].copy(), DZs[r][:2 * k1 + 1].copy(), ddl, out, oe, start, st)
+            else:
+                pos = K.advance(state, mode_dir, done * h, n, h, codes[r], FPs[r], PPs[r], smooth[r], 0.0, sp,
+                                Zs[r], DZs[r], DDZs[r], out, oe, start, st)
             for j in range(start, pos):
                 if out[j, 0] < t_stat[r] - 1e-12:
                     continue
@@ -173,6 +186,13 @@ def prepare(campaign, runs, base=None):
         half[i] = campaign.band.half_width(W0[i])
         heaves.append(jonswap_samples(run.hs, run.tp, s.gamma, run.seed, p.heave.ramp, nsteps[i] * h, 0.5 * h,
                                       spectra))
+    kink_step = np.full(n, -1, dtype=np.int64)
+    ddz_left = np.zeros(n)
+    for i, hv in enumerate(heaves):  # the same condition as simulate.core.run_kernel
+        if hv.kink is not None and hv.kink[0] % 2 == 0:
+            k1 = hv.kink[0] // 2
+            if 0 < k1 <= nsteps[i] and k1 % out_every[i] == 0:
+                kink_step[i], ddz_left[i] = k1, hv.kink[1]
     m = max(hv.z.size for hv in heaves)
     Zs, DZs, DDZs = (np.empty((n, m)) for _ in range(3))
     for i, hv in enumerate(heaves):
@@ -180,7 +200,7 @@ def prepare(campaign, runs, base=None):
             arr[i, :src.size] = src
             arr[i, src.size:] = src[-1]  # never reached: padding to a common length only
     return dict(codes=codes, FPs=FPs, PPs=PPs, smooth=smooth, hsteps=hsteps, nsteps=nsteps, out_every=out_every,
-                t_stat=t_stat, W0=W0, half=half, Zs=Zs, DZs=DZs, DDZs=DDZs)
+                t_stat=t_stat, W0=W0, half=half, Zs=Zs, DZs=DZs, DDZs=DDZs, kink_step=kink_step, ddz_left=ddz_left)
 
 
 def jonswap_samples(hs, tp, gamma, seed, ramp, duration, spacing, spectra=None):
@@ -220,7 +240,8 @@ def jonswap_samples(hs, tp, gamma, seed, ramp, duration, spacing, spectra=None):
     t = np.arange(k) * spacing
     z[:k], dz[:k], ddz[:k] = excitation._apply_ramp(t, z[:k], dz[:k], ddz[:k], ramp)
     return excitation.HeaveSamples(spacing, z, dz, ddz, {"kind": "jonswap", "hs": hs, "tp": tp, "gamma": gamma,
-                                                         "seed": seed, "ramp": ramp, "repeat_period": n * spacing})
+                                                         "seed": seed, "ramp": ramp, "repeat_period": n * spacing},
+                                   kink=excitation.ramp_kink(spacing, z, ddz, ramp))
 
 
 def hist_columns(nbins: int) -> tuple[list[str], list[str]]:
@@ -263,7 +284,8 @@ def simulate_batch(campaign, runs, *, threads: int | None = None, base=None) -> 
         nb.set_num_threads(max(1, min(int(threads), nb.config.NUMBA_NUM_THREADS)))
     try:
         _batch(a["codes"], a["FPs"], a["PPs"], a["smooth"], a["hsteps"], a["nsteps"], a["out_every"], a["t_stat"],
-               a["W0"], a["half"], a["Zs"], a["DZs"], a["DDZs"], float(o.deviation_max), int(o.bins), acc, hist,
+               a["W0"], a["half"], a["Zs"], a["DZs"], a["DDZs"], a["kink_step"], a["ddz_left"],
+               float(o.deviation_max), int(o.bins), acc, hist,
                phist, stats)
     finally:
         nb.set_num_threads(prev)

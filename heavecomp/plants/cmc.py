@@ -66,10 +66,27 @@ def tension(s, v, yb, vb, zh, dzh, PP):
     return PP[T0] + PP[KDS] * (zh + s - yb) + PP[CDS] * (dzh + v - vb)
 
 
+def contact_force(yb, vb, PP):
+    """The formation's spring-damper force on the bit while in contact, unclamped [N]:
+    ``k_F (delta_0 - y_b) - c_F v_b``."""
+    return PP[KF] * (PP[D0] - yb) - PP[CF] * vb
+
+
 def wob(yb, vb, PP):
     """Weight on bit W [N]: one-sided spring-damper contact with the formation."""
     pen = PP[D0] - yb
-    return np.maximum(0.0, PP[KF] * pen - PP[CF] * vb) * (pen > 0.0)
+    return np.maximum(0.0, contact_force(yb, vb, PP)) * (pen > 0.0)
+
+
+def contact_switch(yb, vb, PP):
+    """Switching function of the bit-rock contact [N]: W > 0 exactly where it is > 0.
+
+    ``min(k_F pen, k_F pen - c_F v_b)`` with ``pen = delta_0 - y_b``; its zero crossings
+    (lift-off and touchdown) are where :func:`wob` has a kink or a jump, located as events
+    by the stepper.
+    """
+    pen = PP[D0] - yb
+    return np.minimum(PP[KF] * pen, PP[KF] * pen - PP[CF] * vb)
 
 
 def holding_force(s, v, yb, vb, zh, dzh, ddzh, u, PP):
@@ -82,6 +99,16 @@ def holding_force(s, v, yb, vb, zh, dzh, ddzh, u, PP):
 def lower_accel(s, v, yb, vb, zh, dzh, PP):
     """dv_b/dt of the lower mass [m/s^2]."""
     return (tension(s, v, yb, vb, zh, dzh, PP) - PP[MB] * PP[G] + wob(yb, vb, PP)) / PP[MB]
+
+
+def lower_accel_contact(s, v, yb, vb, zh, dzh, contact, PP):
+    """dv_b/dt with the contact state held (``contact`` = 1 on the rock, 0 lifted off) [m/s^2].
+
+    Equal to :func:`lower_accel` wherever ``contact == (contact_switch > 0)``; the stepper
+    holds the state through a step and flips it at the located lift-off / touchdown, so
+    its RK4 stages never straddle the kink or the touchdown jump of W.
+    """
+    return (tension(s, v, yb, vb, zh, dzh, PP) - PP[MB] * PP[G] + contact * contact_force(yb, vb, PP)) / PP[MB]
 
 
 def stroke_accel(s, v, yb, vb, zh, dzh, ddzh, u, Ff, PP):

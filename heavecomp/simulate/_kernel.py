@@ -21,8 +21,15 @@ with two modes:
   taken on the side where the limit is exceeded, so the motion that follows
   leaves v = 0 in the direction of the force.
 
+* **bit contact**: lift-off and touchdown (zero crossings of
+  :func:`heavecomp.plants.cmc.contact_switch`, where W has a kink or jumps by
+  c_F |v_b|) are located the same way; the contact state is held through every
+  RK4 sub-step (unclamped contact law on the rock, none off it) and flipped at
+  the event, so no stage straddles the switch.
+
 Laws without a jump (``none``; eq. 7 with C_p = 0) are integrated as one smooth
-system.  The remainder of a step after an event is integrated to the grid, so
+system.  The end of the sine fade-in, where d2z_h/dt2 jumps, is a step
+boundary with the left-limit heave sample before it (``core.run_kernel``).  The remainder of a step after an event is integrated to the grid, so
 the output stays on the uniform grid.
 
 Heave samples come on a grid of spacing h/2 (the RK4 stage times); between
@@ -61,14 +68,17 @@ friction_jump = _compile(_laws.friction_jump)
 friction_cont = _compile(_laws.friction_cont)
 gas_pressure = _compile(_cmc.gas_pressure)
 tension = _compile(_cmc.tension)
+contact_force = _compile(_cmc.contact_force)
 wob = _compile(_cmc.wob)
 holding_force = _compile(_cmc.holding_force)
 lower_accel = _compile(_cmc.lower_accel)
+lower_accel_contact = _compile(_cmc.lower_accel_contact)
 stroke_accel = _compile(_cmc.stroke_accel)
 sliding_friction = _compile(_cmc.sliding_friction)
 static_limit = _compile(_cmc.static_limit)
+contact_switch = _compile(_cmc.contact_switch)
 
-from heavecomp.simulate.layout import CHANNELS, NCH, SLIDING, STATS, STUCK  # noqa: E402,F401
+from heavecomp.simulate.layout import CHANNELS, NCH, NSTATS, SLIDING, STATS, STUCK  # noqa: E402,F401
 
 
 @_jit
@@ -120,10 +130,10 @@ def heave_at(t, sp, Z, DZ, DDZ):
 
 
 @_jit
-def rhs(t, s, v, yb, vb, mode, d, smooth, code, FP, PP, u, sp, Z, DZ, DDZ):
+def rhs(t, s, v, yb, vb, mode, d, cm, smooth, code, FP, PP, u, sp, Z, DZ, DDZ):
     """Time derivatives (ds, dv, dyb, dvb) in the given mode."""
     zh, dzh, ddzh = heave_at(t, sp, Z, DZ, DDZ)
-    dvb = lower_accel(s, v, yb, vb, zh, dzh, PP)
+    dvb = lower_accel_contact(s, v, yb, vb, zh, dzh, cm, PP)
     if mode == STUCK:
         return 0.0, 0.0, vb, dvb
     if smooth:
@@ -136,15 +146,15 @@ def rhs(t, s, v, yb, vb, mode, d, smooth, code, FP, PP, u, sp, Z, DZ, DDZ):
 
 
 @_jit
-def rk4(t, h, s, v, yb, vb, mode, d, smooth, code, FP, PP, u, sp, Z, DZ, DDZ):
-    k1 = rhs(t, s, v, yb, vb, mode, d, smooth, code, FP, PP, u, sp, Z, DZ, DDZ)
+def rk4(t, h, s, v, yb, vb, mode, d, cm, smooth, code, FP, PP, u, sp, Z, DZ, DDZ):
+    k1 = rhs(t, s, v, yb, vb, mode, d, cm, smooth, code, FP, PP, u, sp, Z, DZ, DDZ)
     h2 = 0.5 * h
     k2 = rhs(t + h2, s + h2 * k1[0], v + h2 * k1[1], yb + h2 * k1[2], vb + h2 * k1[3],
-             mode, d, smooth, code, FP, PP, u, sp, Z, DZ, DDZ)
+             mode, d, cm, smooth, code, FP, PP, u, sp, Z, DZ, DDZ)
     k3 = rhs(t + h2, s + h2 * k2[0], v + h2 * k2[1], yb + h2 * k2[2], vb + h2 * k2[3],
-             mode, d, smooth, code, FP, PP, u, sp, Z, DZ, DDZ)
+             mode, d, cm, smooth, code, FP, PP, u, sp, Z, DZ, DDZ)
     k4 = rhs(t + h, s + h * k3[0], v + h * k3[1], yb + h * k3[2], vb + h * k3[3],
-             mode, d, smooth, code, FP, PP, u, sp, Z, DZ, DDZ)
+             mode, d, cm, smooth, code, FP, PP, u, sp, Z, DZ, DDZ)
     h6 = h / 6.0
     return (s + h6 * (k1[0] + 2 * k2[0] + 2 * k3[0] + k4[0]),
             v + h6 * (k1[1] + 2 * k2[1] + 2 * k3[1] + k4[1]),
@@ -199,38 +209,54 @@ def advance(state, mode_dir, t0, n_steps, h, code, FP, PP, smooth, u, sp, Z, DZ,
     s, v, yb, vb = state[0], state[1], state[2], state[3]
     mode = int(mode_dir[0])
     d = mode_dir[1]
+    cm = 1.0 if contact_switch(yb, vb, PP) > 0.0 else 0.0  # bit on the rock (held between events)
     if smooth:
         mode = SLIDING
     pos = out_pos
     if pos == 0 and out.shape[0] > 0:
-        _record(out, pos, t0, s, v, yb, vb, mode, d, smooth, code, FP, PP, u, sp, Z, DZ, DDZ)
+        _record(out, pos, t0, s, v, yb, vb, mode, d, cm, smooth, code, FP, PP, u, sp, Z, DZ, DDZ)
         pos += 1
     for i in range(n_steps):
         tc = t0 + i * h
         left = h
         for _ev in range(8):
+            # tentative step to the grid, cut at the first contact switch (lift-off/touchdown)
+            vs = v if mode == SLIDING else 0.0
+            s1, v1, yb1, vb1 = rk4(tc, left, s, vs, yb, vb, mode, d, cm, smooth, code, FP, PP, u, sp, Z, DZ, DDZ)
+            cut = left
+            switched = False
+            if (contact_switch(yb1, vb1, PP) > 0.0) != (cm > 0.5):
+                cut = _contact_time(tc, left, s, vs, yb, vb, mode, d, cm, smooth, code, FP, PP, u, sp, Z, DZ, DDZ)
+                s1, v1, yb1, vb1 = rk4(tc, cut, s, vs, yb, vb, mode, d, cm, smooth, code, FP, PP, u, sp, Z, DZ, DDZ)
+                switched = True
             if mode == SLIDING:
-                s1, v1, yb1, vb1 = rk4(tc, left, s, v, yb, vb, SLIDING, d, smooth, code, FP, PP, u, sp, Z, DZ, DDZ)
                 if smooth or v1 * d > 0.0:
                     s, v, yb, vb = s1, v1, yb1, vb1
-                    break
-                # velocity reaches zero inside the step: locate it
-                a0 = rhs(tc, s, v, yb, vb, SLIDING, d, smooth, code, FP, PP, u, sp, Z, DZ, DDZ)[1]
-                a1 = rhs(tc + left, s1, v1, yb1, vb1, SLIDING, d, smooth, code, FP, PP, u, sp, Z, DZ, DDZ)[1]
-                tau = _cubic_root(v, a0, v1, a1, left)
+                    tc += cut
+                    left -= cut
+                    if switched:
+                        stats[5] += 1.0
+                        cm = 1.0 - cm
+                    if left <= 0.0:
+                        break
+                    continue
+                # velocity reaches zero before the cut: locate it
+                a0 = rhs(tc, s, v, yb, vb, SLIDING, d, cm, smooth, code, FP, PP, u, sp, Z, DZ, DDZ)[1]
+                a1 = rhs(tc + cut, s1, v1, yb1, vb1, SLIDING, d, cm, smooth, code, FP, PP, u, sp, Z, DZ, DDZ)[1]
+                tau = _cubic_root(v, a0, v1, a1, cut)
                 st, vt, ybt, vbt = s1, v1, yb1, vb1
                 for _n in range(4):
-                    st, vt, ybt, vbt = rk4(tc, tau, s, v, yb, vb, SLIDING, d, smooth, code, FP, PP, u, sp, Z, DZ, DDZ)
+                    st, vt, ybt, vbt = rk4(tc, tau, s, v, yb, vb, SLIDING, d, cm, smooth, code, FP, PP, u, sp, Z, DZ, DDZ)
                     if abs(vt) < 1e-13:
                         break
-                    at = rhs(tc + tau, st, vt, ybt, vbt, SLIDING, d, smooth, code, FP, PP, u, sp, Z, DZ, DDZ)[1]
+                    at = rhs(tc + tau, st, vt, ybt, vbt, SLIDING, d, cm, smooth, code, FP, PP, u, sp, Z, DZ, DDZ)[1]
                     if at == 0.0:
                         break
                     nt = tau - vt / at
                     if nt <= 0.0:
                         nt = 0.5 * tau
-                    if nt >= left:
-                        nt = 0.5 * (tau + left)
+                    if nt >= cut:
+                        nt = 0.5 * (tau + cut)
                     tau = nt
                 s, v, yb, vb = st, 0.0, ybt, vbt
                 tc += tau
@@ -246,19 +272,25 @@ def advance(state, mode_dir, t0, n_steps, h, code, FP, PP, smooth, u, sp, Z, DZ,
                 if left <= 0.0:
                     break
             else:  # STUCK
-                s1, v1, yb1, vb1 = rk4(tc, left, s, 0.0, yb, vb, STUCK, d, smooth, code, FP, PP, u, sp, Z, DZ, DDZ)
-                F1 = hold(tc + left, s1, 0.0, yb1, vb1, u, PP, sp, Z, DZ, DDZ)
+                F1 = hold(tc + cut, s1, 0.0, yb1, vb1, u, PP, sp, Z, DZ, DDZ)
                 lim1 = static_limit(code, s1, FP, PP)
                 if abs(F1) <= lim1:
-                    stats[0] += left
+                    stats[0] += cut
                     s, v, yb, vb = s1, 0.0, yb1, vb1
-                    break
-                # breakaway inside the step: bracket [lo, hi] with margin(lo) >= 0 > margin(hi)
+                    tc += cut
+                    left -= cut
+                    if switched:
+                        stats[5] += 1.0
+                        cm = 1.0 - cm
+                    if left <= 0.0:
+                        break
+                    continue
+                # breakaway before the cut: bracket [lo, hi] with margin(lo) >= 0 > margin(hi)
                 sg = 1.0 if F1 > 0 else -1.0
                 F0 = hold(tc, s, 0.0, yb, vb, u, PP, sp, Z, DZ, DDZ)
                 m_lo = static_limit(code, s, FP, PP) - sg * F0
                 m_hi = lim1 - sg * F1
-                lo, hi = 0.0, left
+                lo, hi = 0.0, cut
                 yb_hi, vb_hi = yb1, vb1
                 side = 0
                 for _n in range(60):
@@ -267,7 +299,7 @@ def advance(state, mode_dir, t0, n_steps, h, code, FP, PP, smooth, u, sp, Z, DZ,
                     tt = lo + (hi - lo) * m_lo / (m_lo - m_hi) if m_lo != m_hi else 0.5 * (lo + hi)
                     if not (lo < tt < hi):
                         tt = 0.5 * (lo + hi)
-                    s2, v2, yb2, vb2 = rk4(tc, tt, s, 0.0, yb, vb, STUCK, d, smooth, code, FP, PP, u, sp, Z, DZ, DDZ)
+                    s2, v2, yb2, vb2 = rk4(tc, tt, s, 0.0, yb, vb, STUCK, d, cm, smooth, code, FP, PP, u, sp, Z, DZ, DDZ)
                     m = static_limit(code, s2, FP, PP) - sg * hold(tc + tt, s2, 0.0, yb2, vb2, u, PP, sp, Z, DZ, DDZ)
                     if m >= 0.0:
                         lo, m_lo = tt, m
@@ -283,7 +315,7 @@ def advance(state, mode_dir, t0, n_steps, h, code, FP, PP, smooth, u, sp, Z, DZ,
                     if abs(m) < 1e-9 * (1.0 + abs(lim1)):
                         if m < 0.0:
                             break
-                if hi < left:
+                if hi < cut:
                     yb, vb = yb_hi, vb_hi
                 else:
                     yb, vb = yb1, vb1
@@ -300,13 +332,13 @@ def advance(state, mode_dir, t0, n_steps, h, code, FP, PP, smooth, u, sp, Z, DZ,
             # more than 8 events inside one step (never seen in practice): finish the
             # step in the current mode without further event checks, and count it
             if left > 0.0:
-                s, v, yb, vb = rk4(tc, left, s, v, yb, vb, mode, d, smooth, code, FP, PP, u, sp, Z, DZ, DDZ)
+                s, v, yb, vb = rk4(tc, left, s, v, yb, vb, mode, d, cm, smooth, code, FP, PP, u, sp, Z, DZ, DDZ)
                 if mode == STUCK:
                     v = 0.0
                     stats[0] += left
                 stats[4] += 1.0
         if (i + 1) % out_every == 0 and pos < out.shape[0]:
-            _record(out, pos, t0 + (i + 1) * h, s, v, yb, vb, mode, d, smooth, code, FP, PP, u, sp, Z, DZ, DDZ)
+            _record(out, pos, t0 + (i + 1) * h, s, v, yb, vb, mode, d, cm, smooth, code, FP, PP, u, sp, Z, DZ, DDZ)
             pos += 1
     state[0], state[1], state[2], state[3] = s, v, yb, vb
     mode_dir[0] = mode
@@ -315,7 +347,38 @@ def advance(state, mode_dir, t0, n_steps, h, code, FP, PP, smooth, u, sp, Z, DZ,
 
 
 @_jit
-def _record(out, pos, t, s, v, yb, vb, mode, d, smooth, code, FP, PP, u, sp, Z, DZ, DDZ):
+def _contact_time(tc, left, s, v, yb, vb, mode, d, cm, smooth, code, FP, PP, u, sp, Z, DZ, DDZ):
+    """Time in (0, left] just past the zero of the contact switch (Illinois on RK4 sub-steps
+    with the contact state ``cm`` held)."""
+    g_lo = contact_switch(yb, vb, PP)
+    c_lo = cm > 0.5
+    s1, v1, yb1, vb1 = rk4(tc, left, s, v, yb, vb, mode, d, cm, smooth, code, FP, PP, u, sp, Z, DZ, DDZ)
+    g_hi = contact_switch(yb1, vb1, PP)
+    lo, hi = 0.0, left
+    side = 0
+    for _n in range(80):
+        if hi - lo < 1e-12 * (1.0 + tc):
+            break
+        tt = lo + (hi - lo) * g_lo / (g_lo - g_hi) if g_lo != g_hi else 0.5 * (lo + hi)
+        if not (lo < tt < hi):
+            tt = 0.5 * (lo + hi)
+        s2, v2, yb2, vb2 = rk4(tc, tt, s, v, yb, vb, mode, d, cm, smooth, code, FP, PP, u, sp, Z, DZ, DDZ)
+        g = contact_switch(yb2, vb2, PP)
+        if (g > 0.0) == c_lo:
+            lo, g_lo = tt, g
+            if side == -1:
+                g_hi *= 0.5  # Illinois
+            side = -1
+        else:
+            hi, g_hi = tt, g
+            if side == 1:
+                g_lo *= 0.5
+            side = 1
+    return hi
+
+
+@_jit
+def _record(out, pos, t, s, v, yb, vb, mode, d, cm, smooth, code, FP, PP, u, sp, Z, DZ, DDZ):
     zh, dzh, ddzh = heave_at(t, sp, Z, DZ, DDZ)
     p = gas_pressure(s, PP)
     if mode == STUCK:

@@ -219,6 +219,17 @@ def run_kernel(law, PP, hs, h, n_steps, out_every, *, u_active=0.0, progress=Non
     smooth = not law.has_stiction
     t0 = time.perf_counter()
     done, pos = 0, 0
+    # the fade-in's end: d2z/dt2 jumps there; step up to it with the left-limit sample so no
+    # RK4 step straddles the jump (only when it falls on the step and output grids)
+    if hs.kink is not None and hs.kink[0] % 2 == 0:
+        k, ddz_left = hs.kink
+        n1 = k // 2
+        if 0 < n1 <= n_steps and n1 % out_every == 0:
+            ddz1 = hs.ddz[:k + 1].copy()
+            ddz1[k] = ddz_left
+            pos = advance(state, mode_dir, 0.0, n1, h, int(law.code), law.FP, PP, bool(smooth), float(u_active),
+                          0.5 * h, hs.z[:k + 1], hs.dz[:k + 1], ddz1, out, int(out_every), 0, stats)
+            done = n1
     while done < n_steps:
         n = min(chunk_steps - chunk_steps % out_every or out_every, n_steps - done)
         pos = advance(state, mode_dir, done * h, n, h, int(law.code), law.FP, PP, bool(smooth), float(u_active),

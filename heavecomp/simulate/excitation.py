@@ -28,6 +28,9 @@ class HeaveSamples:
     dz: np.ndarray
     ddz: np.ndarray
     info: dict = dataclasses.field(default_factory=dict)
+    #: (sample index, left-limit ddz) where the fade-in ends on a sample: d^2r/dt^2 jumps
+    #: there (-pi^2/(2 T_r^2) -> 0), so the interval before it needs the left limit
+    kink: tuple | None = None
 
     @property
     def t(self) -> np.ndarray:
@@ -48,6 +51,16 @@ def ramp_factor(t, ramp):
     return r, dr, ddr
 
 
+def ramp_kink(spacing, z, ddz, ramp):
+    """(index, left-limit ddz) of the sample at t = ramp, or None if no sample is there."""
+    if ramp <= 0:
+        return None
+    k = int(round(ramp / spacing))
+    if k >= z.size or abs(k * spacing - ramp) > 1e-9 * ramp:
+        return None
+    return k, float(ddz[k] - np.pi ** 2 / (2 * ramp ** 2) * z[k])
+
+
 def _apply_ramp(t, z, dz, ddz, ramp):
     """Fade in (z, dz, ddz) by r(t); only the samples with t < ramp change."""
     n = int(np.searchsorted(t, ramp)) if ramp > 0 else 0
@@ -66,7 +79,8 @@ def sine(amplitude, period, ramp, duration, spacing) -> HeaveSamples:
     w = 2 * np.pi / period
     z, dz, ddz = _apply_ramp(t, amplitude * np.sin(w * t), amplitude * w * np.cos(w * t),
                              -amplitude * w * w * np.sin(w * t), ramp)
-    return HeaveSamples(spacing, z, dz, ddz, {"kind": "sine", "amplitude": amplitude, "period": period, "ramp": ramp})
+    return HeaveSamples(spacing, z, dz, ddz, {"kind": "sine", "amplitude": amplitude, "period": period, "ramp": ramp},
+                        kink=ramp_kink(spacing, z, ddz, ramp))
 
 
 def jonswap_spectrum(f, hs, tp, gamma=3.3):
@@ -124,7 +138,7 @@ def jonswap(hs, tp, gamma, seed, ramp, duration, spacing, *, f_cut_factor=6.0) -
     z, dz, ddz = _apply_ramp(t, z, dz, ddz, ramp)
     info = {"kind": "jonswap", "hs": hs, "tp": tp, "gamma": gamma, "seed": seed, "ramp": ramp,
             "repeat_period": T_rep}
-    return HeaveSamples(spacing, z, dz, ddz, info)
+    return HeaveSamples(spacing, z, dz, ddz, info, kink=ramp_kink(spacing, z, ddz, ramp))
 
 
 def spectral_hs_tp(z, dt):

@@ -8,7 +8,8 @@ CHANNELS = ("t", "heave", "stroke", "pressure", "wob", "stroke_velocity", "frict
             "lower_displacement", "lower_velocity", "stuck", "u_active")
 NCH = len(CHANNELS)
 #: slots of the ``stats`` array
-STATS = ("stuck_time", "n_stick", "n_breakaway", "n_reversal", "n_event_overflow")
+STATS = ("stuck_time", "n_stick", "n_breakaway", "n_reversal", "n_event_overflow", "n_contact_switch")
+NSTATS = len(STATS)
 
 #: files whose source the compiled stepper is built from (the AOT build is keyed to them)
 KERNEL_SOURCES = ("friction/laws.py", "plants/cmc.py", "simulate/_kernel.py")
