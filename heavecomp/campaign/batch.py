@@ -204,44 +204,11 @@ def prepare(campaign, runs, base=None):
 
 
 def jonswap_samples(hs, tp, gamma, seed, ramp, duration, spacing, spectra=None):
-    """:func:`heavecomp.simulate.excitation.jonswap`, bit for bit, for many runs.
-
-    Two savings, no change in the numbers (pinned by ``tests/test_campaign.py``):
-    the amplitude spectrum is computed once per (H_s, T_p, gamma, grid) and kept in
-    ``spectra`` (a dict) across runs; the fade-in is applied only on t < ramp
-    (beyond it r = 1, r' = r'' = 0, so the product is the identity).
-    """
-    from scipy import fft as sfft
-
+    """:func:`heavecomp.simulate.excitation.jonswap` with its amplitude spectrum cached in
+    ``spectra`` (a dict) across the runs of a campaign (one spectrum per sea state)."""
     from heavecomp.simulate import excitation
 
-    n_need = int(math.ceil(duration / spacing)) + 2
-    n = sfft.next_fast_len(max(n_need, int(math.ceil(4 * tp / spacing))), real=True)
-    f = np.fft.rfftfreq(n, spacing)
-    key = (hs, tp, gamma, n, spacing)
-    amp = None if spectra is None else spectra.get(key)
-    if amp is None:
-        S = excitation.jonswap_spectrum(f, hs, tp, gamma)
-        S[f > 6.0 / tp] = 0.0
-        amp = np.sqrt(2 * S * (1.0 / (n * spacing)))
-        if spectra is not None:
-            spectra[key] = amp
-    rng = np.random.default_rng(seed)
-    phase = rng.uniform(0, 2 * np.pi, size=f.size)
-    X = amp * np.exp(1j * phase) * n / 2.0
-    X[0] = 0.0
-    if n % 2 == 0:
-        X[-1] = 0.0
-    w = 2 * np.pi * f
-    z = sfft.irfft(X, n)[:n_need]
-    dz = sfft.irfft(1j * w * X, n)[:n_need]
-    ddz = sfft.irfft(-(w ** 2) * X, n)[:n_need]
-    k = min(n_need, int(math.ceil(ramp / spacing)) + 1)
-    t = np.arange(k) * spacing
-    z[:k], dz[:k], ddz[:k] = excitation._apply_ramp(t, z[:k], dz[:k], ddz[:k], ramp)
-    return excitation.HeaveSamples(spacing, z, dz, ddz, {"kind": "jonswap", "hs": hs, "tp": tp, "gamma": gamma,
-                                                         "seed": seed, "ramp": ramp, "repeat_period": n * spacing},
-                                   kink=excitation.ramp_kink(spacing, z, ddz, ramp))
+    return excitation.jonswap(hs, tp, gamma, seed, ramp, duration, spacing, spectra=spectra)
 
 
 def hist_columns(nbins: int) -> tuple[list[str], list[str]]:

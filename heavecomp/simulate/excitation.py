@@ -105,14 +105,15 @@ def jonswap_spectrum(f, hs, tp, gamma=3.3):
     return out * (hs / 4.0) ** 2 / m0
 
 
-def jonswap(hs, tp, gamma, seed, ramp, duration, spacing, *, f_cut_factor=6.0) -> HeaveSamples:
+def jonswap(hs, tp, gamma, seed, ramp, duration, spacing, *, f_cut_factor=6.0, spectra=None) -> HeaveSamples:
     """Irregular platform heave from a JONSWAP spectrum (random phases, deterministic amplitudes).
 
     Components sit on the FFT grid f_k = k / T_rep with T_rep >= duration, so
     the series is synthesised with one inverse FFT per derivative and its
     variance over T_rep equals the spectrum's m0 exactly (H_s = 4 sqrt(m0)).
     Components above ``f_cut_factor / T_p`` are dropped (they carry < 0.1 % of
-    the variance and would only add high-frequency acceleration).
+    the variance and would only add high-frequency acceleration).  ``spectra``, a dict,
+    caches the amplitude spectrum per (H_s, T_p, gamma, grid) across calls (campaigns).
     """
     from scipy import fft as sfft
 
@@ -120,10 +121,14 @@ def jonswap(hs, tp, gamma, seed, ramp, duration, spacing, *, f_cut_factor=6.0) -
     n = sfft.next_fast_len(max(n_need, int(math.ceil(4 * tp / spacing))), real=True)
     T_rep = n * spacing
     f = np.fft.rfftfreq(n, spacing)
-    S = jonswap_spectrum(f, hs, tp, gamma)
-    S[f > f_cut_factor / tp] = 0.0
-    df = 1.0 / T_rep
-    amp = np.sqrt(2 * S * df)
+    key = (hs, tp, gamma, n, spacing, f_cut_factor)
+    amp = None if spectra is None else spectra.get(key)
+    if amp is None:
+        S = jonswap_spectrum(f, hs, tp, gamma)
+        S[f > f_cut_factor / tp] = 0.0
+        amp = np.sqrt(2 * S / T_rep)
+        if spectra is not None:
+            spectra[key] = amp
     rng = np.random.default_rng(seed)
     phase = rng.uniform(0, 2 * np.pi, size=f.size)
     X = amp * np.exp(1j * phase) * n / 2.0  # irfft scaling: a cos(w t + phi)
