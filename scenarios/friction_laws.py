@@ -3,7 +3,8 @@ and what does the smooth form used for optimisation change?
 
 Paper-A main-cylinder parameters at the operating pressure p_0; eq. 4 (Stribeck + pressure),
 eq. 6 and eq. 7 (rotating piston, v_t = 0.05 m/s), the hydromechanical efficiency model (eqs. 1-3,
-eta = 0.98 at the operating force), and eq. 4 regularised with tanh(v/eps).
+eta = 0.98 at the operating force), and eq. 4 regularised with tanh(v/eps); beside them paper B's
+three-regime law of the pneumatic seal (heavecomp.plants.pneumatic defaults).
 """
 
 from __future__ import annotations
@@ -34,17 +35,31 @@ def build(n: int = 2001) -> dict:
         "eqs. 1-3 hydromechanical efficiency 0.98": (v, hydromechanical_friction(p.p0 * p.area, v, 0.98), "b--"),
     }
     limits = {m: float(law.static_limit(p.p0)) for m, law in laws.items()}
-    return {"curves": curves, "static_limits": limits, "p0": p.p0}
+    from heavecomp.friction.three_regime import smooth_friction
+    from heavecomp.plants.pneumatic import default
+
+    tb = default().friction
+    vb = np.linspace(-0.15, 0.15, n)
+    vb = vb[vb != 0.0]
+    pneumatic = {
+        "static -> dynamic (after breakaway from F_s1)": (vb, tb.accelerating(vb), "r-"),
+        "dynamic -> static (decelerating)": (vb, tb.decelerating(vb), "b--"),
+        f"smooth static -> dynamic, eps = {EPS * 1e3:g} mm/s": (
+            vb, smooth_friction(vb, tb.stick_static_force, tb.FPB, EPS), "k:"),
+    }
+    limits["paper_b_stick"] = float(tb.stick_static_force)
+    return {"curves": curves, "static_limits": limits, "p0": p.p0, "pneumatic": pneumatic}
 
 
 def main(argv=None) -> int:
     args = parse_args(argv, "friction_laws", __doc__)
     res = build(401 if args.quick else 4001)
-    fig.save(fig.plot_friction_laws(res["curves"]), args.out / "friction_laws.png")
+    fig.save(fig.plot_friction_laws(res["curves"], pneumatic=res["pneumatic"]), args.out / "friction_laws.png")
     write_metrics(args.out, {"static_limit_N": res["static_limits"], "p0_Pa": res["p0"], "eps_m_per_s": EPS})
     write_report(args.out, "Friction laws of paper A", [
         __doc__, "![laws](friction_laws.png)",
-        md_table(["law", "static limit at p_0 [kN]"], [(k, v / 1e3) for k, v in res["static_limits"].items()]),
+        md_table(["law", "static limit [kN] (CMC at p_0; paper B seal)"],
+                 [(k, v / 1e3) for k, v in res["static_limits"].items()], fmt="{:.4g}"),
         "Eq. 6 lowers the static peak (jump 2) but keeps the sign jump (jump 1); eq. 7 removes the "
         "Stribeck part of the jump — only the pressure term C_p|p| can still hold the piston.",
     ])

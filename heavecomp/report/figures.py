@@ -131,10 +131,23 @@ def plot_wob_run(res, *, title: str | None = None, zoom: float | None = None):
     return fig
 
 
-def plot_friction_laws(curves: dict, *, title: str | None = None):
-    """Friction force vs axial velocity for several laws (label -> (v, F))."""
+def plot_friction_laws(curves: dict, *, title: str | None = None, pneumatic: dict | None = None):
+    """Friction force vs axial velocity for several laws (label -> (v, F, style)); an optional
+    second panel for paper B's pneumatic seal (label -> (v, F, style), in N)."""
     plt = _plt()
-    fig, ax = plt.subplots(figsize=(8, 5))
+    if pneumatic:
+        fig, (ax, axb) = plt.subplots(1, 2, figsize=(13, 5), gridspec_kw={"width_ratios": [1.3, 1]})
+        for label, (v, F, style) in pneumatic.items():
+            axb.plot(v * 1e3, F, style, lw=1.5, label=label)
+        axb.axhline(0, color="0.5", lw=0.6)
+        axb.axvline(0, color="0.5", lw=0.6)
+        axb.set_xlabel("piston velocity v [mm/s]")
+        axb.set_ylabel("friction force F_f [N]")
+        axb.set_title("Paper B: three lubrication regimes (pneumatic seal)", fontsize=10)
+        axb.legend(fontsize=8)
+        axb.grid(alpha=0.3)
+    else:
+        fig, ax = plt.subplots(figsize=(8, 5))
     for label, (v, F, style) in curves.items():
         ax.plot(v * 1e3, F / 1e3, style, lw=1.5, label=label)
     ax.axhline(0, color="0.5", lw=0.6)
