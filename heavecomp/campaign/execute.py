@@ -61,8 +61,11 @@ class CampaignRun:
 
 
 def _check_manifest(campaign, out: Path):
+    from heavecomp.simulate.layout import source_hash
+
     man = out / MANIFEST
     fp = campaign.fingerprint()
+    physics = f"{source_hash():x}"  # the stepper's source files: results of other physics are not resumed
     if man.is_file():
         try:
             old = json.loads(man.read_text())
@@ -71,10 +74,13 @@ def _check_manifest(campaign, out: Path):
         if old.get("fingerprint") != fp:
             raise InputError(f"--out {out}: holds results of a different campaign (fingerprint {old.get('fingerprint')} "
                              f"!= {fp}); choose another --out")
+        if old.get("physics", physics) != physics:
+            raise InputError(f"--out {out}: holds results of another version of the plant/stepper source "
+                             f"({old.get('physics')} != {physics}); choose another --out or remove the folder")
     else:
         out.mkdir(parents=True, exist_ok=True)
         man.write_text(json.dumps({"schema": 1, "campaign": campaign.settings.name, "fingerprint": fp,
-                                   "n_runs": len(campaign.runs())}, indent=2) + "\n")
+                                   "physics": physics, "n_runs": len(campaign.runs())}, indent=2) + "\n")
         (out / "campaign.toml").write_text(campaign.source_text)
 
 
