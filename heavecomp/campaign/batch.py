@@ -120,7 +120,9 @@ def _batch(codes, FPs, PPs, smooth, hsteps, nsteps, out_every, t_stat, W0, half,
                     a[14] = p
                 # histogram of dW: slot 0 underflow, 1..nbins, nbins+1 overflow
                 x = (d + dev_max) / (2.0 * dev_max) * nbins
-                if x < 0.0:
+                if x != x:  # NaN: never index with it (int(NaN) is undefined)
+                    hist[r, nbins + 1] += 1
+                elif x < 0.0:
                     hist[r, 0] += 1
                 elif x >= nbins:
                     hist[r, nbins + 1] += 1

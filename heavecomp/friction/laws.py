@@ -41,8 +41,7 @@ def stribeck_curve(speed, FS, FC, vS):
     """F_0 = F_C + (F_S - F_C) exp(-speed / v_S) — the Stribeck magnitude [N].
 
     ``speed`` is |v| for eq. 4 and the total sliding speed sqrt(v_a^2 + v_t^2)
-    for eqs. 6-7 (paper A eq. 8).  Evaluated for speed < 0 it is the analytic
-    continuation used by the stepper to locate velocity reversals.
+    for eqs. 6-7 (paper A eq. 8).
     """
     return FC + (FS - FC) * np.exp(-speed / vS)
 
@@ -55,8 +54,9 @@ def friction_jump(code, a, p, FP):
     code : int
         Law code (NONE, STRIBECK, EQ6, EQ7).
     a : float
-        Velocity along the sliding direction, ``sign(v) * v`` (= |v| while sliding;
-        0 gives the static limit).
+        Velocity along the sliding direction, ``direction * v`` (= |v| while sliding;
+        0 gives the static limit; < 0 only in the stepper's trial steps past a
+        reversal, where the law is continued with its value at 0).
     p : float
         Pressure drop across the seal [Pa] (cylinder gauge pressure).
     FP : array
@@ -69,7 +69,9 @@ def friction_jump(code, a, p, FP):
     eq. 7: J = C_p |p| (the Stribeck part is continuous through v = 0, see K).
     """
     if code == STRIBECK:
-        return stribeck_curve(a, FP[0], FP[1], FP[2]) + FP[4] * np.abs(p)
+        # beyond v = 0 (a < 0, only in the stepper's trial steps) the magnitude is held at its
+        # v = 0 value: the analytic continuation exp(-a/v_S) explodes within a few v_S
+        return stribeck_curve(np.maximum(a, 0.0), FP[0], FP[1], FP[2]) + FP[4] * np.abs(p)
     if code == EQ6:
         return stribeck_curve(np.sqrt(a * a + FP[5] * FP[5]), FP[0], FP[1], FP[2]) + FP[4] * np.abs(p)
     if code == EQ7:

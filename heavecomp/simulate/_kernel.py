@@ -46,6 +46,46 @@ import numpy as np
 from heavecomp.friction import laws as _laws
 from heavecomp.plants import cmc as _cmc
 
+
+
+def _numba_cache_dir():
+    """A numba cache folder keyed to the hash of every heavecomp source file.
+
+    numba invalidates a cached function only when *its own* file changes, but the
+    compiled steppers inline physics from other files (friction/laws.py,
+    plants/cmc.py, ...): after an edit or an upgrade, a stale cache would run old
+    physics.  Keying the whole cache to all sources makes that impossible.
+    ``NUMBA_CACHE_DIR`` set by the user wins.
+    """
+    import hashlib
+    import os
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    h = hashlib.sha256()
+    for p in sorted(root.rglob("*.py")):
+        h.update(p.relative_to(root).as_posix().encode())
+        h.update(p.read_bytes())
+    base = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "heavecomp"
+    return base / f"numba-{h.hexdigest()[:16]}"
+
+
+def _use_keyed_cache():
+    import os
+
+    if os.environ.get("NUMBA_CACHE_DIR"):
+        return
+    from numba.core import config
+
+    d = _numba_cache_dir()
+    try:
+        d.mkdir(parents=True, exist_ok=True)
+    except OSError:  # read-only home: numba's default (__pycache__ beside the sources)
+        return
+    config.CACHE_DIR = str(d)
+
+
+_use_keyed_cache()  # before any njit(cache=True) below or in modules that import this one
 _jit = nb.njit(cache=True, fastmath=False)
 _ENV: dict = {}
 

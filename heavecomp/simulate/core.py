@@ -14,6 +14,10 @@ import numpy as np
 
 from heavecomp.errors import InputError, ParameterError
 
+
+class SimulationError(InputError):
+    """The integration failed (e.g. diverged for a step too large for the parameters)."""
+
 log = logging.getLogger(__name__)
 
 from heavecomp.simulate.layout import CHANNELS, NCH, STATS, STUCK
@@ -238,7 +242,12 @@ def run_kernel(law, PP, hs, h, n_steps, out_every, *, u_active=0.0, progress=Non
         if progress is not None:
             progress(done / n_steps)
     wall = time.perf_counter() - t0
-    return out[:pos], dict(zip(STATS, stats.tolist())), wall
+    data = out[:pos]
+    if not np.isfinite(data).all():
+        row = int(np.argmax(~np.isfinite(data).all(axis=1)))
+        raise SimulationError(f"the stepper diverged near t = {data[max(row - 1, 0), 0]:g} s (non-finite state); "
+                              f"reduce --dt (now {h:g} s) or check the parameters")
+    return data, dict(zip(STATS, stats.tolist())), wall
 
 
 _STEPPER = None

@@ -12,7 +12,7 @@ STATS = ("stuck_time", "n_stick", "n_breakaway", "n_reversal", "n_event_overflow
 NSTATS = len(STATS)
 
 #: files whose source the compiled stepper is built from (the AOT build is keyed to them)
-KERNEL_SOURCES = ("friction/laws.py", "plants/cmc.py", "simulate/_kernel.py")
+KERNEL_SOURCES = ("friction/laws.py", "plants/cmc.py", "simulate/_kernel.py", "simulate/layout.py")
 
 
 def source_hash() -> int:
