@@ -467,6 +467,7 @@ class GapDiagnoser:
                          "fit_wall_time": fitted["wall_time"], "_values": fitted["values"], "_pred": pred})
         rows.sort(key=lambda r: -r["score"])
         self._report(0.9, "verdict")
+        self.second_tried_ = []
         self._verdict(rows, J_b, J_n)
         self.candidates_ = [{k: v for k, v in r.items() if not k.startswith("_")} for r in rows]
         best_pred = rows[0]["_pred"] if self.verdict_["effect"] not in ("none",) else nom
@@ -516,16 +517,21 @@ class GapDiagnoser:
         self.verdict_ = v
 
     def _second(self, rows):
+        """Joint fit of the best candidate (held at its fitted values) with each of the next
+        ``second`` runners-up; the one whose joint held-out explained share exceeds the best's by
+        more than 0.1 after the parsimony penalty is the ``second_effect``.  Any pair works except
+        two output candidates (one transport delay per configuration): a sensor delay as the best
+        is paired with the plant/nominal runners-up (it was skipped altogether before)."""
         best = rows[0]
         fixed = [(best["effect"], best["_values"])]
-        if best["effect"] == "sensor_delay":
-            return None
+        best_output = get(best["effect"]).kind == "output"
         out = None
         tried = 0
+        self.second_tried_ = []
         for r in rows[1:]:
             if tried >= self.second:
                 break
-            if r["effect"] == "sensor_delay" and best["effect"] == "sensor_delay":
+            if best_output and get(r["effect"]).kind == "output":
                 continue
             tried += 1
             start = r["_values"] if get(r["effect"]).kind != "output" else None
@@ -537,6 +543,7 @@ class GapDiagnoser:
             if not math.isfinite(expl):
                 continue
             gain = expl - best["explained"] - self.penalty * get(r["effect"]).n_params()
+            self.second_tried_.append({"effect": r["effect"], "explained_joint": float(expl), "added_explained": float(gain)})
             if gain > 0.1 and (out is None or gain > out["added_explained"]):
                 mse_a = self._mse(pred, self._valmask)
                 out = {"effect": r["effect"], "parameters": self._public(r["effect"], fitted["values"]),
