@@ -80,6 +80,36 @@ def test_ar_predictor_sine_one_second_ahead():
     assert np.sqrt(np.mean(np.square(derr))) < 0.02
 
 
+def test_heave_predictor_jonswap_one_second_ahead():
+    """Irregular sea (JONSWAP H_s 2 m, T_p 12 s, heave std ~0.5 m) with 5 mm sensor noise.
+
+    The best linear 1 s predictor from these noisy samples (least squares fitted offline
+    on an hour of the same sea) reaches ~7 cm; the online predictor gets 8.6 cm on this
+    record.  The former AR(10)-on-block-means predictor had 11 cm on such a sea, which the
+    MPC could not use (WOB std 42 % of passive).  9.5 cm separates the two with margin
+    either side (deterministic: seeded sea and noise); the velocity at t = now (what the
+    friction feed-forward and the observer see) within 3.5 cm/s (former 4.0 cm/s, now
+    2.6 cm/s)."""
+    from heavecomp.controllers.estimation import HeavePredictor
+    from heavecomp.simulate.excitation import jonswap
+
+    dt = 0.05
+    h = jonswap(2.0, 12.0, 3.3, 3, 60.0, 305.0, dt)
+    zm = h.z + 5e-3 * np.random.default_rng(2).standard_normal(h.z.size)
+    pred = HeavePredictor(dt)
+    err, derr = [], []
+    for k in range(int(300.0 / dt) - 21):
+        pred.update(k * dt, zm[k])
+        if k * dt >= 60.0:
+            H = pred.trajectory(k * dt, 20)
+            assert np.all(np.isfinite(H))
+            err.append(H[-1, 0] - h.z[k + 20])
+            derr.append(H[0, 1] - h.dz[k])
+    assert 0.4 < np.std(h.z[1200:]) < 0.65
+    assert np.sqrt(np.mean(np.square(err))) < 0.095
+    assert np.sqrt(np.mean(np.square(derr))) < 0.035
+
+
 # ---------------------------------------------------------------- observer
 def test_observer_recovers_a_planted_force_on_the_nonlinear_plant():
     """A constant 8 kN upward force the observer is not told about appears as d = -8 kN.

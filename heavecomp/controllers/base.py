@@ -87,9 +87,10 @@ class ControllerConfig:
     sqp_iterations : int
         Largest number of SQP iterations per control step.
     predictor_order : int
-        Order of the AR heave predictor (on 5 Hz block means).
+        Number of past heave samples (every 2nd sample at the control rate) the
+        direct multi-step heave predictor regresses on.
     predictor_window : float [s]
-        Length of measured heave the AR model is fitted on.
+        Forgetting time constant of the predictor's least-squares fit.
     """
 
     u_max: float = 60e3
@@ -110,8 +111,8 @@ class ControllerConfig:
     observer_sigma_d: float = 300.0
     nlp_solver: str = "sqp"
     sqp_iterations: int = 3
-    predictor_order: int = 10
-    predictor_window: float = 60.0
+    predictor_order: int = 80
+    predictor_window: float = 240.0
 
     @property
     def dt(self) -> float:

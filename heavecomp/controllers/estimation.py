@@ -2,15 +2,27 @@
 
 Heave predictor
 ---------------
-An autoregressive model AR(p) fitted online by least squares on the measured
-heave.  The 20 Hz samples are first averaged in blocks of ``decimate`` (5 Hz;
-this also averages the sensor noise), the AR model is refitted every second on
-the last ``window`` seconds, iterated forward over the horizon; z_h, dz_h/dt
-and d^2z_h/dt^2 on the control grid (now .. now + N Ts) are the derivatives of a
-least-squares polynomial (degree 4) through the last 2 s of block means and the
-forecast, which smooths the noise before it is differentiated.  Wave heave is a
-narrow-band process, which an AR model predicts well over a fraction of the
-wave period; the closed loop reports the measured prediction error.
+A direct multi-step linear predictor fitted online by least squares: the heave
+k intervals ahead (k = 0..H, H >= 2 s) is regressed on the last ``order``
+measured samples (every ``step``-th, default 80 samples 0.1 s apart = 8 s of
+history) and a constant.  The sums X'X and X'Y are updated recursively at every
+sample with exponential forgetting (time constant ``window``, default 240 s),
+so the cost per sample is O(order^2 + order H) and the (order+1)^2 system is
+re-solved every ``refit`` seconds (ridge-regularised).  A direct predictor has
+no iterated recursion, hence no stability question, and its k-step error is
+the least-squares optimum for that k (an AR model iterated forward is not).
+dz_h/dt and d^2z_h/dt^2 on the control grid are the derivatives of a
+least-squares polynomial (degree 6) through the last 2 s of measured samples and
+the predicted trajectory, so that "now" is inside the fit and the sensor noise
+is smoothed before it is differentiated; z_h itself is that polynomial at "now"
+(the k = 0 regression is the noisy sample itself) blending linearly into the
+direct prediction over ``z_blend`` intervals (0.5 s).  Until the fit has
+``handover`` seconds of data (~40 s after the start) the former predictor,
+:class:`ARBlockPredictor`, which converges within seconds, gives the preview.
+With 5 mm sensor noise on a JONSWAP
+sea (H_s 2 m, T_p 12 s) the 1 s ahead error is ~8 cm, close to what an offline
+least-squares predictor fitted on an hour of the same noisy sea achieves
+(~7 cm); without noise the band-limited heave would be predictable to < 1 mm.
 
 Observer
 --------
@@ -32,7 +44,139 @@ import numpy as np
 
 
 class HeavePredictor:
-    """Online AR heave predictor on block means (see module docstring).
+    """Online direct multi-step linear heave predictor (see module docstring).
+
+    Parameters
+    ----------
+    dt : float [s]
+        Sample interval of the measured heave (the control interval).
+    order : int
+        Number of past samples regressed on (lags ``0, step, 2 step, ...``).
+    window : float [s]
+        Time constant of the exponential forgetting of the least-squares sums.
+    step : int
+        Lag spacing in samples (default 2: the last 80 x 2 x 50 ms = 8 s at 20 Hz).
+    horizon : int
+        Number of intervals ahead predicted directly (beyond: extrapolated with the
+        last predicted velocity); the derivative polynomial is fitted over it.
+    ridge : float
+        Ridge regularisation, relative to the mean diagonal of the Gram matrix.
+    refit : float [s]
+        Interval between re-solves of the least-squares problem.
+    min_data : float [s]
+        Regression rows (in seconds, forgetting-weighted) before the first solve.
+    poly_degree : int
+        Degree of the least-squares polynomial the velocity and acceleration come from.
+    ridge_start : float
+        Extra ridge, ``ridge_start * order / rows``, large while few rows are in.
+    handover : float [s]
+        Regression rows needed before this predictor replaces :class:`ARBlockPredictor`.
+    z_blend : float
+        Intervals over which z blends from the polynomial (now) into the direct prediction.
+    past : int
+        Measured samples (before and including now) in the derivative polynomial.
+    """
+
+    def __init__(self, dt: float, order: int = 80, window: float = 240.0, step: int = 2, horizon: int = 40,
+                 ridge: float = 1e-6, refit: float = 2.0, min_data: float = 5.0, poly_degree: int = 6,
+                 ridge_start: float = 1e-3, handover: float = 30.0, z_blend: float = 10.0, past: int = 40):
+        self.dt, self.order, self.window, self.step = float(dt), int(order), float(window), int(step)
+        self.horizon, self.ridge, self.refit, self.min_data = int(horizon), float(ridge), float(refit), float(min_data)
+        self.poly_degree, self.past, self.ridge_start = int(poly_degree), int(past), float(ridge_start)
+        self.handover, self.z_blend = float(handover), float(z_blend)
+        self.reset()
+
+    def reset(self):
+        p, H = self.order, self.horizon
+        self._L = (p - 1) * self.step + 1 + H          # samples kept: lags of the oldest regressor + its targets
+        self._z = np.zeros(self._L)
+        self._n = 0
+        self._G = np.zeros((p + 1, p + 1))             # sum of x x' (x: lags and a constant)
+        self._B = np.zeros((p + 1, H + 1))             # sum of x y' (y: the heave 0..H intervals later)
+        self._w = 0.0                                  # sum of the forgetting weights
+        self._lam = float(np.exp(-self.dt / self.window))
+        self._idx = np.arange(p) * self.step
+        self._since = 0
+        self.coef_ = None                              # (p + 1, H + 1): z(t + k dt) = x(t) @ coef_[:, k]
+        self.z_last = 0.0
+        self._startup = ARBlockPredictor(self.dt)     # used until the direct fit has `handover` s of data
+
+    def _ready(self) -> bool:
+        return self.coef_ is not None and self._w * self.dt >= self.handover
+
+    def update(self, t: float, z: float) -> None:
+        """Add one measured heave sample z [m] at time t [s] (samples every ``dt``)."""
+        self.z_last = float(z)
+        if self._startup is not None:
+            if self._ready():
+                self._startup = None
+            else:
+                self._startup.update(t, z)
+        self._z[:-1] = self._z[1:]
+        self._z[-1] = z
+        self._n += 1
+        if self._n < self._L:
+            return
+        j = self._L - 1 - self.horizon                 # the regressor H intervals ago ...
+        x = np.empty(self.order + 1)
+        x[:-1] = self._z[j - self._idx]
+        x[-1] = 1.0
+        y = self._z[j:]                                # ... and what followed it
+        self._G *= self._lam
+        self._G += np.outer(x, x)
+        self._B *= self._lam
+        self._B += np.outer(x, y)
+        self._w = self._lam * self._w + 1.0
+        self._since += 1
+        if self._w * self.dt >= min(self.min_data, 0.5 * self.window) and (
+                self.coef_ is None or self._since * self.dt >= self.refit):
+            G = self._G.copy()
+            d = np.arange(self.order)
+            # ridge: relative to the mean diagonal, larger while few rows are in (start-up)
+            ridge = self.ridge + self.ridge_start * self.order / self._w
+            G[d, d] += ridge * np.trace(self._G[:-1, :-1]) / self.order + 1e-12
+            self.coef_ = np.linalg.solve(G, self._B)
+            self._since = 0
+
+    def trajectory(self, t: float, n: int) -> np.ndarray:
+        """Predicted (z, dz, ddz) at t + k dt, k = 0..n, as an (n+1, 3) array [m, m/s, m/s^2]."""
+        out = np.zeros((n + 1, 3))
+        if not self._ready():
+            return self._startup.trajectory(t, n)
+        x = np.empty(self.order + 1)
+        x[:-1] = self._z[self._L - 1 - self._idx]
+        x[-1] = 1.0
+        zf = x @ self.coef_                           # direct predictions 0..horizon intervals ahead
+        # velocity and acceleration: derivatives of a least-squares polynomial through the
+        # last ``past`` measured samples and the predicted trajectory (differencing the
+        # prediction directly would amplify the sensor noise it passes through; the past
+        # samples keep t = now away from the end of the fit)
+        P = self.past
+        zz = np.r_[self._z[self._L - P:self._L - 1], zf] if P > 1 else zf
+        T = self.dt * self.horizon
+        tau = self.dt * np.arange(-(zz.size - self.horizon - 1), self.horizon + 1) / T
+        c = np.polyfit(tau, zz, self.poly_degree)
+        m = min(n, self.horizon)
+        tt = self.dt * np.arange(m + 1) / T
+        # z: the smoothed polynomial now (the k = 0 prediction is the noisy sample itself),
+        # blending linearly into the direct prediction over ``z_blend`` intervals
+        g = np.clip(1.0 - np.arange(m + 1) / max(self.z_blend, 1e-9), 0.0, 1.0)
+        out[:m + 1, 0] = g * np.polyval(c, tt) + (1.0 - g) * zf[:m + 1]
+        out[:m + 1, 1] = np.polyval(np.polyder(c, 1), tt) / T
+        out[:m + 1, 2] = np.polyval(np.polyder(c, 2), tt) / T ** 2
+        if n > m:                                       # beyond the fitted horizon: constant velocity
+            k = np.arange(1, n - m + 1)
+            out[m + 1:, 0] = out[m, 0] + out[m, 1] * self.dt * k
+            out[m + 1:, 1] = out[m, 1]
+        return out
+
+
+class ARBlockPredictor:
+    """Online AR heave predictor on 5 Hz block means, Kalman-filtered (the former predictor).
+
+    Converges within seconds but predicts an irregular sea poorly (11 cm RMS 1 s ahead on
+    the JONSWAP sea of the module docstring); :class:`HeavePredictor` uses it for its
+    first ``handover`` seconds only.
 
     Parameters
     ----------

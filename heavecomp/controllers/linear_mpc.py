@@ -5,7 +5,7 @@ discretised (ZOH) at the control interval Ts (:mod:`heavecomp.controllers.model`
 
     x_{k+1} = Ad x_k + Bu u_k + Bw w_k + Bf (f_k + d)
 
-with w_k the predicted heave (AR preview, :class:`HeavePredictor`), f_k the
+with w_k the predicted heave (online preview, :class:`HeavePredictor`), f_k the
 friction model (paper A eq. 4/6/7, smoothed with width ``friction_eps``) at the
 stroke velocity full compensation would need, v = -dz_h (the friction jumps at
 every stroke reversal, which the preview sees coming), and d the Kalman
@@ -92,7 +92,8 @@ class LinearMPC(Controller):
         self.solver.setup(sp.csc_matrix(np.triu(P)), np.zeros(N), sp.csc_matrix(Acon), l0, u0,
                           verbose=False, warm_starting=True, polishing=False, eps_abs=1e-4, eps_rel=1e-4,
                           max_iter=4000)
-        self.predictor = HeavePredictor(config.dt, config.predictor_order, config.predictor_window)
+        self.predictor = HeavePredictor(config.dt, config.predictor_order, config.predictor_window,
+                                        horizon=max(config.horizon, 40))
         self.observer = DisturbanceObserver(m, sigma_d=config.observer_sigma_d)
         super().__init__(params, config)
 

@@ -4,7 +4,7 @@ Prediction model: :func:`heavecomp.plants.cmc.casadi_model` with the friction
 law of the parameter file (paper A eq. 4/6/7) regularised with width
 ``friction_eps`` (``sign(v) -> tanh(v/eps)``), integrated by RK4 with two
 sub-steps per control interval (multiple shooting).  The heave over the horizon
-is the AR preview of :class:`~heavecomp.controllers.estimation.HeavePredictor`;
+is the online preview of :class:`~heavecomp.controllers.estimation.HeavePredictor`;
 the initial state comes from the same Kalman observer as the linear MPC, and the
 part of its disturbance estimate the smooth friction model does not explain is
 added as a constant force over the horizon.
