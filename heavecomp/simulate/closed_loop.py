@@ -252,7 +252,7 @@ def _preview_error(previews, hs, sp, Tc, K) -> dict:
         return {}
     E = np.array(errs)
     rms = np.sqrt(np.mean(E ** 2, axis=0))
-    return {"preview_predictor": "AR(p) on 5 Hz block means, refitted every 1 s",
+    return {"preview_predictor": "direct multi-step least squares on the last 8 s of heave (exponential forgetting, re-solved every 2 s; AR block-mean predictor during start-up)",
             "preview_rmse_m": [float(x) for x in rms],
             "preview_rmse_end_m": float(rms[-1]), "preview_horizon_s": float(Tc * (z.size - 1))}
 
