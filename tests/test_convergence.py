@@ -28,7 +28,8 @@ RATE = 10.0  # 0.1 s is a multiple of every step above
 
 
 def wob_errors(model):
-    p = paper_a(model)
+    """rms WOB error vs the fine reference at each of DTS, for a model name or a parameter set."""
+    p = paper_a(model) if isinstance(model, str) else model
     ref = simulate(p, T, dt=DT_REF, rate=RATE)
     errs, stats = [], []
     for dt in DTS:
@@ -62,14 +63,8 @@ def test_wob_history_converges_through_bit_lift_off():
     """3 m heave without friction: the bit leaves the formation every wave period
     (WOB = 0 for ~0.3 s).  Lift-off and touchdown are located as events with the contact
     state held through each sub-step, so the order stays 4 (it was erratic, ~1 kN rms)."""
-    p = paper_a("none").replace(heave={"amplitude": 3.0})
-    ref = simulate(p, T, dt=DT_REF, rate=RATE)
+    errs, _, ref = wob_errors(paper_a("none").replace(heave={"amplitude": 3.0}))
     assert np.count_nonzero(ref["wob"] == 0.0) > 20  # the bit really lifts off
-    errs = []
-    for dt in DTS:
-        e = simulate(p, T, dt=dt, rate=RATE)["wob"] - ref["wob"]
-        errs.append(float(np.sqrt(np.mean(e ** 2))))
-    errs = np.array(errs)
     orders = np.log2(errs[:-1] / errs[1:])
     print(f"lift-off: rms WOB error {['%.3g' % e for e in errs]} N, observed orders {np.round(orders, 2)}")
     assert errs[1] < 1.0 and np.all(orders >= 3.5)
@@ -79,13 +74,7 @@ def test_wob_history_converges_through_bit_lift_off():
                                    {"kind": "jonswap", "hs": 2.0, "tp": 12.0, "amplitude": None, "period": None}],
                          ids=["sine ramp 27 s", "jonswap"])
 def test_wob_history_converges_through_the_end_of_the_fade_in(heave):
-    p = paper_a("none").replace(heave=heave)
-    ref = simulate(p, T, dt=DT_REF, rate=RATE)
-    errs = []
-    for dt in DTS:
-        e = simulate(p, T, dt=dt, rate=RATE)["wob"] - ref["wob"]
-        errs.append(float(np.sqrt(np.mean(e ** 2))))
-    errs = np.array(errs)
+    errs, _, _ = wob_errors(paper_a("none").replace(heave=heave))
     orders = np.log2(errs[:-1] / errs[1:])
     print(f"fade-in {heave}: rms WOB error {['%.3g' % e for e in errs]} N, observed orders {np.round(orders, 2)}")
     assert np.all(orders >= 3.5)

@@ -102,6 +102,7 @@ def nonlinear_vs_fresh_opti(n_peer):
     """Prebuilt, warm-started nlpsol (ours) vs a fresh casadi.Opti per step (peer), same NLP."""
     from heavecomp.controllers import make
     from heavecomp.params import paper_a
+    from heavecomp.controllers.nonlinear_mpc import rk4_steps
     from heavecomp.plants.symbolic import casadi
     from heavecomp.simulate.closed_loop import simulate_closed_loop
 
@@ -143,14 +144,7 @@ def nonlinear_vs_fresh_opti(n_peer):
         for k in range(N):
             hk = 0.5 * (H[:, k] + H[:, k + 1])
             uk = ca.vertcat(hk, (U[k] - dd) * 1e3)
-            xk = X[:, k]
-            for _ in range(M):
-                k1 = F(xk, uk)[0]
-                k2 = F(xk + h / 2 * k1, uk)[0]
-                k3 = F(xk + h / 2 * k2, uk)[0]
-                k4 = F(xk + h * k3, uk)[0]
-                xk = xk + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
-            opti.subject_to(X[:, k + 1] == xk)
+            opti.subject_to(X[:, k + 1] == rk4_steps(F, X[:, k], uk, h, M))
             wob = F(X[:, k + 1], ca.vertcat(H[:, k + 1], 0))[1][0]
             J += cfg.q_wob * 1e6 * ((wob - W0) / 1e3) ** 2 + cfg.r_u * 1e6 * U[k] ** 2
             du = U[k] - (up if k == 0 else U[k - 1])

@@ -25,7 +25,7 @@ from pathlib import Path
 from typing import Any, Mapping
 
 from heavecomp.errors import ParameterError, did_you_mean
-from heavecomp.params.core import choice, from_table, q, text
+from heavecomp.params.core import choice, from_table, q, read_text, text
 
 DEFAULT_FILE = Path(__file__).with_name("default_campaign.toml")
 REGIMES = ("none", "stribeck", "rotating_eq6", "rotating_eq7")
@@ -368,12 +368,7 @@ def loads(text_: str, *, base_dir=None, source: str = "<string>") -> Campaign:
 def load(path) -> Campaign:
     """Read and validate a campaign TOML file."""
     path = Path(path)
-    try:
-        raw = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise ParameterError(f"{path}: campaign file not found") from None
-    except (IsADirectoryError, PermissionError, UnicodeDecodeError) as exc:
-        raise ParameterError(f"{path}: cannot read campaign file ({type(exc).__name__})") from None
+    raw = read_text(path, "campaign file")
     return loads(raw, base_dir=path.resolve().parent, source=str(path))
 
 

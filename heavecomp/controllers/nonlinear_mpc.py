@@ -41,6 +41,18 @@ log = logging.getLogger(__name__)
 _OK = ("Solve_Succeeded", "Solved_To_Acceptable_Level")
 
 
+
+def rk4_steps(f, x, u, h, M):
+    """``M`` classical RK4 steps of size ``h`` of the casadi model ``f(x, u) -> (xdot, y)``
+    with ``u`` held: the MPC's discretisation (symbolic in, symbolic out)."""
+    for _ in range(M):
+        k1 = f(x, u)[0]
+        k2 = f(x + h / 2 * k1, u)[0]
+        k3 = f(x + h / 2 * k2, u)[0]
+        k4 = f(x + h * k3, u)[0]
+        x = x + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+    return x
+
 class NonlinearMPC(LinearMPC):
     """Nonlinear MPC with casadi/ipopt (see module docstring).
 
@@ -77,14 +89,7 @@ class NonlinearMPC(LinearMPC):
         h = Ts / M
         x = ca.SX.sym("x", 4)
         uu = ca.SX.sym("u", 4)  # [z, dz, ddz, force]
-        xk = x
-        for _ in range(M):
-            k1 = f(xk, uu)[0]
-            k2 = f(xk + h / 2 * k1, uu)[0]
-            k3 = f(xk + h / 2 * k2, uu)[0]
-            k4 = f(xk + h * k3, uu)[0]
-            xk = xk + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
-        F = ca.Function("F", [x, uu], [xk])
+        F = ca.Function("F", [x, uu], [rk4_steps(f, x, uu, h, M)])
         Y = ca.Function("Y", [x, uu], [f(x, uu)[1][0]])
 
         X = ca.SX.sym("X", 4, N + 1)

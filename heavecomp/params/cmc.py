@@ -25,7 +25,7 @@ from pathlib import Path
 from typing import Any, Mapping
 
 from heavecomp.errors import ParameterError, did_you_mean
-from heavecomp.params.core import choice, dump_toml, from_table, q, text, to_table
+from heavecomp.params.core import choice, dump_toml, from_table, q, read_text, text, to_table
 
 G = 9.81  #: gravity [m/s^2] (contract value)
 P_ATM = 101325.0  #: atmospheric pressure [Pa] (contract value)
@@ -267,12 +267,7 @@ def loads(text_: str, *, base_dir: Path | None = None, source: str = "<string>")
 def load(path: str | Path) -> CMCParams:
     """Read and validate a CMC parameter file."""
     path = Path(path)
-    try:
-        raw = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise ParameterError(f"{path}: parameter file not found") from None
-    except (IsADirectoryError, PermissionError, UnicodeDecodeError) as exc:
-        raise ParameterError(f"{path}: cannot read parameter file ({type(exc).__name__})") from None
+    raw = read_text(path, "parameter file")
     return loads(raw, base_dir=path.resolve().parent, source=str(path))
 
 

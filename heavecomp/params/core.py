@@ -145,6 +145,19 @@ def describe(cls) -> list[tuple[str, str, str, str, str]]:
     return rows
 
 
+def read_text(path, what: str = "parameter file") -> str:
+    """A user's text file, or a one-line :class:`ParameterError` naming it."""
+    from pathlib import Path
+
+    path = Path(path)
+    try:
+        return path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise ParameterError(f"{path}: {what} not found") from None
+    except (IsADirectoryError, PermissionError, UnicodeDecodeError) as exc:
+        raise ParameterError(f"{path}: cannot read {what} ({type(exc).__name__})") from None
+
+
 def dump_toml(tables: Mapping[str, Mapping[str, Any]], header: str = "") -> str:
     """Write nested ``{table: {key: value}}`` as TOML (numbers, strings, bools)."""
     out = [f"# {line}" if line else "#" for line in header.splitlines()] if header else []
