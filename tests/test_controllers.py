@@ -180,3 +180,33 @@ def test_controller_model_matches_the_analysis_linearisation():
         i_w, i_h, i_u = sys.output_labels.index("wob"), sys.input_labels.index("heave"), sys.input_labels.index("u_active")
         assert g_heave == pytest.approx(ref[i_w, i_h], rel=1e-6)
         assert g_u == pytest.approx(ref[i_w, i_u], rel=1e-6)
+
+
+def test_earth_frame_model_is_the_same_plant_without_heave_acceleration():
+    """The controllers' earth-frame model (X = z_h + s, V = dz_h + v) is an exact change of
+    variables: same frequency responses heave -> (wob, stroke, pressure) as the plant's own
+    coordinates, and its dynamics do not depend on the heave acceleration."""
+    from heavecomp.controllers.model import discrete_model
+
+    p = paper_a("none")
+    me, ms = discrete_model(p, 0.05, "earth"), discrete_model(p, 0.05, "stroke")
+    assert np.allclose(me.Bc[:, 3], 0.0, atol=1e-12)          # ddz_h column
+    assert np.allclose(ms.Bc[1, 3], -1.0)                      # ... which the stroke frame has
+    # heave enters the earth frame through the gas spring only: k_gas / M_c on the top mass
+    assert me.Bc[1, 1] == pytest.approx(p.compensator.gas_stiffness / p.compensator.moving_mass, rel=1e-6)
+    for w in (0.1, 0.52, 3.0, 10.0):
+        s = 1j * w
+        wv = np.array([1.0, s, s * s])
+        for m in (me, ms):
+            R = np.linalg.solve(s * np.eye(4) - m.Ac, np.eye(4))
+            g = m.C @ R @ (m.Bc[:, 1:4] @ wv) + (m.Dw @ wv if m is me else ms.Dw @ wv)
+            if m is me:
+                ge = g
+        assert np.allclose(ge, g, rtol=1e-9, atol=1e-9 * np.max(np.abs(g)))
+
+
+def test_model_frame_option_is_checked():
+    from heavecomp.controllers import make
+
+    with pytest.raises(InputError, match="model_frame = 'ship': not one of earth, stroke"):
+        make("linear-mpc", paper_a(), model_frame="ship")

@@ -91,6 +91,11 @@ class ControllerConfig:
         direct multi-step heave predictor regresses on.
     predictor_window : float [s]
         Forgetting time constant of the predictor's least-squares fit.
+    model_frame : {"earth", "stroke"}
+        Coordinates of the MPCs' prediction model: the top mass in the earth frame
+        (default; the heave acceleration drops out, so heave-preview errors matter
+        through the gas spring only) or relative to the cylinder as the plant is
+        written (:mod:`heavecomp.controllers.model`).
     """
 
     u_max: float = 60e3
@@ -113,6 +118,7 @@ class ControllerConfig:
     sqp_iterations: int = 3
     predictor_order: int = 80
     predictor_window: float = 240.0
+    model_frame: str = "earth"
 
     @property
     def dt(self) -> float:
@@ -138,6 +144,8 @@ class ControllerConfig:
         kw.update(overrides)
         if kw.get("nlp_solver", "sqp") not in ("sqp", "ipopt"):
             raise InputError(f"controller option nlp_solver = {kw['nlp_solver']!r}: not one of sqp, ipopt")
+        if kw.get("model_frame", "earth") not in ("earth", "stroke"):
+            raise InputError(f"controller option model_frame = {kw['model_frame']!r}: not one of earth, stroke")
         return cls(**kw)
 
 

@@ -79,7 +79,7 @@ def sweep(regime, sea, controller, duration, name, values, **fixed):
 
 
 # ------------------------------------------------------------------ figures
-def findings(table: dict, sweeps: dict, robust: dict) -> list[str]:
+def findings(table: dict, sweeps: dict, robust: dict, frames: dict | None = None, frame_sea: str = "jonswap") -> list[str]:
     """Plain-language findings computed from the metrics (no numbers typed in)."""
     out = []
     for sea in table:
@@ -98,11 +98,23 @@ def findings(table: dict, sweeps: dict, robust: dict) -> list[str]:
         out.append(f"- Actuator size (sine, full static friction): the smallest u_max tried that meets the goal is "
                    + (f"{min(good) / 1e3:.0f} kN" if good else "none of those tried") + "; WOB std "
                    + ", ".join(f"{r['wob_std'] / 1e3:.1f} kN at {r['value'] / 1e3:.0f} kN" for r in rows) + ".")
-    worst = max(((c, k, m["wob_std"]) for c, d in robust.items() for k, m in d.items()), key=lambda x: x[2],
-                default=None)
-    if worst:
-        out.append(f"- Robustness: the worst model error tried is {worst[1]} for {worst[0]} "
-                   f"({worst[2] / 1e3:.1f} kN WOB std).")
+    for sea in table:
+        pas = table[sea]["stribeck"]["passive"]["wob_std"]
+        rows = [(c, k.split(": ", 1)[-1], m["wob_std"]) for c, d in robust.items() for k, m in d.items()
+                if k.split(":")[0] == sea]
+        if rows:
+            worst = max(rows, key=lambda x: x[2])
+            out.append(f"- Robustness ({sea}, full static friction): the worst model error tried is {worst[1]} for "
+                       f"{worst[0]}: {worst[2] / 1e3:.1f} kN WOB std = {100 * worst[2] / pas:.0f} % of passive "
+                       f"({'within' if worst[2] <= 0.2 * pas else 'outside'} the 20 % goal).")
+    for c, d in (frames or {}).items():
+        pas = table[frame_sea]["stribeck"]["passive"]["wob_std"]
+        st, ea = d.get("model_frame = stroke"), d.get("model_frame = earth")
+        pf = d.get("model_frame = earth, perfect preview")
+        if st and ea:
+            out.append(f"- Prediction-model frame ({frame_sea}, full static friction, {c}): stroke frame "
+                       f"{100 * st['wob_std'] / pas:.0f} % of passive, earth frame {100 * ea['wob_std'] / pas:.0f} %"
+                       + (f", earth frame with a perfect heave preview {100 * pf['wob_std'] / pas:.0f} %." if pf else "."))
     viol = sum(m["violations_u_max"] + m["violations_rate"] for sea in table for reg in table[sea]
                for m in table[sea][reg].values())
     fb = sum(m["fallbacks"] for sea in table for reg in table[sea] for m in table[sea][reg].values())

@@ -1,7 +1,8 @@
 """Linear MPC (osqp) with friction as an estimated disturbance plus model feed-forward.
 
 Prediction model: the frictionless CMC linearised at the operating point and
-discretised (ZOH) at the control interval Ts (:mod:`heavecomp.controllers.model`)::
+discretised (ZOH) at the control interval Ts, with the top mass in the earth
+frame by default (:mod:`heavecomp.controllers.model`)::
 
     x_{k+1} = Ad x_k + Bu u_k + Bw w_k + Bf (f_k + d)
 
@@ -60,7 +61,7 @@ class LinearMPC(Controller):
         config = config or ControllerConfig.from_params(params)
         self.params, self.config = params, config
         self.cparams = controller_params(params, config)
-        self.model = m = discrete_model(self.cparams, config.dt)
+        self.model = m = discrete_model(self.cparams, config.dt, config.model_frame)
         self.law = controller_friction(self.cparams, config)
         N, n = config.horizon, m.Ad.shape[0]
         self.N = N

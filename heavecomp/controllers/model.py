@@ -12,6 +12,21 @@ Continuous model (deviations from the operating point)::
     y     = C x + D_w w                       y = [wob, stroke, pressure]
 
 f enters like ``-u`` (friction opposes the top mass's stroke, cmc.stroke_accel).
+
+Frame of the state
+------------------
+The plant's state is relative to the heaving cylinder (stroke s, its rate v).
+The controllers predict in the **earth frame** by default (``frame="earth"``):
+the top mass's absolute position X = z_h + s and velocity V = dz_h + v
+(:func:`earth_frame`, an exact change of variables of the same casadi model).
+In that frame the heave acceleration drops out of the equations (the top
+mass's inertia sees only the forces; checked symbolically) and the heave
+position enters only through the gas spring's stroke and the friction's
+relative velocity.  A heave preview error e then moves the predicted WOB by
+about k_gas e instead of k_ds e when z_h and the (separately, noisily)
+predicted ddz_h disagree — with 5 mm heave-sensor noise on a JONSWAP sea this
+halves the closed-loop WOB std (see docs/control.md).  ``frame="stroke"``
+keeps the plant's own coordinates (for comparison).
 """
 
 from __future__ import annotations
@@ -47,7 +62,43 @@ def controller_params(params, config):
     return params
 
 
-def discrete_model(params, Ts: float) -> DiscreteModel:
+FRAMES = ("earth", "stroke")
+
+
+def earth_frame(f):
+    """The casadi model ``f(x, u) -> (xdot, y)`` (x = [s, v, y_b, v_b], u = [z_h, dz_h,
+    ddz_h, u_active]) with the top mass in the earth frame: x_e = [X, V, y_b, v_b],
+    X = z_h + s, V = dz_h + v.  Same inputs and outputs; exact change of variables.
+
+    Raises ValueError if the transformed dynamics still depend on ddz_h (they must
+    not: the heave acceleration acts on the top mass only through the relative
+    coordinates).
+    """
+    from heavecomp.plants.symbolic import casadi
+
+    ca = casadi()
+    xe = ca.SX.sym("xe", 4)
+    u = ca.SX.sym("u", 4)
+    x = ca.vertcat(xe[0] - u[0], xe[1] - u[1], xe[2], xe[3])
+    xdot, y = f(x, u)
+    xedot = xdot + ca.vertcat(u[1], u[2], 0, 0)
+    dep = ca.Function("d", [xe, u], [ca.jacobian(xedot, u[2])])(np.zeros(4), np.zeros(4))
+    if np.max(np.abs(np.array(dep))) > 1e-9:
+        raise ValueError("earth_frame: the model's dynamics depend on the heave acceleration in the earth frame")
+    return ca.Function("cmc_earth", [xe, u], [xedot, y], ["x", "u"], ["xdot", "y"])
+
+
+def controller_model(params, *, eps=None, frame: str = "earth"):
+    """The casadi model the controllers predict with (``frame``: see the module docstring)."""
+    from heavecomp.plants.cmc import casadi_model
+
+    if frame not in FRAMES:
+        raise ValueError(f"model frame {frame!r}: not one of {', '.join(FRAMES)}")
+    f = casadi_model(params, eps=eps)
+    return earth_frame(f) if frame == "earth" else f
+
+
+def discrete_model(params, Ts: float, frame: str = "earth") -> DiscreteModel:
     """Linearise the frictionless CMC at the operating point and discretise (ZOH).
 
     Parameters
@@ -55,14 +106,15 @@ def discrete_model(params, Ts: float) -> DiscreteModel:
     params : CMCParams
     Ts : float [s]
         Control interval.
+    frame : {"earth", "stroke"}
+        Coordinates of the top mass (module docstring).
     """
     from scipy.linalg import expm
 
-    from heavecomp.plants.cmc import casadi_model
     from heavecomp.plants.symbolic import casadi
 
     ca = casadi()
-    f = casadi_model(params.replace(friction={"model": "none"}))
+    f = controller_model(params.replace(friction={"model": "none"}), frame=frame)
     x = ca.SX.sym("x", 4)
     u = ca.SX.sym("u", 4)
     xdot, y = f(x, u)

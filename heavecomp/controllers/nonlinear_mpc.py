@@ -1,7 +1,8 @@
 """Nonlinear MPC (casadi: SQP with qrqp, or ipopt) on the smooth-friction CMC, warm-started.
 
-Prediction model: :func:`heavecomp.plants.cmc.casadi_model` with the friction
-law of the parameter file (paper A eq. 4/6/7) regularised with width
+Prediction model: :func:`heavecomp.plants.cmc.casadi_model` (through
+:func:`heavecomp.controllers.model.controller_model`: the top mass in the earth
+frame by default) with the friction law of the parameter file (paper A eq. 4/6/7) regularised with width
 ``friction_eps`` (``sign(v) -> tanh(v/eps)``), integrated by RK4 with two
 sub-steps per control interval (multiple shooting).  The heave over the horizon
 is the online preview of :class:`~heavecomp.controllers.estimation.HeavePredictor`;
@@ -76,13 +77,13 @@ class NonlinearMPC(LinearMPC):
                                    ("static_force", "coulomb_force", "viscous_coefficient", "pressure_coefficient")})
 
     def _build(self):
-        from heavecomp.plants.cmc import casadi_model
+        from heavecomp.controllers.model import controller_model
         from heavecomp.plants.symbolic import casadi
 
         ca = casadi()
         cfg, N = self.config, self.N
         mp = self._model_params()
-        f = casadi_model(mp, eps=cfg.friction_eps)
+        f = controller_model(mp, eps=cfg.friction_eps, frame=cfg.model_frame)
         self._f = f
         W0 = mp.operating_point.wob_setpoint
         Ts, M = cfg.dt, self.substeps
