@@ -210,3 +210,40 @@ def test_model_frame_option_is_checked():
 
     with pytest.raises(InputError, match="model_frame = 'ship': not one of earth, stroke"):
         make("linear-mpc", paper_a(), model_frame="ship")
+
+
+def test_prediction_error_bound_matches_ar1_closed_form_and_bounds_least_squares():
+    """The spectral-factorisation bound equals the closed form for an AR(1) heave, and no
+    least-squares predictor fitted on an hour of noisy JONSWAP heave beats it."""
+    from heavecomp.controllers.estimation import prediction_error_bound
+    from heavecomp.simulate.excitation import jonswap, jonswap_spectrum
+
+    dt, phi, sig = 0.05, 0.95, 0.01
+
+    def s_ar1(f):                     # one-sided PSD of z_j = phi z_{j-1} + sig w_j
+        return 2 * dt * sig ** 2 / np.abs(1 - phi * np.exp(-2j * np.pi * f * dt)) ** 2
+
+    sn = 1e-6                         # (nearly) no measurement noise: the closed form applies
+    k = np.array([1, 5, 20])
+    exact = sig * np.sqrt((1 - phi ** (2 * k)) / (1 - phi ** 2))
+    assert prediction_error_bound(s_ar1, dt, sn, k) == pytest.approx(exact, rel=1e-3)
+    # JONSWAP with 5 mm noise, 1 s ahead: an offline least-squares predictor (8 s of lags)
+    bound = prediction_error_bound(lambda f: np.where(f > 0.5, 0.0, jonswap_spectrum(f, 2.0, 12.0)),
+                                   dt, 5e-3, [20])[0]
+    rng = np.random.default_rng(3)
+    z_tr = jonswap(2.0, 12.0, 3.3, 11, 0.0, 1800.0, dt).z
+    z_te = jonswap(2.0, 12.0, 3.3, 12, 0.0, 600.0, dt).z
+    lags = np.arange(80) * 2
+
+    def rows(z):
+        i = np.arange(lags.max(), z.size - 20)
+        y = z + 5e-3 * rng.standard_normal(z.size)
+        return np.column_stack([y[i - l] for l in lags] + [np.ones(i.size)]), z[i + 20]
+
+    X, y = rows(z_tr)
+    coef = np.linalg.lstsq(X, y, rcond=None)[0]
+    Xt, yt = rows(z_te)
+    rmse = np.sqrt(np.mean((Xt @ coef - yt) ** 2))
+    assert 0.02 < bound < rmse < 2.0 * bound
+    with pytest.raises(ValueError, match="noise_std must be > 0"):
+        prediction_error_bound(s_ar1, dt, 0.0, [1])

@@ -171,6 +171,49 @@ class HeavePredictor:
         return out
 
 
+def prediction_error_bound(spectrum, dt: float, noise_std: float, steps, n: int = 2 ** 18) -> np.ndarray:
+    """RMS error of the best linear predictor of a stationary heave k samples ahead [m].
+
+    The bound no linear heave predictor can beat, given the whole noisy past:
+    the samples y_j = z(j dt) + e_j (white noise of std ``noise_std``) of a
+    Gaussian heave with one-sided spectral density ``spectrum(f)`` [m^2/Hz]
+    (zero above the Nyquist frequency).  Spectral factorisation via the
+    cepstrum (Kolmogorov-Szego): the noisy sequence's innovation filter h gives
+    the k-step error of y, sum_{j<k} h_j^2, minus the unpredictable noise variance.
+
+    Parameters
+    ----------
+    spectrum : callable
+        f [Hz] -> S(f) [m^2/Hz], one-sided (e.g. ``excitation.jonswap_spectrum``).
+    dt : float [s]
+        Sample interval.
+    noise_std : float [m]
+        White measurement noise; must be > 0 (without noise a band-limited sea is
+        perfectly predictable and the factorisation does not exist).
+    steps : int or sequence of int
+        Prediction distances k >= 1 [samples].
+    n : int
+        FFT length of the factorisation.
+
+    Returns
+    -------
+    ndarray : RMS error of z(t + k dt) for each k [m].
+    """
+    if not noise_std > 0:
+        raise ValueError("prediction_error_bound: noise_std must be > 0")
+    f = np.fft.fftfreq(n, dt)
+    phi = np.asarray(spectrum(np.abs(f)), dtype=float) / 2.0 / dt + noise_std ** 2   # two-sided, per sample
+    c = np.fft.ifft(np.log(phi)).real
+    c[0] *= 0.5
+    c[n // 2 + 1:] = 0.0                                   # causal (minimum-phase) half of the cepstrum
+    h = np.fft.ifft(np.exp(np.fft.fft(c))).real            # innovation filter, sum h^2 = var(y)
+    k = np.atleast_1d(np.asarray(steps, dtype=int))
+    if np.any(k < 1):
+        raise ValueError("prediction_error_bound: steps must be >= 1")
+    ey = np.cumsum(h ** 2)[k - 1]
+    return np.sqrt(np.maximum(ey - noise_std ** 2, 0.0))
+
+
 class ARBlockPredictor:
     """Online AR heave predictor on 5 Hz block means, Kalman-filtered (the former predictor).
 
