@@ -168,3 +168,32 @@ def test_measured_heave_record_covering_just_the_run_is_enough():
     np.testing.assert_allclose(res["heave"], np.interp(res.t, t, z), atol=2e-3)
     with pytest.raises(ParameterError, match="exceeds the heave record's span 30 s"):
         simulate_closed_loop(p, "linear-mpc", 30.0, heave=(t, z), preview="perfect")
+
+
+@pytest.mark.parametrize("opt, msg", [
+    ("horizn=30", "controller option 'horizn': unknown (did you mean 'horizon'?)"),
+    ("horizon=ten", "controller option horizon = 'ten': not a finite int"),
+    ("q_wob=nan", "controller option q_wob = 'nan': not a finite float"),
+    ("horizon", "--controller-option 'horizon': expected KEY=VALUE"),
+    ("model_frame=ship", "controller option model_frame = 'ship': not one of earth, stroke"),
+])
+def test_cli_bad_controller_option_exits_2_with_one_line(tmp_path, opt, msg):
+    f = tmp_path / "p.toml"
+    f.write_text(dumps(paper_a()))
+    r = subprocess.run([sys.executable, "-m", "heavecomp.cli", "simulate", str(f), "--duration", "10",
+                        "--out", str(tmp_path / "o"), "--controller", "linear-mpc", "--controller-option", opt],
+                       capture_output=True, text=True)
+    assert r.returncode == 2
+    assert r.stderr.strip() == f"heavecomp simulate: error: {msg}"
+
+
+def test_cli_controller_options_reach_the_controller(tmp_path):
+    f = tmp_path / "p.toml"
+    f.write_text(dumps(paper_a()))
+    r = subprocess.run([sys.executable, "-m", "heavecomp.cli", "simulate", str(f), "--duration", "10",
+                        "--out", str(tmp_path / "o"), "--controller", "linear-mpc", "--controller-option",
+                        "horizon=12", "--controller-option", "friction_feedforward=false"],
+                       capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    m = json.loads((tmp_path / "o" / "metrics.json").read_text())
+    assert m["config"]["horizon"] == 12 and m["config"]["friction_feedforward"] is False

@@ -17,6 +17,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--controller", default="passive", choices=("passive", "pid", "linear-mpc", "nonlinear-mpc"),
                    help="active-cylinder controller (default passive: no active force); limits from [active]; "
                         "adds u_active to timeseries.csv and solve times / violations to metrics.json")
+    p.add_argument("--controller-option", action="append", default=[], metavar="KEY=VALUE",
+                   help="controller setting (repeatable), e.g. horizon=30, q_wob=1e-6, model_frame=stroke, "
+                        "nlp_solver=ipopt; names: heavecomp.controllers.ControllerConfig (docs/control.md)")
 
 
 def run(args) -> int:
@@ -32,6 +35,10 @@ def run(args) -> int:
         params = params.replace(friction={"model": args.friction})
     if args.controller != "passive":
         return _run_closed_loop(args, params, Progress)
+    if args.controller_option:
+        from heavecomp.errors import InputError
+
+        raise InputError("--controller-option needs --controller pid|linear-mpc|nonlinear-mpc")
     bar = Progress(f"simulate {args.duration:g} s")
     figure = BackgroundFigure()  # imports matplotlib in parallel with the simulation
     try:
@@ -54,9 +61,12 @@ def _run_closed_loop(args, params, Progress) -> int:
     from heavecomp.params.cmc import active
     from heavecomp.simulate.closed_loop import output_every, simulate_closed_loop, write_closed_loop_outputs
 
+    from heavecomp.controllers.base import parse_options
+
     output_every(args.rate, active(params).control_rate)  # bad --rate fails before the run
+    options = parse_options(args.controller_option)
     bar = Progress(f"simulate {args.duration:g} s, {args.controller}")
-    res = simulate_closed_loop(params, args.controller, args.duration, dt=args.dt, progress=bar)
+    res = simulate_closed_loop(params, args.controller, args.duration, dt=args.dt, progress=bar, **options)
     m = write_closed_loop_outputs(res, args.out, title=f"WOB — {Path(args.params).name}, friction: "
                                   f"{params.friction.model}, controller: {args.controller}", rate=args.rate)
     print(f"WOB std {m['wob_std'] / 1e3:.2f} kN, peak-to-peak {m['wob_p2p'] / 1e3:.2f} kN, "

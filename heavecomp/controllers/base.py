@@ -149,6 +149,39 @@ class ControllerConfig:
         return cls(**kw)
 
 
+def parse_options(items) -> dict:
+    """``["horizon=30", "model_frame=stroke", ...]`` -> typed :class:`ControllerConfig` overrides.
+
+    One-line :class:`InputError` naming the option for a missing ``=``, an unknown name
+    (with a suggestion) or a value of the wrong type."""
+    types = {f.name: f.type for f in dataclasses.fields(ControllerConfig)}
+    out = {}
+    for item in items or ():
+        key, sep, val = str(item).partition("=")
+        key, val = key.strip(), val.strip()
+        if not sep or not key:
+            raise InputError(f"--controller-option {item!r}: expected KEY=VALUE")
+        if key not in types:
+            raise InputError(f"controller option {key!r}: unknown{did_you_mean(key, types)}")
+        kind = types[key]
+        try:
+            if kind == "bool":
+                if val.lower() not in ("true", "false", "1", "0", "yes", "no"):
+                    raise ValueError
+                out[key] = val.lower() in ("true", "1", "yes")
+            elif kind == "int":
+                out[key] = int(val)
+            elif kind == "float":
+                out[key] = float(val)
+                if not math.isfinite(out[key]):
+                    raise ValueError
+            else:
+                out[key] = val
+        except ValueError:
+            raise InputError(f"controller option {key} = {val!r}: not a finite {kind}") from None
+    return out
+
+
 def limit(u_cmd: float, u_prev: float, cfg: ControllerConfig) -> float:
     """Clip a command to |u| <= u_max and |u - u_prev| <= rate_max dt [N]."""
     du = cfg.du_max

@@ -229,6 +229,7 @@ def simulate_closed_loop(params, controller="passive", duration: float = 120.0, 
         "saturated_steps": int(ctrl.stats.get("saturated_steps", 0)),
         "preview": preview,
         "noise": dataclasses.asdict(noise) if noise else None,
+        "config": dataclasses.asdict(cfg),
     }
     control.update(_preview_error(previews, hs, sp, Tc, K))
     if stats_start is None:
