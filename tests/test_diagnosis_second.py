@@ -1,8 +1,10 @@
 """Second effect (issue 4): a run with two effects of comparable size names the dominant one and
 mentions the second; single-effect runs get no spurious second effect.
 
-The pair is a lagging stroke sensor (an output effect) and an orifice flow loss (a plant effect):
-before the fix a sensor delay as the best candidate skipped the joint fit altogether."""
+The pair is a lagging sensor (an output effect, dominant) and an orifice flow loss (a plant effect)
+whose own squared gap the generator sizes to 30-60 % of the dominant's: neither explains half the
+held-out gap alone, so the verdict rests on the joint fit.  Before the fixes a sensor delay as the
+best candidate skipped the joint fit altogether, and a best under 50 % was `inconclusive` without one."""
 
 import pytest
 

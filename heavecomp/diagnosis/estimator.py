@@ -22,10 +22,12 @@ Method
    the explained share is the smaller of the one on the replay and the one on a replay with
    the heave perturbed by its own noise level (a gain from lucky stick-event timing does not
    survive the perturbation); score = e - ``penalty`` * (number of parameters).  Verdict: ``none`` when
-   J_before <= ``none_ratio``^2 J_noise; ``inconclusive`` when the best e <
-   ``min_explained``; else the best score, with a confidence from e and the
-   margin to the runner-up; a joint fit of the best with the next candidates
-   names a ``second_effect`` when it adds enough.
+   every channel's held-out rms is within ``none_ratio`` x its noise floor or x the envelope of what
+   the heave noise alone makes of the replay (largest of ``input_draws`` draws), or within
+   ``none_tail`` x that envelope with no candidate explaining ``none_explained`` (low confidence);
+   ``inconclusive`` when the best e < ``min_explained``, alone and jointly with a second
+   candidate; else the best score, with a confidence from e and the margin to the runner-up;
+   a joint fit of the best with the next candidates names a ``second_effect`` when it adds enough.
 """
 
 from __future__ import annotations
@@ -106,6 +108,13 @@ class GapDiagnoser:
         A segment starts stuck when the measured stroke speed is below this.
     grid : int
         Points per axis of the coarse start grid for candidates with <= 2 parameters.
+    input_draws : int
+        Replays with independent heave-noise draws for the input-noise envelope of the ``none``
+        test (the largest held-out difference any of them makes).
+    none_tail, none_explained : float
+        A held-out gap up to ``none_tail`` x the input-noise envelope that no candidate explains
+        ``none_explained`` of is ``none`` (low confidence), not ``inconclusive``: runs without any
+        effect reach 1.0-1.7 x their floor from stick-event noise alone.
 
     Attributes (after ``fit``)
     --------------------------
@@ -120,7 +129,7 @@ class GapDiagnoser:
 
     def __init__(self, nominal, candidates=None, *, split=0.67, settle=None, penalty=0.03, min_explained=0.5,
                  none_ratio=1.2, max_nfev=40, decimate=2, n_jobs=2, progress=None, second=2, segment=None,
-                 reinit=1.5, stuck_speed=2e-3, grid=7):
+                 reinit=1.5, stuck_speed=2e-3, grid=7, input_draws=8, none_tail=2.0, none_explained=0.25):
         self.nominal = nominal
         names = list(CANDIDATES) if candidates is None else list(candidates)
         for n in names:
@@ -142,6 +151,9 @@ class GapDiagnoser:
         self.reinit = reinit
         self.stuck_speed = stuck_speed
         self.grid = int(grid)
+        self.input_draws = max(1, int(input_draws))
+        self.none_tail = none_tail
+        self.none_explained = none_explained
 
     # ------------------------------------------------------------------ replay
     def _setup(self, run):
@@ -402,6 +414,8 @@ class GapDiagnoser:
         self.replay_floor_ = self._replay_floor(run, nom, allmask)
         self.output_noise_ = dict(self.noise_floor_)
         self.noise_floor_ = {c: math.hypot(self.output_noise_[c], self.replay_floor_[c]) for c in CH}
+        self.input_envelope_ = {c: max(math.hypot(self.output_noise_[c], math.sqrt(self._env_ms[c])),
+                                       self.noise_floor_[c]) for c in CH}
         mse_fit = self._mse(nom, self._fitmask)
         self._w = {c: 1.0 / max(mse_fit[c], self.noise_floor_[c] ** 2, 1e-30) for c in CH}
         mse_b = self._mse(nom, self._valmask)
@@ -488,20 +502,38 @@ class GapDiagnoser:
         gap_ratio = max(self.gap_["channels"][c]["rms_validate"] / max(self.noise_floor_[c], 1e-30) for c in CH)
         runner = rows[1] if len(rows) > 1 else None
         margin = best["score"] - runner["score"] if runner else 1.0
-        # the verdict's shrink is on wob (the primary channel) unless wob is at its noise floor and
-        # the gap is elsewhere (e.g. a delayed stroke sensor): then the channel with the largest gap
+        # the verdict's shrink is on wob (the primary channel) unless the gap lies elsewhere (e.g. a
+        # lagging stroke sensor): wob's held-out gap over its floor is under half the largest channel's
+        # (wob can sit at 1.2-1.7x its floor from stick-event noise alone); then on that channel
         ratio = {c: self.gap_["channels"][c]["rms_validate"] / max(self.noise_floor_[c], 1e-30) for c in CH}
-        ch = "wob" if ratio["wob"] > self.none_ratio else max(CH, key=ratio.get)
+        ch = "wob" if ratio["wob"] >= 0.5 * max(ratio.values()) else max(CH, key=ratio.get)
+        # `none`: the held-out gap is no larger than measurement noise plus what the heave noise alone
+        # makes of the replay (its envelope over independent draws: stick-event flips are rare but large)
+        input_ratio = max(self.gap_["channels"][c]["rms_validate"] / max(self.input_envelope_[c], 1e-30) for c in CH)
         v = {"effect": best["effect"], "confidence": "low", "parameters": best["parameters"],
              "shrink": best["channels"][ch]["shrink"], "shrink_channel": ch, "uncertainty": best["uncertainty"], "explained": best["explained"],
-             "gap_to_noise": gap_ratio, "margin": margin}
-        if gap_ratio <= self.none_ratio:
+             "gap_to_noise": gap_ratio, "gap_to_input_envelope": input_ratio, "margin": margin}
+        if input_ratio <= self.none_ratio or (input_ratio <= self.none_tail and best["explained"] < self.none_explained):
+            # between none_ratio and none_tail x the envelope: a gap that no candidate (not even the
+            # six-parameter refit) explains a quarter of is read as the tail of the stick-event noise
+            tail = input_ratio > self.none_ratio
             v.update(effect="none", parameters={}, shrink=0.0, uncertainty={},
-                     confidence="high" if gap_ratio <= 0.5 * (1 + self.none_ratio) else "medium",
-                     note=f"held-out gap within {self.none_ratio:g} x the noise floor on every channel")
+                     confidence="low" if tail else ("high" if gap_ratio <= 0.5 * (1 + self.none_ratio) else "medium"),
+                     note=(f"held-out gap {input_ratio:.2f} x the input-noise envelope and no candidate explains "
+                           f"{100 * self.none_explained:.0f} % of it" if tail else
+                           f"held-out gap within {self.none_ratio:g} x the noise floor (or the envelope of the "
+                           "replay's response to the heave noise) on every channel"))
             self.verdict_ = v
             return
         if best["explained"] < self.min_explained:
+            # two comparable effects: neither explains enough alone; the best with a second one may
+            second = self._second(rows) if self.second else None
+            if second is not None and second["explained_joint"] >= self.min_explained:
+                v.update(second_effect=second, confidence="medium" if second["explained_joint"] >= 0.6 and margin >= 0.03
+                         else "low", note=f"{best['effect']} explains {100 * best['explained']:.0f} % alone, "
+                                          f"{100 * second['explained_joint']:.0f} % with {second['effect']}")
+                self.verdict_ = v
+                return
             v.update(effect="inconclusive", confidence="low", parameters={},
                      note=f"best candidate {best['effect']} explains only {100 * best['explained']:.0f} % of the "
                           "held-out gap above noise", best_candidate=best["effect"])
@@ -562,28 +594,45 @@ class GapDiagnoser:
     def _replay_floor(self, run, nom, mask):
         """Residual an exact model would still show because the *input* is noisy: the nominal
         replay repeated with the heave perturbed by white noise of the heave's own noise level
-        (second-difference estimate); rms difference per channel [SI]."""
-        from heavecomp.diagnosis.data import MeasuredRun, heave_samples, noise_floor
+        (second-difference estimate); rms difference per channel [SI].
 
-        from heavecomp.diagnosis.data import HEAVE_CUTOFF
+        Also the held-out *envelope* of that residual (``self._env_ms``, mean squares): with exact
+        stiction one heave-noise draw can flip a stick event and shift a whole stretch of the
+        replay, so the residual from input noise is heavy-tailed and one draw under-estimates what
+        a run with no effect can show.  The envelope is the largest held-out mean square over
+        ``input_draws`` independent draws, plus the pre-processing term."""
+        from heavecomp.diagnosis.data import HEAVE_CUTOFF, MeasuredRun, heave_samples, noise_floor
 
         sz = noise_floor(run["heave"], run.t if not run.uniform else None)
         rng = np.random.default_rng(12345)
-        pert = MeasuredRun(run.t, {"heave": run["heave"] + rng.normal(0.0, sz, run.t.size)}, run.source)
+        val = self._valmask
+
+        def perturbed():
+            pert = MeasuredRun(run.t, {"heave": run["heave"] + rng.normal(0.0, sz, run.t.size)}, run.source)
+            return heave_samples(pert, self._rp.h, self._rp.n_steps)
+
+        def ms(a, m):
+            return {c: float(np.mean((a[c][m] - nom[c][m]) ** 2)) for c in CH}
+
         saved = self._rp.hs
         try:
-            self._rp.hs = heave_samples(pert, self._rp.h, self._rp.n_steps)
-            self._hs_pert = self._rp.hs
+            self._rp.hs = self._hs_pert = perturbed()
             alt = self.simulate([])
-            self._mse_b_pert = self._mse(alt, self._valmask)
+            self._mse_b_pert = self._mse(alt, val)
+            env = ms(alt, val)
+            for _ in range(self.input_draws - 1):
+                self._rp.hs = perturbed()
+                env = {c: max(v, ms(self.simulate([]), val)[c]) for c, v in env.items()}
             # sensitivity to the heave pre-processing: cut-off 1.5 x higher
             self._rp.hs = heave_samples(run, self._rp.h, self._rp.n_steps, cutoff=1.5 * HEAVE_CUTOFF)
             alt2 = self.simulate([])
         finally:
             self._rp.hs = saved
         self.heave_noise_ = sz
-        return {c: float(np.sqrt(np.mean((alt[c][mask] - nom[c][mask]) ** 2)
-                                 + np.mean((alt2[c][mask] - nom[c][mask]) ** 2))) for c in CH}
+        pre = ms(alt2, val)
+        self._env_ms = {c: env[c] + pre[c] for c in CH}
+        a, b = ms(alt, mask), ms(alt2, mask)
+        return {c: float(np.sqrt(a[c] + b[c])) for c in CH}
 
     def _report(self, frac, msg):
         log.info("diagnose: %s", msg)
@@ -601,6 +650,6 @@ class GapDiagnoser:
                 "split": self.split_,
                 "noise_floor": self.noise_floor_,
                 "noise": {"output": self.output_noise_, "replay_from_heave_noise": self.replay_floor_,
-                          "heave": self.heave_noise_},
+                          "heave": self.heave_noise_, "input_envelope": self.input_envelope_},
                 "warnings": list(getattr(self, "warnings_", [])),
                 "wall_time_s": self.wall_time_}
