@@ -82,8 +82,10 @@ def test_kernel_rhs_equals_casadi_model_away_from_zero_velocity(model):
         cm = 1.0 if K.contact_switch(yb, vb, PP) > 0 else 0.0  # the stepper's contact state here
         # held contact state = the clamped law wherever they agree (physics once)
         assert _close(K.lower_accel_contact(s, v, yb, vb, zh, dzh, cm, PP), cmc.lower_accel(s, v, yb, vb, zh, dzh, PP), 1.0)
-        k = K.rhs(0.0, s, v, yb, vb, K.SLIDING, float(np.sign(v)), cm, smooth, law.code, law.FP, PP, u, 1.0, Z, DZ, DDZ)
-        assert k[0] == v and k[2] == vb
+        X = (s, v, yb, vb, 1.0, 0.0, 0.0)  # effect states at their rest values (EP = 0: unused)
+        EP = K.NO_EFFECTS
+        k = K.rhs(0.0, X, K.SLIDING, float(np.sign(v)), cm, smooth, law.code, law.FP, PP, EP, u, 1.0, Z, DZ, DDZ)
+        assert k[0] == v and k[2] == vb and k[4:] == (0.0, 0.0, 0.0)
         assert _close(k[1], xdot[1], 1.0)
         assert _close(k[3], xdot[3], 1.0)
         # outputs: wob, stroke, pressure, tension, friction
@@ -93,12 +95,78 @@ def test_kernel_rhs_equals_casadi_model_away_from_zero_velocity(model):
         Ff = K.sliding_friction(law.code, float(np.sign(v)), s, v, law.FP, PP)
         assert _close(Ff, y[4], 1e4)
         # holding force = M_c dv + F_f (casadi) = kernel's hold
-        hold = K.hold(0.0, s, v, yb, vb, u, PP, 1.0, Z, DZ, DDZ)
-        assert _close(hold, PP[cmc.MC] * xdot[1] + y[4], 1e5)
+        # the stepper's holding force (at v = 0, where it decides stick or breakaway) = M_c dv of
+        # the casadi model at v = 0, whose friction J tanh(0) + K(0) vanishes there
+        hold, pr = K.hold(0.0, X, u, PP, EP, 1.0, Z, DZ, DDZ)
+        xdot0, y0 = f([s, 0.0, yb, vb], [zh, dzh, ddzh, u])
+        assert float(y0[4]) == 0.0
+        assert _close(hold, PP[cmc.MC] * float(xdot0[1]), 1e5)
+        assert _close(pr, y[2], 1e6)
         # stuck mode: stroke frozen, lower mass as in the model
-        k0 = K.rhs(0.0, s, 0.0, yb, vb, K.STUCK, 1.0, cm, smooth, law.code, law.FP, PP, u, 1.0, Z, DZ, DDZ)
+        k0 = K.rhs(0.0, X, K.STUCK, 1.0, cm, smooth, law.code, law.FP, PP, EP, u, 1.0, Z, DZ, DDZ)
         assert k0[0] == 0.0 and k0[1] == 0.0
         assert _close(k0[3], K.lower_accel(s, 0.0, yb, vb, zh, dzh, PP), 1.0)
+
+
+@pytest.mark.parametrize("model", MODELS)
+def test_effect_plant_without_effects_is_the_cmc_bit_for_bit(model):
+    """One stepper serves simulate() and the diagnosis: the effect-aware plant of
+    heavecomp.effects.terms (what the kernel integrates) with EP = 0 is the CMC of plants/cmc.py
+    exactly, so simulate() did not change when the effect hooks were added."""
+    from heavecomp.effects import terms
+
+    p = paper_a(model)
+    PP = cmc.plant_vector(p)
+    law = FrictionLaw.from_params(p.friction)
+    code, FP = law.code, law.FP
+    EP = terms.zero_ep()
+    for s, v, yb, vb, zh, dzh, ddzh, u in _states(200, 3):
+        for cm in (0.0, 1.0):
+            for f in (terms.plant_fx, K.plant_fx):
+                pr, T, hold, dvb = f(s, v, yb, vb, 1.0, zh, dzh, ddzh, u, cm, PP, EP)
+                assert pr == cmc.gas_pressure(s, PP)
+                assert T == cmc.tension(s, v, yb, vb, zh, dzh, PP)
+                assert hold == cmc.holding_force(s, v, yb, vb, zh, dzh, ddzh, u, PP)
+                assert dvb == cmc.lower_accel_contact(s, v, yb, vb, zh, dzh, cm, PP)
+        pr = cmc.gas_pressure(s, PP)
+        for d in (1.0, -1.0):
+            for a in (d * v, -1e-3):  # also a trial step past a reversal (a < 0)
+                assert K.friction_jump_fx(code, a, pr, 0.0, 0.0, FP, EP) == laws.friction_jump(code, a, pr, FP)
+            assert (K.sliding_friction_fx(code, d, v, pr, 0.0, 0.0, FP, EP)
+                    == cmc.sliding_friction(code, d, s, v, FP, PP))
+        assert K.static_limit_fx(code, pr, 0.0, 0.0, 3.0, FP, EP) == cmc.static_limit(code, s, FP, PP)
+
+
+def test_compiled_effect_terms_equal_python_originals():
+    """The kernel's compiled effect terms evaluate heavecomp.effects.terms (each effect on)."""
+    from heavecomp.effects import terms
+
+    p = paper_a("stribeck")
+    PP = cmc.plant_vector(p)
+    FP = FrictionLaw.from_params(p.friction).FP
+    rng = np.random.default_rng(4)
+    EP = terms.zero_ep()
+    EP[[terms.LAG_T_TRUTH, terms.LAG_T_CAND, terms.LAG_TDOWN_CAND]] = 1.5, 0.5, 0.2
+    EP[[terms.DWELL_DF_TRUTH, terms.DWELL_TAU_TRUTH, terms.DWELL_A_CAND, terms.DWELL_BETA_CAND]] = 1e4, 1.0, 5e3, 0.3
+    EP[[terms.PF_K_TRUTH, terms.PF_PTH_TRUTH, terms.PF_DCP_CAND]] = 0.03, 0.9 * p.p0, 0.01
+    EP[[terms.FLOW_K_TRUTH, terms.FLOW_R_CAND, terms.GAS_LOSS_CAND]] = 3e5, 1e5, 5e4
+    EP[[terms.SD_CQ_TRUTH, terms.SD_C_CAND]] = 5e5, 2e4
+    for thermal in (False, True):
+        EP[[terms.TH_GAMMA_TRUTH, terms.TH_TAU_TRUTH, terms.GAS_N_CAND]] = (1.4, 4.0, 0.0) if thermal else (0, 0, 1.2)
+        for s, v, yb, vb, zh, dzh, ddzh, u in _states(100, 5):
+            th, w, el, tau = rng.uniform(0.9, 1.1), abs(v) * rng.uniform(0.5, 1.5), rng.uniform(0, 2e4), rng.uniform(0, 5)
+            for a, b in zip(K.plant_fx(s, v, yb, vb, th, zh, dzh, ddzh, u, 1.0, PP, EP),
+                            terms.plant_fx(s, v, yb, vb, th, zh, dzh, ddzh, u, 1.0, PP, EP)):
+                assert _close(a, b, 1e5)
+            pr = terms.cylinder_pressure_fx(s, v, th, PP, EP)
+            for code in (laws.NONE, laws.STRIBECK, laws.EQ7):
+                assert _close(K.sliding_friction_fx(code, np.sign(v), v, pr, w, el, FP, EP),
+                              terms.sliding_friction_fx(code, np.sign(v), v, pr, w, el, FP, EP), 1e5)
+                assert _close(K.static_limit_fx(code, pr, w, el, tau, FP, EP),
+                              terms.static_limit_fx(code, pr, w, el, tau, FP, EP), 1e5)
+            assert _close(K.truth_thermal_rate(s, v, th, PP, EP), terms.truth_thermal_rate(s, v, th, PP, EP), 1.0)
+            for a, b in zip(K.lag_rates(v, w, el, FP, EP), terms.lag_rates(v, w, el, FP, EP)):
+                assert _close(a, b, 1e4)
 
 
 def test_heave_interpolation_reproduces_quintics():

@@ -9,8 +9,12 @@ Two families live here, deliberately with **different equations**:
   whose generator shared the candidate's equations would prove nothing.
 
 All effects act through one effect-parameter vector ``EP`` (layout below; a
-zero switches a term off), so the effect-aware stepper
-(:mod:`heavecomp.diagnosis.stepper`) is compiled once for every combination.
+zero switches a term off).  The foundation stepper
+(:func:`heavecomp.simulate._kernel.advance_fx`, wrapped for the diagnosis by
+:mod:`heavecomp.diagnosis.stepper`) integrates the plant with these terms, so it is
+compiled once for every combination; with ``EP = 0`` every term below reduces to the
+nominal CMC of :mod:`heavecomp.plants.cmc` bit for bit (``tests/test_kernel_pins.py``),
+which is how :func:`heavecomp.simulate.simulate` runs it.
 
 Pairs (truth law -> fitted candidate law):
 
@@ -33,6 +37,9 @@ sensor_delay                  first-order sensor lag (causal low-pass)      pure
 from __future__ import annotations
 
 import numpy as np
+
+from heavecomp.friction.laws import STRIBECK, friction_cont, friction_jump
+from heavecomp.plants.cmc import A, G, MB, MC, contact_force, tension
 
 # --------------------------------------------------------------------------
 # EP layout (effect parameter vector)
@@ -75,11 +82,10 @@ def gas_pressure_fx(s, th, PP, EP):
     gas p_abs V = m R T, p_abs = (p_0+p_atm) theta V_0/(V_0 + A s).
     """
     ratio = PP[5] / (PP[5] + PP[0] * s)
-    n = PP[6] + (EP[GAS_N_CAND] - PP[6]) * (EP[GAS_N_CAND] > 0.0)
-    poly = PP[4] * ratio ** n
-    therm = PP[4] * th * ratio
-    use_th = EP[TH_GAMMA_TRUTH] > 0.0
-    return poly * (1.0 - use_th) + therm * use_th - PP[3]
+    if EP[TH_GAMMA_TRUTH] > 0.0:
+        return PP[4] * th * ratio - PP[3]
+    n = EP[GAS_N_CAND] if EP[GAS_N_CAND] > 0.0 else PP[6]
+    return PP[4] * ratio ** n - PP[3]
 
 
 def truth_thermal_rate(s, v, th, PP, EP):
@@ -88,9 +94,10 @@ def truth_thermal_rate(s, v, th, PP, EP):
     Ideal gas with adiabatic index gamma and Newton heat exchange with the
     vessel wall at T_0: dtheta/dt = -(gamma-1) theta A v/(V_0 + A s) + (1 - theta)/tau_th.
     """
-    on = EP[TH_GAMMA_TRUTH] > 0.0
+    if EP[TH_GAMMA_TRUTH] <= 0.0:  # (the effect switches: branches on parameters only)
+        return 0.0 * v
     tau = EP[TH_TAU_TRUTH] + (EP[TH_TAU_TRUTH] <= 0.0)
-    return on * (-(EP[TH_GAMMA_TRUTH] - 1.0) * th * PP[0] * v / (PP[5] + PP[0] * s) + (1.0 - th) / tau)
+    return -(EP[TH_GAMMA_TRUTH] - 1.0) * th * PP[0] * v / (PP[5] + PP[0] * s) + (1.0 - th) / tau
 
 
 def line_drop(v, EP):
@@ -116,7 +123,9 @@ def friction_magnitude_fx(a, p, w, el, FP, EP):
     """
     lag_t = EP[LAG_T_TRUTH] > 0.0
     lag_c = EP[LAG_T_CAND] > 0.0
-    speed = a * (1.0 - lag_t) + w * lag_t
+    # a < 0 only in the stepper's trial steps past a reversal: held at its v = 0 value, as in
+    # friction.laws.friction_jump
+    speed = np.maximum(a, 0.0) * (1.0 - lag_t) + w * lag_t
     excess = (FP[0] - FP[1]) * np.exp(-speed / FP[2])
     excess = excess * (1.0 - lag_c) + el * lag_c
     return FP[1] + excess + FP[4] * np.abs(p) + pressure_friction_fx(p, EP)
@@ -133,10 +142,13 @@ def dwell_gain(tau, EP):
     Truth: dF (1 - exp(-tau/tau_d)) (saturating exponential, paper B's "static
     friction grows with the time at rest"); candidate: a tau^beta.
     """
-    td = EP[DWELL_TAU_TRUTH] + (EP[DWELL_TAU_TRUTH] <= 0.0)
-    truth = EP[DWELL_DF_TRUTH] * (1.0 - np.exp(-tau / td))
-    cand = EP[DWELL_A_CAND] * np.maximum(tau, 1e-12) ** EP[DWELL_BETA_CAND] * (EP[DWELL_A_CAND] > 0.0)
-    return truth + cand
+    gain = 0.0 * tau
+    if EP[DWELL_DF_TRUTH] != 0.0:
+        td = EP[DWELL_TAU_TRUTH] + (EP[DWELL_TAU_TRUTH] <= 0.0)
+        gain = gain + EP[DWELL_DF_TRUTH] * (1.0 - np.exp(-tau / td))
+    if EP[DWELL_A_CAND] > 0.0:
+        gain = gain + EP[DWELL_A_CAND] * np.maximum(tau, 1e-12) ** EP[DWELL_BETA_CAND]
+    return gain
 
 
 def lag_rates(v, w, el, FP, EP):
@@ -147,13 +159,16 @@ def lag_rates(v, w, el, FP, EP):
     asymmetric memory, dE/dt = ((F_S-F_C) e^{-|v|/v_S} - E)/T, T = T_E (recovery, target
     above E) or T_drop (target below E; T_drop = T_E when not set).
     """
-    tw = EP[LAG_T_TRUTH] + (EP[LAG_T_TRUTH] <= 0.0)
-    te = EP[LAG_T_CAND] + (EP[LAG_T_CAND] <= 0.0)
-    td = EP[LAG_TDOWN_CAND] + (EP[LAG_TDOWN_CAND] <= 0.0) * te
-    dw = (np.abs(v) - w) / tw * (EP[LAG_T_TRUTH] > 0.0)
-    target = (FP[0] - FP[1]) * np.exp(-np.abs(v) / FP[2])
-    up = target > el
-    de = (target - el) / (te * up + td * (1.0 - up)) * (EP[LAG_T_CAND] > 0.0)
+    dw = 0.0 * v
+    de = 0.0 * v
+    if EP[LAG_T_TRUTH] > 0.0:
+        dw = (np.abs(v) - w) / EP[LAG_T_TRUTH]
+    if EP[LAG_T_CAND] > 0.0:
+        te = EP[LAG_T_CAND]
+        td = EP[LAG_TDOWN_CAND] + (EP[LAG_TDOWN_CAND] <= 0.0) * te
+        target = (FP[0] - FP[1]) * np.exp(-np.abs(v) / FP[2])
+        up = target > el
+        de = (target - el) / (te * up + td * (1.0 - up))
     return dw, de
 
 
@@ -166,3 +181,57 @@ def string_damping_fx(dv, EP):
     ``dv = dz_h + v - v_b`` is the relative velocity across the string.
     """
     return EP[SD_CQ_TRUTH] * dv * np.abs(dv) + EP[SD_C_CAND] * dv
+
+
+# --------------------------------------------------------------------------
+# the CMC with the effect terms (used by the stepper, heavecomp.simulate._kernel)
+# --------------------------------------------------------------------------
+def friction_jump_fx(code, a, p, w, el, FP, EP):
+    """J with the effect terms [N]: :func:`friction_magnitude_fx` for paper A eq. 4, else the
+    foundation law (:func:`heavecomp.friction.laws.friction_jump`) plus the pressure term."""
+    if code == STRIBECK:
+        return friction_magnitude_fx(a, p, w, el, FP, EP)
+    return friction_jump(code, a, p, FP) + pressure_friction_fx(p, EP)
+
+
+def sliding_friction_fx(code, direction, v, p, w, el, FP, EP):
+    """Friction while sliding in ``direction`` (+1/-1): J(direction v) direction + K(v) [N]
+    (:func:`heavecomp.plants.cmc.sliding_friction` with the effects)."""
+    return friction_jump_fx(code, direction * v, p, w, el, FP, EP) * direction + friction_cont(code, v, p, FP)
+
+
+def static_limit_fx(code, p, w, el, tau, FP, EP):
+    """Largest friction the cylinder can hold at v = 0 after a dwell ``tau`` [s] [N]
+    (:func:`heavecomp.plants.cmc.static_limit` with the effects)."""
+    return friction_jump_fx(code, 0.0 * p, p, w, el, FP, EP) + dwell_gain(tau, EP)
+
+
+def cylinder_pressure_fx(s, v, th, PP, EP):
+    """Cylinder gauge pressure [Pa]: the gas pressure less the line drop."""
+    return gas_pressure_fx(s, th, PP, EP) - line_drop(v, EP)
+
+
+def plant_fx(s, v, yb, vb, th, zh, dzh, ddzh, u, contact, PP, EP):
+    """The CMC forces with the effect terms: ``(p, T_ds, holding force, dv_b/dt)``.
+
+    ``p`` is :func:`cylinder_pressure_fx`; ``T_ds`` the tension of
+    :func:`heavecomp.plants.cmc.tension` plus :func:`string_damping_fx`; the holding
+    force ``p A - M_c g - T_ds + u - M_c ddz_h`` and ``dv_b/dt`` with the contact state
+    held (``contact`` = 1 on the rock, 0 lifted off) are
+    :func:`heavecomp.plants.cmc.holding_force` and
+    :func:`heavecomp.plants.cmc.lower_accel_contact` with that ``p`` and ``T_ds``
+    (pinned to them at ``EP = 0``, bit for bit, by ``tests/test_kernel_pins.py``).
+    The stroke acceleration is ``(holding force - F_f) / M_c``.
+    """
+    p = cylinder_pressure_fx(s, v, th, PP, EP)
+    T = tension(s, v, yb, vb, zh, dzh, PP) + string_damping_fx(dzh + v - vb, EP)
+    hold = p * PP[A] - PP[MC] * PP[G] - T + u - PP[MC] * ddzh
+    dvb = (T - PP[MB] * PP[G] + contact * contact_force(yb, vb, PP)) / PP[MB]
+    return p, T, hold, dvb
+
+
+def adds_stiction(EP) -> bool:
+    """True when an effect adds friction that jumps with sign(v) (pressure friction, dwell):
+    the stepper must then treat even a smooth friction law as stick-slip."""
+    return bool(EP[PF_K_TRUTH] != 0.0 or EP[PF_DCP_CAND] != 0.0 or EP[DWELL_DF_TRUTH] != 0.0
+                or EP[DWELL_A_CAND] != 0.0)

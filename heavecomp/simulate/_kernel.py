@@ -1,9 +1,18 @@
 """Compiled exact stick-slip stepper for the CMC (numba).
 
 The physics is not restated here: the equations are the functions of
-:mod:`heavecomp.plants.cmc` and :mod:`heavecomp.friction.laws`, compiled by
-numba from the same source (``tests/test_kernel_pins.py`` pins the compiled
-forces to the symbolic model anyway).
+:mod:`heavecomp.plants.cmc`, :mod:`heavecomp.friction.laws` and
+:mod:`heavecomp.effects.terms`, compiled by numba from the same source
+(``tests/test_kernel_pins.py`` pins the compiled forces to the symbolic model anyway).
+
+One stepper serves the simulator and the gap diagnosis.  It integrates the CMC with
+the effect terms of :mod:`heavecomp.effects.terms` (:func:`heavecomp.effects.terms.plant_fx`;
+extra states: gas temperature ratio theta, friction memories w and E, dwell time tau),
+switched by the effect-parameter vector ``EP``.  :func:`advance` (used by
+:func:`heavecomp.simulate.simulate`, the closed loop, the campaigns, and compiled ahead
+of time) runs it with every effect off, ``EP = 0``, where the terms reduce to the
+plain CMC bit for bit; :func:`advance_fx` (the diagnosis,
+:mod:`heavecomp.diagnosis.stepper`) with effects.
 
 Scheme
 ------
@@ -27,10 +36,14 @@ with two modes:
   RK4 sub-step (unclamped contact law on the rock, none off it) and flipped at
   the event, so no stage straddles the switch.
 
-Laws without a jump (``none``; eq. 7 with C_p = 0) are integrated as one smooth
-system.  The end of the sine fade-in, where d2z_h/dt2 jumps, is a step
-boundary with the left-limit heave sample before it (``core.run_kernel``).  The remainder of a step after an event is integrated to the grid, so
-the output stays on the uniform grid.
+With the effects, J and the static limit are those of
+:func:`heavecomp.effects.terms.sliding_friction_fx` / ``static_limit_fx`` (friction
+memories, pressure friction, the dwell gain since the stick event).  Laws without a
+jump (``none``; eq. 7 with C_p = 0; and no effect adding one) are integrated as one
+smooth system.  The end of the sine fade-in, where d2z_h/dt2 jumps, is a step
+boundary with the left-limit heave sample before it (``core.drive``).  The
+remainder of a step after an event is integrated to the grid, so the output stays
+on the uniform grid.
 
 Heave samples come on a grid of spacing h/2 (the RK4 stage times); between
 samples they are interpolated with quintic Hermite polynomials.
@@ -43,6 +56,7 @@ import types
 import numba as nb
 import numpy as np
 
+from heavecomp.effects import terms as _terms
 from heavecomp.friction import laws as _laws
 from heavecomp.plants import cmc as _cmc
 
@@ -87,18 +101,21 @@ def _use_keyed_cache():
 
 _use_keyed_cache()  # before any njit(cache=True) below or in modules that import this one
 _jit = nb.njit(cache=True, fastmath=False)
+_jit_inline = nb.njit(cache=True, fastmath=False, inline="always")
 _ENV: dict = {}
 
 
-def _compile(func):
+def _compile(func, inline=False):
     """njit ``func`` from its own source, with the names it calls bound to the
-    already-compiled versions (so the plant modules need not import numba)."""
+    already-compiled versions (so the plant modules need not import numba).
+    ``inline=True`` inlines it into its callers in numba's IR (no call, no array
+    reference counting: LLVM leaves larger functions out of line)."""
     g = dict(func.__globals__)
     g.update(_ENV)
     clone = types.FunctionType(func.__code__, g, func.__name__, func.__defaults__, func.__closure__)
     clone.__qualname__ = func.__qualname__
     clone.__module__ = func.__module__
-    jitted = _jit(clone)
+    jitted = (_jit_inline if inline else _jit)(clone)
     _ENV[func.__name__] = jitted
     return jitted
 
@@ -117,8 +134,29 @@ stroke_accel = _compile(_cmc.stroke_accel)
 sliding_friction = _compile(_cmc.sliding_friction)
 static_limit = _compile(_cmc.static_limit)
 contact_switch = _compile(_cmc.contact_switch)
+# the stepper integrates the CMC through plant_fx below; the composite CMC functions above
+# that it no longer calls directly (holding_force, ..., static_limit) stay compiled for
+# callers and for the pins (tests/test_kernel_pins.py): numba compiles them on first use only.
+# The effect terms (heavecomp.effects.terms), inlined; with EP = 0 they are the CMC above:
+gas_pressure_fx = _compile(_terms.gas_pressure_fx, inline=True)
+line_drop = _compile(_terms.line_drop, inline=True)
+cylinder_pressure_fx = _compile(_terms.cylinder_pressure_fx, inline=True)
+string_damping_fx = _compile(_terms.string_damping_fx, inline=True)
+plant_fx = _compile(_terms.plant_fx, inline=True)
+pressure_friction_fx = _compile(_terms.pressure_friction_fx, inline=True)
+friction_magnitude_fx = _compile(_terms.friction_magnitude_fx, inline=True)
+friction_jump_fx = _compile(_terms.friction_jump_fx, inline=True)
+sliding_friction_fx = _compile(_terms.sliding_friction_fx, inline=True)
+dwell_gain = _compile(_terms.dwell_gain, inline=True)
+static_limit_fx = _compile(_terms.static_limit_fx, inline=True)
+truth_thermal_rate = _compile(_terms.truth_thermal_rate, inline=True)
+lag_rates = _compile(_terms.lag_rates, inline=True)
 
-from heavecomp.simulate.layout import CHANNELS, NCH, NSTATS, SLIDING, STATS, STUCK  # noqa: E402,F401
+from heavecomp.simulate.layout import CHANNELS, FX_CHANNELS, NCH, NSTATS, SLIDING, STATS, STUCK  # noqa: E402,F401
+
+#: the effect parameters of the plain CMC (every effect off; a constant of the compiled code)
+NO_EFFECTS = np.zeros(_terms.N_EP)
+NO_EFFECTS.setflags(write=False)
 
 
 @_jit
@@ -169,43 +207,65 @@ def heave_at(t, sp, Z, DZ, DDZ):
     return z, dz, ddz
 
 
-@_jit
-def rhs(t, s, v, yb, vb, mode, d, cm, smooth, code, FP, PP, u, sp, Z, DZ, DDZ):
-    """Time derivatives (ds, dv, dyb, dvb) in the given mode."""
-    zh, dzh, ddzh = heave_at(t, sp, Z, DZ, DDZ)
-    dvb = lower_accel_contact(s, v, yb, vb, zh, dzh, cm, PP)
+@_jit_inline
+def rhs(t, X, mode, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ):
+    """Time derivatives of ``X = (s, v, yb, vb, theta, w, E)`` in the given mode.
+
+    The plant is :func:`heavecomp.effects.terms.plant_fx` (the CMC of
+    :mod:`heavecomp.plants.cmc`, bit for bit when ``EP = 0``); the contact state
+    ``cm`` is held, the stroke frozen while stuck.
+    """
+    s, v, yb, vb, th, w, el = X
     if mode == STUCK:
-        return 0.0, 0.0, vb, dvb
+        v = 0.0
+    zh, dzh, ddzh = heave_at(t, sp, Z, DZ, DDZ)
+    p, T, hold, dvb = plant_fx(s, v, yb, vb, th, zh, dzh, ddzh, u, cm, PP, EP)
+    dth = truth_thermal_rate(s, v, th, PP, EP)
+    dw, de = lag_rates(v, w, el, FP, EP)
+    if mode == STUCK:
+        return (0.0, 0.0, vb, dvb, dth, dw, de)
     if smooth:
-        p = gas_pressure(s, PP)
         Ff = friction_cont(code, v, p, FP)
     else:
-        Ff = sliding_friction(code, d, s, v, FP, PP)
-    dv = stroke_accel(s, v, yb, vb, zh, dzh, ddzh, u, Ff, PP)
-    return v, dv, vb, dvb
+        Ff = sliding_friction_fx(code, d, v, p, w, el, FP, EP)
+    return (v, (hold - Ff) / PP[1], vb, dvb, dth, dw, de)
 
 
 @_jit
-def rk4(t, h, s, v, yb, vb, mode, d, cm, smooth, code, FP, PP, u, sp, Z, DZ, DDZ):
-    k1 = rhs(t, s, v, yb, vb, mode, d, cm, smooth, code, FP, PP, u, sp, Z, DZ, DDZ)
+def _axpy(X, h, k):
+    return (X[0] + h * k[0], X[1] + h * k[1], X[2] + h * k[2], X[3] + h * k[3], X[4] + h * k[4],
+            X[5] + h * k[5], X[6] + h * k[6])
+
+
+@_jit
+def _at_rest(X):
+    """X with the stroke velocity exactly 0."""
+    return (X[0], 0.0, X[2], X[3], X[4], X[5], X[6])
+
+
+@_jit
+def rk4(t, h, X, mode, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ):
+    k1 = rhs(t, X, mode, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ)
     h2 = 0.5 * h
-    k2 = rhs(t + h2, s + h2 * k1[0], v + h2 * k1[1], yb + h2 * k1[2], vb + h2 * k1[3],
-             mode, d, cm, smooth, code, FP, PP, u, sp, Z, DZ, DDZ)
-    k3 = rhs(t + h2, s + h2 * k2[0], v + h2 * k2[1], yb + h2 * k2[2], vb + h2 * k2[3],
-             mode, d, cm, smooth, code, FP, PP, u, sp, Z, DZ, DDZ)
-    k4 = rhs(t + h, s + h * k3[0], v + h * k3[1], yb + h * k3[2], vb + h * k3[3],
-             mode, d, cm, smooth, code, FP, PP, u, sp, Z, DZ, DDZ)
+    k2 = rhs(t + h2, _axpy(X, h2, k1), mode, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ)
+    k3 = rhs(t + h2, _axpy(X, h2, k2), mode, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ)
+    k4 = rhs(t + h, _axpy(X, h, k3), mode, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ)
     h6 = h / 6.0
-    return (s + h6 * (k1[0] + 2 * k2[0] + 2 * k3[0] + k4[0]),
-            v + h6 * (k1[1] + 2 * k2[1] + 2 * k3[1] + k4[1]),
-            yb + h6 * (k1[2] + 2 * k2[2] + 2 * k3[2] + k4[2]),
-            vb + h6 * (k1[3] + 2 * k2[3] + 2 * k3[3] + k4[3]))
+    return (X[0] + h6 * (k1[0] + 2 * k2[0] + 2 * k3[0] + k4[0]),
+            X[1] + h6 * (k1[1] + 2 * k2[1] + 2 * k3[1] + k4[1]),
+            X[2] + h6 * (k1[2] + 2 * k2[2] + 2 * k3[2] + k4[2]),
+            X[3] + h6 * (k1[3] + 2 * k2[3] + 2 * k3[3] + k4[3]),
+            X[4] + h6 * (k1[4] + 2 * k2[4] + 2 * k3[4] + k4[4]),
+            X[5] + h6 * (k1[5] + 2 * k2[5] + 2 * k3[5] + k4[5]),
+            X[6] + h6 * (k1[6] + 2 * k2[6] + 2 * k3[6] + k4[6]))
 
 
 @_jit
-def hold(t, s, v, yb, vb, u, PP, sp, Z, DZ, DDZ):
+def hold(t, X, u, PP, EP, sp, Z, DZ, DDZ):
+    """(holding force, cylinder pressure) at v = 0: while stuck the friction is the holding force."""
     zh, dzh, ddzh = heave_at(t, sp, Z, DZ, DDZ)
-    return holding_force(s, v, yb, vb, zh, dzh, ddzh, u, PP)
+    p, T, F, dvb = plant_fx(X[0], 0.0, X[2], X[3], X[4], zh, dzh, ddzh, u, 1.0, PP, EP)
+    return F, p
 
 
 @_jit
@@ -245,33 +305,65 @@ def advance(state, mode_dir, t0, n_steps, h, code, FP, PP, smooth, u, sp, Z, DZ,
     in place.  Every ``out_every`` steps a row of CHANNELS is written to
     ``out[out_pos]`` (``out_pos`` is returned, advanced); the first row written
     is the state at ``t0`` when ``out_pos == 0``.  ``stats`` accumulates STATS.
+    This is :func:`advance_fx` with every effect off.
     """
-    s, v, yb, vb = state[0], state[1], state[2], state[3]
-    mode = int(mode_dir[0])
-    d = mode_dir[1]
-    cm = 1.0 if contact_switch(yb, vb, PP) > 0.0 else 0.0  # bit on the rock (held between events)
+    X = (state[0], state[1], state[2], state[3], 1.0, 0.0, 0.0)
+    X, tau, mode, d, pos = _advance(X, 0.0, int(mode_dir[0]), mode_dir[1], t0, n_steps, h, code, FP, PP,
+                                    NO_EFFECTS, smooth, u, sp, Z, DZ, DDZ, out, out_every, out_pos, stats)
+    state[0], state[1], state[2], state[3] = X[0], X[1], X[2], X[3]
+    mode_dir[0] = mode
+    mode_dir[1] = d
+    return pos
+
+
+@nb.njit(cache=True, nogil=True)
+def advance_fx(state, mode_dir, t0, n_steps, h, code, FP, PP, EP, smooth, u, sp, Z, DZ, DDZ,
+               out, out_every, out_pos, stats):
+    """:func:`advance` with the effect terms of :mod:`heavecomp.effects.terms` (parameters ``EP``).
+
+    ``state`` has 8 entries, ``[s, v, yb, vb, theta, w, E, tau]`` (gas temperature ratio,
+    friction memories, dwell time at rest); when ``out`` has more than NCH columns the
+    next ones get FX_CHANNELS.  Releases the GIL (the diagnosis fits in threads).
+    """
+    X = (state[0], state[1], state[2], state[3], state[4], state[5], state[6])
+    X, tau, mode, d, pos = _advance(X, state[7], int(mode_dir[0]), mode_dir[1], t0, n_steps, h, code, FP, PP,
+                                    EP, smooth, u, sp, Z, DZ, DDZ, out, out_every, out_pos, stats)
+    for k in range(7):
+        state[k] = X[k]
+    state[7] = tau
+    mode_dir[0] = mode
+    mode_dir[1] = d
+    return pos
+
+
+@_jit
+def _advance(X, tau, mode, d, t0, n_steps, h, code, FP, PP, EP, smooth, u, sp, Z, DZ, DDZ,
+             out, out_every, out_pos, stats):
+    """The event-handling stepper; returns ``(X, tau, mode, d, out_pos)`` at ``t0 + n_steps h``."""
+    cm = 1.0 if contact_switch(X[2], X[3], PP) > 0.0 else 0.0  # bit on the rock (held between events)
     if smooth:
         mode = SLIDING
     pos = out_pos
     if pos == 0 and out.shape[0] > 0:
-        _record(out, pos, t0, s, v, yb, vb, mode, d, cm, smooth, code, FP, PP, u, sp, Z, DZ, DDZ)
+        _record(out, pos, t0, X, mode, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ)
         pos += 1
     for i in range(n_steps):
         tc = t0 + i * h
         left = h
         for _ev in range(8):
             # tentative step to the grid, cut at the first contact switch (lift-off/touchdown)
-            vs = v if mode == SLIDING else 0.0
-            s1, v1, yb1, vb1 = rk4(tc, left, s, vs, yb, vb, mode, d, cm, smooth, code, FP, PP, u, sp, Z, DZ, DDZ)
+            if mode == STUCK:
+                X = _at_rest(X)
+            X1 = rk4(tc, left, X, mode, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ)
             cut = left
             switched = False
-            if (contact_switch(yb1, vb1, PP) > 0.0) != (cm > 0.5):
-                cut = _contact_time(tc, left, s, vs, yb, vb, mode, d, cm, smooth, code, FP, PP, u, sp, Z, DZ, DDZ)
-                s1, v1, yb1, vb1 = rk4(tc, cut, s, vs, yb, vb, mode, d, cm, smooth, code, FP, PP, u, sp, Z, DZ, DDZ)
+            if (contact_switch(X1[2], X1[3], PP) > 0.0) != (cm > 0.5):
+                cut = _contact_time(tc, left, X, mode, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ)
+                X1 = rk4(tc, cut, X, mode, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ)
                 switched = True
             if mode == SLIDING:
-                if smooth or v1 * d > 0.0:
-                    s, v, yb, vb = s1, v1, yb1, vb1
+                if smooth or X1[1] * d > 0.0:
+                    X = X1
                     tc += cut
                     left -= cut
                     if switched:
@@ -281,30 +373,30 @@ def advance(state, mode_dir, t0, n_steps, h, code, FP, PP, smooth, u, sp, Z, DZ,
                         break
                     continue
                 # velocity reaches zero before the cut: locate it
-                a0 = rhs(tc, s, v, yb, vb, SLIDING, d, cm, smooth, code, FP, PP, u, sp, Z, DZ, DDZ)[1]
-                a1 = rhs(tc + cut, s1, v1, yb1, vb1, SLIDING, d, cm, smooth, code, FP, PP, u, sp, Z, DZ, DDZ)[1]
-                tau = _cubic_root(v, a0, v1, a1, cut)
-                st, vt, ybt, vbt = s1, v1, yb1, vb1
+                a0 = rhs(tc, X, SLIDING, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ)[1]
+                a1 = rhs(tc + cut, X1, SLIDING, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ)[1]
+                tz = _cubic_root(X[1], a0, X1[1], a1, cut)
+                Xt = X1
                 for _n in range(4):
-                    st, vt, ybt, vbt = rk4(tc, tau, s, v, yb, vb, SLIDING, d, cm, smooth, code, FP, PP, u, sp, Z, DZ, DDZ)
-                    if abs(vt) < 1e-13:
+                    Xt = rk4(tc, tz, X, SLIDING, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ)
+                    if abs(Xt[1]) < 1e-13:
                         break
-                    at = rhs(tc + tau, st, vt, ybt, vbt, SLIDING, d, cm, smooth, code, FP, PP, u, sp, Z, DZ, DDZ)[1]
+                    at = rhs(tc + tz, Xt, SLIDING, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ)[1]
                     if at == 0.0:
                         break
-                    nt = tau - vt / at
+                    nt = tz - Xt[1] / at
                     if nt <= 0.0:
-                        nt = 0.5 * tau
+                        nt = 0.5 * tz
                     if nt >= cut:
-                        nt = 0.5 * (tau + cut)
-                    tau = nt
-                s, v, yb, vb = st, 0.0, ybt, vbt
-                tc += tau
-                left -= tau
-                F = hold(tc, s, v, yb, vb, u, PP, sp, Z, DZ, DDZ)
-                lim = static_limit(code, s, FP, PP)
-                if abs(F) <= lim:
+                        nt = 0.5 * (tz + cut)
+                    tz = nt
+                X = _at_rest(Xt)
+                tc += tz
+                left -= tz
+                F, p = hold(tc, X, u, PP, EP, sp, Z, DZ, DDZ)
+                if abs(F) <= static_limit_fx(code, p, X[5], X[6], 0.0, FP, EP):
                     mode = STUCK
+                    tau = 0.0
                     stats[1] += 1.0
                 else:
                     d = 1.0 if F > 0 else -1.0
@@ -312,11 +404,12 @@ def advance(state, mode_dir, t0, n_steps, h, code, FP, PP, smooth, u, sp, Z, DZ,
                 if left <= 0.0:
                     break
             else:  # STUCK
-                F1 = hold(tc + cut, s1, 0.0, yb1, vb1, u, PP, sp, Z, DZ, DDZ)
-                lim1 = static_limit(code, s1, FP, PP)
+                F1, p1 = hold(tc + cut, X1, u, PP, EP, sp, Z, DZ, DDZ)
+                lim1 = static_limit_fx(code, p1, X1[5], X1[6], tau + cut, FP, EP)
                 if abs(F1) <= lim1:
                     stats[0] += cut
-                    s, v, yb, vb = s1, 0.0, yb1, vb1
+                    tau += cut
+                    X = X1
                     tc += cut
                     left -= cut
                     if switched:
@@ -327,11 +420,11 @@ def advance(state, mode_dir, t0, n_steps, h, code, FP, PP, smooth, u, sp, Z, DZ,
                     continue
                 # breakaway before the cut: bracket [lo, hi] with margin(lo) >= 0 > margin(hi)
                 sg = 1.0 if F1 > 0 else -1.0
-                F0 = hold(tc, s, 0.0, yb, vb, u, PP, sp, Z, DZ, DDZ)
-                m_lo = static_limit(code, s, FP, PP) - sg * F0
+                F0, p0 = hold(tc, X, u, PP, EP, sp, Z, DZ, DDZ)
+                m_lo = static_limit_fx(code, p0, X[5], X[6], tau, FP, EP) - sg * F0
                 m_hi = lim1 - sg * F1
                 lo, hi = 0.0, cut
-                yb_hi, vb_hi = yb1, vb1
+                Xhi = X1
                 side = 0
                 for _n in range(60):
                     if hi - lo < 1e-12 * h:
@@ -339,8 +432,9 @@ def advance(state, mode_dir, t0, n_steps, h, code, FP, PP, smooth, u, sp, Z, DZ,
                     tt = lo + (hi - lo) * m_lo / (m_lo - m_hi) if m_lo != m_hi else 0.5 * (lo + hi)
                     if not (lo < tt < hi):
                         tt = 0.5 * (lo + hi)
-                    s2, v2, yb2, vb2 = rk4(tc, tt, s, 0.0, yb, vb, STUCK, d, cm, smooth, code, FP, PP, u, sp, Z, DZ, DDZ)
-                    m = static_limit(code, s2, FP, PP) - sg * hold(tc + tt, s2, 0.0, yb2, vb2, u, PP, sp, Z, DZ, DDZ)
+                    X2 = rk4(tc, tt, X, STUCK, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ)
+                    F2, p2 = hold(tc + tt, X2, u, PP, EP, sp, Z, DZ, DDZ)
+                    m = static_limit_fx(code, p2, X2[5], X2[6], tau + tt, FP, EP) - sg * F2
                     if m >= 0.0:
                         lo, m_lo = tt, m
                         if side == -1:
@@ -348,21 +442,18 @@ def advance(state, mode_dir, t0, n_steps, h, code, FP, PP, smooth, u, sp, Z, DZ,
                         side = -1
                     else:
                         hi, m_hi = tt, m
-                        yb_hi, vb_hi = yb2, vb2
+                        Xhi = X2
                         if side == 1:
                             m_lo *= 0.5
                         side = 1
                     if abs(m) < 1e-9 * (1.0 + abs(lim1)):
                         if m < 0.0:
                             break
-                if hi < cut:
-                    yb, vb = yb_hi, vb_hi
-                else:
-                    yb, vb = yb1, vb1
+                X = _at_rest(Xhi)
                 stats[0] += hi
                 tc += hi
                 left -= hi
-                v = 0.0
+                tau = 0.0
                 mode = SLIDING
                 d = sg
                 stats[2] += 1.0
@@ -372,28 +463,26 @@ def advance(state, mode_dir, t0, n_steps, h, code, FP, PP, smooth, u, sp, Z, DZ,
             # more than 8 events inside one step (never seen in practice): finish the
             # step in the current mode without further event checks, and count it
             if left > 0.0:
-                s, v, yb, vb = rk4(tc, left, s, v, yb, vb, mode, d, cm, smooth, code, FP, PP, u, sp, Z, DZ, DDZ)
+                X = rk4(tc, left, X, mode, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ)
                 if mode == STUCK:
-                    v = 0.0
+                    X = _at_rest(X)
                     stats[0] += left
+                    tau += left
                 stats[4] += 1.0
         if (i + 1) % out_every == 0 and pos < out.shape[0]:
-            _record(out, pos, t0 + (i + 1) * h, s, v, yb, vb, mode, d, cm, smooth, code, FP, PP, u, sp, Z, DZ, DDZ)
+            _record(out, pos, t0 + (i + 1) * h, X, mode, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ)
             pos += 1
-    state[0], state[1], state[2], state[3] = s, v, yb, vb
-    mode_dir[0] = mode
-    mode_dir[1] = d
-    return pos
+    return X, tau, mode, d, pos
 
 
 @_jit
-def _contact_time(tc, left, s, v, yb, vb, mode, d, cm, smooth, code, FP, PP, u, sp, Z, DZ, DDZ):
+def _contact_time(tc, left, X, mode, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ):
     """Time in (0, left] just past the zero of the contact switch (Illinois on RK4 sub-steps
     with the contact state ``cm`` held)."""
-    g_lo = contact_switch(yb, vb, PP)
+    g_lo = contact_switch(X[2], X[3], PP)
     c_lo = cm > 0.5
-    s1, v1, yb1, vb1 = rk4(tc, left, s, v, yb, vb, mode, d, cm, smooth, code, FP, PP, u, sp, Z, DZ, DDZ)
-    g_hi = contact_switch(yb1, vb1, PP)
+    X1 = rk4(tc, left, X, mode, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ)
+    g_hi = contact_switch(X1[2], X1[3], PP)
     lo, hi = 0.0, left
     side = 0
     for _n in range(80):
@@ -402,8 +491,8 @@ def _contact_time(tc, left, s, v, yb, vb, mode, d, cm, smooth, code, FP, PP, u, 
         tt = lo + (hi - lo) * g_lo / (g_lo - g_hi) if g_lo != g_hi else 0.5 * (lo + hi)
         if not (lo < tt < hi):
             tt = 0.5 * (lo + hi)
-        s2, v2, yb2, vb2 = rk4(tc, tt, s, v, yb, vb, mode, d, cm, smooth, code, FP, PP, u, sp, Z, DZ, DDZ)
-        g = contact_switch(yb2, vb2, PP)
+        X2 = rk4(tc, tt, X, mode, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ)
+        g = contact_switch(X2[2], X2[3], PP)
         if (g > 0.0) == c_lo:
             lo, g_lo = tt, g
             if side == -1:
@@ -418,15 +507,18 @@ def _contact_time(tc, left, s, v, yb, vb, mode, d, cm, smooth, code, FP, PP, u, 
 
 
 @_jit
-def _record(out, pos, t, s, v, yb, vb, mode, d, cm, smooth, code, FP, PP, u, sp, Z, DZ, DDZ):
-    zh, dzh, ddzh = heave_at(t, sp, Z, DZ, DDZ)
-    p = gas_pressure(s, PP)
+def _record(out, pos, t, X, mode, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ):
+    s, v, yb, vb, th, w, el = X
     if mode == STUCK:
-        Ff = holding_force(s, 0.0, yb, vb, zh, dzh, ddzh, u, PP)
+        v = 0.0
+    zh, dzh, ddzh = heave_at(t, sp, Z, DZ, DDZ)
+    p, T, F, dvb = plant_fx(s, v, yb, vb, th, zh, dzh, ddzh, u, cm, PP, EP)
+    if mode == STUCK:
+        Ff = F
     elif smooth:
         Ff = friction_cont(code, v, p, FP)
     else:
-        Ff = sliding_friction(code, d, s, v, FP, PP)
+        Ff = sliding_friction_fx(code, d, v, p, w, el, FP, EP)
     out[pos, 0] = t
     out[pos, 1] = zh
     out[pos, 2] = s
@@ -434,8 +526,11 @@ def _record(out, pos, t, s, v, yb, vb, mode, d, cm, smooth, code, FP, PP, u, sp,
     out[pos, 4] = wob(yb, vb, PP)
     out[pos, 5] = v
     out[pos, 6] = Ff
-    out[pos, 7] = tension(s, v, yb, vb, zh, dzh, PP)
+    out[pos, 7] = T
     out[pos, 8] = yb
     out[pos, 9] = vb
     out[pos, 10] = 1.0 if mode == STUCK else 0.0
     out[pos, 11] = u
+    if out.shape[1] >= NCH + 2:  # FX_CHANNELS
+        out[pos, NCH] = gas_pressure_fx(s, th, PP, EP)
+        out[pos, NCH + 1] = th

@@ -221,26 +221,13 @@ def run_kernel(law, PP, hs, h, n_steps, out_every, *, u_active=0.0, progress=Non
     mode_dir = np.array([float(STUCK), 1.0])
     stats = np.zeros(len(STATS))
     smooth = not law.has_stiction
+
+    def step(t0, n, Z, DZ, DDZ, pos):
+        return advance(state, mode_dir, t0, n, h, int(law.code), law.FP, PP, bool(smooth), float(u_active),
+                       0.5 * h, Z, DZ, DDZ, out, int(out_every), int(pos), stats)
+
     t0 = time.perf_counter()
-    done, pos = 0, 0
-    # the fade-in's end: d2z/dt2 jumps there; step up to it with the left-limit sample so no
-    # RK4 step straddles the jump (only when it falls on the step and output grids)
-    if hs.kink is not None and hs.kink[0] % 2 == 0:
-        k, ddz_left = hs.kink
-        n1 = k // 2
-        if 0 < n1 <= n_steps and n1 % out_every == 0:
-            ddz1 = hs.ddz[:k + 1].copy()
-            ddz1[k] = ddz_left
-            pos = advance(state, mode_dir, 0.0, n1, h, int(law.code), law.FP, PP, bool(smooth), float(u_active),
-                          0.5 * h, hs.z[:k + 1], hs.dz[:k + 1], ddz1, out, int(out_every), 0, stats)
-            done = n1
-    while done < n_steps:
-        n = min(chunk_steps - chunk_steps % out_every or out_every, n_steps - done)
-        pos = advance(state, mode_dir, done * h, n, h, int(law.code), law.FP, PP, bool(smooth), float(u_active),
-                      0.5 * h, hs.z, hs.dz, hs.ddz, out, int(out_every), int(pos), stats)
-        done += n
-        if progress is not None:
-            progress(done / n_steps)
+    pos = drive(step, hs, h, n_steps, out_every, progress=progress, chunk_steps=chunk_steps)
     wall = time.perf_counter() - t0
     data = out[:pos]
     if not np.isfinite(data).all():
@@ -248,6 +235,32 @@ def run_kernel(law, PP, hs, h, n_steps, out_every, *, u_active=0.0, progress=Non
         raise SimulationError(f"the stepper diverged near t = {data[max(row - 1, 0), 0]:g} s (non-finite state); "
                               f"reduce --dt (now {h:g} s) or check the parameters")
     return data, dict(zip(STATS, stats.tolist())), wall
+
+
+def drive(step, hs, h, n_steps, out_every, *, progress=None, chunk_steps=200_000) -> int:
+    """Call ``step(t0, n, Z, DZ, DDZ, out_pos) -> out_pos`` (a compiled ``advance`` bound to its
+    state and output) over ``n_steps`` steps of ``h`` in chunks; returns the rows written.
+
+    The fade-in's end, where d2z/dt2 jumps, is made a step boundary: the steps up to it get
+    the heave samples up to it with the left-limit ``ddz`` there, so no RK4 step straddles the
+    jump (only when it falls on the step and output grids).
+    """
+    done, pos = 0, 0
+    if hs.kink is not None and hs.kink[0] % 2 == 0:
+        k, ddz_left = hs.kink
+        n1 = k // 2
+        if 0 < n1 <= n_steps and n1 % out_every == 0:
+            ddz1 = hs.ddz[:k + 1].copy()
+            ddz1[k] = ddz_left
+            pos = step(0.0, n1, hs.z[:k + 1], hs.dz[:k + 1], ddz1, 0)
+            done = n1
+    while done < n_steps:
+        n = min(chunk_steps - chunk_steps % out_every or out_every, n_steps - done)
+        pos = step(done * h, n, hs.z, hs.dz, hs.ddz, pos)
+        done += n
+        if progress is not None:
+            progress(done / n_steps)
+    return pos
 
 
 _STEPPER = None

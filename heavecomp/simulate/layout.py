@@ -7,16 +7,19 @@ SLIDING = 1
 CHANNELS = ("t", "heave", "stroke", "pressure", "wob", "stroke_velocity", "friction", "tension",
             "lower_displacement", "lower_velocity", "stuck", "u_active")
 NCH = len(CHANNELS)
+#: extra channels written by ``_kernel.advance_fx`` when ``out`` has room (after CHANNELS)
+FX_CHANNELS = ("gas_pressure", "theta")
 #: slots of the ``stats`` array
 STATS = ("stuck_time", "n_stick", "n_breakaway", "n_reversal", "n_event_overflow", "n_contact_switch")
 NSTATS = len(STATS)
 
 #: files whose source the compiled stepper is built from (the AOT build is keyed to them)
-KERNEL_SOURCES = ("friction/laws.py", "plants/cmc.py", "simulate/_kernel.py", "simulate/layout.py")
+KERNEL_SOURCES = ("friction/laws.py", "plants/cmc.py", "effects/terms.py", "simulate/_kernel.py",
+                  "simulate/layout.py")
 
 
 def source_hash() -> int:
-    """63-bit hash of the stepper's source files (friction laws, CMC equations, kernel)."""
+    """63-bit hash of the stepper's source files (friction laws, CMC equations, effect terms, kernel)."""
     import hashlib
     from pathlib import Path
 
