@@ -22,6 +22,11 @@ def test_withheld_effects_scenario_quick(tmp_path):
     runs = {x["truth"]: x for x in m["runs"]}
     # no effect -> the gap is at the noise floor
     assert runs["none"]["verdict"] == "none"
+    # a withheld dwell stiction is planted where the compensator sticks, well above the noise floor,
+    # and the diagnosis sees a gap there (not `none`)
+    dw = runs["dwell_stiction"]
+    assert dw["planted_gap"]["dwell_stiction"] >= 3.0 and dw["stuck_share"] >= 0.15
+    assert dw["verdict"] != "none" and dw["gap_to_noise"] > 1.2
     # a withheld orifice loss is named and the held-out gap really shrinks
     assert runs["flow_loss"]["verdict"] == "flow_loss"
     assert runs["flow_loss"]["shrink"] > 0.2

@@ -97,7 +97,7 @@ class GapDiagnoser:
         Candidates fitted concurrently (threads; the stepper releases the GIL).
     progress : callable(fraction, message), optional
     second : int
-        How many runner-up candidates to try jointly with the best (0: none).
+        How many runner-up candidates to try jointly with the best (0: none; default all).
     segment : float [s] or None
         Multiple-shooting segment length: the replay restarts from the measured state every
         ``segment`` seconds, so one early stick-slip event does not decide the rest of the run
@@ -128,7 +128,7 @@ class GapDiagnoser:
     """
 
     def __init__(self, nominal, candidates=None, *, split=0.67, settle=None, penalty=0.03, min_explained=0.5,
-                 none_ratio=1.2, max_nfev=40, decimate=2, n_jobs=2, progress=None, second=2, segment=None,
+                 none_ratio=1.2, max_nfev=40, decimate=2, n_jobs=2, progress=None, second=7, segment=None,
                  reinit=1.5, stuck_speed=2e-3, grid=7, input_draws=8, none_tail=2.0, none_explained=0.25):
         self.nominal = nominal
         names = list(CANDIDATES) if candidates is None else list(candidates)
@@ -204,12 +204,14 @@ class GapDiagnoser:
             reinit |= (t >= tk) & (t < tk + self.reinit)
         return bounds, starts, reinit
 
-    def simulate(self, config, t_end=None):
+    def simulate(self, config, t_end=None, hs=None):
         """Model channels at the run's times (up to ``t_end``) for a configuration
-        ``[(effect name, values), ...]`` (empty: the nominal model)."""
+        ``[(effect name, values), ...]`` (empty: the nominal model), driven by the replay's heave
+        or by ``hs`` (heave samples on the same grid)."""
         from heavecomp.diagnosis.stepper import CHANNELS as SC, run_fx, run_segments
 
         rp = self._rp
+        hs = rp.hs if hs is None else hs
         code, FP, PP = rp.code, rp.FP, rp.PP
         EP = T.zero_ep()
         shift = None
@@ -223,9 +225,9 @@ class GapDiagnoser:
                 shift = (values["channel"], values["delay"])
         n = rp.n_steps if t_end is None else min(rp.n_steps, int(math.ceil(t_end / rp.h)) + 2)
         if self.segment:
-            out = run_segments(code, FP, PP, EP, rp.hs, rp.h, rp.bounds, rp.starts, n + 1)
+            out = run_segments(code, FP, PP, EP, hs, rp.h, rp.bounds, rp.starts, n + 1)
         else:
-            out = run_fx(code, FP, PP, EP, rp.hs, rp.h, n, 1)
+            out = run_fx(code, FP, PP, EP, hs, rp.h, n, 1)
         tg = out[:, 0]
         t = rp.t if t_end is None else rp.t[rp.t <= tg[-1]]
         res = {}
@@ -550,28 +552,34 @@ class GapDiagnoser:
 
     def _second(self, rows):
         """Joint fit of the best candidate (held at its fitted values) with each of the next
-        ``second`` runners-up; the one whose joint held-out explained share exceeds the best's by
-        more than 0.1 after the parsimony penalty is the ``second_effect``.  Any pair works except
-        two output candidates (one transport delay per configuration): a sensor delay as the best
-        is paired with the plant/nominal runners-up (it was skipped altogether before)."""
+        ``second`` runners-up (fitted concurrently); the one whose joint held-out explained share
+        exceeds the best's by more than 0.1 after the parsimony penalty is the ``second_effect``.
+        Any pair works except two output candidates (one transport delay per configuration): a
+        sensor delay as the best is paired with the plant/nominal runners-up.  The ranking alone is
+        a poor guide to the partner (alone, a candidate may mimic the dominant effect's remainder or
+        distort to absorb it), so by default every runner-up is tried."""
         best = rows[0]
         fixed = [(best["effect"], best["_values"])]
         best_output = get(best["effect"]).kind == "output"
-        out = None
-        tried = 0
-        self.second_tried_ = []
-        for r in rows[1:]:
-            if tried >= self.second:
-                break
-            if best_output and get(r["effect"]).kind == "output":
-                continue
-            tried += 1
+        partners = [r for r in rows[1:] if not (best_output and get(r["effect"]).kind == "output")][: self.second]
+
+        def joint(r):
             start = r["_values"] if get(r["effect"]).kind != "output" else None
             fitted = self._fit_candidate(r["effect"], start=start, fixed=fixed)
-            pred = self.simulate(fixed + [(r["effect"], fitted["values"])])
             cfg = fixed + [(r["effect"], fitted["values"])]
+            pred = self.simulate(cfg)
             expl = min(self._explained(self._mse_b, self._mse(pred, self._valmask)),
                        self._explained(self._mse_b_pert, self._mse(self._with_hs(self._hs_pert, cfg), self._valmask)))
+            return fitted, pred, expl
+
+        if self.n_jobs > 1 and len(partners) > 1:
+            with cf.ThreadPoolExecutor(self.n_jobs) as ex:
+                results = list(ex.map(joint, partners))
+        else:
+            results = [joint(r) for r in partners]
+        out = None
+        self.second_tried_ = []
+        for r, (fitted, pred, expl) in zip(partners, results):
             if not math.isfinite(expl):
                 continue
             gain = expl - best["explained"] - self.penalty * get(r["effect"]).n_params()
@@ -584,12 +592,7 @@ class GapDiagnoser:
         return out
 
     def _with_hs(self, hs, config):
-        saved = self._rp.hs
-        try:
-            self._rp.hs = hs
-            return self.simulate(config)
-        finally:
-            self._rp.hs = saved
+        return self.simulate(config, hs=hs)
 
     def _replay_floor(self, run, nom, mask):
         """Residual an exact model would still show because the *input* is noisy: the nominal
@@ -614,20 +617,15 @@ class GapDiagnoser:
         def ms(a, m):
             return {c: float(np.mean((a[c][m] - nom[c][m]) ** 2)) for c in CH}
 
-        saved = self._rp.hs
-        try:
-            self._rp.hs = self._hs_pert = perturbed()
-            alt = self.simulate([])
-            self._mse_b_pert = self._mse(alt, val)
-            env = ms(alt, val)
-            for _ in range(self.input_draws - 1):
-                self._rp.hs = perturbed()
-                env = {c: max(v, ms(self.simulate([]), val)[c]) for c, v in env.items()}
-            # sensitivity to the heave pre-processing: cut-off 1.5 x higher
-            self._rp.hs = heave_samples(run, self._rp.h, self._rp.n_steps, cutoff=1.5 * HEAVE_CUTOFF)
-            alt2 = self.simulate([])
-        finally:
-            self._rp.hs = saved
+        self._hs_pert = perturbed()
+        alt = self.simulate([], hs=self._hs_pert)
+        self._mse_b_pert = self._mse(alt, val)
+        env = ms(alt, val)
+        for _ in range(self.input_draws - 1):
+            other = ms(self.simulate([], hs=perturbed()), val)
+            env = {c: max(env[c], other[c]) for c in CH}
+        # sensitivity to the heave pre-processing: cut-off 1.5 x higher
+        alt2 = self.simulate([], hs=heave_samples(run, self._rp.h, self._rp.n_steps, cutoff=1.5 * HEAVE_CUTOFF))
         self.heave_noise_ = sz
         pre = ms(alt2, val)
         self._env_ms = {c: env[c] + pre[c] for c in CH}

@@ -73,9 +73,9 @@ class TestRun:
         return path
 
 
-GAP_MIN = 3.0  #: a planted effect's own gap over the noise floor (largest channel rms ratio) [-]
+GAP_MIN = 3.0  #: a planted effect's own gap over the noise floor (largest channel rms ratio, each half of the run) [-]
 SECOND_SHARE = (0.3, 0.6)  #: the second effect's own squared gap as a share of the dominant's [-]
-MAX_DRAWS = 40  #: seas / effect draws tried before giving up
+MAX_DRAWS = 100  #: seas / effect draws tried before giving up
 STICK_MIN = 0.15  #: dwell stiction is planted only where the compensator is stuck this share of the time [-]
 
 
@@ -224,10 +224,17 @@ class _Sea:
                 for c in self.OUT}
 
     def gap(self, parts):
-        """Own gap of a configuration: per channel rms(with - without) / noise floor [-]."""
+        """Own gap of a configuration: per channel rms(with - without) / noise floor [-], and the
+        largest channel's ratio in the weaker half of the run (an effect that shows in one burst
+        only cannot be fitted on one part of the run and checked on the other)."""
         _, cols = self.sim(parts)
         m = self.mask
-        return {c: float(np.sqrt(np.mean((cols[c][m] - self.base[c][m]) ** 2)) / self.floor[c]) for c in self.OUT}
+        mid = 0.5 * (self.t[m][0] + self.t[-1])
+
+        def ratio(k):
+            return {c: float(np.sqrt(np.mean((cols[c][k] - self.base[c][k]) ** 2)) / self.floor[c]) for c in self.OUT}
+
+        return ratio(m), min(max(ratio(m & (self.t < mid)).values()), max(ratio(self.t >= mid).values()))
 
 
 def _energy(g):
@@ -237,7 +244,7 @@ def _energy(g):
 
 def _plant(name, rng, sea, nominal, target=None):
     """Draw one effect and size it on ``sea``: alone, its largest channel gap reaches :data:`GAP_MIN`
-    (magnitude raised up to its cap); with ``target`` = (dominant energy, share), its squared gap is
+    in each half of the run (magnitude raised up to its cap); with ``target`` = (dominant energy, share), its squared gap is
     within ``share`` +- 0.05 (inside :data:`SECOND_SHARE`) of the dominant's (bisection on the magnitude).
     A dwell stiction also needs a sea in which the compensator is stuck at least :data:`STICK_MIN` of
     the time.  Returns (desc, part, gap per channel) or None when this sea cannot carry the effect."""
@@ -248,19 +255,19 @@ def _plant(name, rng, sea, nominal, target=None):
     def measure(d):
         EP, extra = _effect_terms(name, d, nominal)
         part = (name, EP, extra)
-        return part, sea.gap([part])
+        return (part,) + sea.gap([part])
 
-    part, g = measure(desc)
+    part, g, weak = measure(desc)
     if target is None:
         for _ in range(8):
-            if max(g.values()) >= GAP_MIN:
+            if weak >= GAP_MIN:
                 return desc, part, g
             if mag is None:
                 return None
-            desc, capped = _scaled(desc, mag, float(np.clip(1.2 * GAP_MIN / max(max(g.values()), 1e-3), 1.25, 4.0)), cap)
-            part, g = measure(desc)
+            desc, capped = _scaled(desc, mag, float(np.clip(1.2 * GAP_MIN / max(weak, 1e-3), 1.25, 4.0)), cap)
+            part, g, weak = measure(desc)
             if capped:
-                return (desc, part, g) if max(g.values()) >= GAP_MIN else None
+                return (desc, part, g) if weak >= GAP_MIN else None
         return None
     e_dom, share = target
     lo_s, hi_s = max(SECOND_SHARE[0], share - 0.05), min(SECOND_SHARE[1], share + 0.05)
@@ -279,7 +286,7 @@ def _plant(name, rng, sea, nominal, target=None):
             f_hi = f
         f = 0.5 * (f_lo + f_hi) if f_lo is not None and f_hi is not None else f + (1.5 if f_hi is None else -1.5)
         d, capped = _scaled(desc, mag, math.exp(f), cap)
-        part, g = measure(d)
+        part, g, _ = measure(d)
     return None
 
 
@@ -287,9 +294,9 @@ def generate(effects, *, seed=0, duration=300.0, rate=50.0, param_set="paper_a",
     """One withheld-effect run, every effect planted at a detectable strength.
 
     Each effect is drawn with its truth law and sized on the drawn sea: alone it must move at least
-    one channel by :data:`GAP_MIN` x the noise floor (rms of with-minus-without the effect over the
-    floor: output noise plus the residual of the nominal model replayed from this run's noisy,
-    filtered heave).  Its magnitude is raised (up to a plausible cap) until it does; if it cannot,
+    one channel by :data:`GAP_MIN` x the noise floor in each half of the run (rms of with-minus-without
+    the effect over the floor: output noise plus the residual of the nominal model replayed from this
+    run's noisy, filtered heave).  Its magnitude is raised (up to a plausible cap) until it does; if it cannot,
     the sea and the effect are redrawn.  A dwell stiction is only planted in a sea where the
     compensator is stuck at least :data:`STICK_MIN` of the time (else it is invisible).  In a two-effect run the second effect is sized so that its own squared gap is a
     share of :data:`SECOND_SHARE` of the first's (the first, dominant one, is ``effects[0]``).
@@ -402,6 +409,7 @@ def run_benchmark(quick=False, duration=None, progress=None, n_jobs=2, max_nfev=
                "truth_parameters": tr.truth["parameters"], "fitted_parameters": v.get("parameters"),
                "planted_gap": tr.truth["gap_to_noise"], "second_share": tr.truth.get("second_share"),
                "second_tried": [s["effect"] for s in d.second_tried_],
+               "best_partner": max(d.second_tried_, key=lambda s: s["added_explained"])["effect"] if d.second_tried_ else None,
                "stuck_share": tr.truth["stick"]["stuck_share"], "sea": tr.truth["sea"]}
         row["correct"] = row["verdict"] == row["truth"]
         rows.append(row)
@@ -427,5 +435,8 @@ def summarize(rows):
             "two_effect_second_named": sum(r["second_effect"] == r["truth_second"] for r in two),
             "n_two_effect": len(two),
             "two_effect_second_tried": sum(r["truth_second"] in r["second_tried"] for r in two),
+            "two_effect_second_best_partner": sum(r["truth_second"] == r["best_partner"] for r in two),
+            "spurious_second": sum(r["second_effect"] is not None for r in rows if not r["truth_second"]),
+            "n_single": sum(not r["truth_second"] for r in rows),
             "min_planted_gap": min((g for r in rows for g in r["planted_gap"].values()), default=None),
             "median_wall_time": float(np.median([r["wall_time"] for r in rows]))}
