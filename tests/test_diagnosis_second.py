@@ -29,6 +29,10 @@ def test_two_effect_run_names_the_second():
     assert v["second_effect"] is not None and v["second_effect"]["effect"] == second
     assert v["second_effect"]["added_explained"] > 0.1
     assert v["second_effect"]["explained_joint"] > v["explained"]
+    # the verdict lists the partners that added most, best first, the named one at the top
+    sc = v["second_candidates"]
+    assert sc[0]["effect"] == second and sc[0]["added_explained"] == v["second_effect"]["added_explained"]
+    assert all(a["added_explained"] >= b["added_explained"] for a, b in zip(sc, sc[1:]))
 
 
 @pytest.mark.parametrize("effect", ["sensor_delay", "flow_loss"])

@@ -530,6 +530,8 @@ class GapDiagnoser:
         if best["explained"] < self.min_explained:
             # two comparable effects: neither explains enough alone; the best with a second one may
             second = self._second(rows) if self.second else None
+            if self.second:
+                v["second_candidates"] = self._second_candidates()
             if second is not None and second["explained_joint"] >= self.min_explained:
                 v.update(second_effect=second, confidence="medium" if second["explained_joint"] >= 0.6 and margin >= 0.03
                          else "low", note=f"{best['effect']} explains {100 * best['explained']:.0f} % alone, "
@@ -548,7 +550,13 @@ class GapDiagnoser:
         # second effect: joint fit of the best with the runners-up
         if self.second and best["explained"] < 0.95:
             v["second_effect"] = self._second(rows)
+            v["second_candidates"] = self._second_candidates()
         self.verdict_ = v
+
+    def _second_candidates(self, n: int = 3) -> list:
+        """The ``n`` joint partners that added most, best first (a user sees the likeliest second
+        effect even when it falls short of the bar for naming it)."""
+        return sorted(self.second_tried_, key=lambda r: -r["added_explained"])[:n]
 
     def _second(self, rows):
         """Joint fit of the best candidate (held at its fitted values) with each of the next

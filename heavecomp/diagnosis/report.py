@@ -154,6 +154,11 @@ def write_report(diag, out_dir, *, title="Sim-to-real gap diagnosis") -> dict:
         se = v["second_effect"]
         lines.append(f"\nSecond effect: `{se['effect']}` adds {100 * se['added_explained']:.0f} % of the held-out "
                      f"gap when fitted jointly with the first.")
+    elif v.get("second_candidates"):
+        sc = v["second_candidates"][0]
+        if sc["added_explained"] > 0.05:
+            lines.append(f"\nPossible second effect: `{sc['effect']}` adds {100 * sc['added_explained']:.0f} % of the "
+                         "held-out gap when fitted jointly with the first — below the 10 % needed to name it.")
     for w in getattr(diag, "warnings_", []):
         lines.append(f"\n> data: {w}")
     lines += ["", "## Gap (nominal replay vs measurement, after the settling window)", "",
