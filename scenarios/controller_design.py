@@ -32,16 +32,10 @@ def build(quick: bool = False) -> dict:
         "u_max": ("N", {"linear-mpc": D.sweep("stribeck", "sine", "linear-mpc", T, "u_max", pick([30e3, 45e3, 60e3, 80e3, 100e3]))}),
         "rate_max": ("N/s", {"linear-mpc": D.sweep("stribeck", "sine", "linear-mpc", T, "rate_max", pick([100e3, 200e3, 300e3, 600e3]))}),
     }
-    robust = {c: {f"{sea}: {name} x{v:g}": D.run_case("stribeck", sea, c, dur[sea], **{name: v})
-                  for sea in seas for name in ("friction_scale", "gas_stiffness_scale")
-                  for v in ((0.7, 1.3) if not quick else (1.3,))}
-              for c in lin}
+    robust = D.robustness(seas, lin, dur, (1.3,) if quick else (0.7, 1.3))
     # the prediction model's frame, and what a perfect heave preview would give (the irregular sea)
     fsea = "jonswap" if "jonswap" in seas else seas[0]
-    frames = {c: {**{f"model_frame = {fr}": D.run_case("stribeck", fsea, c, dur[fsea], model_frame=fr)
-                     for fr in ("stroke", "earth")},
-                  "model_frame = earth, perfect preview": D.run_case("stribeck", fsea, c, dur[fsea], preview="perfect")}
-              for c in lin}
+    frames = D.frame_study(fsea, lin, dur[fsea])
     return {"table": table, "kept": kept, "sweeps": sw, "robust": robust, "frames": frames, "frame_sea": fsea,
             "durations": dur}
 
@@ -75,7 +69,7 @@ def main(argv=None) -> int:
     sw_rows = [(label, c, row["value"], row["wob_std"] / 1e3, row["solve_time_ms_p99"])
                for label, (unit, rows) in r["sweeps"].items() for c, rr in rows.items() for row in rr]
     pas = {sea: table[sea]["stribeck"]["passive"]["wob_std"] for sea in table}
-    rb_rows = [(c, k, m["wob_std"] / 1e3, 100 * m["wob_std"] / pas[k.split(":")[0]])
+    rb_rows = [(c, k, m["wob_std"] / 1e3, 100 * m["wob_std"] / pas[D.label_sea(k)])
                for c, d in r["robust"].items() for k, m in d.items()]
     fsea = r["frame_sea"]
     fr_rows = [(c, k, m["wob_std"] / 1e3, 100 * m["wob_std"] / pas[fsea],

@@ -58,10 +58,9 @@ def _run_closed_loop(args, params, Progress) -> int:
     """Active heave compensation: controller in the loop (heavecomp.simulate.closed_loop)."""
     from pathlib import Path
 
+    from heavecomp.controllers.base import parse_options
     from heavecomp.params.cmc import active
     from heavecomp.simulate.closed_loop import output_every, simulate_closed_loop, write_closed_loop_outputs
-
-    from heavecomp.controllers.base import parse_options
 
     output_every(args.rate, active(params).control_rate)  # bad --rate fails before the run
     options = parse_options(args.controller_option)

@@ -17,7 +17,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from heavecomp.controllers.model import FRAMES
 from heavecomp.errors import InputError, did_you_mean
+
+#: ControllerConfig fields that take one of a few names
+CHOICES = {"nlp_solver": ("sqp", "ipopt"), "model_frame": FRAMES}
 
 
 @dataclass(frozen=True)
@@ -142,10 +146,9 @@ class ControllerConfig:
             if k not in names:
                 raise InputError(f"controller option {k!r}: unknown{did_you_mean(k, names)}")
         kw.update(overrides)
-        if kw.get("nlp_solver", "sqp") not in ("sqp", "ipopt"):
-            raise InputError(f"controller option nlp_solver = {kw['nlp_solver']!r}: not one of sqp, ipopt")
-        if kw.get("model_frame", "earth") not in ("earth", "stroke"):
-            raise InputError(f"controller option model_frame = {kw['model_frame']!r}: not one of earth, stroke")
+        for k, allowed in CHOICES.items():
+            if k in kw and kw[k] not in allowed:
+                raise InputError(f"controller option {k} = {kw[k]!r}: not one of {', '.join(allowed)}")
         return cls(**kw)
 
 

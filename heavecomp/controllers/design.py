@@ -78,6 +78,37 @@ def sweep(regime, sea, controller, duration, name, values, **fixed):
     return rows
 
 
+def robust_label(sea: str, name: str, value: float) -> str:
+    """Key of one robustness run, e.g. ``"jonswap: friction_scale x0.7"``."""
+    return f"{sea}: {name} x{value:g}"
+
+
+def label_sea(label: str) -> str:
+    """The sea of a :func:`robust_label`."""
+    return label.split(": ", 1)[0]
+
+
+def robustness(seas, controllers, durations: dict, values=(0.7, 1.3)) -> dict:
+    """Full static friction with the controller's friction forces and gas stiffness scaled:
+    ``{controller: {robust_label: metrics}}``."""
+    return {c: {robust_label(sea, name, v): run_case("stribeck", sea, c, durations[sea], **{name: v})
+                for sea in seas for name in ("friction_scale", "gas_stiffness_scale") for v in values}
+            for c in controllers}
+
+
+#: the frame study's runs: label -> run_case options
+FRAME_RUNS = {"model_frame = stroke": {"model_frame": "stroke"},
+              "model_frame = earth": {"model_frame": "earth"},
+              "model_frame = earth, perfect preview": {"preview": "perfect"}}
+
+
+def frame_study(sea: str, controllers, duration: float) -> dict:
+    """Full static friction with the MPC model in the stroke and the earth frame, and with a
+    perfect heave preview: ``{controller: {label: metrics}}`` (labels: :data:`FRAME_RUNS`)."""
+    return {c: {label: run_case("stribeck", sea, c, duration, **opts) for label, opts in FRAME_RUNS.items()}
+            for c in controllers}
+
+
 # ------------------------------------------------------------------ figures
 def findings(table: dict, sweeps: dict, robust: dict, frames: dict | None = None, frame_sea: str = "jonswap") -> list[str]:
     """Plain-language findings computed from the metrics (no numbers typed in)."""
@@ -101,7 +132,7 @@ def findings(table: dict, sweeps: dict, robust: dict, frames: dict | None = None
     for sea in table:
         pas = table[sea]["stribeck"]["passive"]["wob_std"]
         rows = [(c, k.split(": ", 1)[-1], m["wob_std"]) for c, d in robust.items() for k, m in d.items()
-                if k.split(":")[0] == sea]
+                if label_sea(k) == sea]
         if rows:
             worst = max(rows, key=lambda x: x[2])
             out.append(f"- Robustness ({sea}, full static friction): the worst model error tried is {worst[1]} for "
@@ -109,8 +140,7 @@ def findings(table: dict, sweeps: dict, robust: dict, frames: dict | None = None
                        f"({'within' if worst[2] <= 0.2 * pas else 'outside'} the 20 % goal).")
     for c, d in (frames or {}).items():
         pas = table[frame_sea]["stribeck"]["passive"]["wob_std"]
-        st, ea = d.get("model_frame = stroke"), d.get("model_frame = earth")
-        pf = d.get("model_frame = earth, perfect preview")
+        st, ea, pf = (d.get(label) for label in FRAME_RUNS)
         if st and ea:
             out.append(f"- Prediction-model frame ({frame_sea}, full static friction, {c}): stroke frame "
                        f"{100 * st['wob_std'] / pas:.0f} % of passive, earth frame {100 * ea['wob_std'] / pas:.0f} %"

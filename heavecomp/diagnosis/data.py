@@ -174,6 +174,19 @@ def _runs(mask):
     return list(zip(np.flatnonzero(dm == 1), np.flatnonzero(dm == -1)))
 
 
+def _check_mean(run, src, column, unit, symbol, nominal, band, other_units, hint):
+    """One-line DataError when a column's mean looks like another unit (within 50 % of the
+    nominal value converted to it) or lies outside ``band`` x the nominal value."""
+    m = float(np.nanmean(run[column]))
+    for factor, other in other_units:
+        if abs(m / (nominal * factor) - 1.0) < 0.5:
+            raise DataError(f"{src}: column '{column}': mean {m:.4g} looks like {other}, expected {unit} "
+                            f"(nominal {symbol} = {nominal:.4g} {unit}); convert the column to {unit}")
+    if not (band[0] * nominal < m < band[1] * nominal):
+        raise DataError(f"{src}: column '{column}': mean {m:.4g} {unit} is far from the nominal {symbol} = "
+                        f"{nominal:.4g} {unit} ({hint})")
+
+
 def check_units(run: MeasuredRun, params) -> None:
     """Compare channel magnitudes with the nominal operating point; DataError naming the likely unit.
 
@@ -183,22 +196,12 @@ def check_units(run: MeasuredRun, params) -> None:
     src = run.source
     p0 = params.p0
     W0 = params.operating_point.wob_setpoint
-    pm = float(np.nanmean(run["pressure"]))
-    for factor, unit in ((1e-5, "bar"), (1e-3, "kPa"), (1e-6, "MPa"), (1.45038e-4, "psi")):
-        if abs(pm / (p0 * factor) - 1.0) < 0.5:
-            raise DataError(f"{src}: column 'pressure': mean {pm:.4g} looks like {unit}, expected Pa "
-                            f"(nominal p_0 = {p0:.4g} Pa); convert the column to Pa")
-    if not (0.2 * p0 < pm < 5 * p0):
-        raise DataError(f"{src}: column 'pressure': mean {pm:.4g} Pa is far from the nominal p_0 = {p0:.4g} Pa "
-                        "(wrong unit, absolute pressure of another rig, or wrong parameter file?)")
-    wm = float(np.nanmean(run["wob"]))
-    for factor, unit in ((1e-3, "kN"), (1.0 / 9810.0, "tonnes"), (1.0 / 4448.22, "kip")):
-        if abs(wm / (W0 * factor) - 1.0) < 0.5:
-            raise DataError(f"{src}: column 'wob': mean {wm:.4g} looks like {unit}, expected N "
-                            f"(nominal W_0 = {W0:.4g} N); convert the column to N")
-    if not (0.05 * W0 < wm < 20 * W0):
-        raise DataError(f"{src}: column 'wob': mean {wm:.4g} N is far from the nominal W_0 = {W0:.4g} N "
-                        "(wrong unit or wrong parameter file?)")
+    _check_mean(run, src, "pressure", "Pa", "p_0", p0, (0.2, 5.0),
+                ((1e-5, "bar"), (1e-3, "kPa"), (1e-6, "MPa"), (1.45038e-4, "psi")),
+                "wrong unit, absolute pressure of another rig, or wrong parameter file?")
+    _check_mean(run, src, "wob", "N", "W_0", W0, (0.05, 20.0),
+                ((1e-3, "kN"), (1.0 / 9810.0, "tonnes"), (1.0 / 4448.22, "kip")),
+                "wrong unit or wrong parameter file?")
     sz = float(np.nanstd(run["heave"]))
     ss = float(np.nanstd(run["stroke"]))
     if sz > 0 and ss > 100 * sz and ss > 1.0:

@@ -97,7 +97,7 @@ class GapDiagnoser:
         Candidates fitted concurrently (threads; the stepper releases the GIL).
     progress : callable(fraction, message), optional
     second : int
-        How many runner-up candidates to try jointly with the best (0: none; default all).
+        How many runner-up candidates to try jointly with the best (0: none; None, the default: all).
     segment : float [s] or None
         Multiple-shooting segment length: the replay restarts from the measured state every
         ``segment`` seconds, so one early stick-slip event does not decide the rest of the run
@@ -128,7 +128,7 @@ class GapDiagnoser:
     """
 
     def __init__(self, nominal, candidates=None, *, split=0.67, settle=None, penalty=0.03, min_explained=0.5,
-                 none_ratio=1.2, max_nfev=40, decimate=2, n_jobs=2, progress=None, second=7, segment=None,
+                 none_ratio=1.2, max_nfev=40, decimate=2, n_jobs=2, progress=None, second=None, segment=None,
                  reinit=1.5, stuck_speed=2e-3, grid=7, input_draws=8, none_tail=2.0, none_explained=0.25):
         self.nominal = nominal
         names = list(CANDIDATES) if candidates is None else list(candidates)
@@ -146,7 +146,7 @@ class GapDiagnoser:
         self.decimate = max(1, int(decimate))
         self.n_jobs = max(1, int(n_jobs))
         self.progress = progress
-        self.second = second
+        self.second = len(names) - 1 if second is None else max(0, int(second))
         self.segment = segment
         self.reinit = reinit
         self.stuck_speed = stuck_speed
@@ -529,8 +529,9 @@ class GapDiagnoser:
             return
         if best["explained"] < self.min_explained:
             # two comparable effects: neither explains enough alone; the best with a second one may
-            second = self._second(rows) if self.second else None
+            second = None
             if self.second:
+                second = self._second(rows)
                 v["second_candidates"] = self._second_candidates()
             if second is not None and second["explained_joint"] >= self.min_explained:
                 v.update(second_effect=second, confidence="medium" if second["explained_joint"] >= 0.6 and margin >= 0.03
