@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import sys
 
-from heavecomp.controllers import design as D
+from heavecomp.closed_loop import design as D
 from heavecomp.report.figures import save
 from heavecomp.report.scenario import md_table, parse_args, write_metrics, write_report
 

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from heavecomp.params import dumps, paper_a
-from heavecomp.simulate.closed_loop import simulate_closed_loop
+from heavecomp.closed_loop.loop import simulate_closed_loop
 
 
 def _u_rate(res):

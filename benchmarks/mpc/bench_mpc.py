@@ -28,7 +28,7 @@ HERE = Path(__file__).resolve().parent
 
 def in_loop(duration):
     from heavecomp.params import paper_a
-    from heavecomp.simulate.closed_loop import simulate_closed_loop
+    from heavecomp.closed_loop.loop import simulate_closed_loop
 
     out = {}
     for c, opts in (("linear-mpc", {}), ("nonlinear-mpc", {}), ("nonlinear-mpc-ipopt", {"nlp_solver": "ipopt"})):
@@ -42,7 +42,7 @@ def states_from_run(duration=60.0, every=5):
     """Realistic initial states: the observer's estimates along a closed-loop run."""
     from heavecomp.controllers import make
     from heavecomp.params import paper_a
-    from heavecomp.simulate.closed_loop import simulate_closed_loop
+    from heavecomp.closed_loop.loop import simulate_closed_loop
 
     # stroke-frame model for the solver comparison: its states are small deviations, the
     # regulation QP from them is the well-conditioned one the peer (SLSQP) converged on; in
@@ -108,7 +108,7 @@ def nonlinear_vs_fresh_opti(n_peer):
     from heavecomp.params import paper_a
     from heavecomp.controllers.nonlinear_mpc import rk4_steps
     from heavecomp.plants.symbolic import casadi
-    from heavecomp.simulate.closed_loop import simulate_closed_loop
+    from heavecomp.closed_loop.loop import simulate_closed_loop
 
     ca = casadi()
     p = paper_a("stribeck")

@@ -41,7 +41,7 @@ def case_params(regime: str, sea: str, active: dict | None = None):
 
 def run_case(regime: str, sea: str, controller: str, duration: float, *, active=None, keep=False, **options):
     """One closed-loop run; returns its metrics (and the result when ``keep``)."""
-    from heavecomp.simulate.closed_loop import simulate_closed_loop
+    from heavecomp.closed_loop.loop import simulate_closed_loop
 
     p = case_params(regime, sea, active)
     res = simulate_closed_loop(p, controller, duration, **({} if controller == "passive" else options))

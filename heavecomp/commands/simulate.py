@@ -55,12 +55,12 @@ def run(args) -> int:
 
 
 def _run_closed_loop(args, params, Progress) -> int:
-    """Active heave compensation: controller in the loop (heavecomp.simulate.closed_loop)."""
+    """Active heave compensation: controller in the loop (heavecomp.closed_loop.loop)."""
     from pathlib import Path
 
     from heavecomp.controllers.base import parse_options
     from heavecomp.params.cmc import active
-    from heavecomp.simulate.closed_loop import output_every, simulate_closed_loop, write_closed_loop_outputs
+    from heavecomp.closed_loop.loop import output_every, simulate_closed_loop, write_closed_loop_outputs
 
     output_every(args.rate, active(params).control_rate)  # bad --rate fails before the run
     options = parse_options(args.controller_option)
