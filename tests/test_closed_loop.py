@@ -16,6 +16,28 @@ def _u_rate(res):
     return np.abs(np.diff(u)) / np.diff(res.t)
 
 
+class Recorder:
+    """Wraps a controller and keeps what it commanded (before the loop's actuator clips it)
+    and the force the actuator had at each step."""
+
+    def __init__(self, ctrl):
+        self.ctrl, self.name, self.config = ctrl, ctrl.name, ctrl.config
+        self.commands, self.applied = [], []
+
+    def reset(self):
+        self.ctrl.reset()
+        self.commands, self.applied = [], []
+
+    def step(self, t, meas, preview=None):
+        u = self.ctrl.step(t, meas, preview)
+        self.commands.append(u)
+        self.applied.append(meas.u_active)
+        return u
+
+    def __getattr__(self, name):  # stats, solve_times, last_preview of the wrapped controller
+        return getattr(self.ctrl, name)
+
+
 def test_passive_closed_loop_reproduces_the_open_loop_simulator():
     """Stepping the kernel one RK4 step at a time (u = 0) is the open-loop run."""
     from heavecomp.simulate import simulate
@@ -29,13 +51,23 @@ def test_passive_closed_loop_reproduces_the_open_loop_simulator():
 
 
 def test_linear_mpc_respects_tight_limits_and_reports_saturation():
+    """The MPC's own commands (not the clipped actuator force) stay within the limits."""
+    from heavecomp.controllers import make
+
     p = paper_a("stribeck").replace(active={"u_max": 25e3, "rate_max": 100e3})
-    res = simulate_closed_loop(p, "linear-mpc", 60.0)
+    rec = Recorder(make("linear-mpc", p))
+    res = simulate_closed_loop(p, rec, 60.0)
     m = res.metrics()
+    cmd, applied = np.array(rec.commands), np.array(rec.applied)
+    tol = 1e-3  # osqp meets its constraints to ~2.6 N here
+    assert np.max(np.abs(cmd)) <= 25e3 * (1 + tol)
+    assert np.max(np.abs(np.clip(cmd, -25e3, 25e3) - applied)) <= 100e3 / 20.0 * (1 + tol)
+    assert np.sum(np.abs(cmd) >= 25e3 * (1 - 1e-6)) > 0  # the limit is active: this checks something
+    assert m["violations_u_max"] == 0 and m["violations_rate"] == 0
+    assert m["u_command_max"] == pytest.approx(np.max(np.abs(cmd)))
     u = res["u_active"]
     assert np.max(np.abs(u)) <= 25e3 * (1 + 1e-9)
     assert np.max(_u_rate(res)) <= 100e3 * (1 + 1e-6)
-    assert m["violations_u_max"] == 0 and m["violations_rate"] == 0
     assert m["saturated_steps"] > 0 and m["u_active_max"] == pytest.approx(25e3)
     # even a small actuator removes part of the friction/gas-spring WOB variation
     passive = simulate_closed_loop(p, "passive", 60.0).metrics()["wob_std"]
@@ -53,6 +85,25 @@ def test_with_a_perfect_model_mpc_beats_pid_and_reaches_the_goal():
     assert mpc["wob_std"] < 0.5 * pid["wob_std"]
     assert mpc["wob_std"] <= 0.2 * passive["wob_std"]  # the issue's goal
     assert mpc["violations_u_max"] == 0 and mpc["violations_rate"] == 0
+
+
+class Greedy:
+    """A plain object (no base class, no reset): 2 u_max up for 5 s, then 0."""
+
+    def step(self, t, meas, preview=None):
+        return 120e3 if t < 5.0 - 1e-9 else 0.0
+
+
+def test_commands_beyond_the_limits_are_counted_and_the_actuator_applies_the_limits():
+    """Counted before the clip: 100 steps at 2 u_max; rate: from 0 the gaps to 60 kN are 60, 45, 30 kN
+    (> 15 kN per 50 ms) at t = 0, 0.05, 0.1 s and the same back down from 60 kN at t = 5, 5.05, 5.1 s."""
+    p = paper_a("stribeck")  # u_max 60 kN, 300 kN/s, 20 Hz
+    res = simulate_closed_loop(p, Greedy(), 10.0)
+    m = res.metrics(start=0.0)
+    assert m["violations_u_max"] == 100 and m["violations_rate"] == 6
+    assert m["u_command_max"] == 120e3 and m["controller"] == "Greedy"
+    u = res["u_active"]
+    assert np.max(np.abs(u)) == pytest.approx(60e3) and np.max(_u_rate(res)) <= 300e3 * (1 + 1e-9)
 
 
 def test_osqp_failure_falls_back_and_is_counted():
@@ -197,3 +248,61 @@ def test_cli_controller_options_reach_the_controller(tmp_path):
     assert r.returncode == 0, r.stderr
     m = json.loads((tmp_path / "o" / "metrics.json").read_text())
     assert m["config"]["horizon"] == 12 and m["config"]["friction_feedforward"] is False
+
+
+def test_the_own_controller_example_in_docs_control_md_runs_and_helps():
+    """docs/control.md's user controller (a plain class, no base class) in the closed loop."""
+    from pathlib import Path
+
+    text = (Path(__file__).resolve().parents[1] / "docs" / "control.md").read_text()
+    code = text.split("## Your own controller", 1)[1].split("```python\n", 1)[1].split("```", 1)[0]
+    ns = {}
+    exec(compile(code, "docs/control.md", "exec"), ns)
+    mine, passive = ns["mine"], ns["passive"]
+    assert mine["controller"] == "WobFeedback"
+    assert mine["wob_std"] < 0.7 * passive["wob_std"]
+    assert mine["violations_u_max"] == 0 and mine["violations_rate"] == 0
+
+
+@pytest.mark.parametrize("thing, msg", [
+    (object(), "controller 'object': neither a name (passive, pid, linear-mpc, nonlinear-mpc) nor an object "
+               "with a step(t, measurement, preview=None) method"),
+    (42, "controller 'int': neither a name"),
+])
+def test_an_object_without_step_is_refused_with_one_line(thing, msg):
+    from heavecomp.errors import InputError
+
+    with pytest.raises(InputError) as err:
+        simulate_closed_loop(paper_a(), thing, 1.0)
+    assert str(err.value).startswith(msg) and "\n" not in str(err.value)
+
+
+def test_options_with_an_own_controller_are_refused():
+    from heavecomp.errors import InputError
+
+    with pytest.raises(InputError, match="controller options horizon: only for a named controller"):
+        simulate_closed_loop(paper_a(), Greedy(), 1.0, horizon=5)
+
+
+def _cli(tmp_path, *extra):
+    f = tmp_path / "p.toml"
+    f.write_text(dumps(paper_a()))
+    return subprocess.run([sys.executable, "-m", "heavecomp.cli", "simulate", str(f), "--duration", "10",
+                           "--out", str(tmp_path / "o"), *extra], capture_output=True, text=True)
+
+
+def test_cli_no_noise_and_perfect_preview_reach_the_loop(tmp_path):
+    r = _cli(tmp_path, "--controller", "linear-mpc", "--no-noise", "--perfect-preview")
+    assert r.returncode == 0, r.stderr
+    m = json.loads((tmp_path / "o" / "metrics.json").read_text())
+    assert m["noise"] is None and m["preview"] == "perfect"
+    r = _cli(tmp_path, "--controller", "linear-mpc")
+    m = json.loads((tmp_path / "o" / "metrics.json").read_text())
+    assert m["noise"]["wob"] == 500.0 and m["preview"] == "predicted"
+
+
+@pytest.mark.parametrize("flag", ["--no-noise", "--perfect-preview"])
+def test_cli_closed_loop_switches_need_a_controller(tmp_path, flag):
+    r = _cli(tmp_path, flag)
+    assert r.returncode == 2
+    assert r.stderr.strip() == f"heavecomp simulate: error: {flag} needs --controller pid|linear-mpc|nonlinear-mpc"

@@ -20,6 +20,12 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--controller-option", action="append", default=[], metavar="KEY=VALUE",
                    help="controller setting (repeatable), e.g. horizon=30, q_wob=1e-6, model_frame=stroke, "
                         "nlp_solver=ipopt; names: heavecomp.controllers.ControllerConfig (docs/control.md)")
+    p.add_argument("--no-noise", action="store_true",
+                   help="closed loop: exact measurements (default: Gaussian sensor noise, stroke 1 mm, "
+                        "pressure 5 kPa, WOB 0.5 kN, heave 5 mm)")
+    p.add_argument("--perfect-preview", action="store_true",
+                   help="closed loop: give the controller the true future heave over its horizon "
+                        "(default: predicted online from the measured heave)")
 
 
 def run(args) -> int:
@@ -35,10 +41,12 @@ def run(args) -> int:
         params = params.replace(friction={"model": args.friction})
     if args.controller != "passive":
         return _run_closed_loop(args, params, Progress)
-    if args.controller_option:
-        from heavecomp.errors import InputError
+    for flag, given in (("--controller-option", args.controller_option), ("--no-noise", args.no_noise),
+                        ("--perfect-preview", args.perfect_preview)):
+        if given:
+            from heavecomp.errors import InputError
 
-        raise InputError("--controller-option needs --controller pid|linear-mpc|nonlinear-mpc")
+            raise InputError(f"{flag} needs --controller pid|linear-mpc|nonlinear-mpc")
     bar = Progress(f"simulate {args.duration:g} s")
     figure = BackgroundFigure()  # imports matplotlib in parallel with the simulation
     try:
@@ -60,12 +68,14 @@ def _run_closed_loop(args, params, Progress) -> int:
 
     from heavecomp.controllers.base import parse_options
     from heavecomp.params.cmc import active
-    from heavecomp.closed_loop.loop import output_every, simulate_closed_loop, write_closed_loop_outputs
+    from heavecomp.closed_loop.loop import Noise, output_every, simulate_closed_loop, write_closed_loop_outputs
 
     output_every(args.rate, active(params).control_rate)  # bad --rate fails before the run
     options = parse_options(args.controller_option)
     bar = Progress(f"simulate {args.duration:g} s, {args.controller}")
-    res = simulate_closed_loop(params, args.controller, args.duration, dt=args.dt, progress=bar, **options)
+    res = simulate_closed_loop(params, args.controller, args.duration, dt=args.dt, progress=bar,
+                               noise=None if args.no_noise else Noise(),
+                               preview="perfect" if args.perfect_preview else "predicted", **options)
     m = write_closed_loop_outputs(res, args.out, title=f"WOB — {Path(args.params).name}, friction: "
                                   f"{params.friction.model}, controller: {args.controller}", rate=args.rate)
     print(f"WOB std {m['wob_std'] / 1e3:.2f} kN, peak-to-peak {m['wob_p2p'] / 1e3:.2f} kN, "

@@ -3,9 +3,15 @@
 Contract (``shared/style/architecture.md``): a controller is built from the
 plant parameters and a frozen config, ``reset()`` clears its memory and
 ``step(t, measurement, preview=None) -> u`` returns the commanded active force
-[N] (positive up on the top mass), already within ``|u| <= u_max`` and
-``|u - u_prev| <= rate_max / control_rate``.  ``stats`` counts solver failures
-and fallbacks; ``solve_times`` holds the wall time of each ``step`` [s].
+[N] (positive up on the top mass).  A controller should command within
+``|u| <= u_max`` and ``|u - u_prev| <= rate_max / control_rate``; the base class
+does not clip its command: the actuator in the closed loop applies the limits,
+once, and counts the commands that break them (``violations_*``).  ``stats``
+counts solver failures and fallbacks; ``solve_times`` holds the wall time of
+each ``step`` [s].
+
+The contract is duck-typed: :class:`Controller` is a convenience, not a
+requirement (:mod:`heavecomp.controllers.registry`, ``docs/control.md``).
 """
 
 from __future__ import annotations
@@ -19,6 +25,7 @@ import numpy as np
 
 from heavecomp.controllers.model import FRAMES
 from heavecomp.errors import InputError, did_you_mean
+from heavecomp.params.cmc import active
 
 #: ControllerConfig fields that take one of a few names
 CHOICES = {"nlp_solver": ("sqp", "ipopt"), "model_frame": FRAMES}
@@ -137,8 +144,6 @@ class ControllerConfig:
     @classmethod
     def from_params(cls, params, **overrides) -> "ControllerConfig":
         """Limits and rate from ``params``' ``[active]`` table (or its defaults)."""
-        from heavecomp.params.cmc import active
-
         a = active(params)
         kw = dict(u_max=a.u_max, rate_max=a.rate_max, control_rate=a.control_rate)
         names = {f.name for f in dataclasses.fields(cls)}
@@ -208,7 +213,12 @@ class Controller:
         self.solve_times: list[float] = []
 
     def step(self, t: float, measurement: Measurement, preview=None) -> float:
-        """Commanded active force [N] for the next control interval."""
+        """Commanded active force [N] for the next control interval, as ``_step`` decided it.
+
+        The command is not clipped here (the loop's actuator applies the limits);
+        ``u_prev`` records the force the actuator will reach, ``limit(u, u_prev)``,
+        which the MPCs' rate constraint starts from.
+        """
         t0 = time.perf_counter()
         u = self._step(t, measurement, preview)
         if not math.isfinite(u):
@@ -219,7 +229,7 @@ class Controller:
             self.stats["saturated_steps"] += 1
         self.u_prev = u_lim
         self.solve_times.append(time.perf_counter() - t0)
-        return u_lim
+        return float(u)
 
     def _step(self, t, m, preview):  # pragma: no cover - abstract
         raise NotImplementedError
@@ -267,41 +277,3 @@ class PIDController(Controller):
         if u_lim == u or np.sign(e) != np.sign(u - u_lim):
             self.integral = integral  # conditional integration (anti-windup)
         return u_lim
-
-
-def _linear_mpc(params, config):
-    from heavecomp.controllers.linear_mpc import LinearMPC
-
-    return LinearMPC(params, config)
-
-
-def _nonlinear_mpc(params, config):
-    from heavecomp.controllers.nonlinear_mpc import NonlinearMPC
-
-    return NonlinearMPC(params, config)
-
-
-#: name -> factory(params, config)
-CONTROLLERS = {
-    "passive": PassiveController,
-    "pid": PIDController,
-    "linear-mpc": _linear_mpc,
-    "nonlinear-mpc": _nonlinear_mpc,
-}
-
-
-def make(name: str, params, config: ControllerConfig | None = None, **options) -> Controller:
-    """Build a controller by name (:data:`CONTROLLERS`) or return a given instance.
-
-    ``options`` override :class:`ControllerConfig` fields (limits default to
-    ``params``' ``[active]`` table).
-    """
-    if isinstance(name, Controller):
-        return name
-    if name not in CONTROLLERS:
-        raise InputError(f"--controller {name!r}: not one of {', '.join(CONTROLLERS)}{did_you_mean(name, CONTROLLERS)}")
-    if config is None:
-        config = ControllerConfig.from_params(params, **options)
-    elif options:
-        config = dataclasses.replace(config, **options)
-    return CONTROLLERS[name](params, config)

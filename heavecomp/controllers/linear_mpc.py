@@ -29,7 +29,7 @@ import logging
 
 import numpy as np
 
-from heavecomp.controllers.base import Controller
+from heavecomp.controllers.base import Controller, ControllerConfig
 from heavecomp.controllers.estimation import DisturbanceObserver, HeavePredictor
 from heavecomp.controllers.model import controller_params, discrete_model
 
@@ -55,8 +55,6 @@ class LinearMPC(Controller):
     def __init__(self, params, config=None):
         import osqp
         import scipy.sparse as sp
-
-        from heavecomp.controllers.base import ControllerConfig
 
         config = config or ControllerConfig.from_params(params)
         self.params, self.config = params, config
