@@ -15,6 +15,9 @@ import argparse
 import importlib
 import sys
 
+from heavecomp import __version__
+from heavecomp.errors import InputError
+
 #: name -> (module, one-line help).  Order is the order shown by --help.
 COMMANDS: dict[str, tuple[str, str]] = {
     "simulate": ("heavecomp.commands.simulate", "simulate the CMC for a parameter file (exact stick-slip; --controller for active compensation)"),
@@ -27,18 +30,22 @@ COMMANDS: dict[str, tuple[str, str]] = {
 }
 
 
-def build_parser() -> tuple[argparse.ArgumentParser, dict]:
+def build_parser(only: str | None = None) -> tuple[argparse.ArgumentParser, dict]:
+    """The parser; with ``only`` the arguments of that command alone (the others' modules,
+    which import the library, are not loaded: ``heavecomp --help`` stays fast)."""
     parser = argparse.ArgumentParser(
         prog="heavecomp",
         description="heavecomp: heave compensation of offshore drilling rigs "
         "(CMC plant, linear analysis, MPC, sim-to-real gap diagnosis).",
     )
-    from heavecomp import __version__
 
     parser.add_argument("--version", action="version", version=f"heavecomp {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     modules = {}
     for name, (modname, helptext) in COMMANDS.items():
+        if only is not None and name != only:
+            sub.add_parser(name, help=helptext, description=helptext)
+            continue
         mod = importlib.import_module(modname)
         p = sub.add_parser(name, help=helptext, description=(mod.__doc__ or helptext).strip().splitlines()[0])
         mod.add_arguments(p)
@@ -47,9 +54,8 @@ def build_parser() -> tuple[argparse.ArgumentParser, dict]:
 
 
 def main(argv: list[str] | None = None) -> int:
-    from heavecomp.errors import InputError
-
-    parser, modules = build_parser()
+    words = sys.argv[1:] if argv is None else argv
+    parser, modules = build_parser(next((w for w in words if not w.startswith("-")), ""))
     args = parser.parse_args(argv)
     if not args.command:
         parser.print_help()

@@ -37,6 +37,12 @@ import math
 
 import numpy as np
 
+from heavecomp.analysis.frequency import freqresp_batch
+from heavecomp.analysis.linear import batch_matrices_from_params
+from heavecomp.friction.laws import FrictionLaw
+from heavecomp.plants.cmc import A as A_IDX, gas_pressure, plant_vector, V0 as V0_IDX
+from heavecomp.simulate import simulate
+
 log = logging.getLogger(__name__)
 
 
@@ -61,8 +67,6 @@ def equivalent_gains(law, stroke_amplitude, omega, PP, *, n: int = 2048):
     k_eq : ndarray [N/m]
         Equivalent stiffness (friction in phase with the stroke).
     """
-    from heavecomp.plants.cmc import gas_pressure
-
     S = np.asarray(stroke_amplitude, dtype=float)
     th = (np.arange(n) + 0.5) * (2 * np.pi / n)
     s = S[..., None] * np.sin(th)
@@ -102,9 +106,6 @@ class DFResult:
 
 
 def _channels(params, omega):
-    from heavecomp.analysis.frequency import freqresp_batch
-    from heavecomp.analysis.linear import batch_matrices_from_params
-
     A, B, C, D = batch_matrices_from_params(params)  # frictionless, u_active = -F_f
     H = freqresp_batch(A, B, C, D, np.atleast_1d(omega))[..., 0]
     return H[1, 0], H[1, 1], H[0, 0], H[0, 1]  # G_sz, G_su, G_wz, G_wu
@@ -124,9 +125,6 @@ def describing_response(params, heave_amplitude: float, omega: float, *, n: int 
     -------
     DFResult
     """
-    from heavecomp.friction.laws import FrictionLaw
-    from heavecomp.plants.cmc import A as A_IDX, V0 as V0_IDX, plant_vector
-
     a, w = float(heave_amplitude), float(omega)
     if not (a > 0 and w > 0 and math.isfinite(a) and math.isfinite(w)):
         raise ValueError("heave_amplitude and omega must be positive")
@@ -190,8 +188,6 @@ def simulated_response(params, heave_amplitude: float, period: float, *, settle_
         ``wob_amplitude`` [N], ``wob_phase_deg`` [deg] (relative to the heave),
         ``stroke_amplitude`` [m], ``stick_fraction`` [-], ``wob_p2p`` [N].
     """
-    from heavecomp.simulate import simulate
-
     ramp = 2.0 * period
     p = params.replace(heave={"kind": "sine", "amplitude": heave_amplitude, "period": period, "ramp": ramp})
     start = ramp + settle_periods * period
@@ -218,9 +214,6 @@ def compare_with_simulation(params, amplitudes, periods, **sim_kw) -> list[dict]
         linear model) [N], ``stroke_df``, ``stroke_sim`` [m], ``stick_fraction``
         and ``df_stuck``.
     """
-    from heavecomp.analysis.linear import batch_matrices_from_params
-    from heavecomp.analysis.frequency import freqresp_batch
-
     A, B, C, D = batch_matrices_from_params(params)
     rows = []
     for T in periods:

@@ -41,6 +41,9 @@ import math
 import numpy as np
 
 from heavecomp.errors import ParameterError
+from heavecomp.friction.laws import FrictionLaw
+from heavecomp.plants.cmc import casadi_model
+from heavecomp.plants.symbolic import casadi
 
 log = logging.getLogger(__name__)
 
@@ -165,9 +168,6 @@ def _friction_params(params, friction: str):
 
 def _eval_model(params, x, u, eps):
     """Values and jacobians of the casadi model at (x, u)."""
-    from heavecomp.plants.cmc import casadi_model
-    from heavecomp.plants.symbolic import casadi
-
     ca = casadi()
     f = casadi_model(params, eps=eps)
     X = ca.SX.sym("X", 4)
@@ -179,8 +179,6 @@ def _eval_model(params, x, u, eps):
 
 
 def _default_eps(params, velocity):
-    from heavecomp.friction.laws import FrictionLaw
-
     law = FrictionLaw.from_params(params.friction)
     if not law.has_stiction:
         return None

@@ -8,11 +8,10 @@ from __future__ import annotations
 
 import numpy as np
 
-
-def _plt():
-    from heavecomp.report.figures import _plt as p
-
-    return p()
+from heavecomp.analysis import pneumatic_linear as PL
+from heavecomp.analysis.stickslip import critical_D
+from heavecomp.plants.test_rig import QUADRANTS
+from heavecomp.report.figures import _plt
 
 
 def plot_exp2(r, p, lin=None):
@@ -86,9 +85,6 @@ def plot_critical_map(g, zc, Dc, default_point=None):
 
 def plot_min_velocity(p, zc, Dc, mv):
     """Critical curve mapped to equilibrium velocity for the default cylinder (paper B Fig. 5)."""
-    from heavecomp.analysis import pneumatic_linear as PL
-    from heavecomp.analysis.stickslip import critical_D
-
     plt = _plt()
     S = np.geomspace(0.02e-6, 1.0e-6, 40)
     u0, margin = [], []
@@ -164,8 +160,6 @@ def plot_cmc_map(m, breakout):
 
 def plot_rig(r_norot, r_rot, p):
     """Paper A Figs. 7 and 8: friction-velocity loops without and with rotation (eq. 12 readings)."""
-    from heavecomp.plants.test_rig import QUADRANTS
-
     plt = _plt()
     fig, axs = plt.subplots(1, 2, figsize=(12, 4.8), sharey=True)
     for ax, r, ttl in ((axs[0], r_norot, "without rotation (Fig. 7): hysteresis, Stribeck when accelerating"),

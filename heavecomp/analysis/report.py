@@ -15,14 +15,15 @@ from pathlib import Path
 
 import numpy as np
 
-from heavecomp.analysis.frequency import WAVE_BAND
+from heavecomp.analysis.frequency import WAVE_BAND, dc_gain, frequency_grid, modes, response_table
+from heavecomp.analysis.linear import linearise_details
+from heavecomp.report.figures import _plt as plt_, save
+from heavecomp.report.scenario import _clean as c
 
 log = logging.getLogger(__name__)
 
 
 def _plt():
-    from heavecomp.report.figures import _plt as plt_
-
     return plt_()
 
 
@@ -157,8 +158,6 @@ def df_figure(rows: list[dict], *, title: str = ""):
 
 
 def _clean(x):
-    from heavecomp.report.scenario import _clean as c
-
     return c(x)
 
 
@@ -172,9 +171,6 @@ def analyse(params, *, n_points: int = 1000, omega_min: float = 1e-3, omega_max:
         ``summary`` (the analysis.json content), ``table`` (CSV columns of the
         frictionless model), ``curves`` (label -> (omega, k_eff(omega))).
     """
-    from heavecomp.analysis.frequency import dc_gain, frequency_grid, modes, response_table
-    from heavecomp.analysis.linear import linearise_details
-
     L0 = linearise_details(params, friction="none")
     sys = L0.sys
     w = frequency_grid(sys, n_points, omega_min, omega_max)
@@ -229,8 +225,6 @@ def write_analysis(params, out, *, source: str = "", **kw) -> dict:
 
     Returns the analysis.json content.
     """
-    from heavecomp.report.figures import save
-
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     res = analyse(params, **kw)

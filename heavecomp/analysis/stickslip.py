@@ -29,6 +29,11 @@ import math
 
 import numpy as np
 
+from heavecomp.analysis import pneumatic_linear as PL
+from heavecomp.friction.laws import FrictionLaw
+from heavecomp.plants.pneumatic import equilibrium
+from heavecomp.simulate import simulate
+
 log = logging.getLogger(__name__)
 
 
@@ -96,7 +101,6 @@ def window(lin, periods: float = 8.0) -> float:
 
 def nonlinear_sticks(p, position=None, periods: float = 8.0) -> bool:
     """Does the nonlinear plant stick again after a restart (exact stick-slip simulation)?"""
-    from heavecomp.analysis import pneumatic_linear as PL
     from heavecomp.analysis import pneumatic_sim as PS
 
     lin = PL.linearise(p, position)
@@ -129,7 +133,6 @@ def grid_map(p, var_x: str, xs, var_y: str, ys, *, convention: str = "paper", po
     dict with arrays (len(ys), len(xs)): ``zeta``, ``D``, ``u0``, ``linear`` (bool),
     ``nonlinear`` (bool), ``agree`` and the scalar ``agreement`` (fraction alike).
     """
-    from heavecomp.analysis import pneumatic_linear as PL
     from heavecomp.analysis import pneumatic_sim as PS
 
     xs, ys = np.asarray(xs, float), np.asarray(ys, float)
@@ -187,9 +190,6 @@ def minimum_velocity(p, *, convention: str = "paper", position=None, nonlinear: 
     """
     from scipy.optimize import brentq
 
-    from heavecomp.analysis import pneumatic_linear as PL
-    from heavecomp.plants.pneumatic import equilibrium
-
     def margin(logS):
         lin = PL.linearise(p.replace(exhaust_area=float(math.exp(logS))), position, convention)
         return lin.D - critical_D(lin.zeta)
@@ -235,8 +235,6 @@ def influence(p, factors=(0.5, 0.71, 1.0, 1.41, 2.0), *, convention: str = "pape
     The linearisation position scales with the stroke (``position_fraction * L``).
     Returns {variable: {"factor": [...], "zeta": [...], "D": [...], "stick_slip": [...]}}.
     """
-    from heavecomp.analysis import pneumatic_linear as PL
-
     res = {}
     drop0 = p.stick_static_force - p.coulomb_force
     for var in INFLUENCE_VARIABLES:
@@ -267,8 +265,6 @@ def cmc_stick_map(params, amplitudes, periods, models=("stribeck", "rotating_eq6
     Returns {model: {"stick_fraction", "n_stick_per_period", "mean_stick_s", "stroke_p2p"}}
     with arrays (len(periods), len(amplitudes)), plus the axes.
     """
-    from heavecomp.simulate import simulate
-
     A, T = np.asarray(amplitudes, float), np.asarray(periods, float)
     out = {"amplitudes": A, "periods": T}
     for m in models:
@@ -307,8 +303,6 @@ def cmc_breakout_amplitude(params, period: float, model: str = "stribeck") -> fl
     ``1/k_s = 1/k_DS + 1/k_F`` (plus the inertia of the top mass, ``M_c omega^2 z_h``);
     breakout when that exceeds the static limit at the operating pressure.
     """
-    from heavecomp.friction.laws import FrictionLaw
-
     law = FrictionLaw.from_params(params.replace(friction={"model": model}).friction)
     Fs = float(law.static_limit(params.p0))
     ds, fo, c = params.drill_string, params.formation, params.compensator

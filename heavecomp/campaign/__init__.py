@@ -4,18 +4,16 @@
 >>> camp = load("heavecomp/campaign/default_campaign.toml")  # doctest: +SKIP
 >>> res = run_campaign(camp, "out/", workers=2)              # doctest: +SKIP
 
-Light imports only here; numba/dask are imported by the sub-modules that run.
+numba (batch, stats) and dask load on first use.
 """
 
+from heavecomp.campaign.execute import run_campaign
 from heavecomp.campaign.spec import Campaign, Run, default, load, loads
 
 __all__ = ["Campaign", "Run", "load", "loads", "default", "run_campaign", "simulate_batch", "statistics"]
 
 
 def __getattr__(name):
-    if name == "run_campaign":
-        from heavecomp.campaign.execute import run_campaign
-        return run_campaign
     if name == "simulate_batch":
         from heavecomp.campaign.batch import simulate_batch
         return simulate_batch

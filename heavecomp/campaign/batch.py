@@ -32,7 +32,10 @@ import time
 import numba as nb
 import numpy as np
 
-from heavecomp.simulate import _kernel as K
+from heavecomp.simulate import _kernel as K, excitation
+from heavecomp.friction.laws import FrictionLaw
+from heavecomp.plants.cmc import plant_vector
+from heavecomp.simulate.core import default_dt
 
 log = logging.getLogger(__name__)
 
@@ -149,10 +152,6 @@ def _batch(codes, FPs, PPs, smooth, hsteps, nsteps, out_every, t_stat, W0, half,
 
 def prepare(campaign, runs, base=None):
     """Per-run arrays for the compiled driver (parameters, steps, heave samples)."""
-    from heavecomp.friction.laws import FrictionLaw
-    from heavecomp.plants.cmc import plant_vector
-    from heavecomp.simulate.core import default_dt
-
     s = campaign.settings
     base = base if base is not None else campaign.base_params()
     n = len(runs)
@@ -208,8 +207,6 @@ def prepare(campaign, runs, base=None):
 def jonswap_samples(hs, tp, gamma, seed, ramp, duration, spacing, spectra=None):
     """:func:`heavecomp.simulate.excitation.jonswap` with its amplitude spectrum cached in
     ``spectra`` (a dict) across the runs of a campaign (one spectrum per sea state)."""
-    from heavecomp.simulate import excitation
-
     return excitation.jonswap(hs, tp, gamma, seed, ramp, duration, spacing, spectra=spectra)
 
 

@@ -30,6 +30,7 @@ import time
 from pathlib import Path
 
 from heavecomp.errors import InputError, ParameterError
+from heavecomp.simulate.layout import source_hash
 
 log = logging.getLogger(__name__)
 
@@ -61,8 +62,6 @@ class CampaignRun:
 
 
 def _check_manifest(campaign, out: Path):
-    from heavecomp.simulate.layout import source_hash
-
     man = out / MANIFEST
     fp = campaign.fingerprint()
     physics = f"{source_hash():x}"  # the stepper's source files: results of other physics are not resumed

@@ -26,6 +26,9 @@ from typing import Any, Mapping
 
 from heavecomp.errors import ParameterError, did_you_mean
 from heavecomp.params.core import choice, from_table, q, read_text, text
+from heavecomp.params import dumps, from_dict, SETS
+from heavecomp.params import load as load_params
+from heavecomp.params.cmc import TABLES
 
 DEFAULT_FILE = Path(__file__).with_name("default_campaign.toml")
 REGIMES = ("none", "stribeck", "rotating_eq6", "rotating_eq7")
@@ -165,7 +168,6 @@ class Campaign:
         return hashlib.sha256(json.dumps(d, sort_keys=True, default=str).encode()).hexdigest()[:16]
 
     def base_text(self) -> str:
-        from heavecomp.params import dumps
         return dumps(self.base_params())
 
     # ---------------------------------------------------------------- parameters
@@ -176,8 +178,6 @@ class Campaign:
         the set's documented v_t); a file must itself hold every key the
         campaign's regimes need (e.g. ``friction.tangential_velocity``).
         """
-        from heavecomp.params import SETS, load
-
         b = self.settings.base
         if b in SETS:
             if regime is not None:
@@ -191,12 +191,10 @@ class Campaign:
             path = Path(self.base_dir) / path
         if not path.is_file():
             raise ParameterError(f"campaign.base: not a named set ({', '.join(SETS)}) nor a file: {b}")
-        return load(path)
+        return load_params(path)
 
     def params_for(self, run: Run, base=None):
         """CMC parameters of one run: base + variant overrides + regime + JONSWAP heave."""
-        from heavecomp.params import from_dict
-
         if base is None or (self.settings.base in _named_sets()):
             base = self.base_params(run.regime)
         d = base.to_dict()
@@ -210,7 +208,6 @@ class Campaign:
 
 
 def _named_sets():
-    from heavecomp.params import SETS
     return SETS
 
 
@@ -262,8 +259,6 @@ def _parse_scatter(t: Mapping[str, Any]) -> Scatter:
 
 
 def _check_override_key(key: str, where: str):
-    from heavecomp.params.cmc import TABLES
-
     parts = key.split(".")
     if len(parts) != 2 or parts[0] not in TABLES or parts[0] == "heave":
         raise ParameterError(f"{where}.{key}: expected \"table.key\" of a CMC parameter table "

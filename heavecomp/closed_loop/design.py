@@ -12,6 +12,8 @@ import logging
 import numpy as np
 
 from heavecomp.params import paper_a
+from heavecomp.closed_loop.loop import simulate_closed_loop
+from heavecomp.report.figures import _plt, REGIME_LABELS
 
 log = logging.getLogger(__name__)
 
@@ -41,8 +43,6 @@ def case_params(regime: str, sea: str, active: dict | None = None):
 
 def run_case(regime: str, sea: str, controller: str, duration: float, *, active=None, keep=False, **options):
     """One closed-loop run; returns its metrics (and the result when ``keep``)."""
-    from heavecomp.closed_loop.loop import simulate_closed_loop
-
     p = case_params(regime, sea, active)
     res = simulate_closed_loop(p, controller, duration, **({} if controller == "passive" else options))
     m = res.metrics()
@@ -154,8 +154,6 @@ def findings(table: dict, sweeps: dict, robust: dict, frames: dict | None = None
 
 def plot_wob_controllers(results: dict, window, *, title: str):
     """WOB and active force over time for several controllers (label -> ClosedLoopResult)."""
-    from heavecomp.report.figures import _plt
-
     plt = _plt()
     fig, (ax, axu) = plt.subplots(2, 1, figsize=(10, 6.2), sharex=True, gridspec_kw={"height_ratios": [3, 2]})
     colors = {"passive": "tab:red", "pid": "tab:orange", "linear-mpc": "tab:blue", "nonlinear-mpc": "tab:green"}
@@ -182,8 +180,6 @@ def plot_wob_controllers(results: dict, window, *, title: str):
 
 def plot_std_table(table: dict, sea: str, *, title: str):
     """Grouped bars: WOB std per friction regime and controller."""
-    from heavecomp.report.figures import REGIME_LABELS, _plt
-
     plt = _plt()
     fig, ax = plt.subplots(figsize=(9, 4.2))
     regs = list(table[sea])
@@ -205,8 +201,6 @@ def plot_std_table(table: dict, sea: str, *, title: str):
 
 def plot_sweeps(sweeps: dict, passive_std: float, *, title: str):
     """One panel per swept option: WOB std (left axis) against the option value."""
-    from heavecomp.report.figures import _plt
-
     plt = _plt()
     n = len(sweeps)
     fig, axes = plt.subplots(1, n, figsize=(3.3 * n, 3.6), squeeze=False)

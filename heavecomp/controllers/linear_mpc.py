@@ -32,6 +32,7 @@ import numpy as np
 from heavecomp.controllers.base import Controller, ControllerConfig
 from heavecomp.controllers.estimation import DisturbanceObserver, HeavePredictor
 from heavecomp.controllers.model import controller_params, discrete_model
+from heavecomp.friction.laws import FrictionLaw
 
 log = logging.getLogger(__name__)
 KN = 1e3
@@ -39,8 +40,6 @@ KN = 1e3
 
 def controller_friction(params, config):
     """The friction law the controller believes: forces scaled by ``friction_scale``."""
-    from heavecomp.friction.laws import FrictionLaw
-
     law = FrictionLaw.from_params(params.friction)
     law.FP = law.FP.copy()
     law.FP[[0, 1, 3, 4]] *= config.friction_scale  # F_S, F_C, C_v, C_p

@@ -35,6 +35,9 @@ import dataclasses
 
 import numpy as np
 
+from heavecomp.plants.cmc import casadi_model
+from heavecomp.plants.symbolic import casadi
+
 OUT = ("wob", "stroke", "pressure")
 
 
@@ -74,8 +77,6 @@ def earth_frame(f):
     not: the heave acceleration acts on the top mass only through the relative
     coordinates).
     """
-    from heavecomp.plants.symbolic import casadi
-
     ca = casadi()
     xe = ca.SX.sym("xe", 4)
     u = ca.SX.sym("u", 4)
@@ -90,8 +91,6 @@ def earth_frame(f):
 
 def controller_model(params, *, eps=None, frame: str = "earth"):
     """The casadi model the controllers predict with (``frame``: see the module docstring)."""
-    from heavecomp.plants.cmc import casadi_model
-
     if frame not in FRAMES:
         raise ValueError(f"model frame {frame!r}: not one of {', '.join(FRAMES)}")
     f = casadi_model(params, eps=eps)
@@ -110,8 +109,6 @@ def discrete_model(params, Ts: float, frame: str = "earth") -> DiscreteModel:
         Coordinates of the top mass (module docstring).
     """
     from scipy.linalg import expm
-
-    from heavecomp.plants.symbolic import casadi
 
     ca = casadi()
     f = controller_model(params.replace(friction={"model": "none"}), frame=frame)

@@ -35,6 +35,8 @@ import logging
 import numpy as np
 
 from heavecomp.controllers.linear_mpc import KN, LinearMPC
+from heavecomp.controllers.model import controller_model
+from heavecomp.plants.symbolic import casadi
 
 log = logging.getLogger(__name__)
 
@@ -77,9 +79,6 @@ class NonlinearMPC(LinearMPC):
                                    ("static_force", "coulomb_force", "viscous_coefficient", "pressure_coefficient")})
 
     def _build(self):
-        from heavecomp.controllers.model import controller_model
-        from heavecomp.plants.symbolic import casadi
-
         ca = casadi()
         cfg, N = self.config, self.N
         mp = self._model_params()

@@ -8,14 +8,7 @@
 Heavy modules (numba, scipy) load on first use.
 """
 
+from heavecomp.diagnosis.data import MeasuredRun, check_run, load_run
+from heavecomp.diagnosis.estimator import GapDiagnoser
+
 __all__ = ["GapDiagnoser", "load_run", "check_run", "MeasuredRun"]
-
-
-def __getattr__(name):
-    if name == "GapDiagnoser":
-        from heavecomp.diagnosis.estimator import GapDiagnoser
-        return GapDiagnoser
-    if name in ("load_run", "check_run", "MeasuredRun"):
-        from heavecomp.diagnosis import data
-        return getattr(data, name)
-    raise AttributeError(name)

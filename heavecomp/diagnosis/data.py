@@ -28,6 +28,7 @@ from pathlib import Path
 import numpy as np
 
 from heavecomp.errors import DataError
+from heavecomp.simulate.excitation import HeaveSamples
 
 REQUIRED = ("t", "heave", "stroke", "pressure", "wob")
 CHANNELS = ("wob", "stroke", "pressure")
@@ -250,8 +251,6 @@ def heave_samples(run: MeasuredRun, h: float, n_steps: int, cutoff=HEAVE_CUTOFF)
     The first sample is the operating point's heave reference (cmc-reference.md).
     """
     from scipy.interpolate import CubicSpline
-
-    from heavecomp.simulate.excitation import HeaveSamples
 
     tu, zu = uniform(run.t, run["heave"])
     zf = zero_phase_lowpass(zu, tu[1] - tu[0], cutoff)

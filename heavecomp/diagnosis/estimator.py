@@ -43,6 +43,11 @@ import numpy as np
 from heavecomp.effects import terms as T
 from heavecomp.effects.candidates import CANDIDATES, ParameterMismatch, get
 from heavecomp.errors import InputError
+from heavecomp.diagnosis import where as W
+from heavecomp.diagnosis.data import (derivative_zero_phase, HEAVE_CUTOFF, heave_samples, MeasuredRun,
+                                      noise_floor, uniform, zero_phase_lowpass)
+from heavecomp.friction.laws import FrictionLaw
+from heavecomp.plants.cmc import D0, KF, plant_vector
 
 log = logging.getLogger(__name__)
 CH = ("wob", "stroke", "pressure")
@@ -62,9 +67,6 @@ class Replay:
 
 
 def _vectors(params):
-    from heavecomp.friction.laws import FrictionLaw
-    from heavecomp.plants.cmc import plant_vector
-
     law = FrictionLaw.from_params(params.friction)
     return law.code, law.FP.copy(), plant_vector(params)
 
@@ -157,7 +159,6 @@ class GapDiagnoser:
 
     # ------------------------------------------------------------------ replay
     def _setup(self, run):
-        from heavecomp.diagnosis.data import heave_samples
         from heavecomp.diagnosis.stepper import replay_dt
 
         h = replay_dt(self.nominal)
@@ -175,9 +176,6 @@ class GapDiagnoser:
         (stroke and its zero-phase derivative; lower mass from the low-passed WOB through the
         formation spring, y_b = delta_0 - W/k_F, v_b = -dW/dt / k_F).  The first ``reinit`` s of
         every restarted segment are left out of the residuals."""
-        from heavecomp.diagnosis.data import derivative_zero_phase, uniform, zero_phase_lowpass
-        from heavecomp.plants.cmc import D0, KF
-
         t = run.t
         L = self.segment
         n_seg = max(1, int(math.floor(t[-1] / L)))
@@ -391,9 +389,6 @@ class GapDiagnoser:
     # ------------------------------------------------------------------- fit
     def fit(self, run):
         """Diagnose a :class:`~heavecomp.diagnosis.data.MeasuredRun`; returns self."""
-        from heavecomp.diagnosis import where as W
-        from heavecomp.diagnosis.data import noise_floor
-
         t_wall = time.perf_counter()
         T_end = float(run.t[-1])
         settle = self.settle if self.settle is not None else min(30.0, 0.1 * T_end)
@@ -613,8 +608,6 @@ class GapDiagnoser:
         replay, so the residual from input noise is heavy-tailed and one draw under-estimates what
         a run with no effect can show.  The envelope is the largest held-out mean square over
         ``input_draws`` independent draws, plus the pre-processing term."""
-        from heavecomp.diagnosis.data import HEAVE_CUTOFF, MeasuredRun, heave_samples, noise_floor
-
         sz = noise_floor(run["heave"], run.t if not run.uniform else None)
         rng = np.random.default_rng(12345)
         val = self._valmask

@@ -29,6 +29,10 @@ import math
 import numpy as np
 
 from heavecomp.effects import terms as T
+from heavecomp.diagnosis.data import check_run, heave_samples, MeasuredRun
+from heavecomp.diagnosis.estimator import _vectors, GapDiagnoser
+from heavecomp.params import paper_a
+from heavecomp.simulate import excitation
 
 NOISE = {"heave": 0.002, "stroke": 0.002, "pressure": 2e3, "wob": 400.0}  #: 1-sigma noise [SI]
 CASES = ("none", "friction_lag", "dwell_stiction", "pressure_friction", "gas_heat_transfer", "flow_loss",
@@ -38,8 +42,6 @@ TWO_EFFECTS = (("dwell_stiction", "flow_loss"), ("friction_lag", "sensor_delay")
 
 def parameter_sets():
     """Nominal parameter sets the benchmark cycles through (paper A load case and two variants)."""
-    from heavecomp.params import paper_a
-
     p = paper_a("stribeck")
     return {
         "paper_a": p,
@@ -62,8 +64,6 @@ class TestRun:
     truth: dict
 
     def to_run(self):
-        from heavecomp.diagnosis.data import check_run
-
         return check_run(self.t, self.columns, params=self.nominal, source=f"generated:{self.truth['label']}")
 
     def to_csv(self, path):
@@ -164,7 +164,6 @@ class _Sea:
 
     def __init__(self, nominal, rng, duration, rate):
         from heavecomp.diagnosis.stepper import replay_dt
-        from heavecomp.simulate import excitation
 
         self.nominal = nominal
         self.hsig, self.tp = rng.uniform(1.5, 3.0), rng.uniform(9.0, 13.0)
@@ -189,7 +188,6 @@ class _Sea:
         """Clean channels of the truth model with the effects ``[(name, EP, extra), ...]``."""
         from scipy.signal import lfilter
 
-        from heavecomp.diagnosis.estimator import _vectors
         from heavecomp.diagnosis.stepper import CHANNELS as SC, run_fx
 
         EPs = T.zero_ep()
@@ -215,8 +213,6 @@ class _Sea:
         """Noise floor per channel [SI]: the output noise and the residual of the nominal model replayed
         from this run's noisy, filtered heave (what a run with no effect shows to the diagnosis; exact
         stiction makes it well above the sensor noise), in quadrature."""
-        from heavecomp.diagnosis.data import MeasuredRun, heave_samples
-
         run = MeasuredRun(self.t, {"heave": self.base["heave"] + self.heave_noise})
         _, rep = self.sim([], hs=heave_samples(run, self.h, self.n_steps))
         m = self.mask
@@ -389,8 +385,6 @@ def benchmark_cases(quick=False, seed0=1000):
 
 def run_benchmark(quick=False, duration=None, progress=None, n_jobs=2, max_nfev=None, seed0=1000):
     """Diagnose every benchmark case; returns rows and the summary (confusion matrix, shrink table)."""
-    from heavecomp.diagnosis.estimator import GapDiagnoser
-
     duration = duration or (120.0 if quick else 300.0)
     rows = []
     cases = benchmark_cases(quick, seed0)

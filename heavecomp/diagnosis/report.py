@@ -8,6 +8,10 @@ from pathlib import Path
 
 import numpy as np
 
+from heavecomp.diagnosis.where import residual_spectrum
+from heavecomp.report.figures import _plt, save
+from heavecomp.report.scenario import md_table
+
 CH_UNITS = {"wob": ("kN", 1e-3), "stroke": ("mm", 1e3), "pressure": ("kPa", 1e-3)}
 
 
@@ -31,8 +35,6 @@ def write_json(diag, path) -> Path:
 
 def fig_where(diag):
     """Residual over stroke velocity x acceleration (nominal replay), coloured by |WOB residual|."""
-    from heavecomp.report.figures import _plt
-
     plt = _plt()
     tr = diag.traces_
     t = tr["t"]
@@ -64,9 +66,6 @@ def fig_where(diag):
 
 def fig_spectra(diag):
     """Residual spectra per channel before (nominal) and after (best candidate), with the band edges."""
-    from heavecomp.diagnosis.where import residual_spectrum
-    from heavecomp.report.figures import _plt
-
     plt = _plt()
     tr = diag.traces_
     t = tr["t"]
@@ -93,8 +92,6 @@ def fig_spectra(diag):
 
 def fig_overlay(diag, span=40.0):
     """Measured vs nominal vs best candidate on held-out data around the worst held-out segment."""
-    from heavecomp.report.figures import _plt
-
     plt = _plt()
     tr = diag.traces_
     t = tr["t"]
@@ -129,9 +126,6 @@ def fig_overlay(diag, span=40.0):
 
 def write_report(diag, out_dir, *, title="Sim-to-real gap diagnosis") -> dict:
     """Write diagnosis.json, report.md and where.png / spectra.png / overlay.png into ``out_dir``."""
-    from heavecomp.report.figures import save
-    from heavecomp.report.scenario import md_table
-
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     write_json(diag, out / "diagnosis.json")
@@ -192,8 +186,6 @@ def write_report(diag, out_dir, *, title="Sim-to-real gap diagnosis") -> dict:
 
 def fig_confusion(summary):
     """Confusion matrix of the withheld-effect benchmark (rows: withheld effect, columns: verdict)."""
-    from heavecomp.report.figures import _plt
-
     plt = _plt()
     cm = summary["confusion"]
     truths = list(cm)
@@ -217,8 +209,6 @@ def fig_confusion(summary):
 
 def fig_shrink(rows):
     """Held-out shrink of the verdict per benchmark run, coloured by correctness."""
-    from heavecomp.report.figures import _plt
-
     plt = _plt()
     fig, ax = plt.subplots(figsize=(10, 4))
     labels = [r["truth"] + (f"+{r['truth_second']}" if r["truth_second"] else "") for r in rows]

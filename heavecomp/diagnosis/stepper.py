@@ -26,10 +26,12 @@ import time
 import numpy as np
 
 from heavecomp.effects import terms as _terms
-from heavecomp.simulate import _kernel as K
-from heavecomp.simulate.core import drive
+from heavecomp.simulate import _kernel as K, excitation
+from heavecomp.simulate.core import drive, plant_eigen_rate
 from heavecomp.simulate.layout import CHANNELS as _SIM_CHANNELS
 from heavecomp.simulate.layout import FX_CHANNELS, NSTATS, SLIDING, STUCK
+from heavecomp.friction.laws import FrictionLaw
+from heavecomp.plants.cmc import plant_vector
 
 #: recorded channels (columns of the output array): simulate()'s channels, then the gas
 #: pressure before the line drop and the gas temperature ratio
@@ -50,8 +52,6 @@ def initial_state(FP, EP) -> np.ndarray:
 def smooth_fx(code, FP, EP) -> bool:
     """True when neither the friction law nor an effect has a part that jumps with sign(v):
     the stepper then integrates one smooth system, as :func:`heavecomp.simulate.simulate` does."""
-    from heavecomp.friction.laws import FrictionLaw
-
     law = object.__new__(FrictionLaw)  # the law's own rule, from its code and parameters
     law.code, law.FP = int(code), np.asarray(FP, dtype=float)
     return not (law.has_stiction or _terms.adds_stiction(EP))
@@ -103,8 +103,6 @@ def replay_dt(params, rate: float | None = None) -> float:
     below the measurement noise, or the discretisation error itself shows up as a gap.
     ``lambda_max`` is :func:`heavecomp.simulate.core.plant_eigen_rate`.
     """
-    from heavecomp.simulate.core import plant_eigen_rate
-
     h = min(0.01, 0.25 / plant_eigen_rate(params))
     if rate:
         interval = 1.0 / rate
@@ -117,9 +115,6 @@ def simulate_fx(params, duration, EP=None, *, rate=50.0, heave=None, dt=None):
 
     Returns a dict channel -> array sampled at ``rate`` [Hz].
     """
-    from heavecomp.friction.laws import FrictionLaw
-    from heavecomp.plants.cmc import plant_vector
-    from heavecomp.simulate import excitation
     h = dt if dt is not None else replay_dt(params, rate)
     out_every = max(1, int(round(1.0 / (rate * h))))
     n_steps = int(math.ceil(duration / h - 1e-9))

@@ -6,6 +6,8 @@ import math
 
 import numpy as np
 
+from heavecomp.diagnosis.data import uniform
+
 REGIMES = ("stuck", "breakaway", "sliding_accelerating", "sliding_decelerating")
 BANDS = ("below_wave", "wave", "resonance", "above")
 BREAKAWAY_WINDOW = 0.3  #: s after a stuck -> sliding transition counted as "breakaway"
@@ -27,7 +29,6 @@ def eigenfrequencies(params) -> list[float]:
 
 def wave_band(t, z) -> tuple[float, float]:
     """Frequencies [Hz] holding the central 90 % of the heave variance (5 %..95 %)."""
-    from heavecomp.diagnosis.data import uniform
     from scipy.signal import welch
 
     tu, zu = uniform(t, z)
@@ -47,7 +48,6 @@ def band_edges(run, params):
 
 def residual_spectrum(t, r):
     """Welch PSD of a residual [unit^2/Hz] on a uniform resampling (dropouts bridged)."""
-    from heavecomp.diagnosis.data import uniform
     from scipy.signal import welch
 
     tu, ru = uniform(t, r)

@@ -27,6 +27,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from heavecomp.errors import did_you_mean, ParameterError
+
 NONE, STRIBECK, EQ6, EQ7 = 0, 1, 2, 3
 CODES = {"none": NONE, "stribeck": STRIBECK, "rotating_eq6": EQ6, "rotating_eq7": EQ7}
 FP_NAMES = ("static_force", "coulomb_force", "stribeck_velocity", "viscous_coefficient",
@@ -153,7 +155,6 @@ class FrictionLaw:
     def __init__(self, model="stribeck", static_force=0.0, coulomb_force=0.0, stribeck_velocity=1.0,
                  viscous_coefficient=0.0, pressure_coefficient=0.0, tangential_velocity=0.0):
         if model not in CODES:
-            from heavecomp.errors import ParameterError, did_you_mean
             raise ParameterError(f"friction.model = {model!r} is not one of {', '.join(CODES)}"
                                  f"{did_you_mean(model, CODES)}")
         self.model = model

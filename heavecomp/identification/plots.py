@@ -6,11 +6,10 @@ from __future__ import annotations
 import numpy as np
 
 from heavecomp.plants.axis import BASE_NAMES, EMPS_PUBLISHED, EMPS_UNITS
+from heavecomp.report.figures import _plt as plt
 
 
 def _plt():
-    from heavecomp.report.figures import _plt as plt
-
     return plt()
 
 

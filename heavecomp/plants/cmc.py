@@ -31,7 +31,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from heavecomp.friction.laws import friction_cont, friction_jump, friction_smooth
+from heavecomp.friction.laws import friction_cont, friction_jump, friction_smooth, FrictionLaw
+from heavecomp.params.cmc import G as g, P_ATM
+from heavecomp.plants.symbolic import casadi
 
 # PP layout
 A, MC, MB, PATM, P0ABS, V0, N, KDS, CDS, T0, KF, CF, D0, G = range(14)
@@ -42,8 +44,6 @@ STATE_NAMES = ("stroke", "stroke_velocity", "lower_displacement", "lower_velocit
 
 def plant_vector(params) -> np.ndarray:
     """Plant parameter vector PP from a :class:`heavecomp.params.CMCParams`."""
-    from heavecomp.params.cmc import G as g, P_ATM
-
     c, ds, f, op = params.compensator, params.drill_string, params.formation, params.operating_point
     W0 = op.wob_setpoint
     return np.array([
@@ -148,9 +148,6 @@ def casadi_model(params, *, eps: float | None = None, sym: str = "SX"):
         Inputs ``x`` (4: s, v, y_b, v_b) and ``u`` (4: z_h, dz_h, ddz_h, u_active);
         outputs ``xdot`` (4) and ``y`` (5: wob, stroke, pressure, tension, friction).
     """
-    from heavecomp.friction.laws import FrictionLaw
-    from heavecomp.plants.symbolic import casadi
-
     ca = casadi()
 
     law = FrictionLaw.from_params(params.friction)

@@ -15,19 +15,17 @@ import logging
 import os
 import sys
 
+from heavecomp.report.figures import pyplot, save
+
 log = logging.getLogger(__name__)
 
 
 def _draw(func, args, kwargs, path, save_kwargs):
-    from heavecomp.report.figures import save
-
     save(func(*args, **kwargs), path, **save_kwargs)
 
 
 def _worker(conn):
     try:
-        from heavecomp.report.figures import pyplot
-
         pyplot()  # the expensive import happens while the parent computes
         job = conn.recv()
         if job is not None:

@@ -12,6 +12,8 @@ matches the files on disk, so an edited plant can never run stale code.
 
 from __future__ import annotations
 
+from heavecomp.simulate.layout import source_hash
+
 ADVANCE_SIGNATURE = ("i8(f8[::1], f8[::1], f8, i8, f8, i8, f8[::1], f8[::1], b1, f8, f8, "
                      "f8[::1], f8[::1], f8[::1], f8[:,::1], i8, i8, f8[::1])")
 
@@ -21,7 +23,6 @@ def build_cc(output_dir=None):
     from numba.pycc import CC
 
     from heavecomp.simulate import _kernel
-    from heavecomp.simulate.layout import source_hash
 
     cc = CC("_cmc_aot")
     if output_dir is not None:

@@ -20,7 +20,10 @@ class SimulationError(InputError):
 
 log = logging.getLogger(__name__)
 
-from heavecomp.simulate.layout import CHANNELS, NCH, STATS, STUCK
+from heavecomp.simulate.layout import CHANNELS, NCH, STATS, STUCK, source_hash
+from heavecomp.friction.laws import FrictionLaw
+from heavecomp.plants.cmc import plant_vector
+from heavecomp.simulate import excitation
 #: columns written to timeseries.csv (contract columns first)
 CSV_COLUMNS = ("t", "heave", "stroke", "pressure", "wob", "stroke_velocity", "friction", "tension", "stuck")
 
@@ -28,8 +31,6 @@ CSV_COLUMNS = ("t", "heave", "stroke", "pressure", "wob", "stroke_velocity", "fr
 def plant_eigen_rate(params) -> float:
     """Largest |eigenvalue| [1/s] of the linearised plant (stroke stuck or free),
     including the steepest friction slope near v = 0 — sets the default step."""
-    from heavecomp.friction.laws import FrictionLaw
-
     c, ds, fo = params.compensator, params.drill_string, params.formation
     Mc, mb = c.moving_mass, ds.lower_mass
     law = FrictionLaw.from_params(params.friction)
@@ -147,9 +148,6 @@ class SimulationResult:
 
 
 def _friction_vectors(params):
-    from heavecomp.friction.laws import FrictionLaw
-    from heavecomp.plants.cmc import plant_vector
-
     law = FrictionLaw.from_params(params.friction)
     return law, plant_vector(params)
 
@@ -178,8 +176,6 @@ def simulate(params, duration: float, *, dt: float | None = None, rate: float = 
     u_active : float [N]
         Constant active-cylinder force (closed loops use :mod:`heavecomp.controllers`).
     """
-    from heavecomp.simulate import excitation
-
     if not (duration > 0 and math.isfinite(duration)):
         raise InputError(f"--duration must be a positive number of seconds, got {duration}")
     if not (rate > 0 and math.isfinite(rate)):
@@ -278,8 +274,6 @@ def stepper():
     global _STEPPER
     if _STEPPER is None:
         import os
-
-        from heavecomp.simulate.layout import source_hash
 
         fn = None
         if not os.environ.get("HEAVECOMP_JIT"):
