@@ -38,6 +38,7 @@ LAYER_OF = {
     "heavecomp.diagnosis": "analysis",
     "heavecomp.campaign": "analysis",
     "heavecomp.identification": "analysis",
+    "heavecomp.estimator": "analysis",        # base of the gap diagnosers
     "heavecomp.report": "report",
     # modules that draw figures and write reports belong to the report layer wherever they sit
     # today (issue 11 item 4 moves them into heavecomp/report/)

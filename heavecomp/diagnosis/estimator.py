@@ -43,6 +43,7 @@ import numpy as np
 from heavecomp.effects import terms as T
 from heavecomp.effects.candidates import CANDIDATES, ParameterMismatch, get
 from heavecomp.errors import InputError
+from heavecomp.estimator import GapEstimator
 from heavecomp.diagnosis import where as W
 from heavecomp.diagnosis.data import (derivative_zero_phase, HEAVE_CUTOFF, heave_samples, MeasuredRun,
                                       noise_floor, uniform, zero_phase_lowpass)
@@ -71,7 +72,7 @@ def _vectors(params):
     return law.code, law.FP.copy(), plant_vector(params)
 
 
-class GapDiagnoser:
+class GapDiagnoser(GapEstimator):
     """Sim-to-real gap diagnosis of a measured CMC run (an estimator: configure, ``fit``, results).
 
     Parameters
@@ -128,6 +129,8 @@ class GapDiagnoser:
     split_ : dict        fit / validate intervals [s]
     traces_ : dict       time series for the report (t, measured, nominal, best)
     """
+
+    _ranking_attr, _choice_attr = "candidates_", "verdict_"  # GapEstimator's ranking_ and effect_
 
     def __init__(self, nominal, candidates=None, *, split=0.67, settle=None, penalty=0.03, min_explained=0.5,
                  none_ratio=1.2, max_nfev=40, decimate=2, n_jobs=2, progress=None, second=None, segment=None,

@@ -27,6 +27,7 @@ from typing import Callable
 import numpy as np
 
 from heavecomp.errors import ParameterError, did_you_mean
+from heavecomp.estimator import GapEstimator
 from heavecomp.identification import terms as T
 from heavecomp.identification.inverse import AxisRegression, least_squares
 from heavecomp.plants.axis import BASE_NAMES
@@ -92,11 +93,15 @@ CANDIDATES: dict[str, Candidate] = {c.name: c for c in (
 
 
 def get_candidates(names=None) -> list[Candidate]:
-    """Candidates by name (None = all); an unknown name raises with the list of known ones."""
+    """Candidates by name or as :class:`Candidate` objects (None = all); an unknown name raises
+    with the list of known ones."""
     if names is None:
         return list(CANDIDATES.values())
     out = []
     for n in names:
+        if isinstance(n, Candidate):
+            out.append(n)
+            continue
         if n not in CANDIDATES:
             raise ParameterError(f"unknown candidate '{n}'{did_you_mean(n, CANDIDATES)}; "
                                  f"known: {', '.join(CANDIDATES)}")
@@ -162,7 +167,7 @@ class _Design:
     k_extra: int = 0
 
 
-class ResidualDiagnoser:
+class ResidualDiagnoser(GapEstimator):
     """Localise the held-out residual of the EMPS model and rank candidate effects.
 
     Parameters
