@@ -2,6 +2,7 @@
 dropouts and jittered sampling, and the Python API's contract fields."""
 
 import json
+import math
 import subprocess
 import sys
 from pathlib import Path
@@ -9,8 +10,6 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
-CONTRACT_EFFECTS = {"friction_lag", "dwell_stiction", "pressure_friction", "gas_heat_transfer", "flow_loss",
-                    "string_damping", "sensor_delay", "parameter_mismatch", "none", "inconclusive"}
 
 
 @pytest.mark.slow
@@ -30,13 +29,19 @@ def test_withheld_effects_scenario_quick(tmp_path):
     # a withheld orifice loss is named and the held-out gap really shrinks
     assert runs["flow_loss"]["verdict"] == "flow_loss"
     assert runs["flow_loss"]["shrink"] > 0.2
-    assert runs["flow_loss"]["fitted_parameters"]["resistance"] > 0
+    # the laminar candidate's resistance is the orifice's equivalent at the run's stroke velocity:
+    # describing function of K v|v| at amplitude V is 8 K V / (3 pi); V ~ heave velocity pi Hs / Tp
+    fl = runs["flow_loss"]
+    V = math.pi * fl["sea"]["hs"] / fl["sea"]["tp"]
+    r_eq = 8.0 * fl["truth_parameters"]["flow_loss"]["K"] * V / (3.0 * math.pi)
+    assert 0.5 * r_eq < fl["fitted_parameters"]["resistance"] < 2.0 * r_eq
     s = m["summary"]
     assert s["accuracy"] == pytest.approx(sum(x["correct"] for x in m["runs"]) / len(m["runs"]))
     assert sum(sum(r.values()) for r in s["confusion"].values()) == len(m["runs"])
     assert (tmp_path / "confusion.png").stat().st_size > 5000 and (tmp_path / "report.md").is_file()
 
 
+@pytest.mark.slow
 def test_cli_diagnose_contract_json(tmp_path):
     from heavecomp.diagnosis.generator import generate
     from heavecomp.params import dumps
@@ -53,7 +58,7 @@ def test_cli_diagnose_contract_json(tmp_path):
     assert d["schema"] == 1
     v = d["verdict"]
     assert {"effect", "confidence", "parameters", "shrink"} <= set(v)
-    assert v["effect"] in CONTRACT_EFFECTS and v["confidence"] in ("high", "medium", "low")
+    assert v["confidence"] in ("high", "medium", "low")
     # the lagged channel is found and the delay is of the order of the generated sensor lag
     lag = tr.truth["parameters"]["sensor_delay"]
     assert v["effect"] == "sensor_delay" and v["parameters"]["channel"] == lag["channel"]
@@ -75,6 +80,7 @@ def test_cli_diagnose_contract_json(tmp_path):
         assert (tmp_path / "out" / name).is_file()
 
 
+@pytest.mark.slow
 def test_diagnosis_example_scenario_quick(tmp_path):
     """Withheld quadratic string drag: the linear-dashpot candidate fits a positive damping that
     shrinks the held-out WOB residual, and the report files are written."""
@@ -85,6 +91,6 @@ def test_diagnosis_example_scenario_quick(tmp_path):
     sd = next(c for c in m["candidates"] if c["effect"] == "string_damping")
     assert sd["parameters"]["damping"] > 1e3
     assert sd["channels"]["wob"]["rms_after"] < sd["channels"]["wob"]["rms_before"]
-    assert m["verdict"]["effect"] in CONTRACT_EFFECTS
+    assert m["verdict"]["effect"] == "string_damping"
     d = json.loads((tmp_path / "diagnosis.json").read_text())
     assert d["schema"] == 1 and (tmp_path / "overlay.png").is_file()
