@@ -55,6 +55,7 @@ def test_df_amplitude_dependence_friction_adds_wob(pa):
     assert k[0] > k[1] > k[2] > k_lin
 
 
+@pytest.mark.slow
 def test_df_matches_simulation_while_sliding(pa):
     rows = compare_with_simulation(pa, [0.5, 2.0], [12.0]) + compare_with_simulation(
         paper_a("rotating_eq7"), [1.0], [8.0])

@@ -54,6 +54,7 @@ def _rows_by_id(path):
 
 
 # ---------------------------------------------------------------- batch == single runs
+@pytest.mark.slow
 def test_batch_equals_single_runs(tiny):
     """Every statistic of the batch path equals the same numbers computed from simulate()'s series."""
     from heavecomp.campaign.batch import simulate_batch
@@ -157,6 +158,7 @@ def test_resume_into_other_campaign_refused(tiny, tmp_path):
 
 
 # ---------------------------------------------------------------- Dask
+@pytest.mark.slow
 def test_tiny_campaign_on_local_dask_cluster(tiny, tmp_path):
     distributed = pytest.importorskip("distributed")
     from heavecomp.campaign.execute import run_campaign

@@ -5,9 +5,12 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 ROOT = Path(__file__).resolve().parents[1]
 
 
+@pytest.mark.slow
 def test_campaign_default_quick(tmp_path):
     r = subprocess.run([sys.executable, str(ROOT / "scenarios" / "campaign_default.py"), "--quick", "--out",
                         str(tmp_path)], capture_output=True, text=True)

@@ -291,6 +291,7 @@ def _cli(tmp_path, *extra):
                            "--out", str(tmp_path / "o"), *extra], capture_output=True, text=True)
 
 
+@pytest.mark.slow
 def test_cli_no_noise_and_perfect_preview_reach_the_loop(tmp_path):
     r = _cli(tmp_path, "--controller", "linear-mpc", "--no-noise", "--perfect-preview")
     assert r.returncode == 0, r.stderr

@@ -3,9 +3,12 @@
 import importlib.util
 import json
 
+import pytest
+
 from heavecomp.report.scenario import ROOT
 
 
+@pytest.mark.slow
 def test_controller_design_quick(tmp_path):
     spec = importlib.util.spec_from_file_location("controller_design", ROOT / "scenarios" / "controller_design.py")
     mod = importlib.util.module_from_spec(spec)

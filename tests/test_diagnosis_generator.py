@@ -46,6 +46,7 @@ def _clean(tr, EP):
     return out[:, 0], {c: out[:, SC.index(c)] for c in OUT + ("stuck",)}
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name,pset,seed", [("dwell_stiction", "paper_a", 3), ("string_damping", "light_friction", 4),
                                             ("friction_lag", "light_friction", 5)])
 def test_planted_effect_is_above_the_noise_floor(name, pset, seed):

@@ -64,6 +64,7 @@ def test_candidate_recovers_planted_parameters(name, values, rtol):
     assert d.candidates_[0]["explained"] > 0.8
 
 
+@pytest.mark.slow
 def test_parameter_mismatch_names_what_moved():
     nominal = paper_a()
     truth = nominal.replace(compensator={"gas_stiffness": 60e3}, drill_string={"stiffness": 1.2e6})

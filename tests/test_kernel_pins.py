@@ -217,6 +217,7 @@ def _smooth_trajectory(p, eps, T, rate):
     return sol.t, wob
 
 
+@pytest.mark.slow
 def test_smooth_model_approaches_exact_stick_slip_as_eps_shrinks():
     """tanh-regularised friction creeps while it should stick; the creep, and with it
     the WOB error against the exact simulator, shrinks ~linearly with eps."""

@@ -4,6 +4,8 @@ import importlib.util
 import json
 from pathlib import Path
 
+import pytest
+
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -24,6 +26,7 @@ def test_exp2_scenario(tmp_path):
     assert m["measurement"]["rms_error_N"] < 0.05 * m["measurement"]["friction_span_N"]
 
 
+@pytest.mark.slow
 def test_stickslip_map_scenario(tmp_path):
     m = _run("pneumatic_stickslip_map", tmp_path)
     assert m["agreement_paper"] >= 0.85
@@ -41,6 +44,7 @@ def test_cmc_stick_map_scenario(tmp_path):
         assert agree >= 0.8, mod
 
 
+@pytest.mark.slow
 def test_seal_scenario(tmp_path, shared_dir):
     m = _run("pneumatic_seal_friction", tmp_path)
     assert m["pressure_coefficient_N_per_Pa"] > 0
