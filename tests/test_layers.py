@@ -232,12 +232,19 @@ def test_the_cycle_check_sees_a_cycle():
     assert _cycles({("a", "b"), ("b", "c"), ("c", "a"), ("c", "d")}) == [["a", "b", "c"]]
 
 
+#: layers whose modules import the library inside their functions: a command module is loaded
+#: to build its parser, so ``heavecomp CMD --help`` and bad arguments answer without numpy and the
+#: library (50 ms instead of 460 ms); nothing imports a command, so the graph stays visible
+LAZY_LAYERS = {"commands"}
+
+
 def test_own_imports_sit_at_module_top():
     """In-function imports of the package's own modules only for modules that load a heavy library,
-    or for a known upward import waiting to be moved."""
+    in the command layer, or for a known upward import waiting to be moved."""
     heavy = _heavy_modules()
     hidden = [f"{i.importer}:{i.line} imports {i.target}" for i in OWN
-              if not i.at_top and i.target not in heavy and (i.importer, i.target) not in KNOWN_UPWARD]
+              if not i.at_top and i.target not in heavy and (i.importer, i.target) not in KNOWN_UPWARD
+              and not (layer(i.importer) in LAZY_LAYERS and i.importer != "heavecomp.cli")]
     assert not hidden, f"{len(hidden)} imports of the package's own modules inside functions:\n" + "\n".join(hidden)
 
 
@@ -251,12 +258,13 @@ def test_heavy_libraries_are_not_imported_by_the_cli_or_light_layers():
 
 
 def test_the_command_line_parser_loads_no_heavy_library():
-    """``heavecomp --help`` builds the parser of every command: no heavy library may load."""
+    """Building every command's parser loads no heavy library, nor numpy (commands import the
+    library in ``run``)."""
     import subprocess
     import sys
 
     code = ("import sys, heavecomp.cli; heavecomp.cli.build_parser(); "
-            f"print(' '.join(sorted(m for m in {sorted(HEAVY_LIBRARIES)!r} if m in sys.modules)))")
+            f"print(' '.join(sorted(m for m in {sorted(HEAVY_LIBRARIES | {'numpy'})!r} if m in sys.modules)))")
     r = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True)
     assert r.returncode == 0, r.stderr
     assert r.stdout.strip() == ""

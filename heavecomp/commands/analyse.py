@@ -7,10 +7,6 @@ from __future__ import annotations
 
 import argparse
 
-from heavecomp.analysis.report import write_analysis
-from heavecomp.errors import InputError
-from heavecomp.params import load
-
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("params", metavar="PARAMS.toml", help="CMC parameter file (cmc-reference.md contract)")
@@ -28,6 +24,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 def _check(args):
     import math
 
+    from heavecomp.errors import InputError
+
     if not (2 <= args.points <= 1_000_000):
         raise InputError(f"--points must be between 2 and 1000000, got {args.points}")
     if not (args.omega_min > 0 and math.isfinite(args.omega_min)):
@@ -41,6 +39,9 @@ def _check(args):
 
 def run(args) -> int:
     from pathlib import Path
+
+    from heavecomp.analysis.report import write_analysis
+    from heavecomp.params import load
 
     _check(args)
     params = load(args.params)

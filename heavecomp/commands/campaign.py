@@ -4,11 +4,6 @@ from __future__ import annotations
 
 import argparse
 
-from heavecomp.campaign import spec
-from heavecomp.campaign.execute import run_and_report
-from heavecomp.commands._progress import Progress
-from heavecomp.errors import InputError
-
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("campaign", metavar="CAMPAIGN.toml",
@@ -23,6 +18,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 def run(args) -> int:
     import logging
     import sys
+
+    from heavecomp.campaign import spec
+    from heavecomp.campaign.execute import run_and_report
+    from heavecomp.commands._progress import Progress
+    from heavecomp.errors import InputError
 
     if args.workers is not None and args.workers < 1:
         raise InputError(f"--workers must be >= 1, got {args.workers}")

@@ -4,13 +4,6 @@ from __future__ import annotations
 
 import argparse
 
-from heavecomp.diagnosis.data import load_run
-from heavecomp.diagnosis.estimator import GapDiagnoser
-from heavecomp.diagnosis.report import write_report
-from heavecomp.effects import get
-from heavecomp.errors import InputError
-from heavecomp.params import load
-
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("run", metavar="RUN.csv", help="measured run: columns t, heave, stroke, pressure, wob (SI)")
@@ -29,9 +22,17 @@ def run(args) -> int:
     import sys
     import time
 
+    from heavecomp.diagnosis.data import load_run
+    from heavecomp.diagnosis.estimator import GapDiagnoser
+    from heavecomp.diagnosis.report import write_report
+    from heavecomp.errors import InputError
+    from heavecomp.params import load
+
     params = load(args.params)
     cands = None
     if args.candidates:
+        from heavecomp.effects import get
+
         cands = [c.strip() for c in args.candidates.split(",") if c.strip()]
         for c in cands:
             get(c)  # unknown names fail before any work

@@ -4,14 +4,6 @@ from __future__ import annotations
 
 import argparse
 
-from heavecomp.errors import ParameterError
-from heavecomp.identification import plots
-from heavecomp.identification.seal import load_seal_csv, SealFrictionFit
-from heavecomp.identification.study import emps_study, seal_study
-from heavecomp.plants.axis import load_emps
-from heavecomp.report.figures import save
-from heavecomp.report.scenario import write_metrics
-
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     sub = p.add_subparsers(dest="kind", metavar="KIND", required=True)
@@ -36,8 +28,16 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 def run(args) -> int:
     from pathlib import Path
 
+    from heavecomp.errors import ParameterError
+    from heavecomp.identification import plots
+    from heavecomp.report.figures import save
+    from heavecomp.report.scenario import write_metrics
+
     out = Path(args.out)
     if args.kind == "emps":
+        from heavecomp.identification.study import emps_study
+        from heavecomp.plants.axis import load_emps
+
         rec = load_emps(args.data)
         if not rec.t[0] + 1.0 < args.split < rec.t[-1] - 1.0:
             raise ParameterError(f"--split must lie inside the record ({rec.t[0] + 1:g} .. {rec.t[-1] - 1:g} s), "
@@ -61,6 +61,9 @@ def run(args) -> int:
               f"held-out residual {m['baseline_fit_part']['rms_validate']:.2f} N rms, best effect {best['effect']} "
               f"(shrink {best['shrink']:.3f}) -> {out}")
         return 0
+
+    from heavecomp.identification.study import seal_study
+    from heavecomp.identification.seal import SealFrictionFit, load_seal_csv
 
     if args.n_boot < 10:
         raise ParameterError(f"--n-boot must be at least 10, got {args.n_boot}")

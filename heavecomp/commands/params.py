@@ -4,9 +4,6 @@ from __future__ import annotations
 
 import argparse
 
-from heavecomp.errors import did_you_mean, ParameterError
-from heavecomp.params import dumps, load, SETS
-
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("source", metavar="NAME|PARAMS.toml",
@@ -18,6 +15,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 def run(args) -> int:
     import sys
     from pathlib import Path
+
+    from heavecomp.errors import ParameterError, did_you_mean
+    from heavecomp.params import SETS, dumps, load
 
     if args.source in SETS:
         factory = SETS[args.source]

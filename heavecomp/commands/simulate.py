@@ -4,15 +4,6 @@ from __future__ import annotations
 
 import argparse
 
-from heavecomp.closed_loop.loop import Noise, output_every, simulate_closed_loop, write_closed_loop_outputs
-from heavecomp.commands._progress import Progress
-from heavecomp.controllers.base import parse_options
-from heavecomp.errors import InputError
-from heavecomp.params import load
-from heavecomp.params.cmc import active
-from heavecomp.report.background import BackgroundFigure
-from heavecomp.simulate import simulate, write_outputs
-
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("params", metavar="PARAMS.toml", help="CMC parameter file (cmc-reference.md contract)")
@@ -40,6 +31,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 def run(args) -> int:
     from pathlib import Path
 
+    from heavecomp.commands._progress import Progress
+    from heavecomp.params import load
+    from heavecomp.report.background import BackgroundFigure
+    from heavecomp.simulate import simulate, write_outputs
+
     params = load(args.params)
     if args.friction:
         params = params.replace(friction={"model": args.friction})
@@ -48,6 +44,8 @@ def run(args) -> int:
     for flag, given in (("--controller-option", args.controller_option), ("--no-noise", args.no_noise),
                         ("--perfect-preview", args.perfect_preview)):
         if given:
+            from heavecomp.errors import InputError
+
             raise InputError(f"{flag} needs --controller pid|linear-mpc|nonlinear-mpc")
     bar = Progress(f"simulate {args.duration:g} s")
     figure = BackgroundFigure()  # imports matplotlib in parallel with the simulation
@@ -67,6 +65,10 @@ def run(args) -> int:
 def _run_closed_loop(args, params, Progress) -> int:
     """Active heave compensation: controller in the loop (heavecomp.closed_loop.loop)."""
     from pathlib import Path
+
+    from heavecomp.controllers.base import parse_options
+    from heavecomp.params.cmc import active
+    from heavecomp.closed_loop.loop import Noise, output_every, simulate_closed_loop, write_closed_loop_outputs
 
     output_every(args.rate, active(params).control_rate)  # bad --rate fails before the run
     options = parse_options(args.controller_option)

@@ -4,11 +4,6 @@ from __future__ import annotations
 
 import argparse
 
-from heavecomp.analysis import pneumatic_linear as PL, stickslip as SS
-from heavecomp.errors import InputError, ParameterError
-from heavecomp.plants import pneumatic as pn
-from heavecomp.report.scenario import write_metrics
-
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("params", metavar="PARAMS.toml|default",
@@ -30,6 +25,11 @@ def run(args) -> int:
     from pathlib import Path
 
     import numpy as np
+
+    from heavecomp.analysis import pneumatic_linear as PL
+    from heavecomp.analysis import stickslip as SS
+    from heavecomp.errors import InputError, ParameterError
+    from heavecomp.plants import pneumatic as pn
 
     if args.params == "default":
         p = pn.default()
@@ -75,6 +75,8 @@ def run(args) -> int:
                     "stick_slip_linear": int(g["linear"].sum())}
         print(f"map {n}x{n}: critical curve and simulation agree on {100 * g['agreement']:.1f} % of the points")
     if out:
+        from heavecomp.report.scenario import write_metrics
+
         write_metrics(out, m)
         print(f"-> {out}")
     return 0
