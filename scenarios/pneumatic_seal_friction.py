@@ -9,8 +9,8 @@ import os
 import sys
 from pathlib import Path
 
-from heavecomp.analysis import pneumatic_friction as PF
-from heavecomp.analysis import pneumatic_plots as PLT
+from heavecomp.pneumatic import measurement as PF
+from heavecomp.report import rigs as PLT
 from heavecomp.report.figures import save
 from heavecomp.report.scenario import ROOT, md_table, parse_args, write_metrics, write_report
 

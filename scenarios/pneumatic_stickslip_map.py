@@ -10,10 +10,10 @@ import time
 
 import numpy as np
 
-from heavecomp.analysis import pneumatic_linear as PL
-from heavecomp.analysis import pneumatic_plots as PLT
-from heavecomp.analysis import stickslip as SS
-from heavecomp.plants import pneumatic as pn
+from heavecomp.pneumatic import linear as PL
+from heavecomp.report import rigs as PLT
+from heavecomp.pneumatic import stickslip as SS
+from heavecomp.pneumatic import plant as pn
 from heavecomp.report.figures import save
 from heavecomp.report.scenario import md_table, parse_args, write_metrics, write_report
 

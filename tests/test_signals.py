@@ -48,7 +48,7 @@ def test_bad_time_column_is_named():
 
 def test_friction_recovered_from_synthetic_pneumatic_measurement():
     """Plant with known three-regime friction, 12.5 um encoder, 200 Pa pressure noise."""
-    from heavecomp.analysis.pneumatic_friction import synthetic_validation
+    from heavecomp.pneumatic.measurement import synthetic_validation
 
     r = synthetic_validation(duration=2.5)
     assert r["rms_error_N"] < 0.02 * r["friction_span_N"]
@@ -56,7 +56,7 @@ def test_friction_recovered_from_synthetic_pneumatic_measurement():
 
 
 def test_seal_friction_files(shared_dir):
-    from heavecomp.analysis.pneumatic_friction import seal_summary
+    from heavecomp.pneumatic.measurement import seal_summary
 
     s = seal_summary(shared_dir / "data" / "seal-friction")
     rows = s["rows"]

@@ -5,9 +5,9 @@ import math
 import numpy as np
 import pytest
 
-from heavecomp.analysis import pneumatic_linear as PL
-from heavecomp.analysis import stickslip as SS
-from heavecomp.plants import pneumatic as pn
+from heavecomp.pneumatic import linear as PL
+from heavecomp.pneumatic import stickslip as SS
+from heavecomp.pneumatic import plant as pn
 
 
 def test_critical_curve_limits():

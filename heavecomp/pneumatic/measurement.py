@@ -44,8 +44,8 @@ def synthetic_validation(p=None, *, duration: float = 3.0, fs: float = 1000.0, c
     samples (excluding 30 ms around each stick/branch event, where the true
     friction jumps and no band-limited method can follow).
     """
-    from heavecomp.analysis import pneumatic_sim as PS
-    from heavecomp.plants import pneumatic as pn
+    from heavecomp.pneumatic import stepper as PS
+    from heavecomp.pneumatic import plant as pn
     from heavecomp.signals import friction_from_motion
 
     p = p or pn.default()

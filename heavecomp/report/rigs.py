@@ -86,8 +86,8 @@ def plot_critical_map(g, zc, Dc, default_point=None):
 
 def plot_min_velocity(p, zc, Dc, mv):
     """Critical curve mapped to equilibrium velocity for the default cylinder (paper B Fig. 5)."""
-    from heavecomp.analysis import pneumatic_linear as PL
-    from heavecomp.analysis.stickslip import critical_D
+    from heavecomp.pneumatic import linear as PL
+    from heavecomp.pneumatic.stickslip import critical_D
 
     plt = _plt()
     S = np.geomspace(0.02e-6, 1.0e-6, 40)
@@ -164,7 +164,7 @@ def plot_cmc_map(m, breakout):
 
 def plot_rig(r_norot, r_rot, p):
     """Paper A Figs. 7 and 8: friction-velocity loops without and with rotation (eq. 12 readings)."""
-    from heavecomp.plants.test_rig import QUADRANTS
+    from heavecomp.test_rig.plant import QUADRANTS
 
     plt = _plt()
     fig, axs = plt.subplots(1, 2, figsize=(12, 4.8), sharey=True)

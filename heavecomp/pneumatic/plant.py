@@ -5,7 +5,7 @@ Chamber a (charging side) is fed from the supply ``P_s`` through a valve of
 effective area ``S_s``; chamber b (discharge side) exhausts to atmosphere
 through the speed-control valve of effective area ``S_e``.  A load mass ``M``
 rides on the piston; the seal friction is paper B's three-regime law
-(:mod:`heavecomp.friction.three_regime`).
+(:mod:`heavecomp.pneumatic.friction`).
 
 Equations (written once, scalar ``np.*``; numba and casadi use the same source)
 ---------------------------------------------------------------------------------
@@ -177,7 +177,7 @@ class PneumaticParams:
 
     @property
     def friction(self):
-        from heavecomp.friction.three_regime import ThreeRegimeFriction
+        from heavecomp.pneumatic.friction import ThreeRegimeFriction
 
         return ThreeRegimeFriction(self.start_static_force, self.stick_static_force, self.coulomb_force,
                                    self.viscous_coefficient, self.critical_velocity, self.return_peak_force)
@@ -254,7 +254,7 @@ def equilibrium(p: PneumaticParams, x: float | None = None):
     from scipy.optimize import brentq
 
     from heavecomp.errors import ParameterError
-    from heavecomp.friction.three_regime import branch_magnitude
+    from heavecomp.pneumatic.friction import branch_magnitude
 
     PP = p.plant_vector()
     FPB = p.friction.FPB
@@ -281,7 +281,7 @@ def casadi_discharge_model(p: PneumaticParams, x: float):
     """casadi Function f([v, P_b]) -> [dv/dt, dP_b/dt] with the charging side held at P_s
     (paper B's assumption) and the decelerating friction branch, at position ``x`` [m].
     Traced from the same scalar functions the stepper compiles."""
-    from heavecomp.friction.three_regime import branch_magnitude
+    from heavecomp.pneumatic.friction import branch_magnitude
     from heavecomp.plants.symbolic import casadi
 
     ca = casadi()

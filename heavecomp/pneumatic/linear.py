@@ -4,7 +4,7 @@ Paper B's assumptions (section "Analysis of occurrence conditions"): the
 charging-side pressure stays at P_s (the meter-out restriction dominates); the
 discharge side is linearised about its equilibrium (u_0, P_be); temperature
 effects on the mass flow are neglected.  Small deviations ``w = v - u_0``,
-``p = P_b - P_be`` then obey (module :mod:`heavecomp.plants.pneumatic`)::
+``p = P_b - P_be`` then obey (module :mod:`heavecomp.pneumatic.plant`)::
 
     M dw/dt = -A p - c w                      c = dF/dv at u_0 (decelerating branch; = C in EHDL)
     dp/dt   =  b w - a p                      b = kappa P_be A / V_b
@@ -71,7 +71,7 @@ def discharge_conductance(p, Pb: float) -> float:
     Choked (P_a/P_b <= b): ``g = G/P_b``; unchoked:
     ``g = S K [psi(r) - r psi'(r)]`` with ``r = P_a/P_b``, ``K = sqrt(2 kappa/((kappa-1) R T))``.
     """
-    from heavecomp.plants.pneumatic import LAMINAR_RATIO, critical_ratio
+    from heavecomp.pneumatic.plant import LAMINAR_RATIO, critical_ratio
 
     k, R, T = p.kappa, p.gas_constant, p.temperature
     K = math.sqrt(2 * k / ((k - 1) * R * T))
@@ -102,7 +102,7 @@ def linearise(p, position: float | None = None, convention: str = "paper") -> Li
         Neglect (paper B) or keep the volume-change term in ``a``.
     """
     from heavecomp.errors import InputError
-    from heavecomp.plants.pneumatic import chamber_volumes, equilibrium
+    from heavecomp.pneumatic.plant import chamber_volumes, equilibrium
 
     if convention not in ("paper", "full"):
         raise InputError(f"convention must be 'paper' or 'full', got {convention!r}")
@@ -130,7 +130,7 @@ def casadi_jacobian(p, position: float | None = None) -> np.ndarray:
     """Jacobian d[dv/dt, dP_b/dt]/d[v, P_b] at the equilibrium, by casadi from the
     plant's own scalar functions (no restated physics); equals
     ``linearise(p, position, "full").A``."""
-    from heavecomp.plants.pneumatic import casadi_discharge_model, equilibrium
+    from heavecomp.pneumatic.plant import casadi_discharge_model, equilibrium
     from heavecomp.plants.symbolic import casadi
 
     ca = casadi()

@@ -96,8 +96,8 @@ def window(lin, periods: float = 8.0) -> float:
 
 def nonlinear_sticks(p, position=None, periods: float = 8.0) -> bool:
     """Does the nonlinear plant stick again after a restart (exact stick-slip simulation)?"""
-    from heavecomp.analysis import pneumatic_linear as PL
-    from heavecomp.analysis import pneumatic_sim as PS
+    from heavecomp.pneumatic import linear as PL
+    from heavecomp.pneumatic import stepper as PS
 
     lin = PL.linearise(p, position)
     res = PS.simulate(p, window(lin, periods), state=restart_state(p, position), moved=True, stop_at_stick=True,
@@ -122,15 +122,15 @@ def grid_map(p, var_x: str, xs, var_y: str, ys, *, convention: str = "paper", po
     xs, ys : arrays
         Values (SI).
     convention : {"paper", "full"}
-        Linearisation convention (see :mod:`heavecomp.analysis.pneumatic_linear`).
+        Linearisation convention (see :mod:`heavecomp.pneumatic.linear`).
 
     Returns
     -------
     dict with arrays (len(ys), len(xs)): ``zeta``, ``D``, ``u0``, ``linear`` (bool),
     ``nonlinear`` (bool), ``agree`` and the scalar ``agreement`` (fraction alike).
     """
-    from heavecomp.analysis import pneumatic_linear as PL
-    from heavecomp.analysis import pneumatic_sim as PS
+    from heavecomp.pneumatic import linear as PL
+    from heavecomp.pneumatic import stepper as PS
 
     xs, ys = np.asarray(xs, float), np.asarray(ys, float)
     ny, nx = ys.size, xs.size
@@ -187,8 +187,8 @@ def minimum_velocity(p, *, convention: str = "paper", position=None, nonlinear: 
     """
     from scipy.optimize import brentq
 
-    from heavecomp.analysis import pneumatic_linear as PL
-    from heavecomp.plants.pneumatic import equilibrium
+    from heavecomp.pneumatic import linear as PL
+    from heavecomp.pneumatic.plant import equilibrium
 
     def margin(logS):
         lin = PL.linearise(p.replace(exhaust_area=float(math.exp(logS))), position, convention)
@@ -235,7 +235,7 @@ def influence(p, factors=(0.5, 0.71, 1.0, 1.41, 2.0), *, convention: str = "pape
     The linearisation position scales with the stroke (``position_fraction * L``).
     Returns {variable: {"factor": [...], "zeta": [...], "D": [...], "stick_slip": [...]}}.
     """
-    from heavecomp.analysis import pneumatic_linear as PL
+    from heavecomp.pneumatic import linear as PL
 
     res = {}
     drop0 = p.stick_static_force - p.coulomb_force
