@@ -10,7 +10,7 @@ import sys
 import numpy as np
 
 from heavecomp.report import rigs as PLT
-from heavecomp.pneumatic import stickslip as SS
+from heavecomp.analysis import stick_map as SS
 from heavecomp.params import paper_a
 from heavecomp.report.figures import save
 from heavecomp.report.scenario import md_table, parse_args, write_metrics, write_report

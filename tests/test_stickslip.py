@@ -103,11 +103,12 @@ def test_influence_directions_of_paper_b_fig6():
 
 
 def test_cmc_zero_stroke_below_the_breakout_amplitude():
+    from heavecomp.analysis.stick_map import cmc_breakout_amplitude, cmc_stick_map
     from heavecomp.params import paper_a
 
     p = paper_a()
-    a0 = SS.cmc_breakout_amplitude(p, 12.0, "stribeck")
-    m = SS.cmc_stick_map(p, [0.5 * a0, 2.0 * a0], [12.0], ("stribeck",), n_periods=1.0)
+    a0 = cmc_breakout_amplitude(p, 12.0, "stribeck")
+    m = cmc_stick_map(p, [0.5 * a0, 2.0 * a0], [12.0], ("stribeck",), n_periods=1.0)
     sf = m["stribeck"]["stick_fraction"][0]
     assert sf[0] == pytest.approx(1.0)
     assert sf[1] < 0.95

@@ -38,6 +38,11 @@ import math
 
 import numpy as np
 
+from heavecomp.errors import InputError, ParameterError
+from heavecomp.pneumatic.plant import (LAMINAR_RATIO, casadi_discharge_model, chamber_volumes, critical_ratio,
+                                       equilibrium)
+from heavecomp.plants.symbolic import casadi
+
 
 @dataclasses.dataclass(frozen=True)
 class Linearisation:
@@ -71,15 +76,11 @@ def discharge_conductance(p, Pb: float) -> float:
     Choked (P_a/P_b <= b): ``g = G/P_b``; unchoked:
     ``g = S K [psi(r) - r psi'(r)]`` with ``r = P_a/P_b``, ``K = sqrt(2 kappa/((kappa-1) R T))``.
     """
-    from heavecomp.pneumatic.plant import LAMINAR_RATIO, critical_ratio
-
     k, R, T = p.kappa, p.gas_constant, p.temperature
     K = math.sqrt(2 * k / ((k - 1) * R * T))
     r = p.atmosphere / Pb
     bcr = critical_ratio(k)
     if r > LAMINAR_RATIO:
-        from heavecomp.errors import ParameterError
-
         raise ParameterError("pneumatic.supply_pressure: the equilibrium exhaust pressure ratio is above 0.995 "
                              "(supply too low to linearise the exhaust flow)")
     if r <= bcr:
@@ -101,9 +102,6 @@ def linearise(p, position: float | None = None, convention: str = "paper") -> Li
     convention : {"paper", "full"}
         Neglect (paper B) or keep the volume-change term in ``a``.
     """
-    from heavecomp.errors import InputError
-    from heavecomp.pneumatic.plant import chamber_volumes, equilibrium
-
     if convention not in ("paper", "full"):
         raise InputError(f"convention must be 'paper' or 'full', got {convention!r}")
     x = 0.25 * p.stroke if position is None else float(position)
@@ -130,9 +128,6 @@ def casadi_jacobian(p, position: float | None = None) -> np.ndarray:
     """Jacobian d[dv/dt, dP_b/dt]/d[v, P_b] at the equilibrium, by casadi from the
     plant's own scalar functions (no restated physics); equals
     ``linearise(p, position, "full").A``."""
-    from heavecomp.pneumatic.plant import casadi_discharge_model, equilibrium
-    from heavecomp.plants.symbolic import casadi
-
     ca = casadi()
     x = 0.25 * p.stroke if position is None else float(position)
     f = casadi_discharge_model(p, x)

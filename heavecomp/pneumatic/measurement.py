@@ -19,6 +19,9 @@ from pathlib import Path
 import numpy as np
 
 from heavecomp.errors import DataError
+from heavecomp.pneumatic import plant as pn
+from heavecomp.pneumatic import stepper as PS
+from heavecomp.signals import differentiate, friction_from_motion, zero_phase_lowpass
 
 log = logging.getLogger(__name__)
 
@@ -44,10 +47,6 @@ def synthetic_validation(p=None, *, duration: float = 3.0, fs: float = 1000.0, c
     samples (excluding 30 ms around each stick/branch event, where the true
     friction jumps and no band-limited method can follow).
     """
-    from heavecomp.pneumatic import stepper as PS
-    from heavecomp.pneumatic import plant as pn
-    from heavecomp.signals import friction_from_motion
-
     p = p or pn.default()
     r = PS.simulate(p, duration, rate=fs)
     rng = np.random.default_rng(seed)
@@ -102,8 +101,6 @@ def seal_friction(path, *, fs: float = 100.0, cutoff: float = 2.0, v_min: float 
     Returns mean pressure [Pa], velocity [m/s], friction [N] arrays and the mean
     sliding friction for v > v_min and v < -v_min.
     """
-    from heavecomp.signals import differentiate, zero_phase_lowpass
-
     d = load_seal_file(path)
     t = d["time_ms"] / 1e3
     if np.any(np.diff(t) <= 0):

@@ -53,7 +53,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from heavecomp.params.core import from_table, q, to_table
+from heavecomp.errors import ParameterError, did_you_mean
+from heavecomp.params.core import dump_toml, from_table, q, to_table
+from heavecomp.plants.symbolic import casadi
+from heavecomp.pneumatic.friction import ThreeRegimeFriction, branch_magnitude
 
 #: layout of the plant parameter vector PP
 PP_NAMES = ("area", "stroke", "dead_volume_a", "dead_volume_b", "supply_abs", "atmosphere", "temperature",
@@ -177,8 +180,6 @@ class PneumaticParams:
 
     @property
     def friction(self):
-        from heavecomp.pneumatic.friction import ThreeRegimeFriction
-
         return ThreeRegimeFriction(self.start_static_force, self.stick_static_force, self.coulomb_force,
                                    self.viscous_coefficient, self.critical_velocity, self.return_peak_force)
 
@@ -203,8 +204,6 @@ class PneumaticParams:
 
 def from_dict(d) -> PneumaticParams:
     """Build from ``{"pneumatic": {...}}`` strictly (unknown keys/out-of-range values raise ParameterError)."""
-    from heavecomp.errors import ParameterError, did_you_mean
-
     d = dict(d or {})
     for key in d:
         if key != "pneumatic":
@@ -219,8 +218,6 @@ def load(path) -> PneumaticParams:
     import tomllib
     from pathlib import Path
 
-    from heavecomp.errors import ParameterError
-
     path = Path(path)
     try:
         text = path.read_text()
@@ -234,8 +231,6 @@ def load(path) -> PneumaticParams:
 
 
 def dumps(p: PneumaticParams) -> str:
-    from heavecomp.params.core import dump_toml
-
     return dump_toml(p.to_dict(), "paper B pneumatic meter-out cylinder (heavecomp stickslip)")
 
 
@@ -252,9 +247,6 @@ def equilibrium(p: PneumaticParams, x: float | None = None):
     Raises ParameterError when the supply cannot overcome Coulomb friction.
     """
     from scipy.optimize import brentq
-
-    from heavecomp.errors import ParameterError
-    from heavecomp.pneumatic.friction import branch_magnitude
 
     PP = p.plant_vector()
     FPB = p.friction.FPB
@@ -281,9 +273,6 @@ def casadi_discharge_model(p: PneumaticParams, x: float):
     """casadi Function f([v, P_b]) -> [dv/dt, dP_b/dt] with the charging side held at P_s
     (paper B's assumption) and the decelerating friction branch, at position ``x`` [m].
     Traced from the same scalar functions the stepper compiles."""
-    from heavecomp.pneumatic.friction import branch_magnitude
-    from heavecomp.plants.symbolic import casadi
-
     ca = casadi()
     s = ca.SX.sym("s", 2)
     PP = p.plant_vector()

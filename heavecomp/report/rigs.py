@@ -8,11 +8,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from heavecomp.pneumatic import linear as PL
+from heavecomp.pneumatic.stickslip import critical_D
+from heavecomp.report.figures import _plt
+from heavecomp.test_rig.plant import QUADRANTS
 
-def _plt():
-    from heavecomp.report.figures import _plt as p
-
-    return p()
 
 
 def plot_exp2(r, p, lin=None):
@@ -86,9 +86,6 @@ def plot_critical_map(g, zc, Dc, default_point=None):
 
 def plot_min_velocity(p, zc, Dc, mv):
     """Critical curve mapped to equilibrium velocity for the default cylinder (paper B Fig. 5)."""
-    from heavecomp.pneumatic import linear as PL
-    from heavecomp.pneumatic.stickslip import critical_D
-
     plt = _plt()
     S = np.geomspace(0.02e-6, 1.0e-6, 40)
     u0, margin = [], []
@@ -164,8 +161,6 @@ def plot_cmc_map(m, breakout):
 
 def plot_rig(r_norot, r_rot, p):
     """Paper A Figs. 7 and 8: friction-velocity loops without and with rotation (eq. 12 readings)."""
-    from heavecomp.test_rig.plant import QUADRANTS
-
     plt = _plt()
     fig, axs = plt.subplots(1, 2, figsize=(12, 4.8), sharey=True)
     for ax, r, ttl in ((axs[0], r_norot, "without rotation (Fig. 7): hysteresis, Stribeck when accelerating"),

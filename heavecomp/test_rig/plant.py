@@ -40,6 +40,8 @@ import math
 
 import numpy as np
 
+from heavecomp.friction import laws
+
 #: quadrant order: (sign v, sign a) = (+,+) accelerating forward, (+,-) decelerating forward,
 #: (-,-) accelerating backward, (-,+) decelerating backward
 QUADRANTS = ("v+a+", "v+a-", "v-a-", "v-a+")
@@ -120,8 +122,6 @@ def rig_friction(p: RigParams, v, a, v_t):
     eq. 4 with the quadrant's parameters when v_t = 0, eq. 7 (same parameters) when v_t > 0
     (:func:`heavecomp.friction.laws.friction_exact`).
     """
-    from heavecomp.friction import laws
-
     v, a, v_t = np.broadcast_arrays(np.asarray(v, float), np.asarray(a, float), np.asarray(v_t, float))
     q = quadrant_index(v, a)
     F = np.zeros(v.shape)
