@@ -9,8 +9,8 @@ import sys
 
 import numpy as np
 
-from heavecomp.analysis import pneumatic_plots as PLT
-from heavecomp.analysis import stickslip as SS
+from heavecomp.report import rigs as PLT
+from heavecomp.analysis import stick_map as SS
 from heavecomp.params import paper_a
 from heavecomp.report.figures import save
 from heavecomp.report.scenario import md_table, parse_args, write_metrics, write_report

@@ -4,7 +4,7 @@ and what does the smooth form used for optimisation change?
 Paper-A main-cylinder parameters at the operating pressure p_0; eq. 4 (Stribeck + pressure),
 eq. 6 and eq. 7 (rotating piston, v_t = 0.05 m/s), the hydromechanical efficiency model (eqs. 1-3,
 eta = 0.98 at the operating force), and eq. 4 regularised with tanh(v/eps); beside them paper B's
-three-regime law of the pneumatic seal (heavecomp.plants.pneumatic defaults).
+three-regime law of the pneumatic seal (heavecomp.pneumatic.plant defaults).
 """
 
 from __future__ import annotations
@@ -35,8 +35,8 @@ def build(n: int = 2001) -> dict:
         "eqs. 1-3 hydromechanical efficiency 0.98": (v, hydromechanical_friction(p.p0 * p.area, v, 0.98), "b--"),
     }
     limits = {m: float(law.static_limit(p.p0)) for m, law in laws.items()}
-    from heavecomp.friction.three_regime import smooth_friction
-    from heavecomp.plants.pneumatic import default
+    from heavecomp.pneumatic.friction import smooth_friction
+    from heavecomp.pneumatic.plant import default
 
     tb = default().friction
     vb = np.linspace(-0.15, 0.15, n)

@@ -7,11 +7,11 @@ from __future__ import annotations
 
 import sys
 
-from heavecomp.analysis import pneumatic_friction as PF
-from heavecomp.analysis import pneumatic_linear as PL
-from heavecomp.analysis import pneumatic_plots as PLT
-from heavecomp.analysis import pneumatic_sim as PS
-from heavecomp.plants import pneumatic as pn
+from heavecomp.pneumatic import measurement as PF
+from heavecomp.pneumatic import linear as PL
+from heavecomp.report import rigs as PLT
+from heavecomp.pneumatic import stepper as PS
+from heavecomp.pneumatic import plant as pn
 from heavecomp.report.figures import save
 from heavecomp.report.scenario import md_table, parse_args, write_metrics, write_report
 

@@ -9,8 +9,8 @@ import sys
 
 import numpy as np
 
-from heavecomp.analysis import pneumatic_plots as PLT
-from heavecomp.plants import test_rig as TR
+from heavecomp.report import rigs as PLT
+from heavecomp.test_rig import plant as TR
 from heavecomp.report.figures import save
 from heavecomp.report.scenario import md_table, parse_args, write_metrics, write_report
 

@@ -40,10 +40,16 @@ LAYER_OF = {
     "heavecomp.identification": "analysis",
     "heavecomp.estimator": "analysis",        # base of the gap diagnosers
     "heavecomp.report": "report",
+    # the wings (paper B's pneumatic cylinder, paper A's rotating-piston rig) keep the same order
+    "heavecomp.pneumatic.friction": "physics",
+    "heavecomp.pneumatic.plant": "physics",
+    "heavecomp.pneumatic.stepper": "stepper",
+    "heavecomp.pneumatic": "analysis",        # linear, stickslip, measurement
+    "heavecomp.test_rig": "physics",
     # modules that draw figures and write reports belong to the report layer wherever they sit
     # today (issue 11 item 4 moves them into heavecomp/report/)
     "heavecomp.analysis.report": "report",
-    "heavecomp.analysis.pneumatic_plots": "report",
+    "heavecomp.report.rigs": "report",
     "heavecomp.campaign.report": "report",
     "heavecomp.diagnosis.report": "report",
     "heavecomp.identification.plots": "report",

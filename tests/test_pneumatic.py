@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from heavecomp.errors import ParameterError
-from heavecomp.plants import pneumatic as pn
+from heavecomp.pneumatic import plant as pn
 
 
 @pytest.fixture(scope="module")
@@ -16,7 +16,7 @@ def p():
 
 @pytest.fixture(scope="module")
 def exp2(p):
-    from heavecomp.analysis import pneumatic_sim as PS
+    from heavecomp.pneumatic import stepper as PS
 
     return PS.simulate(p, 3.0, rate=1000.0)
 
@@ -77,8 +77,8 @@ def test_stuck_friction_never_exceeds_the_static_limit(p, exp2):
 
 
 def test_compiled_functions_equal_their_source(p):
-    from heavecomp.analysis import pneumatic_sim as PS
-    from heavecomp.friction import three_regime as fr
+    from heavecomp.pneumatic import stepper as PS
+    from heavecomp.pneumatic import friction as fr
 
     PP, FPB = p.plant_vector(), p.friction.FPB
     rng = np.random.default_rng(0)
@@ -91,7 +91,7 @@ def test_compiled_functions_equal_their_source(p):
 
 
 def test_three_regime_branches():
-    from heavecomp.friction.three_regime import ThreeRegimeFriction
+    from heavecomp.pneumatic.friction import ThreeRegimeFriction
 
     f = ThreeRegimeFriction(28.0, 20.0, 8.0, 64.0, 0.06, 8.0)
     # accelerating branch starts at the static force, decelerating at F_k; both join the EHDL line at u_cr

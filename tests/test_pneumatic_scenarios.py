@@ -1,10 +1,8 @@
-"""The pneumatic, stick-map and seal scenarios run with --quick and their metrics hold physics."""
+"""The pneumatic and stick-map scenarios run with --quick and their metrics hold physics."""
 
 import importlib.util
 import json
 from pathlib import Path
-
-import pytest
 
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -26,7 +24,6 @@ def test_exp2_scenario(tmp_path):
     assert m["measurement"]["rms_error_N"] < 0.05 * m["measurement"]["friction_span_N"]
 
 
-@pytest.mark.slow
 def test_stickslip_map_scenario(tmp_path):
     m = _run("pneumatic_stickslip_map", tmp_path)
     assert m["agreement_paper"] >= 0.85
@@ -42,9 +39,3 @@ def test_cmc_stick_map_scenario(tmp_path):
         assert bo["rotating_eq7"][i] < bo["rotating_eq6"][i] < bo["stribeck"][i]
     for mod, agree in m["zero_stroke_estimate_agreement"].items():
         assert agree >= 0.8, mod
-
-
-@pytest.mark.slow
-def test_seal_scenario(tmp_path, shared_dir):
-    m = _run("pneumatic_seal_friction", tmp_path)
-    assert m["pressure_coefficient_N_per_Pa"] > 0

@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 
 from heavecomp.errors import DataError
-from heavecomp.identification.seal import BAR, BORE_AREA, SealFrictionFit, SealRecord, load_seal_csv
+from heavecomp.identification.seal import (BAR, BORE_AREA, METHOD_VARIANTS, SealFrictionFit, SealRecord,
+                                          load_seal_csv, velocity, velocity_fir)
 
 ROOT = __import__("pathlib").Path(__file__).resolve().parents[1]
 FILES = ("O-ring_1bar.csv", "O-ring_3bar.csv", "O-ring_5bar.csv", "O-ring_7bar.csv")
@@ -74,6 +75,39 @@ def test_planted_cp_recovered():
     assert abs(fit.fits_["split"]["C_0"]) * BAR < 0.05                 # no direction asymmetry planted
 
 
+def test_fir_and_slope_velocity_agree_on_a_jittered_clock():
+    """Paper B's FIR derivative (after resampling) and the +-0.1 s slope both give the stroke
+    speed mid-stroke on a logger clock with jitter, as the O-ring files have."""
+    rng = np.random.default_rng(1)
+    t = np.cumsum(0.01 + 0.002 * rng.random(6000))
+    speed, half = 0.012, 3.0                                   # 12 mm/s, 3 s per stroke
+    phase = (t % (2 * half)) / half
+    x = speed * half * np.where(phase < 1, phase, 2 - phase)
+    mid = np.abs((t % half) - 0.5 * half) < 0.15 * half         # > 1 s from the reversals (the 2 Hz FIR rings)
+    mid &= (t > 1.0) & (t < t[-1] - 1.0)
+    for v in (velocity(t, x), velocity_fir(t, x)):
+        assert np.nanmax(np.abs(np.abs(v[mid]) - speed)) < 0.02 * speed
+
+
+def test_analysis_choices_move_cp_less_than_its_uncertainty(records, seal_fit):
+    """The one seal study reports how far its analysis choices move C_p; on the O-ring files each
+    (and paper B's measurement with all of them) stays well inside the uncertainty, and the
+    5 mm/s threshold fragments the slow strokes (why 2 mm/s is the headline's)."""
+    from heavecomp.identification.study import method_sensitivity
+
+    sens = method_sensitivity(records, seal_fit)
+    assert list(sens) == list(METHOD_VARIANTS)
+    head = sens[next(iter(METHOD_VARIANTS))]
+    assert head["C_p_split_N_per_bar"] == pytest.approx(seal_fit.C_p_ * BAR, rel=1e-12)
+    assert head["n_strokes"] == 80
+    for label, v in sens.items():
+        assert abs(v["change_in_uncertainties"]) < 0.5, label
+        assert v["C_p_split_N_per_bar"] != head["C_p_split_N_per_bar"] or v is head, label   # the choice acts
+    paper_b = sens[list(METHOD_VARIANTS)[-1]]
+    assert paper_b["settings"]["velocity"] == "fir" and paper_b["settings"]["statistic"] == "median"
+    assert sens["speed > 5 mm/s"]["n_strokes"] > 90
+
+
 def test_bad_seal_file_names_row_and_column(tmp_path):
     good = "0.000\t3.476\t0.498\t1.069\t-0.009\t0.996\t49.749\n"
     p = tmp_path / "short.csv"
@@ -97,3 +131,5 @@ def test_seal_scenario_quick(tmp_path):
     assert f7["friction_negative_N"] < f1["friction_negative_N"]
     assert m["paper_a"]["scaled_to_bore_N_per_bar"] == pytest.approx(200 * 0.025 / 0.72)
     assert (tmp_path / "friction_vs_pressure.png").stat().st_size > 1000
+    assert (tmp_path / "friction_vs_velocity.png").stat().st_size > 1000
+    assert set(m["method_sensitivity"]) == set(METHOD_VARIANTS)

@@ -48,22 +48,8 @@ def test_bad_time_column_is_named():
 
 def test_friction_recovered_from_synthetic_pneumatic_measurement():
     """Plant with known three-regime friction, 12.5 um encoder, 200 Pa pressure noise."""
-    from heavecomp.analysis.pneumatic_friction import synthetic_validation
+    from heavecomp.pneumatic.measurement import synthetic_validation
 
     r = synthetic_validation(duration=2.5)
     assert r["rms_error_N"] < 0.02 * r["friction_span_N"]
     assert r["velocity_rms_error"] < 1e-3  # m/s, vs u_0 = 30 mm/s
-
-
-def test_seal_friction_files(shared_dir):
-    from heavecomp.analysis.pneumatic_friction import seal_summary
-
-    s = seal_summary(shared_dir / "data" / "seal-friction")
-    rows = s["rows"]
-    assert len(rows) == 4
-    for r in rows:
-        assert r["friction_pos_N"] > 0 > r["friction_neg_N"]  # friction opposes the measured velocity
-        assert 3e-3 < r["speed_m_s"] < 2e-2                  # strokes at ~13 mm/s (data README)
-    fc = [r["coulomb_N"] for r in rows]
-    assert fc == sorted(fc)                                    # grows with pressure
-    assert s["pressure_coefficient_N_per_Pa"] > 0

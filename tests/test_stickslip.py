@@ -5,9 +5,9 @@ import math
 import numpy as np
 import pytest
 
-from heavecomp.analysis import pneumatic_linear as PL
-from heavecomp.analysis import stickslip as SS
-from heavecomp.plants import pneumatic as pn
+from heavecomp.pneumatic import linear as PL
+from heavecomp.pneumatic import stickslip as SS
+from heavecomp.pneumatic import plant as pn
 
 
 def test_critical_curve_limits():
@@ -103,11 +103,12 @@ def test_influence_directions_of_paper_b_fig6():
 
 
 def test_cmc_zero_stroke_below_the_breakout_amplitude():
+    from heavecomp.analysis.stick_map import cmc_breakout_amplitude, cmc_stick_map
     from heavecomp.params import paper_a
 
     p = paper_a()
-    a0 = SS.cmc_breakout_amplitude(p, 12.0, "stribeck")
-    m = SS.cmc_stick_map(p, [0.5 * a0, 2.0 * a0], [12.0], ("stribeck",), n_periods=1.0)
+    a0 = cmc_breakout_amplitude(p, 12.0, "stribeck")
+    m = cmc_stick_map(p, [0.5 * a0, 2.0 * a0], [12.0], ("stribeck",), n_periods=1.0)
     sf = m["stribeck"]["stick_fraction"][0]
     assert sf[0] == pytest.approx(1.0)
     assert sf[1] < 0.95
@@ -122,3 +123,55 @@ def test_cli_bad_input_exits_2(capsys):
     assert err == "heavecomp stickslip: error: --map must be a grid size between 2 and 200, got 1"
     assert main(["stickslip", "nonexistent.toml"]) == 2
     assert "nonexistent.toml: no such parameter file" in capsys.readouterr().err
+
+
+def _by_imag(ev):
+    ev = np.asarray(ev, dtype=complex)
+    return ev[np.lexsort((ev.real, ev.imag))]
+
+
+def test_pneumatic_linearisation_is_a_named_statespace_with_the_closed_form_poles():
+    """issue 13: the pneumatic linearisation as a python-control StateSpace; its poles are the
+    roots of s^2 + 2 zeta* omega_n s + omega_n^2 (closed form) and, in the full convention,
+    the eigenvalues of the casadi Jacobian of the plant's own functions."""
+    import control as ct
+
+    p = pn.default()
+    for q in (p, p.replace(exhaust_area=2e-6, supply_pressure=0.15e6)):   # choked and unchoked exhaust
+        for conv in ("paper", "full"):
+            lin = PL.linearise(q, convention=conv)
+            sys = lin.sys
+            assert isinstance(sys, ct.StateSpace)
+            assert sys.state_labels == ["velocity", "pressure_b"]
+            assert sys.input_labels == ["force"] and sys.output_labels == ["velocity", "pressure_b"]
+            wn, z = lin.omega_n, lin.zeta
+            closed = _by_imag(np.roots([1.0, 2 * z * wn, wn * wn]))
+            np.testing.assert_allclose(_by_imag(sys.poles()), closed, rtol=1e-9)
+            np.testing.assert_allclose(_by_imag(lin.poles()), closed, rtol=1e-9)
+            (w_mode, z_mode), = lin.modes()                                 # one oscillatory mode
+            assert w_mode == pytest.approx(wn, rel=1e-9) and z_mode == pytest.approx(z, rel=1e-9)
+            if conv == "full":
+                J = PL.casadi_jacobian(q)
+                np.testing.assert_allclose(_by_imag(sys.poles()), _by_imag(np.linalg.eigvals(J)), rtol=1e-7)
+            # a steady extra force F speeds the piston up by F a / (A b + a c) = F a / (M omega_n^2)
+            dc = np.asarray(ct.dcgain(sys)).reshape(2)
+            assert dc[0] == pytest.approx(lin.a / (q.mass * wn * wn), rel=1e-9)
+            assert dc[1] == pytest.approx(lin.b * dc[0] / lin.a, rel=1e-9)   # dp = b w / a
+
+
+def test_linear_model_modes_of_the_cmc():
+    """The CMC's Linearisation is the same LinearModel: its modes are the 2-DOF eigenfrequencies."""
+    from heavecomp.analysis.linear import LinearModel, linearise_details
+    from heavecomp.params import paper_a
+
+    pa = paper_a()
+    lin = linearise_details(pa, friction="none")
+    assert isinstance(lin, LinearModel) and isinstance(PL.linearise(pn.default()), LinearModel)
+    c, ds, fo = pa.compensator, pa.drill_string, pa.formation
+    M = np.diag([c.moving_mass, ds.lower_mass])
+    K = np.array([[c.gas_stiffness + ds.stiffness, -ds.stiffness], [-ds.stiffness, ds.stiffness + fo.stiffness]])
+    w_undamped = np.sqrt(np.sort(np.linalg.eigvals(np.linalg.solve(M, K)).real))
+    modes = lin.modes()
+    assert [w for w, _ in modes] == sorted(w for w, _ in modes)
+    lightly = [w for w, z in modes if abs(z) < 0.3]
+    np.testing.assert_allclose(lightly, w_undamped, rtol=0.05)

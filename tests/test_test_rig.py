@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from heavecomp.plants import test_rig as TR
+from heavecomp.test_rig import plant as TR
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -1,9 +1,9 @@
 """Benchmark: 40 x 40 grid of nonlinear pneumatic stick-slip simulations (paper B map).
 
 heavecomp: exact stick-slip RK4 stepper compiled by numba, grid run with numba prange
-(``heavecomp.analysis.stickslip.grid_map``).  Peer: ``scipy.integrate.solve_ivp``
+(``heavecomp.pneumatic.stickslip.grid_map``).  Peer: ``scipy.integrate.solve_ivp``
 (LSODA) on the same plant equations (the same Python functions of
-``heavecomp.plants.pneumatic``) with the friction regularised, ``tanh(v/eps)``
+``heavecomp.pneumatic.plant``) with the friction regularised, ``tanh(v/eps)``
 times the accelerating branch from F_s1, eps = 1e-4 m/s — the usual way to
 simulate stick-slip without an event-driven stepper.  The peer runs on a
 sub-grid (every 8th point in each direction, 25 runs) and its time per run is
@@ -26,8 +26,8 @@ import numpy as np
 def peer_run(q, state, t_end, eps=1e-4):
     from scipy.integrate import solve_ivp
 
-    from heavecomp.friction.three_regime import smooth_friction
-    from heavecomp.plants import pneumatic as pn
+    from heavecomp.pneumatic.friction import smooth_friction
+    from heavecomp.pneumatic import plant as pn
 
     PP, FPB = q.plant_vector(), q.friction.FPB
     peak = q.stick_static_force
@@ -50,9 +50,9 @@ def main(argv=None) -> int:
     ap.add_argument("--n", type=int, default=40)
     ap.add_argument("--peer-stride", type=int, default=8)
     args = ap.parse_args(argv)
-    from heavecomp.analysis import pneumatic_linear as PL
-    from heavecomp.analysis import stickslip as SS
-    from heavecomp.plants import pneumatic as pn
+    from heavecomp.pneumatic import linear as PL
+    from heavecomp.pneumatic import stickslip as SS
+    from heavecomp.pneumatic import plant as pn
 
     p = pn.default()
     xs, ys = np.geomspace(8.0, 250.0, args.n), np.geomspace(1.0, 120.0, args.n)

@@ -107,8 +107,33 @@ class OperatingPoint:
         return d
 
 
+class LinearModel:
+    """A plant linearised about an operating point: the one linear-model abstraction.
+
+    Every linearisation in the package (the CMC's :class:`Linearisation`, paper B's
+    cylinder :class:`heavecomp.pneumatic.linear.Linearisation`) carries ``sys``, a
+    ``control.StateSpace`` with named states, inputs and outputs (deviations from the
+    operating point); the quantities every user derives from a linear model come from it
+    here, once.
+    """
+
+    sys: object
+
+    def poles(self) -> np.ndarray:
+        """Eigenvalues of the state matrix [1/s], sorted by modulus (then imaginary part)."""
+        ev = np.linalg.eigvals(np.asarray(self.sys.A, dtype=float))
+        return ev[np.lexsort((ev.imag, np.abs(ev)))]
+
+    def modes(self) -> list[tuple[float, float]]:
+        """``(omega_n [rad/s], zeta [-])`` of each mode, slowest first; a complex pair counts
+        once, a real pole is a mode with zeta = 1 (stable) or -1 (unstable)."""
+        out = [(float(abs(p)), float(-p.real / abs(p)) if abs(p) > 0 else 1.0)
+               for p in self.poles() if p.imag >= 0]
+        return sorted(out)
+
+
 @dataclasses.dataclass(frozen=True)
-class Linearisation:
+class Linearisation(LinearModel):
     """Full result of :func:`linearise_details`.
 
     Attributes

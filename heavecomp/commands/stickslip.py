@@ -26,10 +26,10 @@ def run(args) -> int:
 
     import numpy as np
 
-    from heavecomp.analysis import pneumatic_linear as PL
-    from heavecomp.analysis import stickslip as SS
+    from heavecomp.pneumatic import linear as PL
+    from heavecomp.pneumatic import stickslip as SS
     from heavecomp.errors import InputError, ParameterError
-    from heavecomp.plants import pneumatic as pn
+    from heavecomp.pneumatic import plant as pn
 
     if args.params == "default":
         p = pn.default()
@@ -56,7 +56,7 @@ def run(args) -> int:
     if out:
         out.mkdir(parents=True, exist_ok=True)
     if args.duration is not None:
-        from heavecomp.analysis import pneumatic_sim as PS
+        from heavecomp.pneumatic import stepper as PS
 
         r = PS.simulate(p, args.duration, rate=1000.0)
         m["simulation"] = r["stats"]

@@ -17,6 +17,12 @@ maximal runs of one velocity sign above ``v_min``; the first and last
 stroke is summarised by its mean friction and pressure, so that the least-squares
 fit works on (nearly) independent points.  A bootstrap over strokes, stratified
 by file, gives a robust uncertainty.
+
+The velocity is either the slope over +-0.1 s (default) or paper B's measurement
+(``velocity="fir"``: resampled to 100 Hz, differentiated through a 2 Hz zero-phase
+FIR, :func:`heavecomp.signals.differentiate`); the stroke summary is the mean or the
+median.  :data:`METHOD_VARIANTS` are the analysis choices whose effect on C_p the
+study reports (the single seal study: this module + :func:`heavecomp.identification.study.seal_study`).
 """
 
 from __future__ import annotations
@@ -30,6 +36,7 @@ import numpy as np
 
 from heavecomp.errors import DataError, ParameterError
 from heavecomp.identification.inverse import least_squares
+from heavecomp.signals import differentiate
 
 log = logging.getLogger(__name__)
 
@@ -108,15 +115,49 @@ def velocity(t, x, half_window: int = 10, max_span: float = 0.5) -> np.ndarray:
     return v
 
 
+def velocity_fir(t, x, fs: float = 100.0, cutoff: float = 2.0) -> np.ndarray:
+    """Velocity [m/s] by paper B's method: ``x`` resampled to ``fs`` [Hz] by linear
+    interpolation (the logger clock has jitter and gaps), differentiated through a
+    zero-phase FIR low-pass of ``cutoff`` [Hz], interpolated back onto ``t``."""
+    tu = np.arange(t[0], t[-1], 1.0 / fs)
+    _, vu = differentiate(tu, np.interp(tu, t, x), cutoff, order=1, name="position [mm]")
+    return np.interp(t, tu, vu)
+
+
+#: velocity estimators of :func:`strokes`
+VELOCITY_METHODS = {"slope": velocity, "fir": velocity_fir}
+#: stroke summaries of :func:`strokes`
+STATISTICS = {"mean": np.mean, "median": np.median}
+#: analysis choices whose effect on C_p the seal study reports: label -> SealFrictionFit settings
+#: (changed from the defaults one at a time, then all four of paper B's friction measurement at once)
+METHOD_VARIANTS = {
+    "headline: slope over +-0.1 s, speed > 2 mm/s, 20 % trim, stroke mean": {},
+    "velocity by paper B's 2 Hz zero-phase FIR": {"velocity": "fir"},
+    "speed > 5 mm/s": {"v_min": 5e-3},
+    "no trim": {"trim": 0.0},
+    "stroke median": {"statistic": "median"},
+    "paper B's measurement: FIR, speed > 5 mm/s, no trim, median": {"velocity": "fir", "v_min": 5e-3, "trim": 0.0,
+                                                                   "statistic": "median"},
+}
+
+
 def strokes(rec: SealRecord, v_min: float = 2e-3, trim: float = 0.2, min_samples: int = 40,
-            area: float = BORE_AREA) -> list[dict]:
+            area: float = BORE_AREA, velocity: str = "slope", statistic: str = "mean") -> list[dict]:
     """Steady-sliding strokes of one file.
 
-    Returns a list of dicts: ``direction`` (+1/-1), ``friction`` mean [N], ``dp`` mean
-    gauge pressure [Pa], ``speed`` mean |v| [m/s], ``n`` samples kept, ``t0``, ``t1`` [s],
-    ``std`` of the friction within the stroke [N], ``file``.
+    ``velocity`` names the estimator (:data:`VELOCITY_METHODS`), ``statistic`` the
+    stroke summary of friction and pressure (:data:`STATISTICS`).
+
+    Returns a list of dicts: ``direction`` (+1/-1), ``friction`` [N], ``dp`` gauge
+    pressure [Pa] (the stroke's mean or median), ``speed`` mean |v| [m/s], ``n`` samples
+    kept, ``t0``, ``t1`` [s], ``std`` of the friction within the stroke [N], ``file``.
     """
-    v = velocity(rec.t, rec.x)
+    if velocity not in VELOCITY_METHODS:
+        raise ParameterError(f"velocity = {velocity!r}: must be one of {', '.join(VELOCITY_METHODS)}")
+    if statistic not in STATISTICS:
+        raise ParameterError(f"statistic = {statistic!r}: must be one of {', '.join(STATISTICS)}")
+    stat = STATISTICS[statistic]
+    v = VELOCITY_METHODS[velocity](rec.t, rec.x)
     f = rec.friction(area)
     s = np.where(np.abs(v) > v_min, np.sign(v), 0.0)
     s[~np.isfinite(v)] = 0.0
@@ -133,8 +174,8 @@ def strokes(rec: SealRecord, v_min: float = 2e-3, trim: float = 0.2, min_samples
         lo, hi = i + int(trim * m), j - int(trim * m)
         if hi - lo >= min_samples:
             sl = slice(lo, hi)
-            out.append({"direction": int(s[i]), "friction": float(f[sl].mean()), "std": float(f[sl].std()),
-                        "dp": float(rec.p[sl].mean()), "speed": float(np.abs(v[sl]).mean()),
+            out.append({"direction": int(s[i]), "friction": float(stat(f[sl])), "std": float(f[sl].std()),
+                        "dp": float(stat(rec.p[sl])), "speed": float(np.abs(v[sl]).mean()),
                         "n": hi - lo, "t0": float(rec.t[lo]), "t1": float(rec.t[hi - 1]), "file": rec.name})
         i = j
     return out
@@ -161,11 +202,16 @@ class SealFrictionFit:
     trim : float
         Fraction of each stroke dropped at either end (acceleration, reversal).
     n_boot : int
-        Bootstrap resamples over strokes (stratified by file).
+        Bootstrap resamples over strokes (stratified by file); 0 skips the bootstrap
+        (its fields are then None).
     seed : int
         Bootstrap random seed.
     area : float, m^2
         Piston area used in F_f = force - p A.
+    velocity : {"slope", "fir"}
+        Velocity estimator (:data:`VELOCITY_METHODS`).
+    statistic : {"mean", "median"}
+        Stroke summary (:data:`STATISTICS`).
 
     Attributes
     ----------
@@ -190,13 +236,15 @@ class SealFrictionFit:
     """
 
     def __init__(self, v_min: float = 2e-3, trim: float = 0.2, n_boot: int = 2000, seed: int = 0,
-                 area: float = BORE_AREA):
+                 area: float = BORE_AREA, velocity: str = "slope", statistic: str = "mean"):
         self.v_min, self.trim, self.n_boot, self.seed, self.area = v_min, trim, n_boot, seed, area
+        self.velocity, self.statistic = velocity, statistic
 
     def fit(self, records) -> "SealFrictionFit":
         rows = []
         for rec in records:
-            got = strokes(rec, self.v_min, self.trim, area=self.area)
+            got = strokes(rec, self.v_min, self.trim, area=self.area, velocity=self.velocity,
+                          statistic=self.statistic)
             if not got:
                 raise DataError(f"{rec.name}: no steady stroke faster than v_min = {self.v_min * 1e3:g} mm/s")
             rows += got
@@ -221,9 +269,10 @@ class SealFrictionFit:
             boot = np.asarray(boot)
             fit = {"F_C": float(res.theta[0]), "C_p": float(res.theta[1]),
                    "F_C_se": float(res.stderr[0]), "C_p_se": float(res.stderr[1]),
-                   "F_C_boot": float(boot[:, 0].std(ddof=1)), "C_p_boot": float(boot[:, 1].std(ddof=1)),
-                   "C_p_ci95": [float(x) for x in np.percentile(boot[:, 1], [2.5, 97.5])],
-                   "rms": res.rms, "n_strokes": len(sub)}
+                   "F_C_boot": None, "C_p_boot": None, "C_p_ci95": None, "rms": res.rms, "n_strokes": len(sub)}
+            if self.n_boot > 1:
+                fit.update({"F_C_boot": float(boot[:, 0].std(ddof=1)), "C_p_boot": float(boot[:, 1].std(ddof=1)),
+                            "C_p_ci95": [float(x) for x in np.percentile(boot[:, 1], [2.5, 97.5])]})
             if model == "split":
                 fit.update({"F_0": float(res.theta[2]), "C_0": float(res.theta[3]),
                             "F_0_se": float(res.stderr[2]), "C_0_se": float(res.stderr[3])})
@@ -245,7 +294,7 @@ class SealFrictionFit:
                                         "rms": res.rms, "n_strokes": len(rows), "n_files": len(yf)}
         self.C_p_ = self.fits_["split"]["C_p"]
         self.F_C_ = self.fits_["split"]["F_C"]
-        self.C_p_se_ = max(self.fits_["split"]["C_p_boot"],
+        self.C_p_se_ = max(self.fits_["split"]["C_p_boot"] or 0.0,
                            self.fits_.get("file_means", {}).get("C_p_se", 0.0))
         log.info("seal friction: C_p = %.3f +- %.3f N/bar over %d strokes", self.C_p_ * BAR,
                  self.C_p_se_ * BAR, len(rows))

@@ -9,7 +9,7 @@ import numpy as np
 
 from heavecomp.identification.inverse import AxisRegression, InverseModelLS, cutoff_sensitivity
 from heavecomp.identification.residual import ResidualDiagnoser
-from heavecomp.identification.seal import BAR, BORE_DIAMETER, SealFrictionFit, scale_by_circumference
+from heavecomp.identification.seal import BAR, BORE_DIAMETER, METHOD_VARIANTS, SealFrictionFit, scale_by_circumference
 from heavecomp.plants.axis import BASE_NAMES, EMPS_PUBLISHED
 
 #: Paper A main-cylinder friction: C_p = 200 N/bar for a 0.72 m plunger.
@@ -70,8 +70,30 @@ def emps_study(record, cutoff: float = 50.0, order: int = 4, decimate: int = 10,
     return {"metrics": metrics, "estimator": est, "diagnoser": diag, "sensitivity": sens}
 
 
+def method_sensitivity(records, fit: SealFrictionFit, variants=None) -> dict:
+    """C_p of the ``split`` and ``file_means`` fits when the analysis choices of ``fit`` are
+    changed as :data:`~heavecomp.identification.seal.METHOD_VARIANTS` lists (no bootstrap).
+
+    Returns {label: {"settings": dict, "C_p_split_N_per_bar", "C_p_file_means_N_per_bar" (None
+    with fewer than 3 files),
+    "n_strokes", "change_in_uncertainties": (C_p_split - C_p of ``fit``) / its uncertainty}}.
+    """
+    base = {"v_min": fit.v_min, "trim": fit.trim, "area": fit.area, "velocity": fit.velocity,
+            "statistic": fit.statistic}
+    out = {}
+    for label, change in (METHOD_VARIANTS if variants is None else variants).items():
+        f = SealFrictionFit(n_boot=0, **{**base, **change}).fit(records)
+        out[label] = {"settings": {**base, **change},
+                      "C_p_split_N_per_bar": f.fits_["split"]["C_p"] * BAR,
+                      "C_p_file_means_N_per_bar": f.fits_["file_means"]["C_p"] * BAR if "file_means" in f.fits_ else None,
+                      "n_strokes": len(f.strokes_),
+                      "change_in_uncertainties": (f.C_p_ - fit.C_p_) / fit.C_p_se_}
+    return out
+
+
 def seal_study(records, n_boot: int = 2000, seed: int = 0, fit: SealFrictionFit | None = None) -> dict:
-    """Fit F_C + C_p dp over the O-ring files; compare with paper A scaled by circumference.
+    """Fit F_C + C_p dp over the O-ring files; how much the analysis choices move C_p
+    (:func:`method_sensitivity`); compare with paper A scaled by circumference.
 
     Returns ``{"metrics": dict, "fit": SealFrictionFit}``; pass ``fit`` (unfitted) to
     change its settings.
@@ -95,13 +117,16 @@ def seal_study(records, n_boot: int = 2000, seed: int = 0, fit: SealFrictionFit 
     scaled = scale_by_circumference(PAPER_A_CP, PAPER_A_DIAMETER, BORE_DIAMETER)
     metrics = {
         "settings": {"v_min_m_s": fit.v_min, "trim": fit.trim, "n_boot": fit.n_boot, "area_m2": fit.area,
-                     "velocity": "slope over +-10 samples (0.2 s)"},
+                     "velocity": {"slope": "slope over +-10 samples (0.2 s)",
+                                  "fir": "paper B: 100 Hz resampling, 2 Hz zero-phase FIR derivative"}[fit.velocity],
+                     "statistic": fit.statistic},
         "files": per_file,
         "fits": fits,
         "C_p_N_per_Pa": fit.C_p_, "C_p_uncertainty_N_per_Pa": fit.C_p_se_,
         "C_p_N_per_bar": fit.C_p_ * BAR, "C_p_uncertainty_N_per_bar": fit.C_p_se_ * BAR,
         "F_C_N": fit.F_C_,
         "headline_fit": "split",
+        "method_sensitivity": method_sensitivity(records, fit),
         "paper_a": {"C_p_N_per_bar": PAPER_A_CP * BAR, "plunger_diameter_m": PAPER_A_DIAMETER,
                     "scaled_to_bore_N_per_bar": scaled * BAR,
                     "ratio_measured_to_scaled": fit.C_p_ / scaled if scaled else math.nan},

@@ -4,7 +4,7 @@ Paper B's assumptions (section "Analysis of occurrence conditions"): the
 charging-side pressure stays at P_s (the meter-out restriction dominates); the
 discharge side is linearised about its equilibrium (u_0, P_be); temperature
 effects on the mass flow are neglected.  Small deviations ``w = v - u_0``,
-``p = P_b - P_be`` then obey (module :mod:`heavecomp.plants.pneumatic`)::
+``p = P_b - P_be`` then obey (module :mod:`heavecomp.pneumatic.plant`)::
 
     M dw/dt = -A p - c w                      c = dF/dv at u_0 (decelerating branch; = C in EHDL)
     dp/dt   =  b w - a p                      b = kappa P_be A / V_b
@@ -38,15 +38,31 @@ import math
 
 import numpy as np
 
+from heavecomp.analysis.linear import LinearModel
 from heavecomp.errors import InputError, ParameterError
-from heavecomp.plants.pneumatic import (casadi_discharge_model, chamber_volumes, critical_ratio,
-                                        equilibrium, LAMINAR_RATIO)
+from heavecomp.pneumatic.plant import (LAMINAR_RATIO, casadi_discharge_model, chamber_volumes, critical_ratio,
+                                       equilibrium)
 from heavecomp.plants.symbolic import casadi
 
 
+#: named signals of :attr:`Linearisation.sys` (deviations from the equilibrium)
+STATES = ("velocity", "pressure_b")
+INPUTS = ("force",)
+OUTPUTS = ("velocity", "pressure_b")
+
+
 @dataclasses.dataclass(frozen=True)
-class Linearisation:
-    """Result of :func:`linearise` (SI units)."""
+class Linearisation(LinearModel):
+    """Result of :func:`linearise` (SI units).
+
+    ``sys`` is the linear model as a ``control.StateSpace``: states and outputs
+    ``velocity`` w = v - u_0 [m/s] and ``pressure_b`` p = P_b - P_be [Pa], input
+    ``force`` [N], an external force on the piston in the direction of motion::
+
+        M dw/dt = -A p - c w + force,    dp/dt = b w - a p
+
+    Its poles are the roots of ``s^2 + 2 zeta* omega_n s + omega_n^2``.
+    """
 
     u0: float            #: equilibrium velocity [m/s]
     pb_eq: float         #: equilibrium discharge pressure [Pa abs]
@@ -60,14 +76,16 @@ class Linearisation:
     D: float             #: dimensionless friction drop D* [-]
     T_f: float           #: isothermal natural period / 2 pi [s]
     convention: str
+    sys: object = dataclasses.field(repr=False, compare=False)  #: control.StateSpace (see above)
 
     @property
     def A(self) -> np.ndarray:
-        """State matrix of (w, p)."""
-        return self._A
+        """State matrix of (w, p) [1/s, m/(s^2 Pa); Pa/m, 1/s]."""
+        return np.asarray(self.sys.A, dtype=float)
 
     def as_dict(self) -> dict:
-        return {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
+        """The scalars (JSON-ready); the state-space model is left out."""
+        return {f.name: getattr(self, f.name) for f in dataclasses.fields(self) if f.name != "sys"}
 
 
 def discharge_conductance(p, Pb: float) -> float:
@@ -101,7 +119,15 @@ def linearise(p, position: float | None = None, convention: str = "paper") -> Li
         Piston position (sets V_b); default a quarter of the stroke.
     convention : {"paper", "full"}
         Neglect (paper B) or keep the volume-change term in ``a``.
+
+    Returns
+    -------
+    Linearisation
+        The scalars of the module docstring and ``sys``, the model as a named
+        ``control.StateSpace``.
     """
+    import control as ct
+
     if convention not in ("paper", "full"):
         raise InputError(f"convention must be 'paper' or 'full', got {convention!r}")
     x = 0.25 * p.stroke if position is None else float(position)
@@ -119,9 +145,9 @@ def linearise(p, position: float | None = None, convention: str = "paper") -> Li
     F_eq = A * (p.supply_abs - Pb)
     D = (p.stick_static_force - (F_eq - c * u0)) / (M * u0 * wn)
     T_f = math.sqrt(M * Vb / (Pb * A * A))
-    lin = Linearisation(*(float(v) for v in (u0, Pb, x, a, b, c, g, wn, zeta, D, T_f)), convention)
-    object.__setattr__(lin, "_A", np.array([[-c / M, -A / M], [b, -a]]))
-    return lin
+    sys = ct.ss(np.array([[-c / M, -A / M], [b, -a]]), np.array([[1.0 / M], [0.0]]), np.eye(2), np.zeros((2, 1)),
+                states=list(STATES), inputs=list(INPUTS), outputs=list(OUTPUTS), name=f"pneumatic_linear_{convention}")
+    return Linearisation(*(float(v) for v in (u0, Pb, x, a, b, c, g, wn, zeta, D, T_f)), convention, sys)
 
 
 def casadi_jacobian(p, position: float | None = None) -> np.ndarray:

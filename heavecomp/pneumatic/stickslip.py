@@ -1,4 +1,5 @@
-"""Stick-slip occurrence: paper B's critical curve, maps, minimum velocity, and the CMC's stick map.
+"""Stick-slip occurrence: paper B's critical curve, maps, minimum velocity (the CMC's stick map is
+:mod:`heavecomp.analysis.stick_map`).
 
 Critical curve (paper B eqs. 13-14, re-derived because the OCR lost them)
 -------------------------------------------------------------------------
@@ -29,10 +30,9 @@ import math
 
 import numpy as np
 
-from heavecomp.analysis import pneumatic_linear as PL
-from heavecomp.friction.laws import FrictionLaw
-from heavecomp.plants.pneumatic import equilibrium
-from heavecomp.simulate import simulate
+from heavecomp.pneumatic import linear as PL
+from heavecomp.pneumatic import stepper as PS
+from heavecomp.pneumatic.plant import equilibrium
 
 log = logging.getLogger(__name__)
 
@@ -101,7 +101,6 @@ def window(lin, periods: float = 8.0) -> float:
 
 def nonlinear_sticks(p, position=None, periods: float = 8.0) -> bool:
     """Does the nonlinear plant stick again after a restart (exact stick-slip simulation)?"""
-    from heavecomp.analysis import pneumatic_sim as PS
 
     lin = PL.linearise(p, position)
     res = PS.simulate(p, window(lin, periods), state=restart_state(p, position), moved=True, stop_at_stick=True,
@@ -126,14 +125,13 @@ def grid_map(p, var_x: str, xs, var_y: str, ys, *, convention: str = "paper", po
     xs, ys : arrays
         Values (SI).
     convention : {"paper", "full"}
-        Linearisation convention (see :mod:`heavecomp.analysis.pneumatic_linear`).
+        Linearisation convention (see :mod:`heavecomp.pneumatic.linear`).
 
     Returns
     -------
     dict with arrays (len(ys), len(xs)): ``zeta``, ``D``, ``u0``, ``linear`` (bool),
     ``nonlinear`` (bool), ``agree`` and the scalar ``agreement`` (fraction alike).
     """
-    from heavecomp.analysis import pneumatic_sim as PS
 
     xs, ys = np.asarray(xs, float), np.asarray(ys, float)
     ny, nx = ys.size, xs.size
@@ -190,6 +188,7 @@ def minimum_velocity(p, *, convention: str = "paper", position=None, nonlinear: 
     """
     from scipy.optimize import brentq
 
+
     def margin(logS):
         lin = PL.linearise(p.replace(exhaust_area=float(math.exp(logS))), position, convention)
         return lin.D - critical_D(lin.zeta)
@@ -235,6 +234,7 @@ def influence(p, factors=(0.5, 0.71, 1.0, 1.41, 2.0), *, convention: str = "pape
     The linearisation position scales with the stroke (``position_fraction * L``).
     Returns {variable: {"factor": [...], "zeta": [...], "D": [...], "stick_slip": [...]}}.
     """
+
     res = {}
     drop0 = p.stick_static_force - p.coulomb_force
     for var in INFLUENCE_VARIABLES:
@@ -249,63 +249,3 @@ def influence(p, factors=(0.5, 0.71, 1.0, 1.41, 2.0), *, convention: str = "pape
             rows["stick_slip"].append(bool(predicts_stick_slip(lin.zeta, lin.D)))
         res[var] = rows
     return res
-
-
-# ----------------------------------------------------------------------------------------------
-# the CMC main cylinder through the same lens
-# ----------------------------------------------------------------------------------------------
-def cmc_stick_map(params, amplitudes, periods, models=("stribeck", "rotating_eq6", "rotating_eq7"), *,
-                  n_periods: float = 4.0, rate: float = 10.0, tangential_velocity: float = 0.05) -> dict:
-    """Stick fraction, stick count and mean stick duration of the CMC main cylinder over
-    heave amplitude x period, for each friction model (foundation simulator, exact stick).
-
-    Statistics are taken after the heave fade-in (``ramp`` = one period) over ``n_periods``.
-    ``tangential_velocity`` [m/s] is used for the rotating models when ``params``
-    has none (paper A: v_t = omega d / 2 ~ 0.05 m/s).
-    Returns {model: {"stick_fraction", "n_stick_per_period", "mean_stick_s", "stroke_p2p"}}
-    with arrays (len(periods), len(amplitudes)), plus the axes.
-    """
-    A, T = np.asarray(amplitudes, float), np.asarray(periods, float)
-    out = {"amplitudes": A, "periods": T}
-    for m in models:
-        sf = np.empty((T.size, A.size))
-        ns = np.empty_like(sf)
-        dur = np.empty_like(sf)
-        smax = np.empty_like(sf)
-        for i, per in enumerate(T):
-            for j, amp in enumerate(A):
-                fr = {"model": m}
-                if m.startswith("rotating") and params.friction.tangential_velocity is None:
-                    fr["tangential_velocity"] = tangential_velocity
-                q = params.replace(friction=fr,
-                                   heave={"kind": "sine", "amplitude": float(amp), "period": float(per),
-                                          "ramp": float(per)})
-                res = simulate(q, (n_periods + 1) * per, rate=rate)
-                met = res.metrics()
-                w = res.window()
-                stuck = res["stuck"][w] > 0.5
-                # stick episodes inside the window (rising edges)
-                starts = np.count_nonzero(np.diff(stuck.astype(int)) == 1) + int(stuck[0])
-                sf[i, j] = met["stick_fraction"]
-                ns[i, j] = starts / n_periods
-                dur[i, j] = (met["stick_fraction"] * n_periods * per / starts) if starts else \
-                    (n_periods * per if met["stick_fraction"] > 0.99 else 0.0)
-                smax[i, j] = np.ptp(res["stroke"][w])
-        out[m] = {"stick_fraction": sf, "n_stick_per_period": ns, "mean_stick_s": dur, "stroke_p2p": smax}
-    return out
-
-
-def cmc_breakout_amplitude(params, period: float, model: str = "stribeck") -> float:
-    """Heave amplitude [m] below which the main cylinder never breaks loose (zero stroke).
-
-    Quasi-static estimate: stuck, the rod holds the heave through the drill-string
-    and formation springs in series, so the holding force changes by ``k_s z_h`` with
-    ``1/k_s = 1/k_DS + 1/k_F`` (plus the inertia of the top mass, ``M_c omega^2 z_h``);
-    breakout when that exceeds the static limit at the operating pressure.
-    """
-    law = FrictionLaw.from_params(params.replace(friction={"model": model}).friction)
-    Fs = float(law.static_limit(params.p0))
-    ds, fo, c = params.drill_string, params.formation, params.compensator
-    ks = 1.0 / (1.0 / ds.stiffness + 1.0 / fo.stiffness)
-    w = 2 * math.pi / period
-    return Fs / abs(ks - c.moving_mass * w * w) if Fs > 0 else 0.0

@@ -8,10 +8,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from heavecomp.analysis import pneumatic_linear as PL
-from heavecomp.analysis.stickslip import critical_D
-from heavecomp.plants.test_rig import QUADRANTS
+from heavecomp.pneumatic import linear as PL
+from heavecomp.pneumatic.stickslip import critical_D
 from heavecomp.report.figures import _plt
+from heavecomp.test_rig.plant import QUADRANTS
+
 
 
 def plot_exp2(r, p, lin=None):

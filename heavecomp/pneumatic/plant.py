@@ -5,7 +5,7 @@ Chamber a (charging side) is fed from the supply ``P_s`` through a valve of
 effective area ``S_s``; chamber b (discharge side) exhausts to atmosphere
 through the speed-control valve of effective area ``S_e``.  A load mass ``M``
 rides on the piston; the seal friction is paper B's three-regime law
-(:mod:`heavecomp.friction.three_regime`).
+(:mod:`heavecomp.pneumatic.friction`).
 
 Equations (written once, scalar ``np.*``; numba and casadi use the same source)
 ---------------------------------------------------------------------------------
@@ -53,10 +53,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from heavecomp.params.core import from_table, q, to_table, dump_toml
-from heavecomp.errors import did_you_mean, ParameterError
-from heavecomp.friction.three_regime import branch_magnitude, ThreeRegimeFriction
+from heavecomp.errors import ParameterError, did_you_mean
+from heavecomp.params.core import dump_toml, from_table, q, to_table
 from heavecomp.plants.symbolic import casadi
+from heavecomp.pneumatic.friction import ThreeRegimeFriction, branch_magnitude
 
 #: layout of the plant parameter vector PP
 PP_NAMES = ("area", "stroke", "dead_volume_a", "dead_volume_b", "supply_abs", "atmosphere", "temperature",

@@ -1,7 +1,7 @@
 """Exact stick-slip simulation of paper B's pneumatic meter-out cylinder (numba).
 
-The physics is not restated: the plant (:mod:`heavecomp.plants.pneumatic`) and
-the friction (:mod:`heavecomp.friction.three_regime`) are compiled from their
+The physics is not restated: the plant (:mod:`heavecomp.pneumatic.plant`) and
+the friction (:mod:`heavecomp.pneumatic.friction`) are compiled from their
 own source with :func:`heavecomp.simulate._kernel._compile`.
 
 Scheme: classical RK4 on a fixed step ``h`` as a hybrid system.
@@ -24,8 +24,8 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
-from heavecomp.friction import three_regime as _fr
-from heavecomp.plants import pneumatic as _pn
+from heavecomp.pneumatic import friction as _fr
+from heavecomp.pneumatic import plant as _pn
 from heavecomp.simulate._kernel import _compile
 
 mixed_shape = _compile(_fr.mixed_shape)
