@@ -28,8 +28,9 @@ def run(args) -> int:
         if args.friction:
             params = params.replace(friction={"model": args.friction})
         header = f"checked copy of {args.source}"
-        print(f"{args.source}: valid (k_eff = {params.k_eff:.6g} N/m, p_0 = {params.p0:.6g} Pa, "
-              f"V_0 = {params.gas_volume:.4g} m^3)", file=sys.stderr)
+        if not getattr(args, "quiet", False):
+            print(f"{args.source}: valid (k_eff = {params.k_eff:.6g} N/m, p_0 = {params.p0:.6g} Pa, "
+                  f"V_0 = {params.gas_volume:.4g} m^3)", file=sys.stderr)
     else:
         raise ParameterError(f"{args.source}: not a built-in set nor a file{did_you_mean(args.source, SETS)}; "
                              f"built-in sets: {', '.join(SETS)}")

@@ -46,8 +46,9 @@ def run(args) -> int:
     except BaseException:
         figure.cancel()
         raise
+    big = res.data.shape[0] > 200_000  # a bar only where writing takes a noticeable time
     m = write_outputs(res, args.out, title=f"WOB — {Path(args.params).name}, friction: {params.friction.model}",
-                      figure=figure)
+                      figure=figure, progress=Progress("writing timeseries.csv") if big else None)
     print(f"WOB mean {m['wob_mean'] / 1e3:.2f} kN, std {m['wob_std'] / 1e3:.2f} kN, "
           f"peak-to-peak {m['wob_p2p'] / 1e3:.2f} kN, stuck {100 * m['stick_fraction']:.1f} % of the time "
           f"-> {args.out}")

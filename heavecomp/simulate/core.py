@@ -64,16 +64,25 @@ def default_dt(params, rate: float | None = None) -> float:
     return h
 
 
-def write_csv(path, data: np.ndarray, columns, fmt: str = "%.10g", block: int = 8192) -> Path:
-    """CSV with a header row; formats whole blocks of rows at once (~2x np.savetxt)."""
+def write_csv(path, data: np.ndarray, columns, fmt: str = "%.10g", block: int = 8192,
+              progress: Callable[[float], None] | None = None) -> Path:
+    """CSV with a header row; formats whole blocks of rows at once (~2x np.savetxt).
+
+    ``progress(fraction)`` is called after each block (the CLI draws a bar for large files).
+    """
     path = Path(path)
     ncol = data.shape[1]
+    n = data.shape[0]
     row = ",".join([fmt] * ncol) + "\n"
     with path.open("w") as fh:
         fh.write(",".join(columns) + "\n")
-        for i in range(0, data.shape[0], block):
+        for i in range(0, n, block):
             blk = data[i:i + block]
             fh.write((row * blk.shape[0]) % tuple(blk.ravel().tolist()))
+            if progress is not None:
+                progress(min(i + block, n) / n)
+    if progress is not None and n == 0:
+        progress(1.0)
     return path
 
 
@@ -138,9 +147,9 @@ class SimulationResult:
             "wall_time_s": self.wall_time,
         }
 
-    def to_csv(self, path, columns=CSV_COLUMNS) -> Path:
+    def to_csv(self, path, columns=CSV_COLUMNS, progress: Callable[[float], None] | None = None) -> Path:
         idx = [CHANNELS.index(c) for c in columns]
-        return write_csv(path, self.data[:, idx], columns)
+        return write_csv(path, self.data[:, idx], columns, progress=progress)
 
     def to_dict(self) -> dict[str, np.ndarray]:
         return {c: self.data[:, i] for i, c in enumerate(CHANNELS)}
@@ -300,12 +309,13 @@ def stepper():
     return _STEPPER
 
 
-def write_outputs(res: SimulationResult, out_dir, *, title: str | None = None, figure=None) -> dict:
+def write_outputs(res: SimulationResult, out_dir, *, title: str | None = None, figure=None,
+                  progress: Callable[[float], None] | None = None) -> dict:
     """Write ``timeseries.csv``, ``metrics.json`` and ``wob.png`` into ``out_dir``.
 
     ``figure`` may be a :class:`heavecomp.report.background.BackgroundFigure`
     started before the simulation (the CLI does), so the figure is drawn in
-    parallel with the CSV.
+    parallel with the CSV.  ``progress(fraction)`` follows the CSV being written.
     """
     from heavecomp.report.figures import plot_wob_run
 
@@ -313,7 +323,7 @@ def write_outputs(res: SimulationResult, out_dir, *, title: str | None = None, f
     out_dir.mkdir(parents=True, exist_ok=True)
     if figure is not None:
         figure.draw(plot_wob_run, res, title=title, path=out_dir / "wob.png", save_kwargs={"tight": False, "dpi": 100})
-    res.to_csv(out_dir / "timeseries.csv")
+    res.to_csv(out_dir / "timeseries.csv", progress=progress)
     metrics = res.metrics()
     metrics["heave"] = {k: v for k, v in res.heave_info.items() if isinstance(v, (int, float, str))}
     (out_dir / "metrics.json").write_text(json.dumps(metrics, indent=2) + "\n")
