@@ -119,6 +119,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"heavecomp {args.command}: error: {_unknown_arguments(parser, args, extra)}", file=sys.stderr)
         return 2
     try:
+        _check_outputs(args)
         if getattr(args, "quiet", False):
             return _run_quiet(modules[args.command], args)
         return int(modules[args.command].run(args) or 0)
@@ -134,6 +135,16 @@ def main(argv: list[str] | None = None) -> int:
 
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
+
+
+def _check_outputs(args) -> None:
+    """``--out DIR`` and ``params -o FILE`` checked before any work (one line, exit 2)."""
+    from heavecomp.commands import _output
+
+    if getattr(args, "out", None):
+        _output.out_dir(args.out, "--out")
+    if args.command == "params" and getattr(args, "output", None):
+        _output.out_file(args.output, "-o")
 
 
 def _run_quiet(module, args) -> int:
