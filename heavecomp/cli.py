@@ -111,6 +111,9 @@ def main(argv: list[str] | None = None) -> int:
 
     parser, modules = build_parser()
     _Parser.argv = list(sys.argv[1:] if argv is None else argv)
+    from heavecomp.report import provenance
+
+    provenance.COMMAND = ["heavecomp", *_Parser.argv]
     args, extra = parser.parse_known_args(argv)
     if not args.command:
         parser.print_help()

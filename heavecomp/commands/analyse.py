@@ -47,6 +47,9 @@ def run(args) -> int:
     params = load(args.params)
     s = write_analysis(params, args.out, source=f"({Path(args.params).name})", n_points=args.points,
                        omega_min=args.omega_min, omega_max=args.omega_max, sliding_velocity=args.sliding_velocity)
+    from heavecomp.report.provenance import finish
+
+    finish(args.out, params=params, json_files=("analysis.json",), csv_files=("frequency_response.csv",))
     wn = ", ".join(f"{x:.3f}" for x in s["natural_frequencies"])
     zeta = ", ".join(f"{x:.4f}" for x in s["damping_ratios"])
     print(f"k_eff_dc {s['k_eff_dc'] / 1e3:.3f} kN/m (eq. 14: {s['k_eff_eq14'] / 1e3:.3f}), natural frequencies "

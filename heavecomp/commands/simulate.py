@@ -49,6 +49,9 @@ def run(args) -> int:
     big = res.data.shape[0] > 200_000  # a bar only where writing takes a noticeable time
     m = write_outputs(res, args.out, title=f"WOB — {Path(args.params).name}, friction: {params.friction.model}",
                       figure=figure, progress=Progress("writing timeseries.csv") if big else None)
+    from heavecomp.report.provenance import finish
+
+    finish(args.out, params=params, csv_files=("timeseries.csv",))
     print(f"WOB mean {m['wob_mean'] / 1e3:.2f} kN, std {m['wob_std'] / 1e3:.2f} kN, "
           f"peak-to-peak {m['wob_p2p'] / 1e3:.2f} kN, stuck {100 * m['stick_fraction']:.1f} % of the time "
           f"-> {args.out}")
@@ -69,6 +72,9 @@ def _run_closed_loop(args, params, Progress) -> int:
     res = simulate_closed_loop(params, args.controller, args.duration, dt=args.dt, progress=bar, **options)
     m = write_closed_loop_outputs(res, args.out, title=f"WOB — {Path(args.params).name}, friction: "
                                   f"{params.friction.model}, controller: {args.controller}", rate=args.rate)
+    from heavecomp.report.provenance import finish
+
+    finish(args.out, params=params, csv_files=("timeseries.csv",))
     print(f"WOB std {m['wob_std'] / 1e3:.2f} kN, peak-to-peak {m['wob_p2p'] / 1e3:.2f} kN, "
           f"|u_active| max {m['u_active_max'] / 1e3:.1f} kN, solve p50/p99 {m['solve_time_ms_p50']:.2f}/"
           f"{m['solve_time_ms_p99']:.2f} ms, fallbacks {m['fallbacks']} -> {args.out}")

@@ -12,15 +12,9 @@ CH_UNITS = {"wob": ("kN", 1e-3), "stroke": ("mm", 1e3), "pressure": ("kPa", 1e-3
 
 
 def _clean(x):
-    if isinstance(x, float) and not math.isfinite(x):
-        return None
-    if isinstance(x, dict):
-        return {str(k): _clean(v) for k, v in x.items()}
-    if isinstance(x, (list, tuple)):
-        return [_clean(v) for v in x]
-    if isinstance(x, (np.floating, np.integer, np.bool_)):
-        return _clean(x.item())
-    return x
+    from heavecomp.report.scenario import _clean as clean
+
+    return clean(x)
 
 
 def write_json(diag, path) -> Path:
@@ -184,7 +178,7 @@ def write_report(diag, out_dir, *, title="Sim-to-real gap diagnosis") -> dict:
                         for c in diag.candidates_]),
               "", f"Split: fit {diag.split_['fit'][0]:.0f}-{diag.split_['fit'][1]:.0f} s, held out "
                   f"{diag.split_['validate'][0]:.0f}-{diag.split_['validate'][1]:.0f} s; first "
-                  f"{diag.split_['settle']:.0f} s excluded (start-up). Run time {diag.wall_time_:.1f} s.",
+                  f"{diag.split_['settle']:.0f} s excluded (start-up).",
               "", "## Before / after", "", "![overlay](overlay.png)", ""]
     (out / "report.md").write_text("\n".join(lines))
     return diag.to_json()

@@ -23,6 +23,10 @@ log = logging.getLogger(__name__)
 from heavecomp.simulate.layout import CHANNELS, NCH, STATS, STUCK
 #: columns written to timeseries.csv (contract columns first)
 CSV_COLUMNS = ("t", "heave", "stroke", "pressure", "wob", "stroke_velocity", "friction", "tension", "stuck")
+#: unit of every channel (SI; ``stuck`` is 1 while the main cylinder sticks, else 0)
+CHANNEL_UNITS = {"t": "s", "heave": "m", "stroke": "m", "pressure": "Pa", "wob": "N", "stroke_velocity": "m/s",
+                 "friction": "N", "tension": "N", "lower_displacement": "m", "lower_velocity": "m/s", "stuck": "-",
+                 "u_active": "N"}
 
 
 def plant_eigen_rate(params) -> float:
@@ -153,6 +157,35 @@ class SimulationResult:
 
     def to_dict(self) -> dict[str, np.ndarray]:
         return {c: self.data[:, i] for i, c in enumerate(CHANNELS)}
+
+    def to_pandas(self, columns=None, *, time_index: bool = True):
+        """The channels as a ``pandas.DataFrame`` (pandas imported only here).
+
+        Follows python-control's ``TimeResponseData.to_pandas``: one column per signal, named
+        by the signal, time labelled ``"time"`` — here the index (``time_index=False`` gives
+        python-control's layout with ``time`` as the first column).  Units are in
+        ``df.attrs["units"]`` (column -> unit, SI; :data:`CHANNEL_UNITS`); ``stuck`` is a bool.
+
+        Parameters
+        ----------
+        columns : sequence of str, optional
+            Channels to include (default every channel of :data:`CHANNELS` but ``t``).
+        time_index : bool
+            Index the frame by time [s] (default) or keep ``time`` as a column.
+        """
+        import pandas as pd
+
+        cols = [c for c in (columns or CHANNELS) if c != "t"]
+        for c in cols:
+            if c not in CHANNELS:
+                raise KeyError(f"no channel {c!r}; channels: {', '.join(CHANNELS)}")
+        data = {c: (self[c] > 0.5) if c == "stuck" else self[c] for c in cols}
+        df = pd.DataFrame(data, index=pd.Index(self.t, name="time"))
+        units = {"time": CHANNEL_UNITS["t"], **{c: CHANNEL_UNITS[c] for c in cols}}
+        if not time_index:
+            df = df.reset_index()
+        df.attrs["units"] = units
+        return df
 
 
 def _friction_vectors(params):
