@@ -14,7 +14,7 @@ import sys
 
 import numpy as np
 
-from heavecomp.analysis import report as ar
+from heavecomp.report import analysis as ar
 from heavecomp.analysis.describing import compare_with_simulation, describing_transmissibility
 from heavecomp.analysis.frequency import effective_stiffness
 from heavecomp.analysis.linear import linearise

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import sys
 
-from heavecomp.identification import plots
+from heavecomp.report import identification as plots
 from heavecomp.identification.seal import load_seal_csv
 from heavecomp.identification.study import seal_study
 from heavecomp.report.figures import save

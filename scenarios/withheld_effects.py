@@ -13,7 +13,7 @@ import logging
 import time
 
 from heavecomp.diagnosis.generator import GAP_MIN, SECOND_SHARE, STICK_MIN, run_benchmark
-from heavecomp.diagnosis.report import fig_confusion, fig_shrink
+from heavecomp.report.diagnosis import fig_confusion, fig_shrink
 from heavecomp.report.figures import save
 from heavecomp.report.scenario import md_table, parse_args, write_metrics, write_report
 

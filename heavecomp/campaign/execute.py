@@ -298,7 +298,8 @@ def run_and_report(campaign, out_dir, **kw):
     """:func:`run_campaign`, then (when every run is in the table) the statistics,
     ``report.md``, ``metrics.json``, ``statistics.json``, figures and, if asked,
     ``runs.parquet``.  Returns ``(CampaignRun, statistics dict or None)``."""
-    from heavecomp.campaign import report, stats
+    from heavecomp.campaign import stats
+    from heavecomp.report import campaign as report
 
     info = run_campaign(campaign, out_dir, **kw)
     if not info.complete:

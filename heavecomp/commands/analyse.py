@@ -40,7 +40,7 @@ def _check(args):
 def run(args) -> int:
     from pathlib import Path
 
-    from heavecomp.analysis.report import write_analysis
+    from heavecomp.report.analysis import write_analysis
     from heavecomp.params import load
 
     _check(args)

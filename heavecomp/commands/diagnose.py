@@ -25,7 +25,7 @@ def run(args) -> int:
 
     from heavecomp.diagnosis.data import load_run
     from heavecomp.diagnosis.estimator import GapDiagnoser
-    from heavecomp.diagnosis.report import write_report
+    from heavecomp.report.diagnosis import write_report
     from heavecomp.errors import InputError
     from heavecomp.params import load
 

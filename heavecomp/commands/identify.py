@@ -29,7 +29,7 @@ def run(args) -> int:
     from pathlib import Path
 
     from heavecomp.errors import ParameterError
-    from heavecomp.identification import plots
+    from heavecomp.report import identification as plots
     from heavecomp.report.figures import save
     from heavecomp.report.provenance import finish
     from heavecomp.report.scenario import write_metrics
