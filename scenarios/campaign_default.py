@@ -11,7 +11,7 @@ import dataclasses
 import sys
 
 from heavecomp.campaign import spec
-from heavecomp.campaign.execute import run_and_report
+from heavecomp.report.campaign import run_and_report
 from heavecomp.report.scenario import ROOT, parse_args, write_metrics
 
 

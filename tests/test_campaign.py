@@ -305,7 +305,8 @@ def test_parquet_export_and_relative_band(tmp_path):
     pytest.importorskip("pyarrow")
     import pyarrow.parquet as pq
 
-    from heavecomp.campaign.execute import read_table, run_and_report
+    from heavecomp.campaign.execute import read_table
+    from heavecomp.report.campaign import run_and_report
 
     camp = spec.loads(TINY.replace("duration = 90.0", "duration = 40.0").replace("tolerance = 20e3", "relative = 0.1")
                       .replace("[outputs]", "[outputs]\nformat = \"parquet\""))

@@ -292,25 +292,3 @@ def export_parquet(table: dict, path) -> Path:
     tab = pa.table({k: (list(v) if v.dtype == object else v) for k, v in table.items()})
     pq.write_table(tab, path)
     return Path(path)
-
-
-def run_and_report(campaign, out_dir, **kw):
-    """:func:`run_campaign`, then (when every run is in the table) the statistics,
-    ``report.md``, ``metrics.json``, ``statistics.json``, figures and, if asked,
-    ``runs.parquet``.  Returns ``(CampaignRun, statistics dict or None)``."""
-    from heavecomp.campaign import stats
-    from heavecomp.report import campaign as report
-
-    info = run_campaign(campaign, out_dir, **kw)
-    if not info.complete:
-        log.info("campaign incomplete (%d of %d runs); rerun to resume", info.n_skipped + info.n_simulated,
-                 info.n_total)
-        return info, None
-    table = read_table(info.table_path)
-    st = stats.statistics(campaign, table)
-    run_info = {"executor": info.executor, "workers": info.workers, "runs_simulated": info.n_simulated,
-                "runs_resumed": info.n_skipped, "wall_time_s": round(info.wall_time, 2)}
-    report.write_report(info.out_dir, campaign, st, run_info)
-    if campaign.outputs.format == "parquet":
-        export_parquet(table, info.out_dir / "runs.parquet")
-    return info, st

@@ -20,7 +20,7 @@ def run(args) -> int:
     import sys
 
     from heavecomp.campaign import spec
-    from heavecomp.campaign.execute import run_and_report
+    from heavecomp.report.campaign import run_and_report
     from heavecomp.commands._progress import Progress
     from heavecomp.errors import InputError
 

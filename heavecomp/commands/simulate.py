@@ -28,7 +28,8 @@ def run(args) -> int:
     from heavecomp.commands._progress import Progress
     from heavecomp.params import load
     from heavecomp.report.background import BackgroundFigure
-    from heavecomp.simulate import simulate, write_outputs
+    from heavecomp.report.simulation import write_outputs
+    from heavecomp.simulate import simulate
 
     params = load(args.params)
     if args.friction:

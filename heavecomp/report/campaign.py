@@ -3,12 +3,15 @@
 from __future__ import annotations
 
 import json
+import logging
 import math
 from pathlib import Path
 
 import numpy as np
 
 from heavecomp.report.figures import REGIME_COLORS, REGIME_LABELS, _plt, save
+
+log = logging.getLogger(__name__)
 
 
 def _label(key, g, multi_variant):
@@ -201,3 +204,25 @@ def _clean(x, digits=None):
     if isinstance(x, (list, tuple)):
         return [_clean(v, digits) for v in x]
     return x
+
+
+def run_and_report(campaign, out_dir, **kw):
+    """:func:`run_campaign`, then (when every run is in the table) the statistics,
+    ``report.md``, ``metrics.json``, ``statistics.json``, figures and, if asked,
+    ``runs.parquet``.  Returns ``(CampaignRun, statistics dict or None)``."""
+    from heavecomp.campaign import stats
+    from heavecomp.campaign.execute import export_parquet, read_table, run_campaign
+
+    info = run_campaign(campaign, out_dir, **kw)
+    if not info.complete:
+        log.info("campaign incomplete (%d of %d runs); rerun to resume", info.n_skipped + info.n_simulated,
+                 info.n_total)
+        return info, None
+    table = read_table(info.table_path)
+    st = stats.statistics(campaign, table)
+    run_info = {"executor": info.executor, "workers": info.workers, "runs_simulated": info.n_simulated,
+                "runs_resumed": info.n_skipped, "wall_time_s": round(info.wall_time, 2)}
+    write_report(info.out_dir, campaign, st, run_info)
+    if campaign.outputs.format == "parquet":
+        export_parquet(table, info.out_dir / "runs.parquet")
+    return info, st
