@@ -50,8 +50,10 @@ def run(args) -> int:
     from heavecomp.report.provenance import finish
 
     finish(args.out, params=params, json_files=("analysis.json",), csv_files=("frequency_response.csv",))
-    wn = ", ".join(f"{x:.3f}" for x in s["natural_frequencies"])
-    zeta = ", ".join(f"{x:.4f}" for x in s["damping_ratios"])
-    print(f"k_eff_dc {s['k_eff_dc'] / 1e3:.3f} kN/m (eq. 14: {s['k_eff_eq14'] / 1e3:.3f}), natural frequencies "
-          f"{wn} rad/s, damping ratios {zeta} -> {args.out}")
+    from heavecomp.report.analysis import mode_rows
+
+    modes = "; ".join(f"{n} {w:.3f} rad/s (zeta {z:.4f})"
+                      for n, w, f, T, z in mode_rows(s["natural_frequencies"], s["damping_ratios"]))
+    print(f"k_eff_dc {s['k_eff_dc'] / 1e3:.3f} kN/m (eq. 14: {s['k_eff_eq14'] / 1e3:.3f}), natural frequencies: "
+          f"{modes} -> {args.out}")
     return 0

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import logging
+import math
 from pathlib import Path
 
 import numpy as np
@@ -185,29 +186,47 @@ def write_analysis(params, out, *, source: str = "", **kw) -> dict:
     return s
 
 
+#: the CMC's two modes, ascending (linearised, frictionless: the top mass rides on the soft gas
+#: spring, the lower mass on the much stiffer drill string and formation)
+MODE_NAMES = ("mode 1: top mass on the gas spring", "mode 2: lower mass on drill string and formation")
+
+
+def mode_rows(freqs_rad_s, damping=None) -> list[tuple]:
+    """``(name, omega [rad/s], f [Hz], period [s], zeta [-])`` per mode, sorted by frequency."""
+    damping = list(damping) if damping is not None else [math.nan] * len(freqs_rad_s)
+    names = MODE_NAMES if len(freqs_rad_s) == len(MODE_NAMES) else [f"mode {i + 1}" for i in range(len(freqs_rad_s))]
+    order = np.argsort(freqs_rad_s)
+    return [(names[k], float(freqs_rad_s[i]), float(freqs_rad_s[i]) / (2 * math.pi),
+             2 * math.pi / float(freqs_rad_s[i]), float(damping[i])) for k, i in enumerate(order)]
+
+
 def report_markdown(s: dict, source: str = "") -> str:
     """Markdown frequency-response report from an analysis.json dict."""
-    wn = ", ".join(f"{x:.3f}" for x in s["natural_frequencies"])
-    Tn = ", ".join(f"{x:.2f}" for x in s["natural_periods"])
-    z = ", ".join(f"{x:.4f}" for x in s["damping_ratios"])
     inband = any(s["modes_in_wave_band"])
+    modes = ["| mode | natural frequency (undamped) [rad/s] | [Hz] | natural period [s] | damping ratio [-] |",
+             "|---|---|---|---|---|"]
+    modes += [f"| {n} | {w:.3f} | {f:.4f} | {T:.3f} | {z:.4f} |"
+              for n, w, f, T, z in mode_rows(s["natural_frequencies"], s["damping_ratios"])]
     lines = [
         f"# Frequency response heave -> WOB {source}".rstrip(),
         "",
         "Linearised CMC (frictionless, about the operating point s = 0, WOB = W_0), from the same casadi "
         "equations the simulator uses (`heavecomp.analysis.linear`).",
         "",
-        "| quantity | value |",
-        "|---|---|",
-        f"| k_eff_dc (DC gain heave -> WOB, sign flipped) | {s['k_eff_dc'] / 1e3:.3f} kN/m |",
-        f"| paper A eq. 14 k_eff | {s['k_eff_eq14'] / 1e3:.3f} kN/m |",
-        f"| natural frequencies (undamped) | {wn} rad/s |",
-        f"| natural periods | {Tn} s |",
-        f"| damping ratios | {z} |",
-        f"| peak |k_eff(w)| | {s['peak_k_eff'] / 1e3:.1f} kN/m at {s['peak_omega']:.3f} rad/s |",
+        "| quantity | value | unit |",
+        "|---|---|---|",
+        f"| k_eff_dc (DC gain heave -> WOB, sign flipped) | {s['k_eff_dc'] / 1e3:.3f} | kN/m |",
+        f"| paper A eq. 14 k_eff | {s['k_eff_eq14'] / 1e3:.3f} | kN/m |",
+        f"| peak abs(k_eff(w)) | {s['peak_k_eff'] / 1e3:.1f} | kN/m |",
+        f"| frequency of the peak | {s['peak_omega']:.3f} | rad/s |",
         "",
-        "Transmissibility |k_eff(w)|/k_eff(0) at wave periods: "
-        + ", ".join(f"{k} s: {v:.3f}" for k, v in s["transmissibility_at_wave_periods"].items()) + ".",
+        "Modes, sorted by frequency:",
+        "",
+        *modes,
+        "",
+        "| wave period [s] | transmissibility abs(k_eff(w))/k_eff(0) [-] |",
+        "|---|---|",
+        *[f"| {k} | {v:.3f} |" for k, v in s["transmissibility_at_wave_periods"].items()],
         "",
         ("A natural frequency lies **inside** the wave band (periods 5-20 s): waves excite a resonance."
          if inband else
@@ -220,7 +239,7 @@ def report_markdown(s: dict, source: str = "") -> str:
     for key, label in (("viscous", "viscous friction only"), ("sliding", "sliding linearisation")):
         if key in s:
             v = s[key]
-            lines.append(f"With {label}: natural frequencies "
-                         + ", ".join(f"{x:.3f}" for x in v["natural_frequencies"]) + " rad/s, damping ratios "
-                         + ", ".join(f"{x:.4f}" for x in v["damping_ratios"]) + ".")
+            lines.append(f"With {label}: " + "; ".join(
+                f"{n} {w:.3f} rad/s, damping ratio {z:.4f}"
+                for n, w, f, T, z in mode_rows(v["natural_frequencies"], v["damping_ratios"])) + ".")
     return "\n".join(lines) + "\n"

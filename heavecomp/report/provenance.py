@@ -125,7 +125,7 @@ def _param_units() -> dict[str, str]:
         from heavecomp.effects import CANDIDATES
 
         for cand in (CANDIDATES.values() if isinstance(CANDIDATES, dict) else CANDIDATES):
-            for spec in cand.parameter_specs() if hasattr(cand, "parameter_specs") else ():
+            for spec in cand.describe() if hasattr(cand, "describe") else ():
                 out.setdefault(spec["name"], spec["unit"])
     except Exception as exc:  # noqa: BLE001
         log.debug("effect parameter units unavailable: %s", exc)
