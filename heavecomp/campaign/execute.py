@@ -29,7 +29,7 @@ import os
 import time
 from pathlib import Path
 
-from heavecomp.errors import InputError, ParameterError
+from heavecomp.errors import InputError
 
 log = logging.getLogger(__name__)
 
@@ -280,15 +280,3 @@ def read_table(path) -> dict:
             except ValueError:
                 raise InputError(f"{path}: column '{name}': non-numeric value") from None
     return cols
-
-
-def export_parquet(table: dict, path) -> Path:
-    """Write the table as Parquet (needs pyarrow)."""
-    try:
-        import pyarrow as pa
-        import pyarrow.parquet as pq
-    except ImportError:
-        raise ParameterError("outputs.format = \"parquet\" needs pyarrow (pip install pyarrow), or use \"csv\"") from None
-    tab = pa.table({k: (list(v) if v.dtype == object else v) for k, v in table.items()})
-    pq.write_table(tab, path)
-    return Path(path)

@@ -211,7 +211,11 @@ def run_and_report(campaign, out_dir, **kw):
     ``report.md``, ``metrics.json``, ``statistics.json``, figures and, if asked,
     ``runs.parquet``.  Returns ``(CampaignRun, statistics dict or None)``."""
     from heavecomp.campaign import stats
-    from heavecomp.campaign.execute import export_parquet, read_table, run_campaign
+    from heavecomp.campaign.execute import read_table, run_campaign
+    from heavecomp.campaign.tables import check_parquet, export_parquet
+
+    if campaign.outputs.format == "parquet":
+        check_parquet()  # before the runs, not after
 
     info = run_campaign(campaign, out_dir, **kw)
     if not info.complete:
@@ -224,5 +228,5 @@ def run_and_report(campaign, out_dir, **kw):
                 "runs_resumed": info.n_skipped, "wall_time_s": round(info.wall_time, 2)}
     write_report(info.out_dir, campaign, st, run_info)
     if campaign.outputs.format == "parquet":
-        export_parquet(table, info.out_dir / "runs.parquet")
+        export_parquet(table, info.out_dir, campaign.outputs.deviation_max, campaign.outputs.bins)
     return info, st
