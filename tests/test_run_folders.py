@@ -165,3 +165,24 @@ def test_scenario_rerun_writes_the_same_bytes(tmp_path, name):
     assert m["provenance"]["command"] == f"python scenarios/{name}.py --quick --out {out}"
     assert "wall" not in json.dumps({k: v for k, v in m.items() if k != "units"})
     assert (root / "reports" / ".gitignore").read_text().split() == ["timings.json"]
+
+
+@pytest.mark.parametrize("rel", ["reports/diagnosis_example/diagnosis.json", "reports/emps_identification/metrics.json",
+                                 "reports/seal_friction/metrics.json", "reports/campaign_default/statistics.json"])
+def test_every_number_of_the_other_commands_outputs_has_a_unit(rel):
+    """diagnose, identify and campaign results: the units table covers every number (timings aside)."""
+    from pathlib import Path
+
+    from heavecomp.report.provenance import split_timings, units_of
+
+    data, _ = split_timings(json.loads((Path(__file__).resolve().parents[1] / rel).read_text()))
+    units, missing = units_of(data)
+    assert missing == [] and units
+
+
+def test_json_results_rounded_above_last_bit_noise():
+    from heavecomp.report.provenance import round_floats
+
+    a, b = 97202.81366735144, 97202.8136673514  # the same WOB mean from two machines
+    assert a != b and round_floats({"x": [a]}) == round_floats({"x": [b]})
+    assert round_floats(0.1 + 0.2) == 0.3 and round_floats(3) == 3 and round_floats(True) is True

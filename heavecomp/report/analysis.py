@@ -174,7 +174,9 @@ def write_analysis(params, out, *, source: str = "", **kw) -> dict:
     out.mkdir(parents=True, exist_ok=True)
     res = analyse(params, **kw)
     s, table = res["summary"], res["table"]
-    (out / "analysis.json").write_text(json.dumps(_clean(s), indent=2) + "\n")
+    from heavecomp.report.provenance import round_floats
+
+    (out / "analysis.json").write_text(json.dumps(round_floats(_clean(s)), indent=2) + "\n")
     cols = list(table)
     np.savetxt(out / "frequency_response.csv", np.column_stack([table[c] for c in cols]), delimiter=",",
                header=",".join(cols), comments="", fmt="%.10g")
@@ -182,6 +184,9 @@ def write_analysis(params, out, *, source: str = "", **kw) -> dict:
                      title=f"Heave -> WOB {source}: |k_eff(w)| with the wave band and the natural frequencies"),
          out / "bode.png", dpi=100)
     (out / "report.md").write_text(report_markdown(s, source))
+    from heavecomp.report.provenance import stamp, stamp_report
+
+    stamp_report(out / "report.md", stamp())
     log.info("analysis written to %s", out)
     return s
 

@@ -176,6 +176,9 @@ def write_report(out_dir, campaign, st: dict, run_info=None) -> Path:
         text += [f"![{f}]({f})", ""]
     path = out / "report.md"
     path.write_text("\n".join(text))
+    from heavecomp.report.provenance import stamp, stamp_report
+
+    stamp_report(path, stamp(params_file="campaign.toml"))
     return path
 
 

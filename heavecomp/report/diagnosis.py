@@ -214,6 +214,9 @@ def write_report(diag, out_dir, *, title="Sim-to-real gap diagnosis") -> dict:
                   f"{diag.split_['settle']:.0f} s excluded (start-up).",
               "", "## Before / after", "", "![overlay](overlay.png)", ""]
     (out / "report.md").write_text("\n".join(lines))
+    from heavecomp.report.provenance import stamp, stamp_report
+
+    stamp_report(out / "report.md", stamp())
     return diag.to_json()
 
 

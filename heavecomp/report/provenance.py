@@ -87,7 +87,20 @@ UNITS: dict[str, str] = {
     "theta": "-", "n_parameters": "count", "coulomb_negative": "N", "coulomb_positive": "N",
     "viscous_negative": "N s/m", "viscous_positive": "N s/m", "viscous_asymmetry": "N s/m", "lag_force": "N",
     "presliding_length": "m", "stribeck_excess": "N", "stribeck_velocity": "m/s",
+    # closed loop (heavecomp.controllers.ControllerConfig documents these units)
+    "u_max": "N", "rate_max": "N/s", "horizon": "count", "q_wob": "1/N^2", "r_u": "1/N^2", "r_du": "1/N^2",
+    "friction_eps": "m/s", "friction_scale": "-", "gas_stiffness_scale": "-", "kp": "-", "ki": "1/s", "kd": "s",
+    "pid_tf": "s", "observer_sigma_d": "N", "sqp_iterations": "count", "predictor_order": "count",
+    "predictor_window": "s", "n_control_steps": "count", "saturated_steps": "count",
+    # residual statistics (forces unless under a channel, see _CHANNEL_STATS)
+    "rms": "N", "rms_before": "N", "rms_after": "N", "noise_floor": "N",
 }
+
+#: key patterns -> unit (Fourier coefficients of a position-dependent force: f_cos1, fc_sin2, ...)
+PATTERN_UNITS = [(re.compile(r"^fc?_(cos|sin)\d+$"), "N")]
+
+#: statistics that carry the unit of the channel named among their parents (gap.channels.stroke.rms = m)
+_CHANNEL_STATS = ("rms", "rms_before", "rms_after", "rms_validate", "noise_floor")
 
 #: key suffixes that name their unit (``F_C_N``, ``fs_Hz``, ``C_p_N_per_bar``, ...)
 SUFFIX_UNITS = [("_N_per_bar", "N/bar"), ("_N_per_Pa", "N/Pa"), ("_mm_s", "mm/s"), ("_m_s", "m/s"),
@@ -141,6 +154,13 @@ def unit_of(path: tuple[str, ...]) -> str | None:
     if len(path) > 1 and re.fullmatch(r"[-+0-9.eE]+", key):  # e.g. transmissibility_at_wave_periods.12
         return unit_of(path[:-1])
     parents = [str(p) for p in path[:-1]]
+    if key in _CHANNEL_STATS:
+        for p in reversed(parents):
+            if p in ("wob", "stroke", "pressure", "heave"):
+                return UNITS[p]
+    for pat, unit in PATTERN_UNITS:
+        if pat.match(key):
+            return unit
     for block in _SHARE_BLOCKS:
         if parents and parents[-1] == block:
             return "-"
@@ -280,8 +300,26 @@ def write_units_csv(csv_path, columns, units: dict | None = None) -> Path:
     return path
 
 
+#: significant digits kept in JSON results: far below any physical resolution, and above the
+#: last-bit noise between machines, BLAS builds or the JIT and ahead-of-time steppers, so a
+#: re-run elsewhere writes the same bytes
+DIGITS = 12
+
+
+def round_floats(x, digits: int = DIGITS):
+    """Copy of a JSON-like value with every float rounded to ``digits`` significant digits."""
+    if isinstance(x, float):
+        return float(f"{x:.{digits}g}")
+    if isinstance(x, dict):
+        return {k: round_floats(v, digits) for k, v in x.items()}
+    if isinstance(x, list):
+        return [round_floats(v, digits) for v in x]
+    return x
+
+
 def annotate_json(path, st: dict, *, indent: int | None = 2) -> dict:
-    """Move timings out of a JSON result into ``timings.json``; add ``provenance`` and ``units``."""
+    """Move timings out of a JSON result into ``timings.json``; add ``provenance`` and ``units``;
+    round floats to :data:`DIGITS` significant digits."""
     from heavecomp.report.scenario import _clean
 
     path = Path(path)
@@ -298,7 +336,7 @@ def annotate_json(path, st: dict, *, indent: int | None = 2) -> dict:
             log.debug("%s: no unit known for %s", path.name, ", ".join(missing))
         data["provenance"] = st
         data["units"] = units
-    path.write_text(json.dumps(_clean(data), indent=indent) + "\n")
+    path.write_text(json.dumps(round_floats(_clean(data)), indent=indent) + "\n")
     return data
 
 
