@@ -11,8 +11,8 @@ import dataclasses
 import sys
 
 from heavecomp.campaign import spec
-from heavecomp.campaign.execute import run_and_report
-from heavecomp.report.scenario import ROOT, parse_args
+from heavecomp.report.campaign import run_and_report
+from heavecomp.report.scenario import ROOT, parse_args, write_metrics
 
 
 def build(quick: bool = False):
@@ -40,8 +40,9 @@ def main(argv=None) -> int:
     import json
 
     m = json.loads((args.out / "metrics.json").read_text())
+    m.pop("provenance", None), m.pop("units", None)
     m["verdict"] = verdict(st)
-    (args.out / "metrics.json").write_text(json.dumps(m, indent=2) + "\n")
+    write_metrics(args.out, m)
     v = m["verdict"]
     with (args.out / "report.md").open("a") as fh:
         share = v["share_won_back_by_eq7"]
@@ -50,6 +51,9 @@ def main(argv=None) -> int:
                  + (f". The rotating piston (eq. 7) wins back {100 * share:.0f} % of the friction penalty "
                     "(full static friction -> no friction)." if share is not None else ".")
                  + " Scatter diagram and tolerance are illustrative (platform heave terms), not site data.\n")
+    from heavecomp.report.provenance import finish
+
+    finish(args.out, json_files=("statistics.json",), params_file="campaign.toml")
     return 0
 
 

@@ -13,6 +13,7 @@ from __future__ import annotations
 import sys
 
 from heavecomp.closed_loop import design as D
+from heavecomp.report import controllers as RC
 from heavecomp.report.figures import save
 from heavecomp.report.scenario import md_table, parse_args, write_metrics, write_report
 
@@ -46,27 +47,28 @@ def main(argv=None) -> int:
     table, kept = r["table"], r["kept"]
     passive = table["sine"]["stribeck"]["passive"]["wob_std"]
     T = r["durations"]["sine"]
-    save(D.plot_wob_controllers({c: kept[("sine", "stribeck", c)] for c in D.CONTROLLERS}, (T - 36, T),
+    save(RC.plot_wob_controllers({c: kept[("sine", "stribeck", c)] for c in D.CONTROLLERS}, (T - 36, T),
                                 title="Full static friction, paper A sine: MPC holds the WOB where passive and PID "
                                       "let gas spring and friction through"), args.out / "wob_controllers.png", dpi=100)
     sections = ["## Findings", "\n".join(D.findings(table, r["sweeps"], r["robust"], r["frames"], r["frame_sea"])),
-                "Solve times here are wall-clock inside the loop on a shared 2-core machine; see "
-                "`benchmarks/mpc/README.md` for the dedicated measurement and the peer comparison."]
+                "Solve times are wall-clock and depend on the machine, so they are kept out of this report and "
+                "metrics.json (a re-run must leave git clean): a run writes them to timings.json (not tracked); "
+                "see `benchmarks/mpc/README.md` for the dedicated measurement and the peer comparison."]
     for sea in table:
-        save(D.plot_std_table(table, sea, title=f"WOB std per friction regime and controller ({sea})"),
+        save(RC.plot_std_table(table, sea, title=f"WOB std per friction regime and controller ({sea})"),
              args.out / f"wob_std_{sea}.png", dpi=100)
         rows = [(reg, c, m["wob_std"] / 1e3, 100 * m["wob_std"] / table[sea][reg]["passive"]["wob_std"],
-                 m["wob_p2p"] / 1e3, m["u_active_max"] / 1e3, m["solve_time_ms_p50"], m["solve_time_ms_p99"],
+                 m["wob_p2p"] / 1e3, m["u_active_max"] / 1e3,
                  m["violations_u_max"] + m["violations_rate"], m["fallbacks"],
                  m["preview_rmse_end_m"] if m["preview_rmse_end_m"] is not None else "-")
                 for reg, cs in table[sea].items() for c, m in cs.items()]
         sections += [f"## {sea}: WOB per controller and friction regime ({r['durations'][sea]:g} s, stats after the fade-in)",
                      md_table(["regime", "controller", "WOB std [kN]", "% of passive", "WOB p2p [kN]", "max abs(u) [kN]",
-                               "solve p50 [ms]", "solve p99 [ms]", "limit violations", "fallbacks",
+                               "limit violations", "fallbacks",
                                "preview RMSE at 1 s [m]"], rows, fmt="{:.3g}")]
-    save(D.plot_sweeps(r["sweeps"], passive, title="Full static friction, sine: WOB std against horizon, "
+    save(RC.plot_sweeps(r["sweeps"], passive, title="Full static friction, sine: WOB std against horizon, "
                        "force-rate weight and actuator size"), args.out / "sweeps.png", dpi=100)
-    sw_rows = [(label, c, row["value"], row["wob_std"] / 1e3, row["solve_time_ms_p99"])
+    sw_rows = [(label, c, row["value"], row["wob_std"] / 1e3)
                for label, (unit, rows) in r["sweeps"].items() for c, rr in rows.items() for row in rr]
     pas = {sea: table[sea]["stribeck"]["passive"]["wob_std"] for sea in table}
     rb_rows = [(c, k, m["wob_std"] / 1e3, 100 * m["wob_std"] / pas[D.label_sea(k)])
@@ -76,7 +78,7 @@ def main(argv=None) -> int:
                 m["preview_rmse_end_m"] if m["preview_rmse_end_m"] is not None else "-")
                for c, d in r["frames"].items() for k, m in d.items()]
     sections += ["## Horizon, weights and actuator size (full static friction, sine)",
-                 md_table(["option", "controller", "value", "WOB std [kN]", "solve p99 [ms]"], sw_rows, fmt="{:.3g}"),
+                 md_table(["option", "controller", "value", "WOB std [kN]"], sw_rows, fmt="{:.3g}"),
                  f"## Frame of the prediction model and the value of the heave preview (full static friction, {fsea})",
                  "The plant is written relative to the heaving cylinder (stroke s); the MPCs predict with the top "
                  "mass in the earth frame (X = z_h + s) by default, where the heave acceleration drops out and a "

@@ -11,7 +11,7 @@ from __future__ import annotations
 from heavecomp.diagnosis.data import load_run
 from heavecomp.diagnosis.estimator import GapDiagnoser
 from heavecomp.diagnosis.generator import generate
-from heavecomp.diagnosis.report import write_report
+from heavecomp.report.diagnosis import write_report
 from heavecomp.params import dumps
 from heavecomp.report.scenario import parse_args, write_metrics
 

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import sys
 
-from heavecomp.identification import plots
+from heavecomp.report import identification as plots
 from heavecomp.identification.study import emps_study
 from heavecomp.plants.axis import load_emps
 from heavecomp.report.figures import save

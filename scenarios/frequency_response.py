@@ -14,7 +14,8 @@ import sys
 
 import numpy as np
 
-from heavecomp.analysis import report as ar
+from heavecomp.analysis.summary import analyse
+from heavecomp.report import analysis as ar
 from heavecomp.analysis.describing import compare_with_simulation, describing_transmissibility
 from heavecomp.analysis.frequency import effective_stiffness
 from heavecomp.analysis.linear import linearise
@@ -43,8 +44,8 @@ def build(quick: bool = False) -> dict:
     for a in (0.1, 0.5, 2.0):
         curves[f"eq. 4 friction, DF, heave a = {a:g} m"] = (
             w, np.asarray(describing_transmissibility(p, a, w, n=512).frdata).ravel())
-    return {"params": p, "analysis": ar.analyse(p, sliding_velocity=0.05), "df_curves": curves,
-            "analysis_208": ar.analyse(p.replace(drill_string={"stiffness": 208e3})),
+    return {"params": p, "analysis": analyse(p, sliding_velocity=0.05), "df_curves": curves,
+            "analysis_208": analyse(p.replace(drill_string={"stiffness": 208e3})),
             "map": eigenfrequency_map(p, lengths, kF, wave_periods=(8.0, 12.0, 16.0)), "df": rows}
 
 

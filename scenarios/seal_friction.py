@@ -15,7 +15,7 @@ import os
 import sys
 from pathlib import Path
 
-from heavecomp.identification import plots
+from heavecomp.report import identification as plots
 from heavecomp.identification.seal import load_seal_csv, velocity_fir
 from heavecomp.identification.study import seal_study
 from heavecomp.report.figures import save

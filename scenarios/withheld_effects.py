@@ -13,7 +13,7 @@ import logging
 import time
 
 from heavecomp.diagnosis.generator import GAP_MIN, SECOND_SHARE, STICK_MIN, run_benchmark
-from heavecomp.diagnosis.report import fig_confusion, fig_shrink
+from heavecomp.report.diagnosis import fig_confusion, fig_shrink
 from heavecomp.report.figures import save
 from heavecomp.report.scenario import md_table, parse_args, write_metrics, write_report
 
@@ -34,12 +34,12 @@ def main(argv=None) -> int:
     save(fig_confusion(summary), args.out / "confusion.png", dpi=90)
     save(fig_shrink(rows), args.out / "shrink.png", dpi=90)
     table = md_table(["withheld", "second", "set", "planted gap [x floor]", "2nd share", "verdict", "confidence",
-                      "named 2nd", "best joint partner", "shrink", "explained", "time [s]"],
+                      "named 2nd", "best joint partner", "shrink [-]", "explained [-]"],
                      [[r["truth"], r["truth_second"] or "", r["param_set"],
                        " / ".join(f"{g:.1f}" for g in r["planted_gap"].values()),
                        f"{r['second_share']:.2f}" if r["second_share"] else "", r["verdict"], r["confidence"],
-                       r["second_effect"] or "", r["best_partner"] or "", f"{r['shrink']:.2f}", f"{r['explained']:.2f}",
-                       f"{r['wall_time']:.1f}"] for r in rows])
+                       r["second_effect"] or "", r["best_partner"] or "", f"{r['shrink']:.2f}", f"{r['explained']:.2f}"]
+                      for r in rows])
     s = summary
     write_report(args.out, "Withheld-effect benchmark of the gap diagnosis", [
         __doc__.split("\n\n", 1)[1],
@@ -47,8 +47,8 @@ def main(argv=None) -> int:
         f"runs {s['median_shrink_all_effect_runs']:.2f} (correct verdicts: {s['median_shrink_correct']:.2f}); "
         f"second effect named in {s['two_effect_second_named']} of {s['n_two_effect']} two-effect runs (the true "
         f"second was the best joint partner in {s['two_effect_second_best_partner']}), spurious second effects in "
-        f"{s['spurious_second']} of {s['n_single']} single-effect or no-effect runs; median diagnosis time "
-        f"{s['median_wall_time']:.1f} s per run, {s['wall_time_s']:.0f} s in all."
+        f"{s['spurious_second']} of {s['n_single']} single-effect or no-effect runs (diagnosis times: "
+        f"timings.json, not tracked)."
         + (" (quick mode: 3 short runs)" if args.quick else ""),
         f"Every planted effect moves some channel by at least {GAP_MIN:g} x its noise floor in each half of the run "
         f"(*planted gap*: rms of the truth run with minus without the effect over the floor, dominant / second; the "

@@ -305,9 +305,11 @@ def test_default_campaign_is_documented_illustrative_platform_heave():
 
 def test_parquet_export_and_relative_band(tmp_path):
     pytest.importorskip("pyarrow")
+    pd = pytest.importorskip("pandas")
     import pyarrow.parquet as pq
 
-    from heavecomp.campaign.execute import read_table, run_and_report
+    from heavecomp.campaign.execute import read_table
+    from heavecomp.report.campaign import run_and_report
 
     camp = spec.loads(TINY.replace("duration = 90.0", "duration = 40.0").replace("tolerance = 20e3", "relative = 0.1")
                       .replace("[outputs]", "[outputs]\nformat = \"parquet\""))
@@ -317,6 +319,21 @@ def test_parquet_export_and_relative_band(tmp_path):
     assert tab.num_rows == len(camp.runs()) == csv_tab["run_id"].size
     assert np.array_equal(np.sort(tab.column("wob_std").to_numpy()), np.sort(csv_tab["wob_std"]))
     assert st["band_half_width"] == pytest.approx(0.1 * 98.1e3)  # 10 % of the paper-A set-point
+    # tidy and typed (issue 13.5): counts stay integers, no wide histogram columns
+    runs = pd.read_parquet(tmp_path / "runs.parquet")
+    assert runs["n_stick"].dtype == np.int64 and runs["seed"].dtype == np.int64
+    assert runs["regime"].dtype == "category" and not any(c.startswith("dev_") for c in runs.columns)
+    h = pd.read_parquet(tmp_path / "histograms.parquet")
+    assert list(h.columns) == ["run_id", "histogram", "bin", "lower_N", "upper_N", "count"]
+    assert h["count"].dtype == np.int64
+    # every sample of a run lies in one deviation bin; the bin edges tile the real line
+    dev = h[h["histogram"] == "deviation"]
+    per_run = dev.groupby("run_id")["count"].sum()
+    n_samples = runs.set_index("run_id")["n_samples"]
+    assert (per_run.sort_index().to_numpy() == n_samples.sort_index().to_numpy()).all()
+    one = dev[dev["run_id"] == runs["run_id"][0]].sort_values("bin")
+    assert np.isneginf(one["lower_N"].iloc[0]) and np.isposinf(one["upper_N"].iloc[-1])
+    np.testing.assert_array_equal(one["upper_N"].to_numpy()[:-1], one["lower_N"].to_numpy()[1:])
 
 
 def test_cli_killed_mid_campaign_resumes(tmp_path):

@@ -167,9 +167,12 @@ def test_cli_simulate_with_controller_writes_u_active_and_metrics(tmp_path):
     header = (tmp_path / "o" / "timeseries.csv").read_text().splitlines()[0].split(",")
     assert header[:5] == ["t", "heave", "stroke", "pressure", "wob"] and "u_active" in header
     m = json.loads((tmp_path / "o" / "metrics.json").read_text())
-    for key in ("wob_std", "wob_p2p", "u_active_max", "solve_time_ms_p50", "solve_time_ms_p99",
+    for key in ("wob_std", "wob_p2p", "u_active_max",
                 "violations_u_max", "violations_rate", "solver_failures", "fallbacks"):
         assert key in m
+    # solve times are wall-clock: in the run folder's timings.json, not in metrics.json (issue 13.4)
+    t = json.loads((tmp_path / "o" / "timings.json").read_text())["metrics.json"]
+    assert t["solve_time_ms_p99"] >= t["solve_time_ms_p50"] > 0
     assert m["u_active_max"] <= 60e3
 
 

@@ -67,7 +67,8 @@ def lap(name):
     t = time.perf_counter(); T[name] = t - t0; t0 = t
 import numpy
 from heavecomp.params import load
-from heavecomp.simulate import simulate, write_outputs
+from heavecomp.report.simulation import write_outputs
+from heavecomp.simulate import simulate
 from heavecomp.simulate.core import SimulationResult
 lap("imports (numpy, heavecomp)")
 p = load(sys.argv[1]); lap("read parameters")

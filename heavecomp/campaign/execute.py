@@ -279,36 +279,3 @@ def read_table(path) -> dict:
             except ValueError:
                 raise InputError(f"{path}: column '{name}': non-numeric value") from None
     return cols
-
-
-def export_parquet(table: dict, path) -> Path:
-    """Write the table as Parquet (needs pyarrow)."""
-    try:
-        import pyarrow as pa
-        import pyarrow.parquet as pq
-    except ImportError:
-        raise ParameterError("outputs.format = \"parquet\" needs pyarrow (pip install pyarrow), or use \"csv\"") from None
-    tab = pa.table({k: (list(v) if v.dtype == object else v) for k, v in table.items()})
-    pq.write_table(tab, path)
-    return Path(path)
-
-
-def run_and_report(campaign, out_dir, **kw):
-    """:func:`run_campaign`, then (when every run is in the table) the statistics,
-    ``report.md``, ``metrics.json``, ``statistics.json``, figures and, if asked,
-    ``runs.parquet``.  Returns ``(CampaignRun, statistics dict or None)``."""
-    from heavecomp.campaign import report, stats
-
-    info = run_campaign(campaign, out_dir, **kw)
-    if not info.complete:
-        log.info("campaign incomplete (%d of %d runs); rerun to resume", info.n_skipped + info.n_simulated,
-                 info.n_total)
-        return info, None
-    table = read_table(info.table_path)
-    st = stats.statistics(campaign, table)
-    run_info = {"executor": info.executor, "workers": info.workers, "runs_simulated": info.n_simulated,
-                "runs_resumed": info.n_skipped, "wall_time_s": round(info.wall_time, 2)}
-    report.write_report(info.out_dir, campaign, st, run_info)
-    if campaign.outputs.format == "parquet":
-        export_parquet(table, info.out_dir / "runs.parquet")
-    return info, st

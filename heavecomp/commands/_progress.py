@@ -5,11 +5,14 @@ from __future__ import annotations
 import sys
 import time
 
+#: set by ``--quiet`` (every command): no bar even on a terminal
+QUIET = False
+
 
 class Progress:
     def __init__(self, label: str, *, stream=None, enabled: bool | None = None):
         self.stream = stream or sys.stderr
-        self.enabled = self.stream.isatty() if enabled is None else enabled
+        self.enabled = (self.stream.isatty() and not QUIET) if enabled is None else enabled
         self.label = label
         self.t0 = time.perf_counter()
         self._last = -1

@@ -40,15 +40,20 @@ def _check(args):
 def run(args) -> int:
     from pathlib import Path
 
-    from heavecomp.analysis.report import write_analysis
+    from heavecomp.report.analysis import write_analysis
     from heavecomp.params import load
 
     _check(args)
     params = load(args.params)
     s = write_analysis(params, args.out, source=f"({Path(args.params).name})", n_points=args.points,
                        omega_min=args.omega_min, omega_max=args.omega_max, sliding_velocity=args.sliding_velocity)
-    wn = ", ".join(f"{x:.3f}" for x in s["natural_frequencies"])
-    zeta = ", ".join(f"{x:.4f}" for x in s["damping_ratios"])
-    print(f"k_eff_dc {s['k_eff_dc'] / 1e3:.3f} kN/m (eq. 14: {s['k_eff_eq14'] / 1e3:.3f}), natural frequencies "
-          f"{wn} rad/s, damping ratios {zeta} -> {args.out}")
+    from heavecomp.report.provenance import finish
+
+    finish(args.out, params=params, json_files=("analysis.json",), csv_files=("frequency_response.csv",))
+    from heavecomp.report.analysis import mode_rows
+
+    modes = "; ".join(f"{n} {w:.3f} rad/s (zeta {z:.4f})"
+                      for n, w, f, T, z in mode_rows(s["natural_frequencies"], s["damping_ratios"]))
+    print(f"k_eff_dc {s['k_eff_dc'] / 1e3:.3f} kN/m (eq. 14: {s['k_eff_eq14'] / 1e3:.3f}), natural frequencies: "
+          f"{modes} -> {args.out}")
     return 0

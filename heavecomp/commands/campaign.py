@@ -20,7 +20,7 @@ def run(args) -> int:
     import sys
 
     from heavecomp.campaign import spec
-    from heavecomp.campaign.execute import run_and_report
+    from heavecomp.report.campaign import run_and_report
     from heavecomp.commands._progress import Progress
     from heavecomp.errors import InputError
 
@@ -31,6 +31,9 @@ def run(args) -> int:
     bar = Progress(f"campaign {camp.settings.name}")
     info, st = run_and_report(camp, args.out, workers=args.workers, scheduler=args.scheduler,
                               progress=lambda done, total: bar(done / total if total else 1.0))
+    from heavecomp.report.provenance import finish
+
+    finish(info.out_dir, json_files=("metrics.json", "statistics.json"), params_file="campaign.toml")
     print(f"{info.n_simulated} runs simulated, {info.n_skipped} resumed, {info.wall_time:.1f} s "
           f"({info.executor}, {info.workers} workers) -> {info.table_path}")
     if st is not None:

@@ -21,10 +21,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 def run(args) -> int:
     import sys
     import time
+    from pathlib import Path
 
     from heavecomp.diagnosis.data import load_run
     from heavecomp.diagnosis.estimator import GapDiagnoser
-    from heavecomp.diagnosis.report import write_report
+    from heavecomp.report.diagnosis import write_report
     from heavecomp.errors import InputError
     from heavecomp.params import load
 
@@ -48,6 +49,9 @@ def run(args) -> int:
     d = GapDiagnoser(params, cands, split=args.split, settle=args.settle, n_jobs=args.jobs, progress=progress)
     d.fit(run_)
     write_report(d, args.out, title=f"Sim-to-real gap diagnosis — {run_.source}")
+    from heavecomp.report.provenance import finish
+
+    finish(args.out, params=params, json_files=("diagnosis.json",), measured_run=str(Path(args.run).resolve()))
     v = d.verdict_
     extra = f", second effect {v['second_effect']['effect']}" if v.get("second_effect") else ""
     print(f"verdict: {v['effect']} (confidence {v['confidence']}), held-out shrink {v['shrink']:.2f} "

@@ -29,8 +29,9 @@ def run(args) -> int:
     from pathlib import Path
 
     from heavecomp.errors import ParameterError
-    from heavecomp.identification import plots
+    from heavecomp.report import identification as plots
     from heavecomp.report.figures import save
+    from heavecomp.report.provenance import finish
     from heavecomp.report.scenario import write_metrics
 
     out = Path(args.out)
@@ -54,6 +55,7 @@ def run(args) -> int:
                                      diag.where_, diag.where_after_), out / "residual_map.png", dpi=90)
         save(plots.emps_cutoff_sensitivity(res["sensitivity"]), out / "cutoff_sensitivity.png", dpi=90)
         write_metrics(out, m)
+        finish(out, inputs=[str(Path(args.data).resolve())])
         p = m["identified_whole_record"]
         best = m["candidates"][0]
         print(f"M = {p['mass']:.3f} kg, F_v = {p['viscous']:.2f} N s/m, F_c = {p['coulomb']:.3f} N, "
@@ -79,6 +81,7 @@ def run(args) -> int:
          dpi=90)
     m = res["metrics"]
     write_metrics(out, m)
+    finish(out, inputs=[str(Path(f).resolve()) for f in args.files])
     print(f"C_p = {m['C_p_N_per_bar']:.3f} +- {m['C_p_uncertainty_N_per_bar']:.3f} N/bar, F_C = {m['F_C_N']:.2f} N "
           f"over {len(res['fit'].strokes_)} strokes -> {out}")
     return 0

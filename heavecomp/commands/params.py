@@ -28,14 +28,33 @@ def run(args) -> int:
         if args.friction:
             params = params.replace(friction={"model": args.friction})
         header = f"checked copy of {args.source}"
-        print(f"{args.source}: valid (k_eff = {params.k_eff:.6g} N/m, p_0 = {params.p0:.6g} Pa, "
-              f"V_0 = {params.gas_volume:.4g} m^3)", file=sys.stderr)
+        if not getattr(args, "quiet", False):
+            print(f"{args.source}: valid (k_eff = {params.k_eff:.6g} N/m, p_0 = {params.p0:.6g} Pa, "
+                  f"V_0 = {params.gas_volume:.4g} m^3)", file=sys.stderr)
     else:
         raise ParameterError(f"{args.source}: not a built-in set nor a file{did_you_mean(args.source, SETS)}; "
                              f"built-in sets: {', '.join(SETS)}")
+    params = _heave_path_for(params, args.output)
     text = dumps(params, header=header)
     if args.output:
         Path(args.output).write_text(text)
     else:
         sys.stdout.write(text)
     return 0
+
+
+def _heave_path_for(params, output):
+    """A relative ``heave.path`` re-pointed for the file being written: relative to the output's
+    folder when writing a file, absolute on stdout (where the file lands is unknown)."""
+    import os
+    from pathlib import Path
+
+    h = params.heave
+    if h is None or h.kind != "file" or not h.path or Path(h.path).is_absolute() or params.base_dir is None:
+        return params
+    src = (Path(params.base_dir) / h.path).resolve()
+    if output:
+        new = os.path.relpath(src, Path(output).resolve().parent)
+    else:
+        new = str(src)
+    return params.replace(heave={"path": Path(new).as_posix()})

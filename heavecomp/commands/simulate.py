@@ -34,7 +34,8 @@ def run(args) -> int:
     from heavecomp.commands._progress import Progress
     from heavecomp.params import load
     from heavecomp.report.background import BackgroundFigure
-    from heavecomp.simulate import simulate, write_outputs
+    from heavecomp.report.simulation import write_outputs
+    from heavecomp.simulate import simulate
 
     params = load(args.params)
     if args.friction:
@@ -54,8 +55,12 @@ def run(args) -> int:
     except BaseException:
         figure.cancel()
         raise
+    big = res.data.shape[0] > 200_000  # a bar only where writing takes a noticeable time
     m = write_outputs(res, args.out, title=f"WOB — {Path(args.params).name}, friction: {params.friction.model}",
-                      figure=figure)
+                      figure=figure, progress=Progress("writing timeseries.csv") if big else None)
+    from heavecomp.report.provenance import finish
+
+    finish(args.out, params=params, csv_files=("timeseries.csv",))
     print(f"WOB mean {m['wob_mean'] / 1e3:.2f} kN, std {m['wob_std'] / 1e3:.2f} kN, "
           f"peak-to-peak {m['wob_p2p'] / 1e3:.2f} kN, stuck {100 * m['stick_fraction']:.1f} % of the time "
           f"-> {args.out}")
@@ -78,6 +83,9 @@ def _run_closed_loop(args, params, Progress) -> int:
                                preview="perfect" if args.perfect_preview else "predicted", **options)
     m = write_closed_loop_outputs(res, args.out, title=f"WOB — {Path(args.params).name}, friction: "
                                   f"{params.friction.model}, controller: {args.controller}", rate=args.rate)
+    from heavecomp.report.provenance import finish
+
+    finish(args.out, params=params, csv_files=("timeseries.csv",))
     print(f"WOB std {m['wob_std'] / 1e3:.2f} kN, peak-to-peak {m['wob_p2p'] / 1e3:.2f} kN, "
           f"|u_active| max {m['u_active_max'] / 1e3:.1f} kN, solve p50/p99 {m['solve_time_ms_p50']:.2f}/"
           f"{m['solve_time_ms_p99']:.2f} ms, fallbacks {m['fallbacks']} -> {args.out}")

@@ -75,8 +75,11 @@ def run(args) -> int:
                     "stick_slip_linear": int(g["linear"].sum())}
         print(f"map {n}x{n}: critical curve and simulation agree on {100 * g['agreement']:.1f} % of the points")
     if out:
+        from heavecomp.report.provenance import finish
         from heavecomp.report.scenario import write_metrics
 
         write_metrics(out, m)
+        (out / "params.toml").write_text(pn.dumps(p))
+        finish(out, params_file="params.toml", csv_files=("timeseries.csv",) if args.duration is not None else ())
         print(f"-> {out}")
     return 0

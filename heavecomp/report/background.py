@@ -24,8 +24,31 @@ def _draw(func, args, kwargs, path, save_kwargs):
     save(func(*args, **kwargs), path, **save_kwargs)
 
 
-def _worker(conn):
+def _die_with_parent(parent_pid: int) -> None:
+    """Have the kernel kill this (child) process when its parent dies (Linux ``PR_SET_PDEATHSIG``).
+
+    Without it a child blocked in ``recv`` outlives a parent killed by SIGTERM/SIGKILL
+    (issue 14.2).  The ``getppid`` check closes the race of a parent that died before
+    the ``prctl`` call.
+    """
     try:
+        import ctypes
+        import signal
+
+        libc = ctypes.CDLL(None, use_errno=True)
+        PR_SET_PDEATHSIG = 1
+        libc.prctl(PR_SET_PDEATHSIG, int(signal.SIGKILL), 0, 0, 0)
+    except Exception:  # noqa: BLE001 - no prctl: the closed pipe below still ends the child
+        pass
+    if os.getppid() != parent_pid:
+        os._exit(1)
+
+
+def _worker(conn, send_end, parent_pid):
+    try:
+        _die_with_parent(parent_pid)
+        # drop the child's copy of the parent's end: if the parent dies, recv() sees EOF
+        send_end.close()
         pyplot()  # the expensive import happens while the parent computes
         job = conn.recv()
         if job is not None:
@@ -48,8 +71,9 @@ class BackgroundFigure:
 
             ctx = mp.get_context("fork")
             recv, self._send = ctx.Pipe(duplex=False)
-            self._proc = ctx.Process(target=_worker, args=(recv,), daemon=True)
+            self._proc = ctx.Process(target=_worker, args=(recv, self._send, os.getpid()), daemon=True)
             self._proc.start()
+            recv.close()  # the parent only sends
 
     def draw(self, func, *args, path, save_kwargs=None, **kwargs):
         """Hand the figure job over (``func(*args, **kwargs)`` must return a Figure)."""

@@ -112,7 +112,13 @@ def plot_min_velocity(p, zc, Dc, mv):
 def plot_influence(inf, zc, Dc):
     """Paper B Fig. 6: where (zeta*, D*) moves when each variable is scaled 0.5..2."""
     plt = _plt()
-    fig, ax = plt.subplots(figsize=(8.5, 6))
+    fig, ax = plt.subplots(figsize=(10, 6))
+    zs = np.concatenate([np.asarray(r["zeta"], float) for r in inf.values()])
+    Ds = np.concatenate([np.asarray(r["D"], float) for r in inf.values()])
+    # axes on the influence points (the critical curve runs to D* ~ 1e6 at small zeta*: clip it)
+    xlim = (zs.min() / 1.5, zs.max() * 1.5)
+    ylim = (Ds.min() / 2.0, Ds.max() * 2.0)
+    zc, Dc = np.asarray(zc, float), np.asarray(Dc, float)
     ax.plot(zc, Dc, "k-", lw=2, label="critical curve")
     for i, (var, rows) in enumerate(inf.items()):
         z, D = np.array(rows["zeta"]), np.array(rows["D"])
@@ -121,10 +127,12 @@ def plot_influence(inf, zc, Dc):
                     arrowprops=dict(arrowstyle="->", color=f"C{i}", lw=1.5))
     ax.set_xscale("log")
     ax.set_yscale("log")
+    ax.set_xlim(*xlim)
+    ax.set_ylim(*ylim)
     ax.set_xlabel("damping factor zeta* [-]")
     ax.set_ylabel("dimensionless friction drop D* [-]")
     ax.set_title("Influence of each variable (arrow: increasing it); above the curve = stick-slip", fontsize=10)
-    ax.legend(fontsize=7, loc="lower right")
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0.0)  # beside, not over
     ax.grid(alpha=0.3, which="both")
     fig.tight_layout()
     return fig

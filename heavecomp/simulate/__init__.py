@@ -6,6 +6,6 @@
 >>> res.metrics()["wob_p2p"]                          # doctest: +SKIP
 """
 
-from heavecomp.simulate.core import CHANNELS, SimulationResult, default_dt, simulate, write_outputs
+from heavecomp.simulate.core import CHANNELS, SimulationResult, default_dt, simulate
 
-__all__ = ["simulate", "SimulationResult", "CHANNELS", "default_dt", "write_outputs"]
+__all__ = ["simulate", "SimulationResult", "CHANNELS", "default_dt"]

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import dataclasses
-import json
 import logging
 import math
 import time
@@ -26,6 +25,10 @@ from heavecomp.plants.cmc import plant_vector
 from heavecomp.simulate import excitation
 #: columns written to timeseries.csv (contract columns first)
 CSV_COLUMNS = ("t", "heave", "stroke", "pressure", "wob", "stroke_velocity", "friction", "tension", "stuck")
+#: unit of every channel (SI; ``stuck`` is 1 while the main cylinder sticks, else 0)
+CHANNEL_UNITS = {"t": "s", "heave": "m", "stroke": "m", "pressure": "Pa", "wob": "N", "stroke_velocity": "m/s",
+                 "friction": "N", "tension": "N", "lower_displacement": "m", "lower_velocity": "m/s", "stuck": "-",
+                 "u_active": "N"}
 
 
 def plant_eigen_rate(params) -> float:
@@ -65,16 +68,25 @@ def default_dt(params, rate: float | None = None) -> float:
     return h
 
 
-def write_csv(path, data: np.ndarray, columns, fmt: str = "%.10g", block: int = 8192) -> Path:
-    """CSV with a header row; formats whole blocks of rows at once (~2x np.savetxt)."""
+def write_csv(path, data: np.ndarray, columns, fmt: str = "%.10g", block: int = 8192,
+              progress: Callable[[float], None] | None = None) -> Path:
+    """CSV with a header row; formats whole blocks of rows at once (~2x np.savetxt).
+
+    ``progress(fraction)`` is called after each block (the CLI draws a bar for large files).
+    """
     path = Path(path)
     ncol = data.shape[1]
+    n = data.shape[0]
     row = ",".join([fmt] * ncol) + "\n"
     with path.open("w") as fh:
         fh.write(",".join(columns) + "\n")
-        for i in range(0, data.shape[0], block):
+        for i in range(0, n, block):
             blk = data[i:i + block]
             fh.write((row * blk.shape[0]) % tuple(blk.ravel().tolist()))
+            if progress is not None:
+                progress(min(i + block, n) / n)
+    if progress is not None and n == 0:
+        progress(1.0)
     return path
 
 
@@ -139,12 +151,41 @@ class SimulationResult:
             "wall_time_s": self.wall_time,
         }
 
-    def to_csv(self, path, columns=CSV_COLUMNS) -> Path:
+    def to_csv(self, path, columns=CSV_COLUMNS, progress: Callable[[float], None] | None = None) -> Path:
         idx = [CHANNELS.index(c) for c in columns]
-        return write_csv(path, self.data[:, idx], columns)
+        return write_csv(path, self.data[:, idx], columns, progress=progress)
 
     def to_dict(self) -> dict[str, np.ndarray]:
         return {c: self.data[:, i] for i, c in enumerate(CHANNELS)}
+
+    def to_pandas(self, columns=None, *, time_index: bool = True):
+        """The channels as a ``pandas.DataFrame`` (pandas imported only here).
+
+        Follows python-control's ``TimeResponseData.to_pandas``: one column per signal, named
+        by the signal, time labelled ``"time"`` — here the index (``time_index=False`` gives
+        python-control's layout with ``time`` as the first column).  Units are in
+        ``df.attrs["units"]`` (column -> unit, SI; :data:`CHANNEL_UNITS`); ``stuck`` is a bool.
+
+        Parameters
+        ----------
+        columns : sequence of str, optional
+            Channels to include (default every channel of :data:`CHANNELS` but ``t``).
+        time_index : bool
+            Index the frame by time [s] (default) or keep ``time`` as a column.
+        """
+        import pandas as pd
+
+        cols = [c for c in (columns or CHANNELS) if c != "t"]
+        for c in cols:
+            if c not in CHANNELS:
+                raise KeyError(f"no channel {c!r}; channels: {', '.join(CHANNELS)}")
+        data = {c: (self[c] > 0.5) if c == "stuck" else self[c] for c in cols}
+        df = pd.DataFrame(data, index=pd.Index(self.t, name="time"))
+        units = {"time": CHANNEL_UNITS["t"], **{c: CHANNEL_UNITS[c] for c in cols}}
+        if not time_index:
+            df = df.reset_index()
+        df.attrs["units"] = units
+        return df
 
 
 def _friction_vectors(params):
@@ -292,29 +333,3 @@ def stepper():
             fn = _kernel.advance
         _STEPPER = fn
     return _STEPPER
-
-
-def write_outputs(res: SimulationResult, out_dir, *, title: str | None = None, figure=None) -> dict:
-    """Write ``timeseries.csv``, ``metrics.json`` and ``wob.png`` into ``out_dir``.
-
-    ``figure`` may be a :class:`heavecomp.report.background.BackgroundFigure`
-    started before the simulation (the CLI does), so the figure is drawn in
-    parallel with the CSV.
-    """
-    from heavecomp.report.figures import plot_wob_run
-
-    out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
-    if figure is not None:
-        figure.draw(plot_wob_run, res, title=title, path=out_dir / "wob.png", save_kwargs={"tight": False, "dpi": 100})
-    res.to_csv(out_dir / "timeseries.csv")
-    metrics = res.metrics()
-    metrics["heave"] = {k: v for k, v in res.heave_info.items() if isinstance(v, (int, float, str))}
-    (out_dir / "metrics.json").write_text(json.dumps(metrics, indent=2) + "\n")
-    if figure is None:
-        from heavecomp.report.figures import save
-
-        save(plot_wob_run(res, title=title), out_dir / "wob.png", tight=False, dpi=100)
-    else:
-        figure.wait()
-    return metrics

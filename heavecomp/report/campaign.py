@@ -3,12 +3,15 @@
 from __future__ import annotations
 
 import json
+import logging
 import math
 from pathlib import Path
 
 import numpy as np
 
 from heavecomp.report.figures import REGIME_COLORS, REGIME_LABELS, _plt, save
+
+log = logging.getLogger(__name__)
 
 
 def _label(key, g, multi_variant):
@@ -133,8 +136,8 @@ def write_report(out_dir, campaign, st: dict, run_info=None) -> Path:
         figs = ["exceedance_long_term.png", "exceedance_short_term.png", "band_by_sea_state.png"]
     (out / "statistics.json").write_text(json.dumps(_clean(st, digits=5)) + "\n")
     m = summary(st)
-    if run_info is not None:
-        m["execution"] = run_info
+    if run_info is not None:  # executor, workers, resumed runs, wall time: differ on every re-run
+        (out / "timings.json").write_text(json.dumps(_clean({"execution": run_info}), indent=2) + "\n")
     (out / "metrics.json").write_text(json.dumps(_clean(m), indent=2) + "\n")
     b = st["band_half_width"] / 1e3
     T = st["exposure"]
@@ -171,10 +174,11 @@ def write_report(out_dir, campaign, st: dict, run_info=None) -> Path:
             "heave realisations (paired comparison).", ""]
     for f in figs:
         text += [f"![{f}]({f})", ""]
-    if run_info:
-        text += ["## Execution", "", ", ".join(f"{k}: {v}" for k, v in run_info.items()), ""]
     path = out / "report.md"
     path.write_text("\n".join(text))
+    from heavecomp.report.provenance import stamp, stamp_report
+
+    stamp_report(path, stamp(params_file="campaign.toml"))
     return path
 
 
@@ -203,3 +207,29 @@ def _clean(x, digits=None):
     if isinstance(x, (list, tuple)):
         return [_clean(v, digits) for v in x]
     return x
+
+
+def run_and_report(campaign, out_dir, **kw):
+    """:func:`run_campaign`, then (when every run is in the table) the statistics,
+    ``report.md``, ``metrics.json``, ``statistics.json``, figures and, if asked,
+    ``runs.parquet``.  Returns ``(CampaignRun, statistics dict or None)``."""
+    from heavecomp.campaign import stats
+    from heavecomp.campaign.execute import read_table, run_campaign
+    from heavecomp.campaign.tables import check_parquet, export_parquet
+
+    if campaign.outputs.format == "parquet":
+        check_parquet()  # before the runs, not after
+
+    info = run_campaign(campaign, out_dir, **kw)
+    if not info.complete:
+        log.info("campaign incomplete (%d of %d runs); rerun to resume", info.n_skipped + info.n_simulated,
+                 info.n_total)
+        return info, None
+    table = read_table(info.table_path)
+    st = stats.statistics(campaign, table)
+    run_info = {"executor": info.executor, "workers": info.workers, "runs_simulated": info.n_simulated,
+                "runs_resumed": info.n_skipped, "wall_time_s": round(info.wall_time, 2)}
+    write_report(info.out_dir, campaign, st, run_info)
+    if campaign.outputs.format == "parquet":
+        export_parquet(table, info.out_dir, campaign.outputs.deviation_max, campaign.outputs.bins)
+    return info, st

@@ -15,10 +15,8 @@ from pathlib import Path
 
 import numpy as np
 
-from heavecomp.analysis.frequency import WAVE_BAND, dc_gain, frequency_grid, modes, response_table
-from heavecomp.analysis.linear import linearise_details
-from heavecomp.report.figures import _plt as plt_, save
-from heavecomp.report.scenario import _clean as c
+from heavecomp.analysis.frequency import WAVE_BAND
+from heavecomp.analysis.summary import analyse
 
 log = logging.getLogger(__name__)
 
@@ -161,65 +159,6 @@ def _clean(x):
     return c(x)
 
 
-def analyse(params, *, n_points: int = 1000, omega_min: float = 1e-3, omega_max: float | None = None,
-            sliding_velocity: float | None = None) -> dict:
-    """Everything ``heavecomp analyse`` reports for one parameter set (no files).
-
-    Returns
-    -------
-    dict
-        ``summary`` (the analysis.json content), ``table`` (CSV columns of the
-        frictionless model), ``curves`` (label -> (omega, k_eff(omega))).
-    """
-    L0 = linearise_details(params, friction="none")
-    sys = L0.sys
-    w = frequency_grid(sys, n_points, omega_min, omega_max)
-    table = response_table(sys, w)
-    md = modes(sys)
-    k_dc = -dc_gain(sys)
-    lo, hi = WAVE_BAND
-    summary = {
-        "k_eff_dc": k_dc,
-        "k_eff_eq14": params.k_eff,
-        "dc_gain_heave_to_wob": -k_dc,
-        "natural_frequencies": md["natural_frequencies"],
-        "natural_periods": [2 * math.pi / x for x in md["natural_frequencies"]],
-        "damping_ratios": md["damping_ratios"],
-        "damped_natural_frequencies": md["damped_natural_frequencies"],
-        "poles": md["poles"],
-        "wave_band_rad_s": [lo, hi],
-        "modes_in_wave_band": [bool(lo <= x <= hi) for x in md["natural_frequencies"]],
-        "peak_k_eff": float(np.max(table["k_eff_mag"])),
-        "peak_omega": float(w[np.argmax(table["k_eff_mag"])]),
-        "transmissibility_at_wave_periods": {
-            f"{T:g}": float(np.interp(2 * math.pi / T, w, table["transmissibility"])) for T in (5, 8, 12, 16, 20)},
-        "operating_point": L0.op.as_dict(),
-        "linearisation": "frictionless (friction='none'); outputs are deviations from the operating point",
-        "frequency_points": int(len(w)),
-        "friction_model": params.friction.model,
-    }
-    curves = {"frictionless": (w, -(table["wob_per_heave_mag"] * np.exp(1j * np.radians(table["wob_per_heave_phase_deg"]))))}
-    if params.friction.viscous_coefficient is not None:
-        Lv = linearise_details(params, friction="viscous")
-        mv = modes(Lv.sys)
-        tv = response_table(Lv.sys, w)
-        summary["viscous"] = {"viscous_coefficient": params.friction.viscous_coefficient,
-                              "natural_frequencies": mv["natural_frequencies"],
-                              "damping_ratios": mv["damping_ratios"], "k_eff_dc": -dc_gain(Lv.sys)}
-        curves[f"viscous C_v = {params.friction.viscous_coefficient / 1e3:g} kN s/m"] = (
-            w, -(tv["wob_per_heave_mag"] * np.exp(1j * np.radians(tv["wob_per_heave_phase_deg"]))))
-    if sliding_velocity is not None and params.friction.model != "none":
-        Ls = linearise_details(params, friction="sliding", velocity=sliding_velocity)
-        ms = modes(Ls.sys)
-        ts = response_table(Ls.sys, w)
-        summary["sliding"] = {"velocity": sliding_velocity, "friction_slope": Ls.friction_slope,
-                              "natural_frequencies": ms["natural_frequencies"],
-                              "damping_ratios": ms["damping_ratios"], "k_eff_dc": -dc_gain(Ls.sys)}
-        curves[f"sliding at {sliding_velocity:g} m/s"] = (
-            w, -(ts["wob_per_heave_mag"] * np.exp(1j * np.radians(ts["wob_per_heave_phase_deg"]))))
-    return {"summary": summary, "table": table, "curves": curves}
-
-
 def write_analysis(params, out, *, source: str = "", **kw) -> dict:
     """Write ``analysis.json``, ``frequency_response.csv``, ``bode.png`` and ``report.md`` into ``out``.
 
@@ -229,7 +168,9 @@ def write_analysis(params, out, *, source: str = "", **kw) -> dict:
     out.mkdir(parents=True, exist_ok=True)
     res = analyse(params, **kw)
     s, table = res["summary"], res["table"]
-    (out / "analysis.json").write_text(json.dumps(_clean(s), indent=2) + "\n")
+    from heavecomp.report.provenance import round_floats
+
+    (out / "analysis.json").write_text(json.dumps(round_floats(_clean(s)), indent=2) + "\n")
     cols = list(table)
     np.savetxt(out / "frequency_response.csv", np.column_stack([table[c] for c in cols]), delimiter=",",
                header=",".join(cols), comments="", fmt="%.10g")
@@ -237,33 +178,54 @@ def write_analysis(params, out, *, source: str = "", **kw) -> dict:
                      title=f"Heave -> WOB {source}: |k_eff(w)| with the wave band and the natural frequencies"),
          out / "bode.png", dpi=100)
     (out / "report.md").write_text(report_markdown(s, source))
+    from heavecomp.report.provenance import stamp, stamp_report
+
+    stamp_report(out / "report.md", stamp())
     log.info("analysis written to %s", out)
     return s
 
 
+#: the CMC's two modes, ascending (linearised, frictionless: the top mass rides on the soft gas
+#: spring, the lower mass on the much stiffer drill string and formation)
+MODE_NAMES = ("mode 1: top mass on the gas spring", "mode 2: lower mass on drill string and formation")
+
+
+def mode_rows(freqs_rad_s, damping=None) -> list[tuple]:
+    """``(name, omega [rad/s], f [Hz], period [s], zeta [-])`` per mode, sorted by frequency."""
+    damping = list(damping) if damping is not None else [math.nan] * len(freqs_rad_s)
+    names = MODE_NAMES if len(freqs_rad_s) == len(MODE_NAMES) else [f"mode {i + 1}" for i in range(len(freqs_rad_s))]
+    order = np.argsort(freqs_rad_s)
+    return [(names[k], float(freqs_rad_s[i]), float(freqs_rad_s[i]) / (2 * math.pi),
+             2 * math.pi / float(freqs_rad_s[i]), float(damping[i])) for k, i in enumerate(order)]
+
+
 def report_markdown(s: dict, source: str = "") -> str:
     """Markdown frequency-response report from an analysis.json dict."""
-    wn = ", ".join(f"{x:.3f}" for x in s["natural_frequencies"])
-    Tn = ", ".join(f"{x:.2f}" for x in s["natural_periods"])
-    z = ", ".join(f"{x:.4f}" for x in s["damping_ratios"])
     inband = any(s["modes_in_wave_band"])
+    modes = ["| mode | natural frequency (undamped) [rad/s] | [Hz] | natural period [s] | damping ratio [-] |",
+             "|---|---|---|---|---|"]
+    modes += [f"| {n} | {w:.3f} | {f:.4f} | {T:.3f} | {z:.4f} |"
+              for n, w, f, T, z in mode_rows(s["natural_frequencies"], s["damping_ratios"])]
     lines = [
         f"# Frequency response heave -> WOB {source}".rstrip(),
         "",
         "Linearised CMC (frictionless, about the operating point s = 0, WOB = W_0), from the same casadi "
         "equations the simulator uses (`heavecomp.analysis.linear`).",
         "",
-        "| quantity | value |",
-        "|---|---|",
-        f"| k_eff_dc (DC gain heave -> WOB, sign flipped) | {s['k_eff_dc'] / 1e3:.3f} kN/m |",
-        f"| paper A eq. 14 k_eff | {s['k_eff_eq14'] / 1e3:.3f} kN/m |",
-        f"| natural frequencies (undamped) | {wn} rad/s |",
-        f"| natural periods | {Tn} s |",
-        f"| damping ratios | {z} |",
-        f"| peak |k_eff(w)| | {s['peak_k_eff'] / 1e3:.1f} kN/m at {s['peak_omega']:.3f} rad/s |",
+        "| quantity | value | unit |",
+        "|---|---|---|",
+        f"| k_eff_dc (DC gain heave -> WOB, sign flipped) | {s['k_eff_dc'] / 1e3:.3f} | kN/m |",
+        f"| paper A eq. 14 k_eff | {s['k_eff_eq14'] / 1e3:.3f} | kN/m |",
+        f"| peak abs(k_eff(w)) | {s['peak_k_eff'] / 1e3:.1f} | kN/m |",
+        f"| frequency of the peak | {s['peak_omega']:.3f} | rad/s |",
         "",
-        "Transmissibility |k_eff(w)|/k_eff(0) at wave periods: "
-        + ", ".join(f"{k} s: {v:.3f}" for k, v in s["transmissibility_at_wave_periods"].items()) + ".",
+        "Modes, sorted by frequency:",
+        "",
+        *modes,
+        "",
+        "| wave period [s] | transmissibility abs(k_eff(w))/k_eff(0) [-] |",
+        "|---|---|",
+        *[f"| {k} | {v:.3f} |" for k, v in s["transmissibility_at_wave_periods"].items()],
         "",
         ("A natural frequency lies **inside** the wave band (periods 5-20 s): waves excite a resonance."
          if inband else
@@ -276,7 +238,7 @@ def report_markdown(s: dict, source: str = "") -> str:
     for key, label in (("viscous", "viscous friction only"), ("sliding", "sliding linearisation")):
         if key in s:
             v = s[key]
-            lines.append(f"With {label}: natural frequencies "
-                         + ", ".join(f"{x:.3f}" for x in v["natural_frequencies"]) + " rad/s, damping ratios "
-                         + ", ".join(f"{x:.4f}" for x in v["damping_ratios"]) + ".")
+            lines.append(f"With {label}: " + "; ".join(
+                f"{n} {w:.3f} rad/s, damping ratio {z:.4f}"
+                for n, w, f, T, z in mode_rows(v["natural_frequencies"], v["damping_ratios"])) + ".")
     return "\n".join(lines) + "\n"

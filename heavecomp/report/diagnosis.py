@@ -13,18 +13,38 @@ from heavecomp.report.figures import _plt, save
 from heavecomp.report.scenario import md_table
 
 CH_UNITS = {"wob": ("kN", 1e-3), "stroke": ("mm", 1e3), "pressure": ("kPa", 1e-3)}
+#: names of :func:`heavecomp.diagnosis.where.eigenfrequencies`, in its order
+MODE_NAMES = ("sliding, low mode (top mass on the gas spring)", "sliding, high mode (lower mass on string and "
+              "formation)", "stuck cylinder (lower mass on k_ds + k_F)")
+
+
+def named_modes(freqs_hz) -> str:
+    """Eigenfrequencies sorted by frequency, each named by its mode: ``"0.44 Hz (sliding, ...)"``."""
+    names = MODE_NAMES if len(freqs_hz) == len(MODE_NAMES) else [f"mode {i + 1}" for i in range(len(freqs_hz))]
+    return ", ".join(f"{f:.2f} Hz ({n})" for f, n in sorted(zip(freqs_hz, names)))
+
+
+def _effect_units(effect: str) -> dict:
+    """Parameter name -> unit from the effect class's own metadata ({} for an unknown name)."""
+    from heavecomp.effects import CANDIDATES
+
+    cls = CANDIDATES.get(effect)
+    return {d["name"]: d["unit"] for d in cls.describe()} if cls is not None else {}
+
+
+def _with_unit(name: str, val, sigma=None, units=None) -> str:
+    """``name = value ± sigma unit`` for a fitted parameter (``units``: :func:`_effect_units`)."""
+    if not isinstance(val, float):
+        return f"{name} = {val}"
+    u = (units or {}).get(name)
+    pm = f" ± {sigma:.2g}" if isinstance(sigma, float) and math.isfinite(sigma) else ""
+    return f"{name} = {val:.4g}{pm}" + (f" {u}" if u and u != "-" else "")
 
 
 def _clean(x):
-    if isinstance(x, float) and not math.isfinite(x):
-        return None
-    if isinstance(x, dict):
-        return {str(k): _clean(v) for k, v in x.items()}
-    if isinstance(x, (list, tuple)):
-        return [_clean(v) for v in x]
-    if isinstance(x, (np.floating, np.integer, np.bool_)):
-        return _clean(x.item())
-    return x
+    from heavecomp.report.scenario import _clean as clean
+
+    return clean(x)
 
 
 def write_json(diag, path) -> Path:
@@ -43,9 +63,15 @@ def fig_where(diag):
     r = tr["nominal"]["wob"] - tr["measured"]["wob"]
     ok = np.isfinite(r) & (t >= diag.split_["settle"])
     fig, (ax, axb) = plt.subplots(1, 2, figsize=(11, 4.2), gridspec_kw={"width_ratios": [1.6, 1]})
-    order = np.argsort(np.abs(r[ok]))
-    sc = ax.scatter(v[ok][order] * 1e3, a[ok][order], c=np.abs(r[ok][order]) / 1e3, s=3, cmap="viridis")
-    fig.colorbar(sc, ax=ax, label="|WOB residual| [kN]")
+    # binned, not one dot per sample: a long run overplots a scatter into a solid blot
+    vv, aa = v[ok] * 1e3, a[ok]
+    lim_v = np.percentile(np.abs(vv), 99.5) * 1.05 or 1.0
+    lim_a = np.percentile(np.abs(aa), 99.5) * 1.05 or 1.0
+    hb = ax.hexbin(vv, aa, C=np.abs(r[ok]) / 1e3, reduce_C_function=np.mean, gridsize=(45, 25), mincnt=1,
+                   cmap="viridis", extent=(-lim_v, lim_v, -lim_a, lim_a))
+    ax.set_xlim(-lim_v, lim_v)
+    ax.set_ylim(-lim_a, lim_a)
+    fig.colorbar(hb, ax=ax, label="mean |WOB residual| per bin [kN]")
     ax.set_xlabel("stroke velocity v [mm/s]")
     ax.set_ylabel("stroke acceleration [m/s²]")
     ax.set_title("Where: WOB residual over (v, dv/dt) of the nominal replay", fontsize=10)
@@ -142,8 +168,7 @@ def write_report(diag, out_dir, *, title="Sim-to-real gap diagnosis") -> dict:
     if v.get("parameters"):
         unc = v.get("uncertainty", {})
         lines.append("\nFitted parameters: " + ", ".join(
-            f"{k} = {val:.4g}" + (f" ± {unc[k]:.2g}" if isinstance(unc.get(k), float) and math.isfinite(unc[k]) else "")
-            if isinstance(val, float) else f"{k} = {val}" for k, val in v["parameters"].items()) + ".")
+            _with_unit(k, val, unc.get(k), _effect_units(v["effect"])) for k, val in v["parameters"].items()) + ".")
     if v.get("second_effect"):
         se = v["second_effect"]
         lines.append(f"\nSecond effect: `{se['effect']}` adds {100 * se['added_explained']:.0f} % of the held-out "
@@ -156,31 +181,36 @@ def write_report(diag, out_dir, *, title="Sim-to-real gap diagnosis") -> dict:
     for w in getattr(diag, "warnings_", []):
         lines.append(f"\n> data: {w}")
     lines += ["", "## Gap (nominal replay vs measurement, after the settling window)", "",
-              md_table(["channel", "rms", "nrmse", "rms held-out", "noise floor"],
-                       [[c, f"{g['channels'][c]['rms']:.4g}", f"{g['channels'][c]['nrmse']:.3f}",
-                         f"{g['channels'][c]['rms_validate']:.4g}", f"{g['channels'][c]['noise_floor']:.4g}"]
+              md_table(["channel", "unit", "rms", "nrmse [-]", "rms held-out", "noise floor"],
+                       [[c, CH_UNITS[c][0], f"{g['channels'][c]['rms'] * CH_UNITS[c][1]:.4g}",
+                         f"{g['channels'][c]['nrmse']:.3f}",
+                         f"{g['channels'][c]['rms_validate'] * CH_UNITS[c][1]:.4g}",
+                         f"{g['channels'][c]['noise_floor'] * CH_UNITS[c][1]:.4g}"]
                         for c in ("wob", "stroke", "pressure")]),
               "", "## Where", "",
               "Share of the squared WOB residual by regime: " + ", ".join(
                   f"{k.replace('_', ' ')} {100 * x:.0f} %" for k, x in diag.where_["regimes"].items()) + ".",
               "By band: " + ", ".join(f"{k.replace('_', ' ')} {100 * x:.0f} %" for k, x in diag.where_["bands"].items())
-              + f" (eigenfrequencies {', '.join(f'{f:.2f}' for f in diag.where_['eigenfrequencies_hz'])} Hz).",
+              + f". Eigenfrequencies: {named_modes(diag.where_['eigenfrequencies_hz'])}.",
               "Largest in: " + ", ".join(f"{a:.1f}-{b:.1f} s" for a, b in diag.where_["segments"]) + ".",
               "", "![where](where.png)", "", "![spectra](spectra.png)", "",
               "## Which: every candidate, fitted on the fit part, scored on the held-out part", "",
-              md_table(["effect", "explained", "score", "wob rms before", "wob rms after", "wob shrink",
-                        "stroke shrink", "pressure shrink", "parameters"],
-                       [[c["effect"], f"{c['explained']:.2f}", f"{c['score']:.2f}", f"{c['rms_before']:.4g}",
-                         f"{c['rms_after']:.4g}", f"{c['channels']['wob']['shrink']:.2f}",
+              md_table(["effect", "explained [-]", "score [-]", "wob rms before [kN]", "wob rms after [kN]",
+                        "wob shrink [-]", "stroke shrink [-]", "pressure shrink [-]", "parameters"],
+                       [[c["effect"], f"{c['explained']:.2f}", f"{c['score']:.2f}", f"{c['rms_before'] / 1e3:.4g}",
+                         f"{c['rms_after'] / 1e3:.4g}", f"{c['channels']['wob']['shrink']:.2f}",
                          f"{c['channels']['stroke']['shrink']:.2f}", f"{c['channels']['pressure']['shrink']:.2f}",
-                         ", ".join(f"{k}={val:.3g}" if isinstance(val, float) else f"{k}={val}"
+                         ", ".join(_with_unit(k, val, units=_effect_units(c["effect"]))
                                    for k, val in c["parameters"].items())]
                         for c in diag.candidates_]),
               "", f"Split: fit {diag.split_['fit'][0]:.0f}-{diag.split_['fit'][1]:.0f} s, held out "
                   f"{diag.split_['validate'][0]:.0f}-{diag.split_['validate'][1]:.0f} s; first "
-                  f"{diag.split_['settle']:.0f} s excluded (start-up). Run time {diag.wall_time_:.1f} s.",
+                  f"{diag.split_['settle']:.0f} s excluded (start-up).",
               "", "## Before / after", "", "![overlay](overlay.png)", ""]
     (out / "report.md").write_text("\n".join(lines))
+    from heavecomp.report.provenance import stamp, stamp_report
+
+    stamp_report(out / "report.md", stamp())
     return diag.to_json()
 
 

@@ -1,0 +1,71 @@
+"""Everything ``heavecomp analyse`` computes for one parameter set (data only; report/analysis.py draws)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from heavecomp.analysis.frequency import WAVE_BAND
+
+
+def analyse(params, *, n_points: int = 1000, omega_min: float = 1e-3, omega_max: float | None = None,
+            sliding_velocity: float | None = None) -> dict:
+    """Everything ``heavecomp analyse`` reports for one parameter set (no files).
+
+    Returns
+    -------
+    dict
+        ``summary`` (the analysis.json content), ``table`` (CSV columns of the
+        frictionless model), ``curves`` (label -> (omega, k_eff(omega))).
+    """
+    from heavecomp.analysis.frequency import dc_gain, frequency_grid, modes, response_table
+    from heavecomp.analysis.linear import linearise_details
+
+    L0 = linearise_details(params, friction="none")
+    sys = L0.sys
+    w = frequency_grid(sys, n_points, omega_min, omega_max)
+    table = response_table(sys, w)
+    md = modes(sys)
+    k_dc = -dc_gain(sys)
+    lo, hi = WAVE_BAND
+    summary = {
+        "k_eff_dc": k_dc,
+        "k_eff_eq14": params.k_eff,
+        "dc_gain_heave_to_wob": -k_dc,
+        "natural_frequencies": md["natural_frequencies"],
+        "natural_periods": [2 * math.pi / x for x in md["natural_frequencies"]],
+        "damping_ratios": md["damping_ratios"],
+        "damped_natural_frequencies": md["damped_natural_frequencies"],
+        "poles": md["poles"],
+        "wave_band_rad_s": [lo, hi],
+        "modes_in_wave_band": [bool(lo <= x <= hi) for x in md["natural_frequencies"]],
+        "peak_k_eff": float(np.max(table["k_eff_mag"])),
+        "peak_omega": float(w[np.argmax(table["k_eff_mag"])]),
+        "transmissibility_at_wave_periods": {
+            f"{T:g}": float(np.interp(2 * math.pi / T, w, table["transmissibility"])) for T in (5, 8, 12, 16, 20)},
+        "operating_point": L0.op.as_dict(),
+        "linearisation": "frictionless (friction='none'); outputs are deviations from the operating point",
+        "frequency_points": int(len(w)),
+        "friction_model": params.friction.model,
+    }
+    curves = {"frictionless": (w, -(table["wob_per_heave_mag"] * np.exp(1j * np.radians(table["wob_per_heave_phase_deg"]))))}
+    if params.friction.viscous_coefficient is not None:
+        Lv = linearise_details(params, friction="viscous")
+        mv = modes(Lv.sys)
+        tv = response_table(Lv.sys, w)
+        summary["viscous"] = {"viscous_coefficient": params.friction.viscous_coefficient,
+                              "natural_frequencies": mv["natural_frequencies"],
+                              "damping_ratios": mv["damping_ratios"], "k_eff_dc": -dc_gain(Lv.sys)}
+        curves[f"viscous C_v = {params.friction.viscous_coefficient / 1e3:g} kN s/m"] = (
+            w, -(tv["wob_per_heave_mag"] * np.exp(1j * np.radians(tv["wob_per_heave_phase_deg"]))))
+    if sliding_velocity is not None and params.friction.model != "none":
+        Ls = linearise_details(params, friction="sliding", velocity=sliding_velocity)
+        ms = modes(Ls.sys)
+        ts = response_table(Ls.sys, w)
+        summary["sliding"] = {"velocity": sliding_velocity, "friction_slope": Ls.friction_slope,
+                              "natural_frequencies": ms["natural_frequencies"],
+                              "damping_ratios": ms["damping_ratios"], "k_eff_dc": -dc_gain(Ls.sys)}
+        curves[f"sliding at {sliding_velocity:g} m/s"] = (
+            w, -(ts["wob_per_heave_mag"] * np.exp(1j * np.radians(ts["wob_per_heave_phase_deg"]))))
+    return {"summary": summary, "table": table, "curves": curves}

@@ -1,0 +1,33 @@
+"""Outputs of ``heavecomp simulate`` (open loop): the contract CSV, metrics and the WOB figure."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Callable
+
+from heavecomp.report.figures import plot_wob_run, save
+from heavecomp.simulate.core import SimulationResult
+
+
+def write_outputs(res: SimulationResult, out_dir, *, title: str | None = None, figure=None,
+                  progress: Callable[[float], None] | None = None) -> dict:
+    """Write ``timeseries.csv``, ``metrics.json`` and ``wob.png`` into ``out_dir``.
+
+    ``figure`` may be a :class:`heavecomp.report.background.BackgroundFigure`
+    started before the simulation (the CLI does), so the figure is drawn in
+    parallel with the CSV.  ``progress(fraction)`` follows the CSV being written.
+    """
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    if figure is not None:
+        figure.draw(plot_wob_run, res, title=title, path=out_dir / "wob.png", save_kwargs={"tight": False, "dpi": 100})
+    res.to_csv(out_dir / "timeseries.csv", progress=progress)
+    metrics = res.metrics()
+    metrics["heave"] = {k: v for k, v in res.heave_info.items() if isinstance(v, (int, float, str))}
+    (out_dir / "metrics.json").write_text(json.dumps(metrics, indent=2) + "\n")
+    if figure is None:
+        save(plot_wob_run(res, title=title), out_dir / "wob.png", tight=False, dpi=100)
+    else:
+        figure.wait()
+    return metrics
