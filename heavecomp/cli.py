@@ -17,7 +17,9 @@ import sys
 
 from heavecomp import __version__
 from heavecomp.errors import InputError, did_you_mean
-from heavecomp.report import provenance
+from heavecomp.report import invocation
+from heavecomp.commands import _progress
+from heavecomp.commands import _output
 
 #: name -> (module, one-line help).  Order is the order shown by --help.
 COMMANDS: dict[str, tuple[str, str]] = {
@@ -113,7 +115,7 @@ def main(argv: list[str] | None = None) -> int:
     words = list(sys.argv[1:] if argv is None else argv)
     parser, modules = build_parser(next((w for w in words if not w.startswith("-")), ""))
     _Parser.argv = words
-    provenance.COMMAND = ["heavecomp", *_Parser.argv]
+    invocation.COMMAND = ["heavecomp", *_Parser.argv]
     args, extra = parser.parse_known_args(argv)
     if not args.command:
         parser.print_help()
@@ -142,7 +144,6 @@ def main(argv: list[str] | None = None) -> int:
 
 def _check_outputs(args) -> None:
     """``--out DIR`` and ``params -o FILE`` checked before any work (one line, exit 2)."""
-    from heavecomp.commands import _output
 
     if getattr(args, "out", None):
         _output.out_dir(args.out, "--out")
@@ -160,7 +161,6 @@ def _run_quiet(module, args) -> int:
     import io
     import logging
 
-    from heavecomp.commands import _progress
 
     _progress.QUIET = True
     logging.getLogger("heavecomp").setLevel(logging.WARNING)

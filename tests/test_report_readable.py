@@ -69,7 +69,7 @@ def _fig_extent(fig, artist):
 
 
 def test_influence_axes_on_the_data_and_legend_beside_the_arrows():
-    from heavecomp.analysis.pneumatic_plots import plot_influence
+    from heavecomp.report.rigs import plot_influence
 
     zc = np.geomspace(1e-3, 3.0, 200)
     Dc = 1.0 / zc ** 2  # a critical curve that runs to 1e6 at small zeta*

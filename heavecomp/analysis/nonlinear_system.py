@@ -31,6 +31,9 @@ from __future__ import annotations
 import numpy as np
 
 from heavecomp.analysis.linear import RAW_INPUTS, RAW_OUTPUTS, RAW_STATES
+from heavecomp.plants.cmc import casadi_model
+from heavecomp.friction.laws import FrictionLaw
+from heavecomp.errors import ParameterError
 
 #: units of the signals, by name
 SIGNAL_UNITS = {"stroke": "m", "stroke_velocity": "m/s", "lower_displacement": "m", "lower_velocity": "m/s",
@@ -59,9 +62,6 @@ def cmc_nlsys(params, *, eps: float | None = None, name: str = "cmc"):
     """
     import control as ct
 
-    from heavecomp.errors import ParameterError
-    from heavecomp.friction.laws import FrictionLaw
-    from heavecomp.plants.cmc import casadi_model
 
     law = FrictionLaw.from_params(params.friction)
     if law.has_stiction and not (eps is not None and eps > 0 and np.isfinite(eps)):

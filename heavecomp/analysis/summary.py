@@ -7,6 +7,8 @@ import math
 import numpy as np
 
 from heavecomp.analysis.frequency import WAVE_BAND
+from heavecomp.analysis.linear import linearise_details
+from heavecomp.analysis.frequency import dc_gain, frequency_grid, modes, response_table
 
 
 def analyse(params, *, n_points: int = 1000, omega_min: float = 1e-3, omega_max: float | None = None,
@@ -19,8 +21,6 @@ def analyse(params, *, n_points: int = 1000, omega_min: float = 1e-3, omega_max:
         ``summary`` (the analysis.json content), ``table`` (CSV columns of the
         frictionless model), ``curves`` (label -> (omega, k_eff(omega))).
     """
-    from heavecomp.analysis.frequency import dc_gain, frequency_grid, modes, response_table
-    from heavecomp.analysis.linear import linearise_details
 
     L0 = linearise_details(params, friction="none")
     sys = L0.sys

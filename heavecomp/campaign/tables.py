@@ -16,6 +16,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+from heavecomp.errors import ParameterError
 
 #: columns holding whole numbers (stored as float64 by the CSV reader)
 INT_COLUMNS = ("sea_state", "seed", "n_samples", "n_band_exits", "n_cycles", "n_stick", "n_breakaway", "n_reversal")
@@ -99,7 +100,6 @@ def histograms_frame(table: dict, deviation_max: float, bins: int):
 
 def check_parquet() -> None:
     """Fail early (one line, exit 2) when pandas/pyarrow are missing for ``outputs.format = "parquet"``."""
-    from heavecomp.errors import ParameterError
 
     try:
         import pandas  # noqa: F401

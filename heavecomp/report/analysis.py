@@ -17,6 +17,9 @@ import numpy as np
 
 from heavecomp.analysis.frequency import WAVE_BAND
 from heavecomp.analysis.summary import analyse
+from heavecomp.report.figures import _plt as plt_, save
+from heavecomp.report.provenance import _clean as c
+from heavecomp.report.provenance import round_floats, stamp, stamp_report
 
 log = logging.getLogger(__name__)
 
@@ -168,7 +171,6 @@ def write_analysis(params, out, *, source: str = "", **kw) -> dict:
     out.mkdir(parents=True, exist_ok=True)
     res = analyse(params, **kw)
     s, table = res["summary"], res["table"]
-    from heavecomp.report.provenance import round_floats
 
     (out / "analysis.json").write_text(json.dumps(round_floats(_clean(s)), indent=2) + "\n")
     cols = list(table)
@@ -178,7 +180,6 @@ def write_analysis(params, out, *, source: str = "", **kw) -> dict:
                      title=f"Heave -> WOB {source}: |k_eff(w)| with the wave band and the natural frequencies"),
          out / "bode.png", dpi=100)
     (out / "report.md").write_text(report_markdown(s, source))
-    from heavecomp.report.provenance import stamp, stamp_report
 
     stamp_report(out / "report.md", stamp())
     log.info("analysis written to %s", out)

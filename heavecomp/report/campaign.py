@@ -10,6 +10,9 @@ from pathlib import Path
 import numpy as np
 
 from heavecomp.report.figures import REGIME_COLORS, REGIME_LABELS, _plt, save
+from heavecomp.campaign.tables import check_parquet, export_parquet
+from heavecomp.campaign.execute import read_table, run_campaign
+from heavecomp.report.provenance import stamp, stamp_report
 
 log = logging.getLogger(__name__)
 
@@ -176,7 +179,6 @@ def write_report(out_dir, campaign, st: dict, run_info=None) -> Path:
         text += [f"![{f}]({f})", ""]
     path = out / "report.md"
     path.write_text("\n".join(text))
-    from heavecomp.report.provenance import stamp, stamp_report
 
     stamp_report(path, stamp(params_file="campaign.toml"))
     return path
@@ -214,8 +216,6 @@ def run_and_report(campaign, out_dir, **kw):
     ``report.md``, ``metrics.json``, ``statistics.json``, figures and, if asked,
     ``runs.parquet``.  Returns ``(CampaignRun, statistics dict or None)``."""
     from heavecomp.campaign import stats
-    from heavecomp.campaign.execute import read_table, run_campaign
-    from heavecomp.campaign.tables import check_parquet, export_parquet
 
     if campaign.outputs.format == "parquet":
         check_parquet()  # before the runs, not after

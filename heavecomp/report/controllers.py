@@ -1,13 +1,14 @@
-"""Figures of the controller design study (:mod:`heavecomp.controllers.design` computes, this draws)."""
+"""Figures of the controller design study (:mod:`heavecomp.closed_loop.design` computes, this draws)."""
 
 from __future__ import annotations
 
 import numpy as np
+from heavecomp.report.figures import _plt
+from heavecomp.report.figures import REGIME_LABELS, _plt
 
 
 def plot_wob_controllers(results: dict, window, *, title: str):
     """WOB and active force over time for several controllers (label -> ClosedLoopResult)."""
-    from heavecomp.report.figures import _plt
 
     plt = _plt()
     fig, (ax, axu) = plt.subplots(2, 1, figsize=(10, 6.2), sharex=True, gridspec_kw={"height_ratios": [3, 2]})
@@ -35,7 +36,6 @@ def plot_wob_controllers(results: dict, window, *, title: str):
 
 def plot_std_table(table: dict, sea: str, *, title: str):
     """Grouped bars: WOB std per friction regime and controller."""
-    from heavecomp.report.figures import REGIME_LABELS, _plt
 
     plt = _plt()
     fig, ax = plt.subplots(figsize=(9, 4.2))
@@ -58,7 +58,6 @@ def plot_std_table(table: dict, sea: str, *, title: str):
 
 def plot_sweeps(sweeps: dict, passive_std: float, *, title: str):
     """One panel per swept option: WOB std (left axis) against the option value."""
-    from heavecomp.report.figures import _plt
 
     plt = _plt()
     n = len(sweeps)

@@ -11,6 +11,9 @@ import numpy as np
 from heavecomp.diagnosis.where import residual_spectrum
 from heavecomp.report.figures import _plt, save
 from heavecomp.report.scenario import md_table
+from heavecomp.report.provenance import stamp, stamp_report
+from heavecomp.report.scenario import _clean as clean
+from heavecomp.effects import CANDIDATES
 
 CH_UNITS = {"wob": ("kN", 1e-3), "stroke": ("mm", 1e3), "pressure": ("kPa", 1e-3)}
 #: names of :func:`heavecomp.diagnosis.where.eigenfrequencies`, in its order
@@ -26,7 +29,6 @@ def named_modes(freqs_hz) -> str:
 
 def _effect_units(effect: str) -> dict:
     """Parameter name -> unit from the effect class's own metadata ({} for an unknown name)."""
-    from heavecomp.effects import CANDIDATES
 
     cls = CANDIDATES.get(effect)
     return {d["name"]: d["unit"] for d in cls.describe()} if cls is not None else {}
@@ -42,7 +44,6 @@ def _with_unit(name: str, val, sigma=None, units=None) -> str:
 
 
 def _clean(x):
-    from heavecomp.report.scenario import _clean as clean
 
     return clean(x)
 
@@ -208,7 +209,6 @@ def write_report(diag, out_dir, *, title="Sim-to-real gap diagnosis") -> dict:
                   f"{diag.split_['settle']:.0f} s excluded (start-up).",
               "", "## Before / after", "", "![overlay](overlay.png)", ""]
     (out / "report.md").write_text("\n".join(lines))
-    from heavecomp.report.provenance import stamp, stamp_report
 
     stamp_report(out / "report.md", stamp())
     return diag.to_json()

@@ -17,16 +17,21 @@ from __future__ import annotations
 
 import json
 import logging
+import math
 import re
 import shlex
 import shutil
 import sys
 from pathlib import Path
+from heavecomp.report import invocation
+from heavecomp.report.html import write_html
+from heavecomp.params import dumps
+from heavecomp import __version__
+from heavecomp.effects import CANDIDATES
+from heavecomp.params.cmc import TABLES
+from heavecomp.simulate.core import CHANNEL_UNITS
 
 log = logging.getLogger(__name__)
-
-#: the command line being run (set by :func:`heavecomp.cli.main` and the scenario runner)
-COMMAND: list[str] | None = None
 
 #: keys that hold wall-clock times (machine-dependent: never in a tracked result)
 TIMING_KEY = re.compile(r"(^|_)(wall|solve_time|elapsed)(_|$)")
@@ -120,12 +125,10 @@ def _param_units() -> dict[str, str]:
     also merges the CMC's channel units into :data:`UNITS` (imported here, not at start-up)."""
     import dataclasses
 
-    from heavecomp.simulate.core import CHANNEL_UNITS
 
     UNITS.update(CHANNEL_UNITS)
     out: dict[str, str] = {}
     try:
-        from heavecomp.params.cmc import TABLES
 
         for tname, cls in TABLES.items():
             for f in dataclasses.fields(cls):
@@ -135,7 +138,6 @@ def _param_units() -> dict[str, str]:
     except Exception as exc:  # noqa: BLE001 - units are documentation: never fail a run over them
         log.debug("parameter units unavailable: %s", exc)
     try:
-        from heavecomp.effects import CANDIDATES
 
         for cand in (CANDIDATES.values() if isinstance(CANDIDATES, dict) else CANDIDATES):
             for spec in cand.describe() if hasattr(cand, "describe") else ():
@@ -237,16 +239,31 @@ def split_timings(obj):
     return obj, None
 
 
+def _clean(x):
+    """JSON-ready copy: NaN/inf -> None, numpy scalars -> Python, keys -> str."""
+    if isinstance(x, float) and not math.isfinite(x):
+        return None
+    if isinstance(x, dict):
+        return {str(k): _clean(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [_clean(v) for v in x]
+    if hasattr(x, "item") and not isinstance(x, (str, bytes)):
+        try:
+            return _clean(x.item())
+        except (ValueError, AttributeError):
+            pass
+    return x
+
+
 def command_line() -> str:
     """The command being run, as a shell line (``heavecomp simulate p.toml ...``)."""
-    argv = COMMAND if COMMAND is not None else ["python", *sys.argv]
+    argv = invocation.COMMAND if invocation.COMMAND is not None else ["python", *sys.argv]
     return shlex.join(str(a) for a in argv)
 
 
 def stamp(params_file: str | None = None, **extra) -> dict:
     """The provenance block: heavecomp version, command line, parameter file (no dates or host:
     a re-run writes the same bytes)."""
-    from heavecomp import __version__
 
     s = {"heavecomp_version": __version__, "command": command_line()}
     if params_file:
@@ -277,7 +294,6 @@ def write_params(out_dir, params, name: str = "params.toml") -> Path:
         if src.resolve() != copy.resolve():
             shutil.copyfile(src, copy)
         params = params.replace(heave={"path": copy.name})
-    from heavecomp.params import dumps
 
     path = out / name
     path.write_text(dumps(params, header="resolved parameter set of this run (heavecomp; re-run from this file)"),
@@ -320,7 +336,6 @@ def round_floats(x, digits: int = DIGITS):
 def annotate_json(path, st: dict, *, indent: int | None = 2) -> dict:
     """Move timings out of a JSON result into ``timings.json``; add ``provenance`` and ``units``;
     round floats to :data:`DIGITS` significant digits."""
-    from heavecomp.report.scenario import _clean
 
     path = Path(path)
     data = json.loads(path.read_text())
@@ -342,7 +357,6 @@ def annotate_json(path, st: dict, *, indent: int | None = 2) -> dict:
 
 def stamp_report(md_path, st: dict) -> Path:
     """End the Markdown report with the stamp (replacing an older one) and write its HTML twin."""
-    from heavecomp.report.html import write_html
 
     md_path = Path(md_path)
     lines = [ln for ln in md_path.read_text(encoding="utf-8").rstrip("\n").split("\n")

@@ -8,6 +8,8 @@ import logging
 import math
 import sys
 from pathlib import Path
+from heavecomp.report import invocation
+from heavecomp.report.provenance import _clean, annotate_json, stamp, stamp_report
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -20,36 +22,19 @@ def parse_args(argv, name: str, doc: str | None = None, extra=None) -> argparse.
     if extra:
         extra(p)
     args = p.parse_args(argv)
-    from heavecomp.report import provenance
 
     given = list(sys.argv[1:] if argv is None else argv)
-    provenance.COMMAND = ["python", f"scenarios/{name}.py", *given]
+    invocation.COMMAND = ["python", f"scenarios/{name}.py", *given]
     args.out = Path(args.out)
     args.out.mkdir(parents=True, exist_ok=True)
     logging.basicConfig(level=logging.INFO, format="%(message)s")
     return args
 
 
-def _clean(x):
-    """JSON-ready copy: NaN/inf -> None, numpy scalars -> Python, keys -> str."""
-    if isinstance(x, float) and not math.isfinite(x):
-        return None
-    if isinstance(x, dict):
-        return {str(k): _clean(v) for k, v in x.items()}
-    if isinstance(x, (list, tuple)):
-        return [_clean(v) for v in x]
-    if hasattr(x, "item") and not isinstance(x, (str, bytes)):
-        try:
-            return _clean(x.item())
-        except (ValueError, AttributeError):
-            pass
-    return x
-
 
 def write_metrics(out: Path, metrics: dict) -> Path:
     """``metrics.json`` with a provenance stamp and units; wall-clock timings go to the untracked
     ``timings.json`` (a re-run leaves the tracked result unchanged)."""
-    from heavecomp.report.provenance import annotate_json, stamp
 
     path = Path(out) / "metrics.json"
     path.write_text(json.dumps(_clean(metrics), indent=2) + "\n")
@@ -68,7 +53,6 @@ def md_table(header, rows, fmt="{:.2f}") -> str:
 
 def write_report(out: Path, title: str, sections: list[str]) -> Path:
     """``report.md`` (ending with the provenance stamp) and its self-contained ``report.html``."""
-    from heavecomp.report.provenance import stamp, stamp_report
 
     path = Path(out) / "report.md"
     path.write_text(f"# {title}\n\n" + "\n\n".join(s.strip() for s in sections) + "\n")
