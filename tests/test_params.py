@@ -82,7 +82,7 @@ BAD = [
     ("static < coulomb", "static_force = 23e3", "static_force = 10e3", "friction.static_force = 10000 N is below friction.coulomb_force"),
     ("stribeck velocity 0", "stribeck_velocity = 0.01", "stribeck_velocity = 0.0", "friction.stribeck_velocity = 0 m/s is outside"),
     ("polytropic < 1", "polytropic_index = 1.3", "polytropic_index = 0.8", "compensator.polytropic_index = 0.8 - is outside"),
-    ("mm instead of m", "plunger_diameter = 0.72", "plunger_diameter = 720", "(wrong unit?)"),
+    ("mm instead of m", "plunger_diameter = 0.72", "plunger_diameter = 720", "; is it in mm? (SI: m)"),
     ("N/bar instead of N/Pa", "pressure_coefficient = 2e-3", "pressure_coefficient = 200", "friction.pressure_coefficient = 200 N/Pa is outside"),
     ("unknown friction model", 'model = "stribeck"', 'model = "stribek"', "friction.model = 'stribek' is not one of none, stribeck, rotating_eq6, rotating_eq7 (did you mean 'stribeck'?)"),
     ("rotating without v_t", 'model = "stribeck"', 'model = "rotating_eq7"', "friction.tangential_velocity: missing required key for model = \"rotating_eq7\""),

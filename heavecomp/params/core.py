@@ -21,7 +21,8 @@ _MISSING = dataclasses.MISSING
 
 
 def q(default=_MISSING, unit: str = "-", *, bounds=(-math.inf, math.inf), symbol: str = "",
-      doc: str = "", open_low: bool = False, integer: bool = False):
+      doc: str = "", open_low: bool = False, integer: bool = False, why: str = "",
+      unit_low: str = "", unit_high: str = ""):
     """A numeric parameter field.
 
     Parameters
@@ -38,9 +39,14 @@ def q(default=_MISSING, unit: str = "-", *, bounds=(-math.inf, math.inf), symbol
         Lower bound is exclusive (e.g. masses must be > 0).
     integer : bool
         Value must be a whole number (e.g. a random seed).
+    why : str
+        Why the bounds are where they are (physical plausibility; shown in the docs).
+    unit_low, unit_high : str
+        The unit a value below / above the bounds was most likely written in
+        (e.g. ``"kN"`` for a WOB of 98.1): the message asks "is it in kN?".
     """
     meta = dict(kind="number", unit=unit, bounds=bounds, symbol=symbol, doc=doc,
-                open_low=open_low, integer=integer)
+                open_low=open_low, integer=integer, why=why, unit_low=unit_low, unit_high=unit_high)
     if default is _MISSING:
         return dataclasses.field(metadata=meta)
     return dataclasses.field(default=default, metadata=meta)
@@ -66,6 +72,18 @@ def _fmt(x) -> str:
     return f"{x:g}" if isinstance(x, float) else str(x)
 
 
+def unit_hint(meta: Mapping[str, Any], value: float) -> str:
+    """``"; is it in kN? (SI: N)"`` for a value outside the bounds on a side with a likely unit."""
+    lo, hi = meta["bounds"]
+    unit = meta.get("unit", "")
+    likely = meta.get("unit_low") if 0 < value <= lo else meta.get("unit_high") if value > hi else ""
+    if likely:
+        return f"; is it in {likely}? (SI: {unit})"
+    if unit not in ("-", "") and (value > hi or 0 < value < lo):
+        return " (wrong unit?)"
+    return ""
+
+
 def check_value(name: str, f: dataclasses.Field, value: Any) -> Any:
     """Validate one value against its field metadata; return the normalised value."""
     meta = f.metadata
@@ -73,13 +91,11 @@ def check_value(name: str, f: dataclasses.Field, value: Any) -> Any:
     if kind == "number":
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             raise ParameterError(f"{name}: expected a number in {meta['unit']}, got {type(value).__name__} {value!r}")
-        if meta.get("integer"):
-            if float(value) != int(value):
-                raise ParameterError(f"{name}: expected a whole number, got {value!r}")
-            return int(value)
-        value = float(value)
         if not math.isfinite(value):
             raise ParameterError(f"{name}: must be finite, got {value}")
+        if meta.get("integer") and float(value) != int(value):
+            raise ParameterError(f"{name}: expected a whole number, got {value!r}")
+        value = int(value) if meta.get("integer") else float(value)
         lo, hi = meta["bounds"]
         too_low = value <= lo if meta.get("open_low") else value < lo
         if too_low or value > hi:
@@ -87,7 +103,7 @@ def check_value(name: str, f: dataclasses.Field, value: Any) -> Any:
             unit = meta["unit"]
             raise ParameterError(
                 f"{name} = {_fmt(value)} {unit} is outside the possible range {lo_s}, {_fmt(hi)}] {unit}"
-                + (" (wrong unit?)" if unit not in ("-", "") and (value > hi or 0 < value < lo) else ""))
+                + unit_hint(meta, value))
         return value
     if kind == "choice":
         if not isinstance(value, str) or value not in meta["options"]:
