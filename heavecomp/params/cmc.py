@@ -334,7 +334,7 @@ class Active:
     rate_max: float = q(300e3, "N/s", bounds=(1e3, 1e9), symbol="du_max", unit_low="kN/s",
                         doc="largest force rate |du/dt| (default 300 kN/s)",
                         why="full force u_max / rate_max in 1 ms to 60 s (checked)")
-    control_rate: float = q(20.0, "Hz", bounds=(1.0, 1e3), symbol="f_c", unit_high="mHz",
+    control_rate: float = q(20.0, "Hz", bounds=(1.0, 1e3), symbol="f_c", unit_low="kHz", unit_high="mHz",
                             doc="controller sample rate; command held between samples (default 20 Hz)",
                             why="slower than 1 Hz cannot act within a wave (5-20 s); over 1 kHz is beyond the "
                                 "actuator and the simulation budget")

@@ -144,7 +144,7 @@ def _check_modes(p) -> None:
         if lo <= fi <= hi:
             continue
         top = phi[0, i] ** 2 >= phi[1, i] ** 2  # which mass the mode moves most (kinetic-energy share)
-        keys = ("compensator.moving_mass", "compensator.gas_stiffness") if top else \
+        keys = ("compensator.moving_mass", "compensator.gas_stiffness", "drill_string.stiffness") if top else \
             ("drill_string.lower_mass", "drill_string.stiffness", "formation.stiffness")
         vals = ", ".join(f"{k} = {_g(_get(p, k))}" for k in keys)
         raise ParameterError(
@@ -165,5 +165,5 @@ def _check_ramp(h) -> None:
     lo, hi = RAMP_PERIODS
     if not lo <= n <= hi:
         raise ParameterError(
-            f"heave.ramp = {_g(h.ramp)} s is {_g(n)} periods of {pname} = {_g(period)} s, outside {lo:g}-{hi:g} "
-            + ("(use 0 for no fade-in)" if n < lo else "; is it in ms? (SI: s)"))
+            f"heave.ramp = {_g(h.ramp)} s is {_g(n)} periods of {pname} = {_g(period)} s, outside {lo:g}-{hi:g} periods"
+            + (" (use 0 for no fade-in)" if n < lo else "; is it in ms? (SI: s)"))
