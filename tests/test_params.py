@@ -351,3 +351,80 @@ def test_closed_loop_checks_the_budget_too():
 
     with pytest.raises(ParameterError, match="--dt = 1e-07 s"):
         simulate_closed_loop(paper_a(), "pid", 600.0, dt=1e-7)
+
+
+# ---- controller options (issue 14.7): bounds on the ControllerConfig fields, one line naming the option ----------
+
+@pytest.mark.parametrize("option, fragment", [
+    ("horizon=0", "controller option horizon = 0"),
+    ("horizon=-3", "controller option horizon = -3"),
+    ("q_wob=-1", "controller option q_wob = -1"),
+    ("friction_eps=0", "controller option friction_eps = 0 m/s"),
+    ("predictor_order=0", "controller option predictor_order = 0"),
+    ("sqp_iterations=0", "controller option sqp_iterations = 0"),
+    ("observer_sigma_d=0", "controller option observer_sigma_d = 0 N"),
+    ("kp=-1", "controller option kp = -1"),
+    ("u_max=-5", "controller option u_max = -5.0: set [active].u_max in the parameter file"),
+    ("control_rate=0", "controller option control_rate = 0.0: set [active].control_rate"),
+    ("control_rate=10", "controller option control_rate = 10.0: set [active].control_rate"),
+])
+def test_bad_controller_options_exit_2_before_the_run(tmp_path, capsys, paper_a_toml, option, fragment):
+    """horizon=0/-3, q_wob=-1, u_max=-5, control_rate=0 gave tracebacks; friction_eps=0 and predictor_order=0
+    fell back on every step with exit 0; sqp_iterations=0 silently left the force at zero."""
+    code, err = _main(["simulate", paper_a_toml, "--duration", "5", "--out", tmp_path / "o",
+                       "--controller", "nonlinear-mpc", "--controller-option", option], capsys)
+    _assert_one_line(code, err, fragment)
+    assert not (tmp_path / "o").exists()
+
+
+def test_controller_config_validates_library_use_too():
+    import dataclasses
+
+    from heavecomp.controllers.base import ControllerConfig
+
+    c = ControllerConfig(horizon=30.0)
+    assert c.horizon == 30 and isinstance(c.horizon, int)
+    with pytest.raises(ParameterError, match="controller option horizon: expected a whole number"):
+        ControllerConfig(horizon=2.5)
+    with pytest.raises(ParameterError, match="controller option sqp_iterations = 0"):
+        dataclasses.replace(c, sqp_iterations=0)
+    with pytest.raises(ParameterError, match="controller option predictor_window: must be finite"):
+        ControllerConfig(predictor_window=math.nan)
+    assert ControllerConfig.from_params(paper_a().replace(active={"control_rate": 10.0})).control_rate == 10.0
+
+
+# ---- reading: encodings and TOML syntax name the problem (issue 14.11) ------------------------------------------
+
+@pytest.mark.parametrize("encode, fragment", [
+    (lambda t: t.encode("utf-16"), "is UTF-16 encoded; save it as UTF-8"),
+    (lambda t: ("# Größe\n" + t).encode("latin-1"), "is not UTF-8 (byte 0xf6 at line 1, column 5"),
+    (lambda t: t.replace("0.72", "0,72").encode(), "not valid TOML at compensator.plunger_diameter"),
+])
+def test_encodings_and_decimal_comma_get_the_right_explanation(tmp_path, capsys, encode, fragment):
+    f = tmp_path / "p.toml"
+    f.write_bytes(encode(CONTRACT_EXAMPLE))
+    code, err = _main(["params", f], capsys)
+    _assert_one_line(code, err, fragment)
+    if "TOML" in fragment:
+        assert "a decimal comma? TOML numbers use a point" in err
+
+
+def test_utf8_bom_is_accepted(tmp_path):
+    f = tmp_path / "p.toml"
+    f.write_bytes(b"\xef\xbb\xbf" + CONTRACT_EXAMPLE.encode())
+    assert load(f) == paper_a()
+
+
+def test_docs_list_every_bound_as_in_the_code():
+    from pathlib import Path
+
+    from heavecomp.controllers.base import ControllerConfig
+    from heavecomp.params.cmc import TABLES, Active
+    from heavecomp.params.core import bounds_rows
+
+    doc = (Path(__file__).resolve().parents[1] / "docs" / "parameters.md").read_text()
+    rows = [r for t, c in list(TABLES.items()) + [("active", Active)] for r in bounds_rows(c, t)]
+    rows += bounds_rows(ControllerConfig, "")
+    assert len(rows) > 40
+    for row in rows:
+        assert row in doc, row

@@ -25,7 +25,7 @@ from pathlib import Path
 from typing import Any, Mapping
 
 from heavecomp.errors import ParameterError, did_you_mean
-from heavecomp.params.core import choice, dump_toml, from_table, q, read_text, text, to_table
+from heavecomp.params.core import choice, dump_toml, from_table, q, read_text, text, to_table, toml_error_message
 
 G = 9.81  #: gravity [m/s^2] (contract value)
 P_ATM = 101325.0  #: atmospheric pressure [Pa] (contract value)
@@ -94,7 +94,8 @@ class Compensator:
                              why="compensators are built soft (tens of kN/m) so heave barely changes the load; "
                                  "the gas volume it implies is checked too")
     polytropic_index: float = q(unit="-", bounds=(1.0, 1.7), symbol="n",
-                                doc="polytropic index of the gas (1 isothermal, 1.4 adiabatic N2)")
+                                doc="polytropic index of the gas (1 isothermal, 1.4 adiabatic N2)",
+                                why="between isothermal (1) and adiabatic for any real gas (<= 5/3 monatomic)")
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -294,7 +295,7 @@ def loads(text_: str, *, base_dir: Path | None = None, source: str = "<string>")
     try:
         data = tomllib.loads(text_)
     except tomllib.TOMLDecodeError as exc:
-        raise ParameterError(f"{source}: not valid TOML: {exc}") from None
+        raise ParameterError(toml_error_message(text_, exc, source)) from None
     return from_dict(data, base_dir=base_dir)
 
 

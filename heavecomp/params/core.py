@@ -161,17 +161,68 @@ def describe(cls) -> list[tuple[str, str, str, str, str]]:
     return rows
 
 
+def bounds_rows(cls, prefix: str) -> list[str]:
+    """Markdown rows ``| key | unit | plausible range | why |`` of a parameter table's numeric fields (docs)."""
+    rows = []
+    for f in dataclasses.fields(cls):
+        m = f.metadata
+        if m.get("kind") != "number":
+            continue
+        lo, hi = m["bounds"]
+        rng = ("(" if m.get("open_low") else "[") + f"{_fmt(lo)}, {_fmt(hi)}]"
+        key = f"{prefix}.{f.name}" if prefix else f.name
+        rows.append(f"| `{key}` | {m['unit']} | {rng} | {m.get('why', '')} |")
+    return rows
+
+
 def read_text(path, what: str = "parameter file") -> str:
-    """A user's text file, or a one-line :class:`ParameterError` naming it."""
+    """A user's text file (UTF-8, a UTF-8 byte-order mark is dropped), or a one-line
+    :class:`ParameterError` naming it and, for other encodings, where and what they are."""
     from pathlib import Path
 
     path = Path(path)
     try:
-        return path.read_text(encoding="utf-8")
+        raw = path.read_bytes()
     except FileNotFoundError:
         raise ParameterError(f"{path}: {what} not found") from None
-    except (IsADirectoryError, PermissionError, UnicodeDecodeError) as exc:
+    except (IsADirectoryError, PermissionError, OSError) as exc:
         raise ParameterError(f"{path}: cannot read {what} ({type(exc).__name__})") from None
+    if raw.startswith((b"\xff\xfe", b"\xfe\xff")) or (len(raw) > 1 and (raw[0] == 0) != (raw[1] == 0)):
+        raise ParameterError(f"{path}: {what} is UTF-16 encoded; save it as UTF-8 (TOML files are UTF-8)")
+    if raw.startswith(b"\xef\xbb\xbf"):  # a BOM some editors write: harmless, dropped
+        raw = raw[3:]
+    try:
+        return raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = raw[:exc.start].count(b"\n") + 1
+        col = exc.start - (raw.rfind(b"\n", 0, exc.start) + 1) + 1
+        raise ParameterError(f"{path}: {what} is not UTF-8 (byte 0x{raw[exc.start]:02x} at line {line}, column {col}; "
+                             f"latin-1/Windows text?); save it as UTF-8") from None
+
+
+def toml_error_message(text_: str, exc: Exception, source: str) -> str:
+    """One line for a TOML syntax error: the file, the key (``table.key``) on the offending line, the parser's
+    message and, for ``0,72``, the hint that TOML numbers use a decimal point."""
+    import re
+
+    msg = str(exc)
+    m = re.search(r"at line (\d+)", msg)
+    where, hint = "", ""
+    if m:
+        n = int(m.group(1))
+        lines = text_.splitlines()
+        line = lines[n - 1] if 0 < n <= len(lines) else ""
+        table = ""
+        for prev in lines[:n]:
+            h = re.match(r"\s*\[+\s*([^\]]*?)\s*\]", prev)
+            if h:
+                table = h.group(1)
+        k = re.match(r"\s*([A-Za-z0-9_\-]+)\s*=", line)
+        if k:
+            where = f" at {table + '.' if table else ''}{k.group(1)}"
+        if re.search(r"=\s*[-+]?\d+,\d", line):
+            hint = " (a decimal comma? TOML numbers use a point, e.g. 0.72)"
+    return f"{source}: not valid TOML{where}: {msg}{hint}"
 
 
 def dump_toml(tables: Mapping[str, Mapping[str, Any]], header: str = "") -> str:
