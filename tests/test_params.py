@@ -428,3 +428,21 @@ def test_docs_list_every_bound_as_in_the_code():
     assert len(rows) > 40
     for row in rows:
         assert row in doc, row
+
+
+@pytest.mark.parametrize("target, fragment", [
+    ("missing/dir/x.toml", "does not exist"),
+    (".", "is a folder"),
+])
+def test_params_output_path_checked_before_the_work(tmp_path, capsys, target, fragment):
+    """Issue 13.3: `heavecomp params paper_a -o /nonexistent/dir/x.toml` gave a traceback."""
+    code, err = _main(["params", "paper_a", "-o", tmp_path / target], capsys)
+    _assert_one_line(code, err, fragment)
+
+
+@pytest.mark.parametrize("digits", [400, 5000])
+def test_integer_literals_beyond_any_float_are_one_line(digits):
+    """Found by tests/test_fuzz_params.py: OverflowError (400 digits) and ValueError (> 4300 digits) tracebacks."""
+    with pytest.raises(ParameterError) as ei:
+        loads(CONTRACT_EXAMPLE.replace("moving_mass = 80000.0", "moving_mass = 1" + "0" * digits))
+    assert "compensator.moving_mass" in str(ei.value) and "\n" not in str(ei.value)

@@ -19,6 +19,8 @@ def run(args) -> int:
     from heavecomp.errors import ParameterError, did_you_mean
     from heavecomp.params import SETS, dumps, load
 
+    if args.output:
+        _check_output(Path(args.output))
     if args.source in SETS:
         factory = SETS[args.source]
         params = factory(args.friction) if args.friction else factory()
@@ -40,7 +42,23 @@ def run(args) -> int:
                              f"built-in sets: {', '.join(SETS)}")
     text = dumps(params, header=header)
     if args.output:
-        Path(args.output).write_text(text)
+        Path(args.output).write_text(text, encoding="utf-8")
     else:
         sys.stdout.write(text)
     return 0
+
+
+def _check_output(path) -> None:
+    """One-line :class:`ParameterError` for an output path that cannot be written (before any work)."""
+    import os
+    from pathlib import Path
+
+    from heavecomp.errors import ParameterError
+
+    if path.is_dir():
+        raise ParameterError(f"-o {path}: is a folder; give a file name, e.g. {path / 'params.toml'}")
+    parent = path.parent if str(path.parent) else Path(".")
+    if not parent.is_dir():
+        raise ParameterError(f"-o {path}: folder {parent} does not exist")
+    if not os.access(parent, os.W_OK) or (path.exists() and not os.access(path, os.W_OK)):
+        raise ParameterError(f"-o {path}: not writable")

@@ -294,7 +294,7 @@ def loads(text_: str, *, base_dir: Path | None = None, source: str = "<string>")
     """Parse TOML text into :class:`CMCParams`."""
     try:
         data = tomllib.loads(text_)
-    except tomllib.TOMLDecodeError as exc:
+    except (tomllib.TOMLDecodeError, ValueError) as exc:  # ValueError: an integer of > 4300 digits
         raise ParameterError(toml_error_message(text_, exc, source)) from None
     return from_dict(data, base_dir=base_dir)
 

@@ -91,7 +91,11 @@ def check_value(name: str, f: dataclasses.Field, value: Any) -> Any:
     if kind == "number":
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             raise ParameterError(f"{name}: expected a number in {meta['unit']}, got {type(value).__name__} {value!r}")
-        if not math.isfinite(value):
+        try:
+            finite = math.isfinite(value)
+        except OverflowError:  # an integer literal beyond any float
+            raise ParameterError(f"{name}: must be finite, got an integer of {len(str(abs(value)))} digits") from None
+        if not finite:
             raise ParameterError(f"{name}: must be finite, got {value}")
         if meta.get("integer") and float(value) != int(value):
             raise ParameterError(f"{name}: expected a whole number, got {value!r}")
@@ -206,11 +210,14 @@ def toml_error_message(text_: str, exc: Exception, source: str) -> str:
     import re
 
     msg = str(exc)
+    lines = text_.splitlines()
     m = re.search(r"at line (\d+)", msg)
+    if m is None and "digits" in msg:  # int() refused a huge literal: no position in the message
+        msg = "an integer literal of more than 4300 digits"
+        m = next((re.match(r"(\d+)", str(i + 1)) for i, ln in enumerate(lines) if re.search(r"\d{4301}", ln)), None)
     where, hint = "", ""
     if m:
         n = int(m.group(1))
-        lines = text_.splitlines()
         line = lines[n - 1] if 0 < n <= len(lines) else ""
         table = ""
         for prev in lines[:n]:
