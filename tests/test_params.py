@@ -446,3 +446,9 @@ def test_integer_literals_beyond_any_float_are_one_line(digits):
     with pytest.raises(ParameterError) as ei:
         loads(CONTRACT_EXAMPLE.replace("moving_mass = 80000.0", "moving_mass = 1" + "0" * digits))
     assert "compensator.moving_mass" in str(ei.value) and "\n" not in str(ei.value)
+
+
+def test_tangential_velocity_zero_means_no_rotation_and_a_tiny_one_is_refused():
+    assert paper_a("rotating_eq7").replace(friction={"tangential_velocity": 0.0}).friction.tangential_velocity == 0.0
+    with pytest.raises(ParameterError, match=r"^friction.tangential_velocity = 0.0005 m/s: use 0 .* is it in mm/s"):
+        paper_a("rotating_eq7").replace(friction={"tangential_velocity": 5e-4})

@@ -31,6 +31,7 @@ G = 9.81  #: gravity [m/s^2] (contract value)
 P_ATM = 101325.0  #: atmospheric pressure [Pa] (contract value)
 
 FRICTION_MODELS = ("none", "stribeck", "rotating_eq6", "rotating_eq7")
+V_T_MIN = 1e-3  #: smallest non-zero friction.tangential_velocity [m/s]
 HEAVE_KINDS = ("sine", "jonswap", "file")
 
 
@@ -117,10 +118,11 @@ class Friction:
                                     doc="pressure coefficient (200 N/bar = 2e-3 N/Pa)",
                                     why="seal contact area x friction coefficient: ~1e-3 N/Pa for a 0.7 m plunger; "
                                         "C_p p_0 is checked against the load")
-    tangential_velocity: float = q(None, "m/s", bounds=(1e-3, 2.0), symbol="v_t", unit_high="mm/s",
+    tangential_velocity: float = q(None, "m/s", bounds=(0.0, 2.0), symbol="v_t", unit_high="mm/s",
                                    doc="piston surface speed from rotation, omega d/2 (rotating models)",
-                                   why="a rotating piston turns at ~0.1-5 rad/s on a < 1.5 m piston; below 1 mm/s "
-                                       "the eq. 7 slope F_S / v_t forces a time step too small to simulate")
+                                   why="0 (rotation stopped: eqs. 6-7 are eq. 4) or 1 mm/s - 2 m/s (checked): a "
+                                       "rotating piston turns at ~0.1-5 rad/s on a < 1.5 m piston; below 1 mm/s the "
+                                       "eq. 7 slope F_S / v_t forces a time step too small to simulate")
 
     _LAW_KEYS = ("static_force", "coulomb_force", "stribeck_velocity", "viscous_coefficient",
                  "pressure_coefficient")
@@ -132,6 +134,11 @@ class Friction:
         for key in needed:
             if getattr(self, key) is None:
                 raise ParameterError(f"friction.{key}: missing required key for model = \"{self.model}\"")
+        vt = self.tangential_velocity
+        if vt is not None and 0.0 < vt < V_T_MIN:
+            raise ParameterError(f"friction.tangential_velocity = {vt:g} m/s: use 0 (rotation stopped) or at least "
+                                 f"{V_T_MIN:g} m/s (slower rotation makes the eq. 7 slope F_S / v_t too steep to "
+                                 f"simulate); is it in mm/s? (SI: m/s)")
         if self.static_force < self.coulomb_force:
             raise ParameterError(
                 f"friction.static_force = {self.static_force:g} N is below friction.coulomb_force = "
