@@ -183,7 +183,7 @@ def test_cli_bad_active_table_exits_2_with_one_line(tmp_path):
                         "--out", str(tmp_path / "o"), "--controller", "pid"], capture_output=True, text=True)
     assert r.returncode == 2
     assert r.stderr.strip() == ("heavecomp simulate: error: active.u_max = -1 N is outside the possible "
-                                "range (0, 1e+08] N")
+                                "range [1000, 1e+07] N")
 
 
 def test_cli_closed_loop_rate_must_divide_the_control_rate(tmp_path):

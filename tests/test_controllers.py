@@ -22,7 +22,7 @@ def test_active_table_defaults_and_files_without_it():
 
 @pytest.mark.parametrize("table, msg", [
     ({"umax": 1.0}, "active.umax: unknown key (did you mean 'u_max'?)"),
-    ({"u_max": -5.0}, "active.u_max = -5 N is outside the possible range (0, 1e+08] N"),
+    ({"u_max": -5.0}, "active.u_max = -5 N is outside the possible range [1000, 1e+07] N"),
     ({"rate_max": "fast"}, "active.rate_max: expected a number in N/s, got str 'fast'"),
 ])
 def test_active_table_bad_values_name_the_key(table, msg):

@@ -34,10 +34,11 @@ import numpy as np
 from heavecomp.controllers import ControllerConfig, Measurement, make
 from heavecomp.errors import InputError
 from heavecomp.friction.laws import FrictionLaw
+from heavecomp.params.budget import check_run_size
 from heavecomp.params.cmc import active
 from heavecomp.plants.cmc import plant_vector
 from heavecomp.simulate import excitation
-from heavecomp.simulate.core import CSV_COLUMNS, SimulationResult, default_dt
+from heavecomp.simulate.core import CSV_COLUMNS, SimulationResult, default_dt, plant_eigen_rate
 
 log = logging.getLogger(__name__)
 
@@ -158,6 +159,7 @@ def simulate_closed_loop(params, controller="passive", duration: float = 120.0, 
         log.warning("dt = %g s does not divide the control interval %g s; using %g s", dt, Tc, Tc / n_sub)
     h = Tc / n_sub
     n_ctrl = int(math.ceil(duration / Tc - 1e-9))
+    check_run_size(params, duration=duration, h=h, n_steps=n_ctrl * n_sub, n_rows=n_ctrl + 1, n_cols=K.NCH, dt=dt, rate=act.control_rate, rate_fn=plant_eigen_rate)
     sp = 0.5 * h
     # the true future heave is only needed for a perfect preview (a record must then reach past the end)
     horizon_t = (cfg.horizon + 2) * Tc if preview == "perfect" else 0.0

@@ -28,16 +28,21 @@ def run(args) -> int:
         if args.friction:
             params = params.replace(friction={"model": args.friction})
         header = f"checked copy of {args.source}"
+        from heavecomp.params.budget import check_default_step
+        from heavecomp.simulate.core import default_dt, plant_eigen_rate
+
+        h = default_dt(params)
+        check_default_step(params, h, plant_eigen_rate)
         if not getattr(args, "quiet", False):
             print(f"{args.source}: valid (k_eff = {params.k_eff:.6g} N/m, p_0 = {params.p0:.6g} Pa, "
-                  f"V_0 = {params.gas_volume:.4g} m^3)", file=sys.stderr)
+                  f"V_0 = {params.gas_volume:.4g} m^3, default step {h:.3g} s)", file=sys.stderr)
     else:
         raise ParameterError(f"{args.source}: not a built-in set nor a file{did_you_mean(args.source, SETS)}; "
                              f"built-in sets: {', '.join(SETS)}")
     params = _heave_path_for(params, args.output)
     text = dumps(params, header=header)
     if args.output:
-        Path(args.output).write_text(text)
+        Path(args.output).write_text(text, encoding="utf-8")
     else:
         sys.stdout.write(text)
     return 0
@@ -58,3 +63,4 @@ def _heave_path_for(params, output):
     else:
         new = str(src)
     return params.replace(heave={"path": Path(new).as_posix()})
+

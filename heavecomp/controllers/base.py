@@ -26,6 +26,7 @@ import numpy as np
 from heavecomp.controllers.model import FRAMES
 from heavecomp.errors import InputError, did_you_mean
 from heavecomp.params.cmc import active
+from heavecomp.params.core import q
 
 #: ControllerConfig fields that take one of a few names
 CHOICES = {"nlp_solver": ("sqp", "ipopt"), "model_frame": FRAMES}
@@ -109,27 +110,47 @@ class ControllerConfig:
         written (:mod:`heavecomp.controllers.model`).
     """
 
-    u_max: float = 60e3
-    rate_max: float = 300e3
-    control_rate: float = 20.0
-    horizon: int = 20
-    q_wob: float = 1e-6
-    r_u: float = 1e-12
-    r_du: float = 3e-7
-    friction_eps: float = 0.02
+    u_max: float = q(60e3, "N", bounds=(1e3, 1e7), unit_low="kN", why="as [active].u_max")
+    rate_max: float = q(300e3, "N/s", bounds=(1e3, 1e9), unit_low="kN/s", why="as [active].rate_max")
+    control_rate: float = q(20.0, "Hz", bounds=(1.0, 1e3), why="as [active].control_rate")
+    horizon: int = q(20, "-", bounds=(1, 500), integer=True,
+                     why="at least one interval; 500 intervals (25 s at 20 Hz) is beyond any useful preview")
+    q_wob: float = q(1e-6, "1/N^2", bounds=(0.0, 1.0), open_low=True,
+                     why="> 0, or the MPC has nothing to track")
+    r_u: float = q(1e-12, "1/N^2", bounds=(0.0, 1.0), why="a non-negative weight")
+    r_du: float = q(3e-7, "1/N^2", bounds=(0.0, 1.0), why="a non-negative weight")
+    friction_eps: float = q(0.02, "m/s", bounds=(1e-3, 1.0), unit_high="mm/s",
+                            why="tanh width: below 1 mm/s the smoothed friction is too stiff for the solvers")
     friction_feedforward: bool = True
-    friction_scale: float = 1.0
-    gas_stiffness_scale: float = 1.0
-    kp: float = 0.5
-    ki: float = 0.3
-    kd: float = 0.2
-    pid_tf: float = 0.2
-    observer_sigma_d: float = 300.0
+    friction_scale: float = q(1.0, "-", bounds=(0.0, 10.0), why="multiplier of the model's friction")
+    gas_stiffness_scale: float = q(1.0, "-", bounds=(0.1, 10.0), why="multiplier of k_gas (keeps the gas "
+                                   "column of the controller's model plausible)")
+    kp: float = q(0.5, "-", bounds=(0.0, 100.0), why="non-negative: a negative gain is positive feedback")
+    ki: float = q(0.3, "1/s", bounds=(0.0, 100.0), why="non-negative")
+    kd: float = q(0.2, "s", bounds=(0.0, 100.0), why="non-negative")
+    pid_tf: float = q(0.2, "s", bounds=(0.0, 100.0), why="a non-negative time constant")
+    observer_sigma_d: float = q(300.0, "N", bounds=(0.0, 1e7), open_low=True,
+                                why="> 0, or the observer never follows the friction")
     nlp_solver: str = "sqp"
-    sqp_iterations: int = 3
-    predictor_order: int = 80
-    predictor_window: float = 240.0
+    sqp_iterations: int = q(3, "-", bounds=(1, 100), integer=True,
+                            why="at least one iteration, or the force stays at its start value")
+    predictor_order: int = q(80, "-", bounds=(2, 400), integer=True,
+                             why="two lags represent one sine; 400 lags (40 s at 20 Hz) overfit")
+    predictor_window: float = q(240.0, "s", bounds=(1.0, 1e5), why="forgetting time of at least 1 s")
     model_frame: str = "earth"
+
+    def __post_init__(self):
+        from heavecomp.params.core import check_value
+
+        for f in dataclasses.fields(self):
+            if "kind" in f.metadata:
+                object.__setattr__(self, f.name, check_value(f"controller option {f.name}", f, getattr(self, f.name)))
+        for k, allowed in CHOICES.items():
+            if getattr(self, k) not in allowed:
+                raise InputError(f"controller option {k} = {getattr(self, k)!r}: not one of {', '.join(allowed)}")
+        if not isinstance(self.friction_feedforward, bool):
+            raise InputError(f"controller option friction_feedforward = {self.friction_feedforward!r}: "
+                             f"not true or false")
 
     @property
     def dt(self) -> float:
@@ -150,10 +171,10 @@ class ControllerConfig:
         for k in overrides:
             if k not in names:
                 raise InputError(f"controller option {k!r}: unknown{did_you_mean(k, names)}")
+            if k in kw and overrides[k] != kw[k]:  # the loop and the actuator read [active]: one source only
+                raise InputError(f"controller option {k} = {overrides[k]!r}: set [active].{k} in the parameter "
+                                 f"file instead (the actuator and the loop use it; now {kw[k]:g})")
         kw.update(overrides)
-        for k, allowed in CHOICES.items():
-            if k in kw and kw[k] not in allowed:
-                raise InputError(f"controller option {k} = {kw[k]!r}: not one of {', '.join(allowed)}")
         return cls(**kw)
 
 

@@ -25,12 +25,13 @@ from pathlib import Path
 from typing import Any, Mapping
 
 from heavecomp.errors import ParameterError, did_you_mean
-from heavecomp.params.core import choice, dump_toml, from_table, q, read_text, text, to_table
+from heavecomp.params.core import choice, dump_toml, from_table, q, read_text, text, to_table, toml_error_message
 
 G = 9.81  #: gravity [m/s^2] (contract value)
 P_ATM = 101325.0  #: atmospheric pressure [Pa] (contract value)
 
 FRICTION_MODELS = ("none", "stribeck", "rotating_eq6", "rotating_eq7")
+V_T_MIN = 1e-3  #: smallest non-zero friction.tangential_velocity [m/s]
 HEAVE_KINDS = ("sine", "jonswap", "file")
 
 
@@ -39,14 +40,23 @@ class Heave:
     """``[heave]``: the platform heave input used by ``simulate``."""
 
     kind: str = choice(HEAVE_KINDS, doc="sine | jonswap | file")
-    amplitude: float = q(None, "m", bounds=(0.0, 50.0), symbol="a", doc="sine amplitude")
-    period: float = q(None, "s", bounds=(0.5, 100.0), symbol="T", doc="sine period")
-    ramp: float = q(None, "s", bounds=(0.0, 1e5), symbol="T_r",
-                    doc="fade-in time; default 2 periods (sine) / 2 peak periods (jonswap)")
-    hs: float = q(None, "m", bounds=(0.0, 30.0), symbol="H_s", doc="significant wave height of the platform heave (jonswap)")
-    tp: float = q(None, "s", bounds=(1.0, 40.0), symbol="T_p", doc="spectral peak period (jonswap)")
-    gamma: float = q(None, "-", bounds=(1.0, 10.0), symbol="gamma", doc="JONSWAP peak enhancement (default 3.3)")
-    seed: int = q(None, "-", bounds=(0, 2**32 - 1), integer=True, doc="random seed of the JONSWAP phases (default 0)")
+    amplitude: float = q(None, "m", bounds=(0.0, 15.0), symbol="a", doc="sine amplitude", unit_high="mm",
+                         why="platform heave: drilling stops at a few metres, 15 m is a survival storm")
+    period: float = q(None, "s", bounds=(0.5, 100.0), symbol="T", doc="sine period", unit_high="ms",
+                      why="sea states are 3-25 s; wider for sweeps and slow quasi-static checks")
+    ramp: float = q(None, "s", bounds=(0.0, 1e5), symbol="T_r", unit_high="ms",
+                    doc="fade-in time; default 2 periods (sine) / 2 peak periods (jonswap)",
+                    why="0 (no fade-in) or 0.5-100 periods (checked against the period): shorter is a jolt, "
+                        "longer never reaches the sea state")
+    hs: float = q(None, "m", bounds=(0.0, 30.0), symbol="H_s", unit_high="mm",
+                  doc="significant wave height of the platform heave (jonswap)",
+                  why="the highest recorded sea states are ~20 m; platform heave is less")
+    tp: float = q(None, "s", bounds=(1.0, 40.0), symbol="T_p", doc="spectral peak period (jonswap)", unit_high="ms",
+                  why="wind sea and swell peak between 3 and 25 s")
+    gamma: float = q(None, "-", bounds=(1.0, 10.0), symbol="gamma", doc="JONSWAP peak enhancement (default 3.3)",
+                     why="1 (Pierson-Moskowitz) to ~7 for very peaked seas (DNV-RP-C205)")
+    seed: int = q(None, "-", bounds=(0, 2**32 - 1), integer=True, doc="random seed of the JONSWAP phases (default 0)",
+                  why="numpy's seed: a whole number in [0, 2**32 - 1]")
     path: str = text(None, doc="CSV with columns t, heave (relative to the parameter file's folder)")
 
     _REQUIRED = {"sine": ("amplitude", "period"), "jonswap": ("hs", "tp"), "file": ("path",)}
@@ -73,14 +83,20 @@ class Heave:
 class Compensator:
     """``[compensator]``: main cylinder, top mass and gas spring."""
 
-    plunger_diameter: float = q(unit="m", bounds=(0.01, 5.0), open_low=True, symbol="d",
-                                doc="single-acting plunger diameter; area A = pi d^2/4")
-    moving_mass: float = q(unit="kg", bounds=(0.0, 5e6), open_low=True, symbol="M_c",
-                           doc="top mass: crown block, travelling block, top drive, plungers")
-    gas_stiffness: float = q(unit="N/m", bounds=(0.0, 1e9), open_low=True, symbol="k_gas",
-                             doc="gas spring stiffness linearised at the operating point (after force equalizers)")
+    plunger_diameter: float = q(unit="m", bounds=(0.05, 3.0), symbol="d", unit_high="mm",
+                                doc="single-acting plunger diameter; area A = pi d^2/4",
+                                why="equivalent single plunger of a 100-1000 t compensator at 50-300 bar: 0.2-1.5 m")
+    moving_mass: float = q(unit="kg", bounds=(1e3, 1e6), symbol="M_c", unit_low="t",
+                           doc="top mass: crown block, travelling block, top drive, plungers",
+                           why="crown block + travelling block + top drive weigh tens of tonnes; < 1 t or "
+                               "> 1000 t is no drilling rig")
+    gas_stiffness: float = q(unit="N/m", bounds=(1e3, 1e8), symbol="k_gas", unit_low="kN/m",
+                             doc="gas spring stiffness linearised at the operating point (after force equalizers)",
+                             why="compensators are built soft (tens of kN/m) so heave barely changes the load; "
+                                 "the gas volume it implies is checked too")
     polytropic_index: float = q(unit="-", bounds=(1.0, 1.7), symbol="n",
-                                doc="polytropic index of the gas (1 isothermal, 1.4 adiabatic N2)")
+                                doc="polytropic index of the gas (1 isothermal, 1.4 adiabatic N2)",
+                                why="between isothermal (1) and adiabatic for any real gas (<= 5/3 monatomic)")
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -88,15 +104,25 @@ class Friction:
     """``[friction]``: main-cylinder friction (paper A eqs. 4, 6, 7)."""
 
     model: str = choice(FRICTION_MODELS, doc="none | stribeck | rotating_eq6 | rotating_eq7")
-    static_force: float = q(None, "N", bounds=(0.0, 1e7), symbol="F_S", doc="static (breakaway) friction")
-    coulomb_force: float = q(None, "N", bounds=(0.0, 1e7), symbol="F_C", doc="Coulomb friction")
-    stribeck_velocity: float = q(None, "m/s", bounds=(0.0, 10.0), open_low=True, symbol="v_S",
-                                 doc="Stribeck velocity")
-    viscous_coefficient: float = q(None, "N s/m", bounds=(0.0, 1e9), symbol="C_v", doc="viscous coefficient")
-    pressure_coefficient: float = q(None, "N/Pa", bounds=(0.0, 1.0), symbol="C_p",
-                                    doc="pressure coefficient (200 N/bar = 2e-3 N/Pa)")
-    tangential_velocity: float = q(None, "m/s", bounds=(0.0, 10.0), symbol="v_t",
-                                   doc="piston surface speed from rotation, omega d/2 (rotating models)")
+    static_force: float = q(None, "N", bounds=(0.0, 5e6), symbol="F_S", doc="static (breakaway) friction",
+                            why="seal friction is a few % of the cylinder load (checked against p_0 A)")
+    coulomb_force: float = q(None, "N", bounds=(0.0, 5e6), symbol="F_C", doc="Coulomb friction",
+                             why="between F_S / 100 and F_S (seals: F_S / F_C ~ 1-3)")
+    stribeck_velocity: float = q(None, "m/s", bounds=(1e-4, 1.0), symbol="v_S", unit_high="mm/s",
+                                 doc="Stribeck velocity",
+                                 why="hydraulic seals: 0.1-50 mm/s; below 0.1 mm/s the friction slope forces "
+                                     "a time step too small to simulate")
+    viscous_coefficient: float = q(None, "N s/m", bounds=(0.0, 1e8), symbol="C_v", doc="viscous coefficient",
+                                   why="viscous friction at 1 m/s must stay below half the cylinder load (checked)")
+    pressure_coefficient: float = q(None, "N/Pa", bounds=(0.0, 0.1), symbol="C_p", unit_high="N/bar",
+                                    doc="pressure coefficient (200 N/bar = 2e-3 N/Pa)",
+                                    why="seal contact area x friction coefficient: ~1e-3 N/Pa for a 0.7 m plunger; "
+                                        "C_p p_0 is checked against the load")
+    tangential_velocity: float = q(None, "m/s", bounds=(0.0, 2.0), symbol="v_t", unit_high="mm/s",
+                                   doc="piston surface speed from rotation, omega d/2 (rotating models)",
+                                   why="0 (rotation stopped: eqs. 6-7 are eq. 4) or 1 mm/s - 2 m/s (checked): a "
+                                       "rotating piston turns at ~0.1-5 rad/s on a < 1.5 m piston; below 1 mm/s the "
+                                       "eq. 7 slope F_S / v_t forces a time step too small to simulate")
 
     _LAW_KEYS = ("static_force", "coulomb_force", "stribeck_velocity", "viscous_coefficient",
                  "pressure_coefficient")
@@ -108,6 +134,11 @@ class Friction:
         for key in needed:
             if getattr(self, key) is None:
                 raise ParameterError(f"friction.{key}: missing required key for model = \"{self.model}\"")
+        vt = self.tangential_velocity
+        if vt is not None and 0.0 < vt < V_T_MIN:
+            raise ParameterError(f"friction.tangential_velocity = {vt:g} m/s: use 0 (rotation stopped) or at least "
+                                 f"{V_T_MIN:g} m/s (slower rotation makes the eq. 7 slope F_S / v_t too steep to "
+                                 f"simulate); is it in mm/s? (SI: m/s)")
         if self.static_force < self.coulomb_force:
             raise ParameterError(
                 f"friction.static_force = {self.static_force:g} N is below friction.coulomb_force = "
@@ -118,24 +149,32 @@ class Friction:
 class DrillString:
     """``[drill_string]``: the string as a spring-damper to the lumped lower mass."""
 
-    stiffness: float = q(unit="N/m", bounds=(0.0, 1e10), open_low=True, symbol="k_ds", doc="axial stiffness EA/L")
-    damping: float = q(0.0, "N s/m", bounds=(0.0, 1e9), symbol="c_ds", doc="axial damping (default 0)")
-    lower_mass: float = q(unit="kg", bounds=(0.0, 5e6), open_low=True, symbol="m_b", doc="lumped string + BHA mass")
+    stiffness: float = q(unit="N/m", bounds=(1e4, 1e8), symbol="k_ds", doc="axial stiffness EA/L", unit_low="kN/m",
+                         why="steel pipe EA ~ 0.5-2e9 N over 30 m to 10 km")
+    damping: float = q(0.0, "N s/m", bounds=(0.0, 1e7), symbol="c_ds", doc="axial damping (default 0)",
+                       why="damping ratio of the lower mass <= 10 (checked)")
+    lower_mass: float = q(unit="kg", bounds=(1e3, 2e6), symbol="m_b", doc="lumped string + BHA mass", unit_low="t",
+                          why="a BHA alone weighs > 1 t; 10 km of heavy pipe with BHA < 2000 t")
 
 
 @dataclass(frozen=True, kw_only=True)
 class Formation:
     """``[formation]``: one-sided bit-rock contact."""
 
-    stiffness: float = q(unit="N/m", bounds=(0.0, 1e10), open_low=True, symbol="k_F", doc="contact stiffness")
-    damping: float = q(0.0, "N s/m", bounds=(0.0, 1e9), symbol="c_F", doc="contact damping (default 0)")
+    stiffness: float = q(unit="N/m", bounds=(5e3, 1e8), symbol="k_F", doc="contact stiffness", unit_low="kN/m",
+                         why="softer than 5 kN/m is > 2 m of give per 10 t of WOB (mud, not rock); the BHA's "
+                             "own compliance caps it near 1e8 N/m")
+    damping: float = q(0.0, "N s/m", bounds=(0.0, 1e7), symbol="c_F", doc="contact damping (default 0)",
+                       why="damping ratio of the lower mass <= 10 (checked)")
 
 
 @dataclass(frozen=True, kw_only=True)
 class OperatingPoint:
     """``[operating_point]``."""
 
-    wob_setpoint: float = q(unit="N", bounds=(0.0, 1e8), open_low=True, symbol="W_0", doc="WOB set-point")
+    wob_setpoint: float = q(unit="N", bounds=(1e3, 2e6), symbol="W_0", doc="WOB set-point", unit_low="kN",
+                            why="bits run at 1-50 t; below 1 kN is a unit slip (kN or t), and W_0 must be below the "
+                                "lower mass's weight (checked)")
 
 
 #: contract tables in file order -> class; optional tables registered by other modules
@@ -176,6 +215,9 @@ class CMCParams:
             raise ParameterError(
                 f"operating_point.wob_setpoint = {self.operating_point.wob_setpoint:g} N must be below the "
                 f"suspended weight (M_c + m_b) g = {g_load:g} N (the cylinder pressure would be <= 0)")
+        from heavecomp.params.plausibility import check
+
+        check(self)  # cross-key plausibility: unit slips inside each key's bounds
 
     # ---- derived quantities (cmc-reference.md) ---------------------------------
     @property
@@ -259,8 +301,8 @@ def loads(text_: str, *, base_dir: Path | None = None, source: str = "<string>")
     """Parse TOML text into :class:`CMCParams`."""
     try:
         data = tomllib.loads(text_)
-    except tomllib.TOMLDecodeError as exc:
-        raise ParameterError(f"{source}: not valid TOML: {exc}") from None
+    except (tomllib.TOMLDecodeError, ValueError) as exc:  # ValueError: an integer of > 4300 digits
+        raise ParameterError(toml_error_message(text_, exc, source)) from None
     return from_dict(data, base_dir=base_dir)
 
 
@@ -293,12 +335,17 @@ class Active:
     a documented default.
     """
 
-    u_max: float = q(60e3, "N", bounds=(0.0, 1e8), open_low=True, symbol="u_max",
-                     doc="largest active force magnitude |u| (default 60 kN)")
-    rate_max: float = q(300e3, "N/s", bounds=(0.0, 1e10), open_low=True, symbol="du_max",
-                        doc="largest force rate |du/dt| (default 300 kN/s)")
-    control_rate: float = q(20.0, "Hz", bounds=(0.0, 1e3), open_low=True, symbol="f_c",
-                            doc="controller sample rate; command held between samples (default 20 Hz)")
+    u_max: float = q(60e3, "N", bounds=(1e3, 1e7), symbol="u_max", unit_low="kN",
+                     doc="largest active force magnitude |u| (default 60 kN)",
+                     why="an active cylinder of under 1 kN does nothing to a 100 t rig; it must stay below the "
+                         "suspended weight (checked)")
+    rate_max: float = q(300e3, "N/s", bounds=(1e3, 1e9), symbol="du_max", unit_low="kN/s",
+                        doc="largest force rate |du/dt| (default 300 kN/s)",
+                        why="full force u_max / rate_max in 1 ms to 60 s (checked)")
+    control_rate: float = q(20.0, "Hz", bounds=(1.0, 1e3), symbol="f_c", unit_low="kHz", unit_high="mHz",
+                            doc="controller sample rate; command held between samples (default 20 Hz)",
+                            why="slower than 1 Hz cannot act within a wave (5-20 s); over 1 kHz is beyond the "
+                                "actuator and the simulation budget")
 
 
 OPTIONAL_EXTRA["active"] = lambda table: from_table(Active, table, "active")

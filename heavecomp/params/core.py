@@ -21,7 +21,8 @@ _MISSING = dataclasses.MISSING
 
 
 def q(default=_MISSING, unit: str = "-", *, bounds=(-math.inf, math.inf), symbol: str = "",
-      doc: str = "", open_low: bool = False, integer: bool = False):
+      doc: str = "", open_low: bool = False, integer: bool = False, why: str = "",
+      unit_low: str = "", unit_high: str = ""):
     """A numeric parameter field.
 
     Parameters
@@ -38,9 +39,14 @@ def q(default=_MISSING, unit: str = "-", *, bounds=(-math.inf, math.inf), symbol
         Lower bound is exclusive (e.g. masses must be > 0).
     integer : bool
         Value must be a whole number (e.g. a random seed).
+    why : str
+        Why the bounds are where they are (physical plausibility; shown in the docs).
+    unit_low, unit_high : str
+        The unit a value below / above the bounds was most likely written in
+        (e.g. ``"kN"`` for a WOB of 98.1): the message asks "is it in kN?".
     """
     meta = dict(kind="number", unit=unit, bounds=bounds, symbol=symbol, doc=doc,
-                open_low=open_low, integer=integer)
+                open_low=open_low, integer=integer, why=why, unit_low=unit_low, unit_high=unit_high)
     if default is _MISSING:
         return dataclasses.field(metadata=meta)
     return dataclasses.field(default=default, metadata=meta)
@@ -66,6 +72,18 @@ def _fmt(x) -> str:
     return f"{x:g}" if isinstance(x, float) else str(x)
 
 
+def unit_hint(meta: Mapping[str, Any], value: float) -> str:
+    """``"; is it in kN? (SI: N)"`` for a value outside the bounds on a side with a likely unit."""
+    lo, hi = meta["bounds"]
+    unit = meta.get("unit", "")
+    likely = meta.get("unit_low") if 0 < value <= lo else meta.get("unit_high") if value > hi else ""
+    if likely:
+        return f"; is it in {likely}? (SI: {unit})"
+    if unit not in ("-", "") and (value > hi or 0 < value < lo):
+        return " (wrong unit?)"
+    return ""
+
+
 def check_value(name: str, f: dataclasses.Field, value: Any) -> Any:
     """Validate one value against its field metadata; return the normalised value."""
     meta = f.metadata
@@ -73,13 +91,15 @@ def check_value(name: str, f: dataclasses.Field, value: Any) -> Any:
     if kind == "number":
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             raise ParameterError(f"{name}: expected a number in {meta['unit']}, got {type(value).__name__} {value!r}")
-        if meta.get("integer"):
-            if float(value) != int(value):
-                raise ParameterError(f"{name}: expected a whole number, got {value!r}")
-            return int(value)
-        value = float(value)
-        if not math.isfinite(value):
+        try:
+            finite = math.isfinite(value)
+        except OverflowError:  # an integer literal beyond any float
+            raise ParameterError(f"{name}: must be finite, got an integer of {len(str(abs(value)))} digits") from None
+        if not finite:
             raise ParameterError(f"{name}: must be finite, got {value}")
+        if meta.get("integer") and float(value) != int(value):
+            raise ParameterError(f"{name}: expected a whole number, got {value!r}")
+        value = int(value) if meta.get("integer") else float(value)
         lo, hi = meta["bounds"]
         too_low = value <= lo if meta.get("open_low") else value < lo
         if too_low or value > hi:
@@ -87,7 +107,7 @@ def check_value(name: str, f: dataclasses.Field, value: Any) -> Any:
             unit = meta["unit"]
             raise ParameterError(
                 f"{name} = {_fmt(value)} {unit} is outside the possible range {lo_s}, {_fmt(hi)}] {unit}"
-                + (" (wrong unit?)" if unit not in ("-", "") and (value > hi or 0 < value < lo) else ""))
+                + unit_hint(meta, value))
         return value
     if kind == "choice":
         if not isinstance(value, str) or value not in meta["options"]:
@@ -145,17 +165,71 @@ def describe(cls) -> list[tuple[str, str, str, str, str]]:
     return rows
 
 
+def bounds_rows(cls, prefix: str) -> list[str]:
+    """Markdown rows ``| key | unit | plausible range | why |`` of a parameter table's numeric fields (docs)."""
+    rows = []
+    for f in dataclasses.fields(cls):
+        m = f.metadata
+        if m.get("kind") != "number":
+            continue
+        lo, hi = m["bounds"]
+        rng = ("(" if m.get("open_low") else "[") + f"{_fmt(lo)}, {_fmt(hi)}]"
+        key = f"{prefix}.{f.name}" if prefix else f.name
+        rows.append(f"| `{key}` | {m['unit']} | {rng} | {m.get('why', '')} |")
+    return rows
+
+
 def read_text(path, what: str = "parameter file") -> str:
-    """A user's text file, or a one-line :class:`ParameterError` naming it."""
+    """A user's text file (UTF-8, a UTF-8 byte-order mark is dropped), or a one-line
+    :class:`ParameterError` naming it and, for other encodings, where and what they are."""
     from pathlib import Path
 
     path = Path(path)
     try:
-        return path.read_text(encoding="utf-8")
+        raw = path.read_bytes()
     except FileNotFoundError:
         raise ParameterError(f"{path}: {what} not found") from None
-    except (IsADirectoryError, PermissionError, UnicodeDecodeError) as exc:
+    except (IsADirectoryError, PermissionError, OSError) as exc:
         raise ParameterError(f"{path}: cannot read {what} ({type(exc).__name__})") from None
+    if raw.startswith((b"\xff\xfe", b"\xfe\xff")) or (len(raw) > 1 and (raw[0] == 0) != (raw[1] == 0)):
+        raise ParameterError(f"{path}: {what} is UTF-16 encoded; save it as UTF-8 (TOML files are UTF-8)")
+    if raw.startswith(b"\xef\xbb\xbf"):  # a BOM some editors write: harmless, dropped
+        raw = raw[3:]
+    try:
+        return raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = raw[:exc.start].count(b"\n") + 1
+        col = exc.start - (raw.rfind(b"\n", 0, exc.start) + 1) + 1
+        raise ParameterError(f"{path}: {what} is not UTF-8 (byte 0x{raw[exc.start]:02x} at line {line}, column {col}; "
+                             f"latin-1/Windows text?); save it as UTF-8") from None
+
+
+def toml_error_message(text_: str, exc: Exception, source: str) -> str:
+    """One line for a TOML syntax error: the file, the key (``table.key``) on the offending line, the parser's
+    message and, for ``0,72``, the hint that TOML numbers use a decimal point."""
+    import re
+
+    msg = str(exc)
+    lines = text_.splitlines()
+    m = re.search(r"at line (\d+)", msg)
+    if m is None and "digits" in msg:  # int() refused a huge literal: no position in the message
+        msg = "an integer literal of more than 4300 digits"
+        m = next((re.match(r"(\d+)", str(i + 1)) for i, ln in enumerate(lines) if re.search(r"\d{4301}", ln)), None)
+    where, hint = "", ""
+    if m:
+        n = int(m.group(1))
+        line = lines[n - 1] if 0 < n <= len(lines) else ""
+        table = ""
+        for prev in lines[:n]:
+            h = re.match(r"\s*\[+\s*([^\]]*?)\s*\]", prev)
+            if h:
+                table = h.group(1)
+        k = re.match(r"\s*([A-Za-z0-9_\-]+)\s*=", line)
+        if k:
+            where = f" at {table + '.' if table else ''}{k.group(1)}"
+        if re.search(r"=\s*[-+]?\d+,\d", line):
+            hint = " (a decimal comma? TOML numbers use a point, e.g. 0.72)"
+    return f"{source}: not valid TOML{where}: {msg}{hint}"
 
 
 def dump_toml(tables: Mapping[str, Mapping[str, Any]], header: str = "") -> str:

@@ -12,6 +12,7 @@ from typing import Callable
 import numpy as np
 
 from heavecomp.errors import InputError, ParameterError
+from heavecomp.params.budget import check_run_size
 
 
 class SimulationError(InputError):
@@ -229,6 +230,7 @@ def simulate(params, duration: float, *, dt: float | None = None, rate: float = 
         log.warning("output interval 1/rate = %g s is not a multiple of dt = %g s; output every %d steps",
                     1 / rate, h, out_every)
     n_steps = int(math.ceil(duration / h - 1e-9))
+    check_run_size(params, duration=duration, h=h, n_steps=n_steps, n_rows=n_steps // out_every + 1, n_cols=NCH, dt=dt, rate=rate, rate_fn=plant_eigen_rate)
     sp = 0.5 * h
     if heave is None:
         hs = excitation.make_heave(params.heave, n_steps * h, sp, params.base_dir)

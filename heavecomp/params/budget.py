@@ -1,0 +1,131 @@
+"""Run-size budget: refuse, before anything is allocated, a run whose step count or memory cannot fit.
+
+A simulation holds the heave samples (z, dz/dt, d2z/dt2 every half step: 48 bytes
+per RK4 step) and the output rows (``rows x columns x 8`` bytes) in memory, and
+takes time proportional to its RK4 steps.  The default step follows the
+fastest plant rate, so a mass, stiffness or friction slope far outside a rig's
+range, or a long ``--duration`` at a tiny ``--dt`` / huge ``--rate``, asks for
+more than any machine has.  :func:`check_run_size` raises a one-line
+:class:`~heavecomp.errors.ParameterError` naming what drives the size (the
+parameter keys that set the default step, found by perturbing each one, or
+``--dt`` / ``--rate`` / ``--duration``) before the work starts.
+
+Budgets (module constants, per run):
+
+- :data:`MAX_STEPS` = 2e8 RK4 steps (about a minute or two of the compiled
+  stepper; 24 h of paper A at its default 25 ms step is 3.5e6);
+- :data:`MAX_BYTES` = 4 GiB for heave samples plus output rows.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Callable
+
+from heavecomp.errors import ParameterError
+
+MAX_STEPS = 200_000_000  #: largest number of RK4 steps of one run
+MAX_BYTES = 4 * 2 ** 30  #: largest memory for heave samples + output rows [bytes]
+HEAVE_BYTES_PER_STEP = 3 * 8 * 2  #: z, dz, ddz at every half step [bytes]
+MIN_DEFAULT_STEP = 1e-5  #: a parameter set whose default step is shorter cannot run an hour within MAX_STEPS [s]
+
+
+def _gb(n: float) -> str:
+    return f"{n / 1e9:.3g} GB"
+
+
+def step_drivers(params, rate_fn: Callable, *, top: int = 3) -> list[str]:
+    """``["friction.stribeck_velocity = 0.0001 m/s", ...]``: the keys the plant rate ``rate_fn(params)`` [1/s]
+    depends on most (elasticity d ln rate / d ln value over a 10 % change, largest first)."""
+    from heavecomp.errors import InputError
+
+    r0 = rate_fn(params)
+    found = []
+    for tname, table in params.to_dict().items():
+        if tname not in ("compensator", "friction", "drill_string", "formation"):
+            continue
+        for key, value in table.items():
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or value == 0:
+                continue
+            try:
+                r1 = rate_fn(params.replace(**{tname: {key: value * 1.1}}))
+            except InputError:  # a 10 % change crosses a bound or a cross-key check
+                try:
+                    r1 = 1.0 / rate_fn(params.replace(**{tname: {key: value / 1.1}})) * r0 * r0
+                except InputError:
+                    continue
+            e = math.log(r1 / r0) / math.log(1.1)
+            if abs(e) >= 0.2:
+                unit = _unit(params, tname, key)
+                found.append((abs(e), f"{tname}.{key} = {value:.4g}{' ' + unit if unit else ''}"))
+    found.sort(key=lambda x: -x[0])
+    return [s for _, s in found[:top]]
+
+
+def _unit(params, tname, key) -> str:
+    import dataclasses
+
+    for f in dataclasses.fields(getattr(params, tname)):
+        if f.name == key:
+            u = f.metadata.get("unit", "")
+            return "" if u == "-" else u
+    return ""
+
+
+def _step_cause(params, h, dt, rate, rate_fn) -> str:
+    if dt is not None:
+        return f"--dt = {h:.3g} s"
+    if rate_fn is None:
+        return f"the default step {h:.3g} s"
+    h_plant = min(0.05, 0.6 / rate_fn(params))
+    if rate and 1.0 / rate < 0.999 * h_plant:
+        return f"a step of {h:.3g} s (one output interval of --rate = {rate:g} Hz)"
+    drivers = step_drivers(params, rate_fn)
+    return (f"the default step {h:.3g} s" + (f", set by {', '.join(drivers)}" if drivers else ""))
+
+
+def check_run_size(params, *, duration: float, h: float, n_steps: int, n_rows: int, n_cols: int,
+                   dt: float | None = None, rate: float | None = None, rate_fn: Callable | None = None) -> None:
+    """Raise :class:`ParameterError` if a run of ``n_steps`` RK4 steps of ``h`` [s] and ``n_rows`` x ``n_cols``
+    output values exceeds :data:`MAX_STEPS` or :data:`MAX_BYTES`.
+
+    Parameters
+    ----------
+    params : CMCParams
+    duration : float [s]
+    h : float [s]
+        The step the run would use.
+    n_steps, n_rows, n_cols : int
+        RK4 steps, output rows and columns.
+    dt : float [s] or None
+        The step the user asked for (None: default step).
+    rate : float [Hz] or None
+        Output (or control) rate.
+    rate_fn : callable(params) -> float [1/s], optional
+        The plant rate the default step is made from; used only to name the keys that set it.
+    """
+    heave_bytes = HEAVE_BYTES_PER_STEP * (n_steps + 1)
+    out_bytes = 8 * n_rows * n_cols
+    if n_steps <= MAX_STEPS and heave_bytes + out_bytes <= MAX_BYTES:
+        return
+    if out_bytes > heave_bytes and n_steps <= MAX_STEPS:
+        raise ParameterError(
+            f"--duration = {duration:g} s at --rate = {rate:g} Hz writes {n_rows:.3g} rows x {n_cols} columns "
+            f"({_gb(out_bytes)}), over the {MAX_BYTES / 2 ** 30:g} GiB budget; lower --rate or --duration")
+    cause = _step_cause(params, h, dt, rate, rate_fn)
+    what = (f"{n_steps:.3g} RK4 steps, over the budget of {MAX_STEPS:.3g}" if n_steps > MAX_STEPS else
+            f"{_gb(heave_bytes + out_bytes)} of heave samples and output, over the {MAX_BYTES / 2 ** 30:g} GiB budget")
+    raise ParameterError(f"--duration = {duration:g} s at {cause} needs {what}; "
+                         f"shorten --duration, pass a larger --dt, or check those values")
+
+
+def check_default_step(params, h: float, rate_fn: Callable) -> None:
+    """Raise :class:`ParameterError` if the default step ``h`` [s] of ``params`` is below :data:`MIN_DEFAULT_STEP`,
+    naming the keys that set it (``heavecomp params`` checks this; no run of useful length would fit)."""
+    if h >= MIN_DEFAULT_STEP:
+        return
+    drivers = step_drivers(params, rate_fn)
+    raise ParameterError(
+        f"{drivers[0].split(' = ')[0] if drivers else 'parameters'}: the default time step would be {h:.3g} s "
+        f"(set by {', '.join(drivers) or 'the plant'}), below {MIN_DEFAULT_STEP:g} s: an hour would need "
+        f"{3600 / h:.3g} RK4 steps (budget {MAX_STEPS:.3g}); check those values")
