@@ -5,16 +5,16 @@ does the sliding friction grow with pressure (F_C + C_p p, paper A eq. 4's press
 
 from __future__ import annotations
 
-import os
 import sys
 from pathlib import Path
 
 from heavecomp.analysis import pneumatic_friction as PF
+from heavecomp.data import SEAL_FRICTION
 from heavecomp.analysis import pneumatic_plots as PLT
 from heavecomp.report.figures import save
-from heavecomp.report.scenario import ROOT, md_table, parse_args, write_metrics, write_report
+from heavecomp.report.scenario import md_table, parse_args, write_metrics, write_report
 
-DATA = Path(os.environ.get("HEAVECOMP_SHARED", ROOT.parent / "shared")) / "data" / "seal-friction"
+DATA = SEAL_FRICTION
 
 
 def build(folder=DATA) -> dict:

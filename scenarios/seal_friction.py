@@ -11,13 +11,14 @@ from __future__ import annotations
 
 import sys
 
+from heavecomp.data import SEAL_FRICTION
 from heavecomp.identification import plots
 from heavecomp.identification.seal import load_seal_csv
 from heavecomp.identification.study import seal_study
 from heavecomp.report.figures import save
-from heavecomp.report.scenario import ROOT, md_table, parse_args, write_metrics, write_report
+from heavecomp.report.scenario import md_table, parse_args, write_metrics, write_report
 
-DATA = ROOT.parent / "shared" / "data" / "seal-friction"
+DATA = SEAL_FRICTION
 FILES = ("O-ring_1bar.csv", "O-ring_3bar.csv", "O-ring_5bar.csv", "O-ring_7bar.csv")
 
 

@@ -41,6 +41,6 @@ def test_cmc_stick_map_scenario(tmp_path):
         assert agree >= 0.8, mod
 
 
-def test_seal_scenario(tmp_path, shared_dir):
+def test_seal_scenario(tmp_path, data_dir):
     m = _run("pneumatic_seal_friction", tmp_path)
     assert m["pressure_coefficient_N_per_Pa"] > 0

@@ -55,10 +55,10 @@ def test_friction_recovered_from_synthetic_pneumatic_measurement():
     assert r["velocity_rms_error"] < 1e-3  # m/s, vs u_0 = 30 mm/s
 
 
-def test_seal_friction_files(shared_dir):
+def test_seal_friction_files(data_dir):
     from heavecomp.analysis.pneumatic_friction import seal_summary
 
-    s = seal_summary(shared_dir / "data" / "seal-friction")
+    s = seal_summary(data_dir / "seal-friction")
     rows = s["rows"]
     assert len(rows) == 4
     for r in rows:

@@ -5,7 +5,7 @@
    sensor noise), and the friction is recovered with
    :func:`heavecomp.signals.friction_from_motion` — only the equation of motion
    ``M a = A (P_a - P_b) - F_f`` is shared with the generator, not the friction law.
-2. **Measured**: TU Delft O-ring seal data (``shared/data/seal-friction``):
+2. **Measured**: TU Delft O-ring seal data (``heavecomp/data/seal-friction``):
    friction = force - p A (the authors' definition) with the velocity from the
    zero-phase twice-differentiated position; sliding friction per direction and
    its growth with pressure (F_C + C_p p).

@@ -1,6 +1,6 @@
 """Seal friction against pressure: fit F_C + C_p dp to steady strokes.
 
-Data: TU Delft pneumatic-cylinder O-ring files (see ``shared/data/README.md``),
+Data: TU Delft pneumatic-cylinder O-ring files (see ``heavecomp/data/README.md``),
 whitespace separated, 7 columns: time [ms], laser [V], pressure [V], force [V],
 position [mm], pressure [bar], force [N].  The friction is, by the authors'
 definition, ``F_f = force - p A`` with ``A = pi 0.0125^2`` m^2 and ``p`` the
