@@ -3,10 +3,18 @@
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("run", metavar="RUN.csv", help="measured run: columns t, heave, stroke, pressure, wob (SI)")
+    p.add_argument("run", metavar="RUN", help="measured run: columns t, heave, stroke, pressure, wob; CSV (any "
+                   "delimiter, decimal comma, .gz/.bz2/.xz/.zip), Parquet or .mat (docs/contracts/measured-run.md)")
+    p.add_argument("--columns", default=None, metavar="t=NAME,...",
+                   help="map contract columns to the file's, e.g. t=Time,heave=MRU_heave,wob=WOB "
+                        "(overrides [measurement] columns)")
+    p.add_argument("--units", default=None, metavar="t=ms,...",
+                   help="declare units, e.g. t=ms,pressure=bar,wob=kN,stroke=mm (converted to SI and recorded; "
+                        "overrides [measurement] units)")
     p.add_argument("--params", required=True, metavar="NOMINAL.toml", help="nominal CMC parameter file")
     p.add_argument("--out", required=True, metavar="DIR", help="output folder (diagnosis.json, report.md, PNGs)")
     p.add_argument("--candidates", default=None, metavar="A,B",
@@ -26,8 +34,11 @@ def run(args) -> int:
     from heavecomp.diagnosis.estimator import GapDiagnoser
     from heavecomp.diagnosis.report import write_report
     from heavecomp.errors import InputError
+    from heavecomp.io.series import check_spec, parse_mapping
     from heavecomp.params import load
 
+    columns, units = check_spec(parse_mapping(args.columns, "--columns"), parse_mapping(args.units, "--units"),
+                                "cli")
     params = load(args.params)
     cands = None
     if args.candidates:
@@ -38,7 +49,7 @@ def run(args) -> int:
             get(c)  # unknown names fail before any work
     if args.jobs < 1:
         raise InputError(f"--jobs must be >= 1, got {args.jobs}")
-    run_ = load_run(args.run, params)
+    run_ = load_run(args.run, params, columns=columns, units=units)
     t0 = time.perf_counter()
 
     def progress(frac, msg):
@@ -48,8 +59,20 @@ def run(args) -> int:
     d = GapDiagnoser(params, cands, split=args.split, settle=args.settle, n_jobs=args.jobs, progress=progress)
     d.fit(run_)
     write_report(d, args.out, title=f"Sim-to-real gap diagnosis — {run_.source}")
+    _record_measurement(Path(args.out) / "diagnosis.json", run_.measurement)
     v = d.verdict_
     extra = f", second effect {v['second_effect']['effect']}" if v.get("second_effect") else ""
     print(f"verdict: {v['effect']} (confidence {v['confidence']}), held-out shrink {v['shrink']:.2f} "
           f"on {v.get('shrink_channel', 'wob')}{extra} -> {args.out}/diagnosis.json")
     return 0
+
+
+def _record_measurement(path: Path, measurement: dict) -> None:
+    """Add how the run was read (format, columns, units, conversions) to diagnosis.json."""
+    import json
+
+    if not measurement or not path.is_file():
+        return
+    d = json.loads(path.read_text(encoding="utf-8"))
+    d["measurement"] = measurement
+    path.write_text(json.dumps(d, indent=2) + "\n", encoding="utf-8")

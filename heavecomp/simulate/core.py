@@ -194,7 +194,8 @@ def simulate(params, duration: float, *, dt: float | None = None, rate: float = 
     n_steps = int(math.ceil(duration / h - 1e-9))
     sp = 0.5 * h
     if heave is None:
-        hs = excitation.make_heave(params.heave, n_steps * h, sp, params.base_dir)
+        hs = excitation.make_heave(params.heave, n_steps * h, sp, params.base_dir,
+                                     measurement=params.extra.get("measurement"))
     elif isinstance(heave, excitation.HeaveSamples):
         if abs(heave.spacing - sp) > 1e-12 * sp:
             raise ValueError("heave samples must be spaced dt/2")
