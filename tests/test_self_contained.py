@@ -43,7 +43,7 @@ def test_markdown_links_resolve_inside_the_repository():
     assert not bad, bad
 
 
-@pytest.mark.parametrize("name", ["EMPS", "SEAL_FRICTION", "WAVERIDER"])
+@pytest.mark.parametrize("name", ["EMPS", "SEAL_FRICTION", "WAVERIDER", "EXAMPLE_RUN", "EXAMPLE_PARAMS"])
 def test_shipped_data_is_in_the_package(name):
     import heavecomp.data as D
 
@@ -61,4 +61,4 @@ def test_cli_help_stays_inside_the_repository():
         texts += [p.format_help() for p in action.choices.values()]
     joined = "\n".join(texts)
     assert not [p for p in OUTSIDE if p in joined]
-    assert "diagnose" in joined
+    assert "diagnose" in joined and "--columns" in joined
