@@ -244,12 +244,15 @@ def test_duplicate_column_names_are_refused(tmp_path, nominal, capsys, header, f
     assert fragment in _cli_err(_diag(tmp_path, f, nominal), capsys)
 
 
-@pytest.mark.parametrize("n", [10, 49])
-def test_too_short_run_is_one_line(tmp_path, nominal, capsys, n):
-    cols = {k: v[:n] for k, v in _si().items()}
+@pytest.mark.parametrize("n,dt,fragment", [(10, 0.1, "need at least 50 samples"), (49, 0.1, "need at least 50"),
+                                           (120, 0.1, "the run spans 11.9 s; diagnose needs at least 60 s"),
+                                           (200, 0.25, "the run spans 49.8 s")])
+def test_too_short_run_is_one_line(tmp_path, nominal, capsys, n, dt, fragment):
+    """50-200 samples used to end in an IndexError or a 'medium confidence' verdict from 5 s of data."""
+    cols = _si(n=n, dt=dt)
     f = tmp_path / "short.csv"
     f.write_text(_csv(cols))
-    assert "need at least 50 samples" in _cli_err(_diag(tmp_path, f, nominal), capsys)
+    assert fragment in _cli_err(_diag(tmp_path, f, nominal), capsys)
 
 
 def test_binary_and_unreadable_files(tmp_path, nominal, capsys):
@@ -350,3 +353,27 @@ def test_odd_heave_files_one_line(tmp_path, capsys, content, fragment):
     err = _cli_err(["simulate", str(_heave_params(tmp_path, f)), "--duration", "2", "--out", str(tmp_path / "o")],
                    capsys)
     assert fragment in err
+
+
+# ---------------------------------------------------------------- identification loaders
+def test_identify_odd_files_one_line(tmp_path, capsys, data_dir):
+    """Seal files gzip-compressed read like the plain ones; binary, Latin-1 garbage and a 5000-character
+    path are one line, exit 2 (issue 14 item 8)."""
+    from heavecomp.identification.seal import load_seal_csv
+
+    plain = data_dir / "seal-friction" / "O-ring_1bar.csv"
+    gz = tmp_path / "O-ring_1bar.csv.gz"
+    gz.write_bytes(gzip.compress(plain.read_bytes()))
+    a, b = load_seal_csv(plain), load_seal_csv(gz)
+    np.testing.assert_array_equal(a.force, b.force)
+    blob = tmp_path / "blob.csv"
+    blob.write_bytes(bytes(range(256)) * 20)
+    err = _cli_err(["identify", "seal", str(plain), str(blob), "--out", str(tmp_path / "o")], capsys)
+    assert "blob.csv: binary file" in err
+    latin = tmp_path / "latin.csv"
+    latin.write_bytes(plain.read_bytes()[:2000] + "é\n".encode("latin-1"))
+    err = _cli_err(["identify", "seal", str(plain), str(latin), "--out", str(tmp_path / "o")], capsys)
+    assert "latin.csv: row" in err
+    long = "/" + "y" * 5000 + ".mat"
+    err = _cli_err(["identify", "emps", long, "--out", str(tmp_path / "o")], capsys)
+    assert len(err) < 300

@@ -5,6 +5,9 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+#: shortest run diagnosed [s]: a third held out must still hold a few 5-20 s wave periods
+MIN_DURATION = 60.0
+
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("run", metavar="RUN", help="measured run: columns t, heave, stroke, pressure, wob; CSV (any "
@@ -50,6 +53,9 @@ def run(args) -> int:
     if args.jobs < 1:
         raise InputError(f"--jobs must be >= 1, got {args.jobs}")
     run_ = load_run(args.run, params, columns=columns, units=units)
+    if run_.duration < MIN_DURATION:
+        raise InputError(f"{run_.source}: column 't': the run spans {run_.duration:.3g} s; diagnose needs at least "
+                         f"{MIN_DURATION:g} s (a fitted and a held-out part of several wave periods each)")
     t0 = time.perf_counter()
 
     def progress(frac, msg):

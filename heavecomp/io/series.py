@@ -230,6 +230,19 @@ def _decode(data: bytes, src: str, warnings: list) -> str:
         return text
 
 
+def read_text(path) -> tuple[str, list]:
+    """Text of a plain or compressed (gzip/bz2/xz/zip) text file, for readers with their own layout.
+
+    Returns ``(text, warnings)``; a missing, unreadable, binary or corrupt file is a one-line
+    :class:`DataError` (never a ``UnicodeDecodeError``).
+    """
+    path = Path(path)
+    src = short(path)
+    warnings: list[str] = []
+    raw, _ = _decompress(_read_bytes(path, src), src)
+    return _decode(raw, src, warnings), warnings
+
+
 _NUM = re.compile(r"^[+-]?(\d+([.,]\d*)?|[.,]\d+)([eE][+-]?\d+)?$")
 
 
@@ -613,5 +626,5 @@ def gaps(t, max_gap: float, factor: float = 3.0):
     return np.flatnonzero(d > lim)
 
 
-__all__ = ["Series", "read_series", "parse_mapping", "check_spec", "split_header", "UNITS", "KINDS", "short",
+__all__ = ["Series", "read_series", "read_text", "parse_mapping", "check_spec", "split_header", "UNITS", "KINDS", "short",
            "gaps"]
