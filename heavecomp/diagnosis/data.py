@@ -118,6 +118,9 @@ def check_run(t, columns: dict, *, params=None, source="<array>", rows=None) -> 
 
     t = np.asarray(t, dtype=float)
     columns = {k: np.asarray(v, dtype=float) for k, v in columns.items()}
+    for col in REQUIRED[1:]:  # an inf cell is a dropout like an empty one (never averaged into a check)
+        if col in columns and np.isinf(columns[col]).any():
+            columns[col] = np.where(np.isinf(columns[col]), np.nan, columns[col])
     line = (lambda i: int(rows[i])) if rows is not None else (lambda i: int(i) + 2)
     for col in REQUIRED[1:]:
         if col not in columns:
