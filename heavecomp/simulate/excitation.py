@@ -204,13 +204,19 @@ def read_heave_csv(path, measurement=None) -> tuple[np.ndarray, np.ndarray]:
 MAX_HEAVE_GAP = 2.0
 #: an interval longer than this many median intervals is a hole
 GAP_FACTOR = 1.5
+#: a heave sample further than max(SPIKE_MIN, g dt^2, SPIKE_NOISE x noise) from the line through its
+#: neighbours is a spike (a sea at <= 1 g moves a sample at most g dt^2 / 2 off that line) [m]
+SPIKE_MIN = 0.5
+SPIKE_NOISE = 12.0
 
 
 def _check_series(t, z, src, rows=None):
     """One-line DataError for a heave record that cannot be used as given.
 
     Too few samples, non-finite values, time not increasing, excursions over 50 m
-    (not metres?), or a hole longer than ``max(MAX_HEAVE_GAP, 3 median intervals)``
+    (not metres?), a spike (one sample off the line through its neighbours by more than
+    max(SPIKE_MIN, g dt^2, SPIKE_NOISE x the noise); it used to end as a diverging stepper
+    with the advice "reduce --dt"), or a hole longer than ``max(MAX_HEAVE_GAP, 3 median intervals)``
     (a spline would invent heave there).
     """
     from heavecomp.io.series import gaps
@@ -228,6 +234,18 @@ def _check_series(t, z, src, rows=None):
                         f"({t[back[0]]:g} -> {t[back[0] + 1]:g} s; duplicate or backwards)")
     if np.max(np.abs(z - z[0])) > 50:
         raise DataError(f"{src}: column 'heave': excursions over 50 m — is it in metres?")
+    if z.size >= 5:
+        # a spike: one sample far off the line through its neighbours, beyond what a sea (and the noise) makes
+        dev = z[1:-1] - 0.5 * (z[:-2] + z[2:])
+        noise = 1.4826 * float(np.median(np.abs(dev - np.median(dev))))
+        dt = float(np.median(np.diff(t)))
+        limit = max(SPIKE_MIN, G * dt * dt, SPIKE_NOISE * noise)
+        bad = np.flatnonzero(np.abs(dev) > limit)
+        if bad.size:
+            first = bad[bad <= bad[0] + 2]  # a spike also pulls its neighbours' lines: name the worst
+            i = int(first[np.argmax(np.abs(dev[first]))]) + 1
+            raise DataError(f"{src}: column 'heave', row {line(i)}: a spike of {dev[i - 1]:+.3g} m off its neighbours "
+                            f"(more than {limit:.3g} m: a glitch or a dropout value?); remove or fill that sample")
     hole = gaps(t, MAX_HEAVE_GAP)
     if hole.size:
         i = hole[0]
