@@ -11,13 +11,14 @@ from __future__ import annotations
 
 import sys
 
+from heavecomp.data import EMPS
 from heavecomp.report import identification as plots
 from heavecomp.identification.study import emps_study
 from heavecomp.plants.axis import load_emps
 from heavecomp.report.figures import save
-from heavecomp.report.scenario import ROOT, md_table, parse_args, write_metrics, write_report
+from heavecomp.report.scenario import md_table, parse_args, write_metrics, write_report
 
-DATA = ROOT.parent / "shared" / "data" / "emps" / "DATA_EMPS.mat"
+DATA = EMPS
 
 
 def build(quick: bool = False, path=DATA) -> dict:

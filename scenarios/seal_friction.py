@@ -11,18 +11,18 @@ circumference (an assumption: same friction per unit seal length).
 
 from __future__ import annotations
 
-import os
 import sys
 from pathlib import Path
 
 from heavecomp.report import identification as plots
+from heavecomp.data import SEAL_FRICTION
 from heavecomp.identification.seal import load_seal_csv, velocity_fir
 from heavecomp.identification.study import seal_study
 from heavecomp.report.figures import save
 from heavecomp.report.rigs import plot_seal
-from heavecomp.report.scenario import ROOT, md_table, parse_args, write_metrics, write_report
+from heavecomp.report.scenario import md_table, parse_args, write_metrics, write_report
 
-DATA = Path(os.environ.get("HEAVECOMP_SHARED", ROOT.parent / "shared")) / "data" / "seal-friction"
+DATA = SEAL_FRICTION
 FILES = ("O-ring_1bar.csv", "O-ring_3bar.csv", "O-ring_5bar.csv", "O-ring_7bar.csv")
 
 

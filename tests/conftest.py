@@ -1,17 +1,16 @@
-import os
 from pathlib import Path
 
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
-SHARED = Path(os.environ.get("HEAVECOMP_SHARED", ROOT.parent / "shared"))
 
 
 @pytest.fixture(scope="session")
-def shared_dir() -> Path:
-    """../shared beside the checkout (CI has it there)."""
-    assert SHARED.is_dir(), f"shared/ folder not found at {SHARED} (set HEAVECOMP_SHARED)"
-    return SHARED
+def data_dir() -> Path:
+    """The measured data shipped inside the package (heavecomp/data, see its README)."""
+    from heavecomp.data import ROOT as DATA
+
+    return DATA
 
 
 @pytest.fixture

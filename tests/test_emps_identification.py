@@ -18,8 +18,8 @@ ROOT = __import__("pathlib").Path(__file__).resolve().parents[1]
 
 
 @pytest.fixture(scope="module")
-def emps(shared_dir):
-    return load_emps(shared_dir / "data" / "emps" / "DATA_EMPS.mat")
+def emps(data_dir):
+    return load_emps(data_dir / "emps" / "DATA_EMPS.mat")
 
 
 @pytest.fixture(scope="module")

@@ -18,8 +18,8 @@ FILES = ("O-ring_1bar.csv", "O-ring_3bar.csv", "O-ring_5bar.csv", "O-ring_7bar.c
 
 
 @pytest.fixture(scope="module")
-def records(shared_dir):
-    return [load_seal_csv(shared_dir / "data" / "seal-friction" / f) for f in FILES]
+def records(data_dir):
+    return [load_seal_csv(data_dir / "seal-friction" / f) for f in FILES]
 
 
 @pytest.fixture(scope="module")

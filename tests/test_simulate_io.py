@@ -69,9 +69,9 @@ def test_heave_from_file_equals_sine(tmp_path):
 
 @pytest.mark.parametrize("content,fragment", [
     ("t,heav\n0,0\n1,0\n2,0\n3,0\n", "missing column 'heave'"),
-    ("t,heave\n0,0\n1,0\n1,0.1\n2,0\n3,0\n", "column 't': time not strictly increasing at data row 3"),
-    ("t,heave\n0,0\n1,nan\n2,0\n3,0\n", "column 'heave': non-finite value at data row 2"),
-    ("t,heave\n0,0\n1,x\n2,0\n3,0\n", "row 3: non-numeric"),
+    ("t,heave\n0,0\n1,0\n1,0.1\n2,0\n3,0\n", "column 't', row 4: time not strictly increasing"),
+    ("t,heave\n0,0\n1,nan\n2,0\n3,0\n", "column 'heave', row 3: missing or non-finite value"),
+    ("t,heave\n0,0\n1,x\n2,0\n3,0\n", "column 'heave', row 3: not a number: 'x'"),
     ("t,heave\n0,0\n1,1500\n2,0\n3,0\n", "column 'heave': excursions over 50 m"),
 ])
 def test_bad_heave_file(tmp_path, content, fragment):

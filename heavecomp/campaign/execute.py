@@ -23,13 +23,14 @@ from __future__ import annotations
 
 import csv
 import dataclasses
+import io
 import json
 import logging
 import os
 import time
 from pathlib import Path
 
-from heavecomp.errors import InputError, ParameterError
+from heavecomp.errors import InputError
 from heavecomp.simulate.layout import source_hash
 
 log = logging.getLogger(__name__)
@@ -93,16 +94,33 @@ def finished_ids(path: Path) -> tuple[set, list | None]:
         log.warning("%s: discarding a partly written last line (interrupted run)", path)
         with path.open("r+b") as fh:
             fh.truncate(cut)
-    with path.open(newline="") as fh:
-        reader = csv.reader(fh)
-        header = next(reader, None)
-        if header is None:
-            return set(), None
-        if "run_id" not in header:
-            raise InputError(f"{path}: column 'run_id' missing — not a campaign table")
-        k = header.index("run_id")
-        ids = {row[k] for row in reader if len(row) == len(header)}
+    reader = csv.reader(io.StringIO(_table_text(path)))
+    header = next(reader, None)
+    if header is None:
+        return set(), None
+    if "run_id" not in header:
+        raise InputError(f"{path}: column 'run_id' missing — not a campaign table")
+    k = header.index("run_id")
+    ids = {row[k] for row in reader if len(row) == len(header)}
     return ids, header
+
+
+def _table_text(path: Path) -> str:
+    """Text of ``runs.csv`` (heavecomp writes plain UTF-8); a compressed, binary or non-UTF-8 file is a
+    one-line InputError, not a traceback."""
+    from heavecomp.io.series import short
+
+    try:
+        raw = path.read_bytes()
+    except OSError as exc:
+        raise InputError(f"{short(path)}: cannot read ({exc.strerror or type(exc).__name__})") from None
+    if raw[:2] == b"\x1f\x8b" or raw[:3] == b"BZh" or raw[:4] in (b"PK\x03\x04", b"PAR1") or b"\x00" in raw[:4096]:
+        raise InputError(f"{short(path)}: not the plain CSV table heavecomp writes (compressed or binary); "
+                         "restore it or remove it to rerun the campaign")
+    try:
+        return raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise InputError(f"{short(path)}: not UTF-8 text (byte {exc.start}); not a table heavecomp wrote") from None
 
 
 class _Writer:
@@ -255,19 +273,54 @@ def _run_dask(campaign, chunks, finished, scheduler, client):
     return "dask", nw
 
 
-def read_table(path) -> dict:
-    """``runs.csv`` as columns (numpy arrays; run_id/regime/variant as str)."""
+def _is_float(v) -> bool:
+    try:
+        float(v)
+    except ValueError:
+        return False
+    return True
+
+
+def read_table(path, campaign=None) -> dict:
+    """``runs.csv`` as columns (numpy arrays; run_id/regime/variant as str).
+
+    Each run counts once: a row repeated exactly is dropped (warning); two different rows with
+    the same ``run_id``, a ``run_id`` that is not a run of ``campaign`` (when given), a row
+    with more or fewer fields than the header and a non-numeric cell are one-line
+    :class:`InputError` naming the row or run.
+    """
     import numpy as np
 
     path = Path(path)
     if not path.is_file():
         raise InputError(f"{path}: results table not found")
-    with path.open(newline="") as fh:
-        reader = csv.reader(fh)
-        header = next(reader, None)
-        rows = [r for r in reader if header and len(r) == len(header)]
+    reader = csv.reader(io.StringIO(_table_text(path)))
+    header = next(reader, None)
     if not header:
         raise InputError(f"{path}: empty results table")
+    if "run_id" not in header:
+        raise InputError(f"{path}: column 'run_id' missing — not a campaign table")
+    k = header.index("run_id")
+    known = {r.run_id for r in campaign.runs()} if campaign is not None else None
+    rows, seen, dropped = [], {}, 0
+    for line, r in enumerate(reader, start=2):
+        if not r:
+            continue
+        if len(r) != len(header):
+            raise InputError(f"{path}: row {line} has {len(r)} fields, the header has {len(header)}")
+        rid = r[k]
+        if known is not None and rid not in known:
+            raise InputError(f"{path}: row {line}: run_id '{rid}' is not a run of this campaign "
+                             "(a table from another campaign?)")
+        if rid in seen:
+            if rows[seen[rid]] != r:
+                raise InputError(f"{path}: row {line}: run_id '{rid}' appears twice with different results")
+            dropped += 1
+            continue
+        seen[rid] = len(rows)
+        rows.append(r)
+    if dropped:
+        log.warning("%s: %d duplicated rows counted once", path, dropped)
     cols = {}
     for j, name in enumerate(header):
         vals = [r[j] for r in rows]
@@ -277,5 +330,7 @@ def read_table(path) -> dict:
             try:
                 cols[name] = np.array([float(v) for v in vals])
             except ValueError:
-                raise InputError(f"{path}: column '{name}': non-numeric value") from None
+                bad = next(i for i, v in enumerate(vals) if not _is_float(v))
+                raise InputError(f"{path}: column '{name}', run_id '{rows[bad][k]}': non-numeric value "
+                                 f"{vals[bad][:20]!r}") from None
     return cols

@@ -164,7 +164,8 @@ def simulate_closed_loop(params, controller="passive", duration: float = 120.0, 
     # the true future heave is only needed for a perfect preview (a record must then reach past the end)
     horizon_t = (cfg.horizon + 2) * Tc if preview == "perfect" else 0.0
     if heave is None:
-        hs = excitation.make_heave(params.heave, n_ctrl * Tc + horizon_t, sp, params.base_dir)
+        hs = excitation.make_heave(params.heave, n_ctrl * Tc + horizon_t, sp, params.base_dir,
+                                     measurement=params.extra.get("measurement"))
     elif isinstance(heave, excitation.HeaveSamples):
         if abs(heave.spacing - sp) > 1e-12 * sp:
             raise ValueError(f"heave samples must be spaced dt/2 = {sp:g} s, got {heave.spacing:g} s")

@@ -9,7 +9,7 @@ import argparse
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("params", metavar="PARAMS.toml", help="CMC parameter file (cmc-reference.md contract)")
+    p.add_argument("params", metavar="PARAMS.toml", help="CMC parameter file (contract: docs/contracts/parameter-file.md)")
     p.add_argument("--out", required=True, metavar="DIR", help="output folder")
     p.add_argument("--points", type=int, default=1000, metavar="N",
                    help="number of log-spaced frequencies (default 1000)")

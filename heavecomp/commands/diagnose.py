@@ -3,10 +3,21 @@
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
+
+#: shortest run diagnosed [s]: a third held out must still hold a few 5-20 s wave periods
+MIN_DURATION = 60.0
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("run", metavar="RUN.csv", help="measured run: columns t, heave, stroke, pressure, wob (SI)")
+    p.add_argument("run", metavar="RUN", help="measured run: columns t, heave, stroke, pressure, wob; CSV (any "
+                   "delimiter, decimal comma, .gz/.bz2/.xz/.zip), Parquet or .mat (docs/contracts/measured-run.md)")
+    p.add_argument("--columns", default=None, metavar="t=NAME,...",
+                   help="map contract columns to the file's, e.g. t=Time,heave=MRU_heave,wob=WOB "
+                        "(overrides [measurement] columns)")
+    p.add_argument("--units", default=None, metavar="t=ms,...",
+                   help="declare units, e.g. t=ms,pressure=bar,wob=kN,stroke=mm (converted to SI and recorded; "
+                        "overrides [measurement] units)")
     p.add_argument("--params", required=True, metavar="NOMINAL.toml", help="nominal CMC parameter file")
     p.add_argument("--out", required=True, metavar="DIR", help="output folder (diagnosis.json, report.md, PNGs)")
     p.add_argument("--candidates", default=None, metavar="A,B",
@@ -27,8 +38,11 @@ def run(args) -> int:
     from heavecomp.diagnosis.estimator import GapDiagnoser
     from heavecomp.report.diagnosis import write_report
     from heavecomp.errors import InputError
+    from heavecomp.io.series import check_spec, parse_mapping
     from heavecomp.params import load
 
+    columns, units = check_spec(parse_mapping(args.columns, "--columns"), parse_mapping(args.units, "--units"),
+                                "cli")
     params = load(args.params)
     cands = None
     if args.candidates:
@@ -39,7 +53,10 @@ def run(args) -> int:
             get(c)  # unknown names fail before any work
     if args.jobs < 1:
         raise InputError(f"--jobs must be >= 1, got {args.jobs}")
-    run_ = load_run(args.run, params)
+    run_ = load_run(args.run, params, columns=columns, units=units)
+    if run_.duration < MIN_DURATION:
+        raise InputError(f"{run_.source}: column 't': the run spans {run_.duration:.3g} s; diagnose needs at least "
+                         f"{MIN_DURATION:g} s (a fitted and a held-out part of several wave periods each)")
     t0 = time.perf_counter()
 
     def progress(frac, msg):
@@ -49,6 +66,7 @@ def run(args) -> int:
     d = GapDiagnoser(params, cands, split=args.split, settle=args.settle, n_jobs=args.jobs, progress=progress)
     d.fit(run_)
     write_report(d, args.out, title=f"Sim-to-real gap diagnosis — {run_.source}")
+    _record_measurement(Path(args.out) / "diagnosis.json", run_.measurement)
     from heavecomp.report.provenance import finish
 
     finish(args.out, params=params, json_files=("diagnosis.json",), measured_run=str(Path(args.run).resolve()))
@@ -57,3 +75,14 @@ def run(args) -> int:
     print(f"verdict: {v['effect']} (confidence {v['confidence']}), held-out shrink {v['shrink']:.2f} "
           f"on {v.get('shrink_channel', 'wob')}{extra} -> {args.out}/diagnosis.json")
     return 0
+
+
+def _record_measurement(path: Path, measurement: dict) -> None:
+    """Add how the run was read (format, columns, units, conversions) to diagnosis.json."""
+    import json
+
+    if not measurement or not path.is_file():
+        return
+    d = json.loads(path.read_text(encoding="utf-8"))
+    d["measurement"] = measurement
+    path.write_text(json.dumps(d, indent=2) + "\n", encoding="utf-8")

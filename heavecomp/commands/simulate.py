@@ -6,7 +6,7 @@ import argparse
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("params", metavar="PARAMS.toml", help="CMC parameter file (cmc-reference.md contract)")
+    p.add_argument("params", metavar="PARAMS.toml", help="CMC parameter file (contract: docs/contracts/parameter-file.md)")
     p.add_argument("--duration", type=float, required=True, metavar="S", help="simulated time [s]")
     p.add_argument("--out", required=True, metavar="DIR", help="output folder")
     p.add_argument("--rate", type=float, default=20.0, metavar="HZ", help="output sample rate [Hz] (default 20)")

@@ -1,6 +1,6 @@
 """Loop contract, controller registry, the passive and PID controllers.
 
-Contract (``shared/style/architecture.md``): a controller is built from the
+Contract (``docs/control.md``): a controller is built from the
 plant parameters and a frozen config, ``reset()`` clears its memory and
 ``step(t, measurement, preview=None) -> u`` returns the commanded active force
 [N] (positive up on the top mass).  A controller should command within

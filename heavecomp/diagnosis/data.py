@@ -1,6 +1,6 @@
 """Measured runs: load and check the CSV contract, derive heave velocity/acceleration.
 
-Contract: ``shared/spec/diagnosis-contract.md`` — columns ``t`` [s], ``heave`` [m],
+Contract: ``docs/contracts/measured-run.md`` — columns ``t`` [s], ``heave`` [m],
 ``stroke`` [m], ``pressure`` [Pa], ``wob`` [N]; other columns are carried along.
 
 Treatments (documented in ``docs/diagnosis.md``):
@@ -20,7 +20,6 @@ Treatments (documented in ``docs/diagnosis.md``):
 
 from __future__ import annotations
 
-import csv
 import dataclasses
 import math
 from pathlib import Path
@@ -30,11 +29,14 @@ import numpy as np
 from heavecomp.errors import DataError
 from heavecomp.simulate.excitation import HeaveSamples
 
+P_ATM = 101325.0  #: atmospheric pressure [Pa] (cmc-reference.md)
+
 REQUIRED = ("t", "heave", "stroke", "pressure", "wob")
 CHANNELS = ("wob", "stroke", "pressure")
 UNITS = {"t": "s", "heave": "m", "stroke": "m", "pressure": "Pa", "wob": "N"}
 MAX_MISSING = 0.2  #: largest tolerated fraction of missing samples per column
-MAX_GAP = 2.0      #: longest heave dropout bridged by interpolation [s]
+MAX_GAP = 2.0      #: longest heave dropout (or hole in the time column) bridged by interpolation [s]
+MIN_SAMPLES = 50   #: fewest samples of a run
 HEAVE_CUTOFF = 0.8  #: zero-phase FIR low-pass cut-off for the heave [Hz] (paper B's method; waves < 0.7 Hz)
 TAPS_PER_CUTOFF = 4.0  #: FIR length in periods of the cut-off (Hamming window)
 
@@ -47,6 +49,8 @@ class MeasuredRun:
     columns: dict
     source: str = "<array>"
     warnings: list = dataclasses.field(default_factory=list)
+    #: how the file was read: format, columns, units, conversions (heavecomp.io.series)
+    measurement: dict = dataclasses.field(default_factory=dict)
 
     def __getitem__(self, name):
         if name == "t":
@@ -68,76 +72,79 @@ class MeasuredRun:
         return bool(np.ptp(d) <= 1e-6 * np.median(d))
 
 
-def load_run(path, params=None) -> MeasuredRun:
-    """Read and check a measured-run CSV (contract columns, SI).
+def load_run(path, params=None, *, columns=None, units=None) -> MeasuredRun:
+    """Read and check a measured run in any supported shape (``docs/contracts/measured-run.md``).
+
+    The file is read by :func:`heavecomp.io.series.read_series` (CSV with any delimiter,
+    decimal comma, header case/units; gzip/bz2/xz/zip; Parquet; MATLAB .mat; time in s, ms
+    or ISO timestamps) and converted to SI; how it was read is kept in ``run.measurement``.
 
     Parameters
     ----------
     path : str or Path
     params : CMCParams, optional
         Nominal parameters; when given, the channel magnitudes are checked
-        against the operating point (wrong-unit detection).
+        against the operating point (wrong-unit detection), and its ``[measurement]``
+        table (if any) maps columns and declares units.
+    columns, units : dict, optional
+        Contract name -> source column / unit; override ``[measurement]`` key by key
+        (``--columns`` / ``--units``).
 
     Raises
     ------
     DataError
         One line naming the column (and row) for every problem.
     """
-    path = Path(path)
-    if not path.is_file():
-        raise DataError(f"{path}: file not found")
-    with path.open(newline="") as fh:
-        reader = csv.reader(fh)
-        try:
-            header = [h.strip() for h in next(reader)]
-        except StopIteration:
-            raise DataError(f"{path}: empty file (expected a header with columns {', '.join(REQUIRED)})") from None
-        for col in REQUIRED:
-            if col not in header:
-                raise DataError(f"{path}: missing column '{col}' (header: {', '.join(header)})")
-        rows = []
-        for row_no, row in enumerate(reader, start=2):
-            if not row or all(not c.strip() for c in row):
-                continue
-            if len(row) < len(header):
-                row = row + [""] * (len(header) - len(row))
-            vals = []
-            for name, cell in zip(header, row):
-                cell = cell.strip()
-                if cell == "" or cell.lower() in ("nan", "na", "null"):
-                    vals.append(math.nan)
-                    continue
-                try:
-                    vals.append(float(cell))
-                except ValueError:
-                    if name in REQUIRED:
-                        raise DataError(f"{path}: column '{name}', row {row_no}: not a number: {cell!r}") from None
-                    vals.append(math.nan)
-            rows.append(vals)
-    if not rows:
-        raise DataError(f"{path}: column 't': no data rows")
-    arr = np.array(rows, dtype=float)
-    cols = {h: arr[:, i] for i, h in enumerate(header) if h != "t"}
-    return check_run(arr[:, header.index("t")], cols, params=params, source=str(path))
+    from heavecomp.io.series import read_series
+
+    spec = getattr(params, "extra", {}).get("measurement") if params is not None else None
+    cols = {**(spec.columns if spec else {}), **(columns or {})}
+    uns = {**(spec.units if spec else {}), **(units or {})}
+    s = read_series(path, REQUIRED, columns=cols, units=uns, what="measured run")
+    data = dict(s.columns)
+    t = data.pop("t")
+    run = check_run(t, data, params=params, source=s.source, rows=s.rows)
+    run.warnings[:0] = s.warnings
+    run.measurement = s.measurement
+    return run
 
 
-def check_run(t, columns: dict, *, params=None, source="<array>") -> MeasuredRun:
-    """Check arrays against the contract (see the module docstring); returns a :class:`MeasuredRun`."""
+def check_run(t, columns: dict, *, params=None, source="<array>", rows=None) -> MeasuredRun:
+    """Check arrays against the contract (see the module docstring); returns a :class:`MeasuredRun`.
+
+    ``rows`` (optional) gives the file line of each sample, for messages (default: header on
+    line 1, one sample per line).
+    """
+    from heavecomp.io.series import MAX_DT_S, gaps
+
     t = np.asarray(t, dtype=float)
     columns = {k: np.asarray(v, dtype=float) for k, v in columns.items()}
+    for col in REQUIRED[1:]:  # an inf cell is a dropout like an empty one (never averaged into a check)
+        if col in columns and np.isinf(columns[col]).any():
+            columns[col] = np.where(np.isinf(columns[col]), np.nan, columns[col])
+    line = (lambda i: int(rows[i])) if rows is not None else (lambda i: int(i) + 2)
     for col in REQUIRED[1:]:
         if col not in columns:
             raise DataError(f"{source}: missing column '{col}'")
-    if t.size < 50:
-        raise DataError(f"{source}: column 't': need at least 50 samples, got {t.size}")
+    if t.size < MIN_SAMPLES:
+        raise DataError(f"{source}: column 't': need at least {MIN_SAMPLES} samples, got {t.size}")
     bad = np.flatnonzero(~np.isfinite(t))
     if bad.size:
-        raise DataError(f"{source}: column 't', row {bad[0] + 2}: missing or non-finite time")
+        raise DataError(f"{source}: column 't', row {line(bad[0])}: missing or non-finite time")
     back = np.flatnonzero(np.diff(t) <= 0)
     if back.size:
         i = back[0]
-        raise DataError(f"{source}: column 't', row {i + 3}: time not strictly increasing "
+        raise DataError(f"{source}: column 't', row {line(i + 1)}: time not strictly increasing "
                         f"({t[i]:g} -> {t[i + 1]:g} s; duplicate or backwards)")
+    dt_med = float(np.median(np.diff(t)))
+    if dt_med > MAX_DT_S:
+        raise DataError(f"{source}: column 't': median interval {dt_med:.4g} s is too coarse for heave "
+                        "(waves need > 1 Hz) — time in milliseconds? convert to s or declare --units t=ms")
+    hole = gaps(t, MAX_GAP)
+    if hole.size:
+        i = hole[0]
+        raise DataError(f"{source}: column 't', row {line(i + 1)}: {t[i + 1] - t[i]:.3g} s without samples "
+                        f"({t[i]:g} -> {t[i + 1]:g} s; longest bridged gap {MAX_GAP:g} s)")
     warnings = []
     for col in REQUIRED[1:]:
         miss = ~np.isfinite(columns[col])
@@ -156,7 +163,7 @@ def check_run(t, columns: dict, *, params=None, source="<array>") -> MeasuredRun
             lo = t[max(a - 1, 0)]
             hi = t[min(b, t.size - 1)]
             if hi - lo > MAX_GAP:
-                raise DataError(f"{source}: column 'heave', row {a + 2}: dropout of {hi - lo:.3g} s "
+                raise DataError(f"{source}: column 'heave', row {line(a)}: dropout of {hi - lo:.3g} s "
                                 f"(longest bridged gap {MAX_GAP:g} s)")
     d = np.diff(t)
     if np.ptp(d) > 1e-6 * np.median(d):
@@ -191,12 +198,17 @@ def _check_mean(run, src, column, unit, symbol, nominal, band, other_units, hint
 def check_units(run: MeasuredRun, params) -> None:
     """Compare channel magnitudes with the nominal operating point; DataError naming the likely unit.
 
-    Pressure: the mean gauge pressure should be near p_0 (cmc-reference.md);
+    Pressure: the mean gauge pressure should be near p_0 (cmc-reference.md); a mean near
+    p_0 + p_atm adds a warning (absolute pressure?) to ``run.warnings``;
     WOB: its mean near W_0; stroke: its spread comparable to the heave's.
     """
     src = run.source
     p0 = params.p0
     W0 = params.operating_point.wob_setpoint
+    pm = float(np.nanmean(run["pressure"]))
+    if abs(pm - p0 - P_ATM) < 0.3 * P_ATM < abs(pm - p0):
+        run.warnings.append(f"column 'pressure': mean {pm:.4g} Pa is p_0 + {(pm - p0) / 1e5:.2f} bar — absolute "
+                            "pressure? the contract is gauge; if so declare --units pressure=bara (or Pa_abs)")
     _check_mean(run, src, "pressure", "Pa", "p_0", p0, (0.2, 5.0),
                 ((1e-5, "bar"), (1e-3, "kPa"), (1e-6, "MPa"), (1.45038e-4, "psi")),
                 "wrong unit, absolute pressure of another rig, or wrong parameter file?")

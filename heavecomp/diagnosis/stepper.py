@@ -119,7 +119,8 @@ def simulate_fx(params, duration, EP=None, *, rate=50.0, heave=None, dt=None):
     out_every = max(1, int(round(1.0 / (rate * h))))
     n_steps = int(math.ceil(duration / h - 1e-9))
     if heave is None:
-        hs = excitation.make_heave(params.heave, n_steps * h, 0.5 * h, params.base_dir)
+        hs = excitation.make_heave(params.heave, n_steps * h, 0.5 * h, params.base_dir,
+                                     measurement=params.extra.get("measurement"))
     else:
         hs = excitation.from_series(heave[0], heave[1], n_steps * h, 0.5 * h)
     law = FrictionLaw.from_params(params.friction)

@@ -1,6 +1,6 @@
 """Seal friction against pressure: fit F_C + C_p dp to steady strokes.
 
-Data: TU Delft pneumatic-cylinder O-ring files (see ``shared/data/README.md``),
+Data: TU Delft pneumatic-cylinder O-ring files (see ``heavecomp/data/README.md``),
 whitespace separated, 7 columns: time [ms], laser [V], pressure [V], force [V],
 position [mm], pressure [bar], force [N].  The friction is, by the authors'
 definition, ``F_f = force - p A`` with ``A = pi 0.0125^2`` m^2 and ``p`` the
@@ -64,7 +64,7 @@ class SealRecord:
 
 
 def load_seal_csv(path) -> SealRecord:
-    """Read one O-ring file (7 whitespace-separated columns, no header).
+    """Read one O-ring file (7 whitespace-separated columns, no header; may be gzip/bz2/xz/zip).
 
     Raises
     ------
@@ -72,26 +72,32 @@ def load_seal_csv(path) -> SealRecord:
         Missing file, wrong number of columns, non-numeric or non-finite cells,
         or a time column (``time [ms]``) that is not strictly increasing.
     """
+    from heavecomp.io.series import read_text
+
     path = Path(path)
-    if not path.is_file():
+    try:
+        missing = not path.is_file()
+    except OSError:  # e.g. a name too long: read_text says so in one line
+        missing = False
+    if missing:
         raise DataError(f"{path}: no such file")
     rows = []
-    with path.open() as fh:
-        for i, line in enumerate(fh, start=1):
-            cells = line.split()
-            if not cells:
-                continue
-            if len(cells) != len(COLUMNS):
-                raise DataError(f"{path.name}: row {i} has {len(cells)} columns, expected {len(COLUMNS)} "
-                                f"({', '.join(COLUMNS)})")
-            try:
-                vals = [float(c) for c in cells]
-            except ValueError:
-                raise DataError(f"{path.name}: row {i} has a non-numeric cell") from None
-            for name, v in zip(COLUMNS, vals):
-                if not math.isfinite(v):
-                    raise DataError(f"{path.name}: column '{name}' is not finite at row {i}")
-            rows.append(vals)
+    text, _ = read_text(path)  # plain or compressed; Latin-1 if not UTF-8; binary: one-line DataError
+    for i, line in enumerate(text.splitlines(), start=1):
+        cells = line.split()
+        if not cells:
+            continue
+        if len(cells) != len(COLUMNS):
+            raise DataError(f"{path.name}: row {i} has {len(cells)} columns, expected {len(COLUMNS)} "
+                            f"({', '.join(COLUMNS)})")
+        try:
+            vals = [float(c) for c in cells]
+        except ValueError:
+            raise DataError(f"{path.name}: row {i} has a non-numeric cell") from None
+        for name, v in zip(COLUMNS, vals):
+            if not math.isfinite(v):
+                raise DataError(f"{path.name}: column '{name}' is not finite at row {i}")
+        rows.append(vals)
     if len(rows) < 100:
         raise DataError(f"{path.name}: only {len(rows)} rows, need at least 100")
     a = np.asarray(rows)

@@ -1,6 +1,6 @@
 """Parameters of the crown-block mounted compensator (CMC) — the TOML contract.
 
-The table and key names are fixed by ``shared/spec/cmc-reference.md``; this
+The table and key names are fixed by ``docs/contracts/parameter-file.md``; this
 module adds nothing to their meaning.  All quantities SI.
 
 Which keys may be omitted (the documented defaults; everything else is required):
@@ -354,3 +354,12 @@ OPTIONAL_EXTRA["active"] = lambda table: from_table(Active, table, "active")
 def active(params: CMCParams) -> Active:
     """The ``[active]`` table of ``params``, or its documented defaults when absent."""
     return params.extra.get("active") or Active()
+
+
+def _measurement(table):
+    from heavecomp.params.measurement import from_table as _from
+
+    return _from(table)
+
+
+OPTIONAL_EXTRA["measurement"] = _measurement  # [measurement]: columns/units of measured series

@@ -248,6 +248,10 @@ def dump_toml(tables: Mapping[str, Mapping[str, Any]], header: str = "") -> str:
                 s = repr(value)
             elif isinstance(value, str):
                 s = '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
+            elif isinstance(value, Mapping) and all(isinstance(v, str) for v in value.values()):
+                # inline table of strings ([measurement] columns / units)
+                s = "{ " + ", ".join(f'{k} = "' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
+                                     for k, v in value.items()) + " }"
             else:
                 raise TypeError(f"cannot write {tname}.{key} of type {type(value).__name__} to TOML")
             out.append(f"{key} = {s}")

@@ -30,7 +30,7 @@ def paper_a(model: str = "stribeck") -> CMCParams:
     F_S = 23 kN, F_C = 12 kN, v_S = 10 mm/s, C_v = 10 kN s/m, C_p = 200 N/bar;
     drill string L = 300 m; formation k_F = 1000 kN/m.
 
-    Assumptions and illegible values (``shared/spec/physics.md``):
+    Assumptions and illegible values (the project's physics notes):
 
     - plunger diameter 0.72 m: digits uncertain in the OCR;
     - drill-string stiffness printed as "208 kN/m"; 300 m of drill pipe

@@ -140,9 +140,15 @@ def load_emps(path) -> AxisRecord:
     """
     import scipy.io
 
+    from heavecomp.io.series import short
+
     path = Path(path)
-    if not path.is_file():
-        raise DataError(f"{path}: no such file")
+    try:
+        found = path.is_file()
+    except OSError as exc:  # e.g. a file name too long for the file system
+        raise DataError(f"{short(path)}: cannot read ({exc.strerror or type(exc).__name__})") from None
+    if not found:
+        raise DataError(f"{short(path)}: no such file")
     try:
         data = scipy.io.loadmat(str(path))
     except Exception as exc:  # scipy raises several types for a bad file

@@ -1,6 +1,6 @@
 """The crown-block mounted compensator (CMC): equations, written once.
 
-Reference structure: ``shared/spec/cmc-reference.md`` (paper A, section 4).
+Reference structure: ``docs/contracts/parameter-file.md`` (paper A, section 4).
 The functions below are scalar and use ``np.*`` only, so one source serves
 
 - the compiled exact stick-slip stepper (:mod:`heavecomp.simulate._kernel`, numba),

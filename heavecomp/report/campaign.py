@@ -225,7 +225,7 @@ def run_and_report(campaign, out_dir, **kw):
         log.info("campaign incomplete (%d of %d runs); rerun to resume", info.n_skipped + info.n_simulated,
                  info.n_total)
         return info, None
-    table = read_table(info.table_path)
+    table = read_table(info.table_path, campaign)
     st = stats.statistics(campaign, table)
     run_info = {"executor": info.executor, "workers": info.workers, "runs_simulated": info.n_simulated,
                 "runs_resumed": info.n_skipped, "wall_time_s": round(info.wall_time, 2)}

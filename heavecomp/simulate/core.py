@@ -233,7 +233,8 @@ def simulate(params, duration: float, *, dt: float | None = None, rate: float = 
     check_run_size(params, duration=duration, h=h, n_steps=n_steps, n_rows=n_steps // out_every + 1, n_cols=NCH, dt=dt, rate=rate, rate_fn=plant_eigen_rate)
     sp = 0.5 * h
     if heave is None:
-        hs = excitation.make_heave(params.heave, n_steps * h, sp, params.base_dir)
+        hs = excitation.make_heave(params.heave, n_steps * h, sp, params.base_dir,
+                                     measurement=params.extra.get("measurement"))
     elif isinstance(heave, excitation.HeaveSamples):
         if abs(heave.spacing - sp) > 1e-12 * sp:
             raise ValueError("heave samples must be spaced dt/2")

@@ -9,6 +9,7 @@ event falls between them.
 from __future__ import annotations
 
 import dataclasses
+import logging
 import math
 from pathlib import Path
 
@@ -17,6 +18,7 @@ import numpy as np
 from heavecomp.errors import DataError, ParameterError
 
 G = 9.81
+log = logging.getLogger(__name__)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -165,59 +167,127 @@ def spectral_hs_tp(z, dt):
     return 4.0 * float(np.std(z)), 1.0 / float(fpk)
 
 
-def read_heave_csv(path) -> tuple[np.ndarray, np.ndarray]:
-    """Read a heave file: CSV with a header naming columns ``t`` and ``heave``."""
-    path = Path(path)
-    if not path.is_file():
-        raise ParameterError(f"heave.path: file not found: {path}")
-    import csv
+def read_heave_csv(path, measurement=None) -> tuple[np.ndarray, np.ndarray]:
+    """Read a heave file: columns ``t`` [s] and ``heave`` [m], in any shape the measured-run
+    reader takes (``docs/contracts/measured-run.md``: any delimiter, decimal comma, header
+    case and units, compressed CSV, Parquet, .mat, time in s/ms/ISO timestamps).
 
-    with path.open(newline="") as fh:
-        reader = csv.reader(fh)
-        try:
-            header = [h.strip() for h in next(reader)]
-        except StopIteration:
-            raise DataError(f"{path}: empty heave file") from None
-        for col in ("t", "heave"):
-            if col not in header:
-                raise DataError(f"{path}: missing column '{col}' (header: {', '.join(header)})")
-        it, ih = header.index("t"), header.index("heave")
-        t, z = [], []
-        for row_no, row in enumerate(reader, start=2):
-            if not row:
-                continue
-            try:
-                t.append(float(row[it]))
-                z.append(float(row[ih]))
-            except (ValueError, IndexError):
-                raise DataError(f"{path}: row {row_no}: non-numeric or missing value in 't' or 'heave'") from None
-    t, z = np.asarray(t), np.asarray(z)
-    _check_series(t, z, str(path))
+    Parameters
+    ----------
+    path : str or Path
+    measurement : Measurement, optional
+        The parameter file's ``[measurement]`` table (column mapping, declared units).
+
+    Returns
+    -------
+    (t, z) : ndarray [s], ndarray [m]
+    """
+    from heavecomp.io.series import read_series, short
+
+    path = Path(path)
+    try:
+        missing = not path.exists()
+    except OSError:  # e.g. a name too long for the file system: read_series says so
+        missing = False
+    if missing:
+        raise ParameterError(f"heave.path: file not found: {short(path)}")
+    cols = getattr(measurement, "columns", None) or {}
+    units = getattr(measurement, "units", None) or {}
+    s = read_series(path, ("t", "heave"), columns={k: v for k, v in cols.items() if k in ("t", "heave")},
+                    units={k: v for k, v in units.items() if k in ("t", "heave")}, what="heave file")
+    t, z = s["t"], s["heave"]
+    _check_series(t, z, s.source, rows=s.rows)
     return t, z
 
 
-def _check_series(t, z, src):
+#: longest hole in a heave record bridged (linearly, with a warning) [s]; longer ones are refused
+MAX_HEAVE_GAP = 2.0
+#: an interval longer than this many median intervals is a hole
+GAP_FACTOR = 1.5
+#: a heave sample further than max(SPIKE_MIN, g dt^2, SPIKE_NOISE x noise) from the line through its
+#: neighbours is a spike (a sea at <= 1 g moves a sample at most g dt^2 / 2 off that line) [m]
+SPIKE_MIN = 0.5
+SPIKE_NOISE = 12.0
+
+
+def _check_series(t, z, src, rows=None):
+    """One-line DataError for a heave record that cannot be used as given.
+
+    Too few samples, non-finite values, time not increasing, excursions over 50 m
+    (not metres?), a spike (one sample off the line through its neighbours by more than
+    max(SPIKE_MIN, g dt^2, SPIKE_NOISE x the noise); it used to end as a diverging stepper
+    with the advice "reduce --dt"), or a hole longer than ``max(MAX_HEAVE_GAP, 3 median intervals)``
+    (a spline would invent heave there).
+    """
+    from heavecomp.io.series import gaps
+
+    line = (lambda i: int(rows[i])) if rows is not None else (lambda i: f"{int(i) + 1} (data)")
     if t.size < 4:
         raise DataError(f"{src}: column 't': need at least 4 samples, got {t.size}")
     for name, arr in (("t", t), ("heave", z)):
         bad = np.flatnonzero(~np.isfinite(arr))
         if bad.size:
-            raise DataError(f"{src}: column '{name}': non-finite value at data row {bad[0] + 1}")
+            raise DataError(f"{src}: column '{name}', row {line(bad[0])}: missing or non-finite value")
     back = np.flatnonzero(np.diff(t) <= 0)
     if back.size:
-        raise DataError(f"{src}: column 't': time not strictly increasing at data row {back[0] + 2} "
-                        f"({t[back[0]]:g} -> {t[back[0] + 1]:g} s)")
+        raise DataError(f"{src}: column 't', row {line(back[0] + 1)}: time not strictly increasing "
+                        f"({t[back[0]]:g} -> {t[back[0] + 1]:g} s; duplicate or backwards)")
     if np.max(np.abs(z - z[0])) > 50:
         raise DataError(f"{src}: column 'heave': excursions over 50 m — is it in metres?")
+    if z.size >= 5:
+        # a spike: one sample far off the line through its neighbours, beyond what a sea (and the noise) makes
+        dev = z[1:-1] - 0.5 * (z[:-2] + z[2:])
+        noise = 1.4826 * float(np.median(np.abs(dev - np.median(dev))))
+        dt = float(np.median(np.diff(t)))
+        limit = max(SPIKE_MIN, G * dt * dt, SPIKE_NOISE * noise)
+        bad = np.flatnonzero(np.abs(dev) > limit)
+        if bad.size:
+            first = bad[bad <= bad[0] + 2]  # a spike also pulls its neighbours' lines: name the worst
+            i = int(first[np.argmax(np.abs(dev[first]))]) + 1
+            raise DataError(f"{src}: column 'heave', row {line(i)}: a spike of {dev[i - 1]:+.3g} m off its neighbours "
+                            f"(more than {limit:.3g} m: a glitch or a dropout value?); remove or fill that sample")
+    hole = gaps(t, MAX_HEAVE_GAP)
+    if hole.size:
+        i = hole[0]
+        raise DataError(f"{src}: column 't', row {line(i + 1)}: {t[i + 1] - t[i]:.3g} s without heave samples "
+                        f"({t[i]:g} -> {t[i + 1]:g} s); holes up to {MAX_HEAVE_GAP:g} s (or 3 sampling "
+                        "intervals) are bridged — fill the record or cut it there")
+
+
+def _bridge(t, z, src):
+    """Fill holes longer than GAP_FACTOR median intervals with linear samples (the spline then follows
+    the straight line instead of swinging through the hole); logs a warning per record."""
+    d = np.diff(t)
+    dt = float(np.median(d))
+    holes = np.flatnonzero(d > GAP_FACTOR * dt)
+    if holes.size == 0:
+        return t, z
+    log.warning("%s: %d hole(s) in the heave record bridged linearly (longest %.3g s)", src, holes.size,
+                float(d[holes].max()))
+    ts, zs = [t[: holes[0] + 1]], [z[: holes[0] + 1]]
+    for k, i in enumerate(holes):
+        n = int(math.ceil(d[i] / dt))
+        fill = t[i] + (t[i + 1] - t[i]) * np.arange(1, n) / n
+        ts.append(fill)
+        zs.append(np.interp(fill, t[i:i + 2], z[i:i + 2]))
+        stop = holes[k + 1] + 1 if k + 1 < holes.size else t.size
+        ts.append(t[i + 1:stop])
+        zs.append(z[i + 1:stop])
+    return np.concatenate(ts), np.concatenate(zs)
 
 
 def from_series(t, z, duration, spacing, src="heave") -> HeaveSamples:
-    """Heave from measured samples: cubic spline through (t, z), first sample as reference."""
+    """Heave from measured samples: cubic spline through (t, z), first sample as reference.
+
+    Holes of more than 1.5 sampling intervals are first bridged linearly (warning); holes over
+    ``max(MAX_HEAVE_GAP, 3 intervals)`` are refused (:func:`_check_series`).
+    """
     from scipy.interpolate import CubicSpline
 
     t = np.asarray(t, dtype=float)
     z = np.asarray(z, dtype=float)
     _check_series(t, z, src)
+    t, z = _bridge(t, z, src)
     span = t[-1] - t[0]
     if duration > span + 1e-9:
         raise ParameterError(f"duration {duration:g} s exceeds the heave record's span {span:g} s ({src})")
@@ -227,8 +297,9 @@ def from_series(t, z, duration, spacing, src="heave") -> HeaveSamples:
     return HeaveSamples(spacing, cs(tg), cs(tg, 1), cs(tg, 2), {"kind": "file", "source": src, "span": span})
 
 
-def make_heave(heave, duration, spacing, base_dir=None) -> HeaveSamples:
-    """Samples for a :class:`heavecomp.params.cmc.Heave` table."""
+def make_heave(heave, duration, spacing, base_dir=None, measurement=None) -> HeaveSamples:
+    """Samples for a :class:`heavecomp.params.cmc.Heave` table (``measurement``: the file's
+    ``[measurement]`` table, for a heave file's column names and units)."""
     if heave is None:
         raise ParameterError("[heave]: missing table (simulate needs a heave input: sine, jonswap or file)")
     if heave.kind == "sine":
@@ -238,12 +309,12 @@ def make_heave(heave, duration, spacing, base_dir=None) -> HeaveSamples:
     path = Path(heave.path)
     if not path.is_absolute() and base_dir is not None:
         path = Path(base_dir) / path
-    t, z = read_heave_csv(path)
+    t, z = read_heave_csv(path, measurement)
     return from_series(t, z, duration, spacing, src=str(path))
 
 
 def load_waverider(path, start_hours=0.0):
-    """Buoy heave from the Datawell Waverider CSV in ``shared/data/waverider``.
+    """Buoy heave from the Datawell Waverider CSV (``heavecomp.data.WAVERIDER``).
 
     Returns ``(t, z)`` with t from 0 [s] and z the sea-surface heave [m]; rows
     with a bad signal-quality flag or non-finite heave are dropped.

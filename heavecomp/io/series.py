@@ -1,0 +1,630 @@
+"""One reader for every measured series: measured runs, heave files, identification data.
+
+Contract: ``docs/contracts/measured-run.md``.  A file in any reasonable shape is read
+into named float columns in SI units, and *how* it was read is recorded
+(``Series.measurement``: format, delimiter, decimal mark, which source column became
+which contract column, the units and every conversion applied), so a result can say
+exactly what it was computed from.
+
+Formats, recognised by content (magic bytes), not by the file name:
+
+- text CSV in UTF-8 (with or without a byte-order mark) or, failing that, Latin-1
+  (with a warning); any delimiter among ``, ; TAB |`` or runs of spaces; a decimal
+  comma; any header case and spacing, units in the header (``Time [s]``, ``wob (kN)``,
+  ``pressure_bar``); a file without a header (columns named ``1``, ``2``, ...);
+- the same compressed: gzip, bzip2, xz, zip (one member);
+- Parquet (pyarrow), MATLAB .mat up to v7 (scipy.io; v7.3/HDF5 is refused with a hint).
+
+Time may be seconds, milliseconds (declared) or ISO 8601 timestamps.  Heavy libraries
+(pandas, pyarrow, scipy.io) are imported only when a file needs them.
+
+Every problem is one :class:`~heavecomp.errors.DataError` line naming the column (and
+the row, as a line number of the file, header = line 1 when there is one): ragged rows
+(a stray delimiter), two columns of the same name, a non-numeric cell, an unknown or
+wrong-kind unit, time that looks like milliseconds, a binary file of no known format.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import io
+import logging
+import re
+from pathlib import Path
+
+import numpy as np
+
+from heavecomp.errors import DataError, InputError
+
+log = logging.getLogger(__name__)
+
+#: contract name -> physical kind (docs/contracts/measured-run.md)
+KINDS = {"t": "time", "heave": "length", "stroke": "length", "pressure": "pressure", "wob": "force"}
+#: SI unit of each kind
+SI = {"time": "s", "length": "m", "pressure": "Pa", "force": "N"}
+P_ATM = 101325.0
+#: unit -> (kind, factor to SI, offset added after scaling [SI]); absolute pressures become gauge
+UNITS = {
+    "s": ("time", 1.0, 0.0), "ms": ("time", 1e-3, 0.0), "us": ("time", 1e-6, 0.0),
+    "min": ("time", 60.0, 0.0), "h": ("time", 3600.0, 0.0),
+    "m": ("length", 1.0, 0.0), "cm": ("length", 1e-2, 0.0), "mm": ("length", 1e-3, 0.0),
+    "in": ("length", 0.0254, 0.0), "ft": ("length", 0.3048, 0.0),
+    "pa": ("pressure", 1.0, 0.0), "kpa": ("pressure", 1e3, 0.0), "mpa": ("pressure", 1e6, 0.0),
+    "bar": ("pressure", 1e5, 0.0), "barg": ("pressure", 1e5, 0.0), "mbar": ("pressure", 1e2, 0.0),
+    "psi": ("pressure", 6894.757, 0.0), "psig": ("pressure", 6894.757, 0.0),
+    "bara": ("pressure", 1e5, -P_ATM), "psia": ("pressure", 6894.757, -P_ATM),
+    "pa_abs": ("pressure", 1.0, -P_ATM), "kpa_abs": ("pressure", 1e3, -P_ATM),
+    "n": ("force", 1.0, 0.0), "kn": ("force", 1e3, 0.0), "mn": ("force", 1e6, 0.0),
+    "t": ("force", 9810.0, 0.0), "tonnes": ("force", 9810.0, 0.0), "kip": ("force", 4448.22, 0.0),
+    "lbf": ("force", 4.44822, 0.0), "klbf": ("force", 4448.22, 0.0),
+}
+#: header spellings of the contract names (after normalisation: lower case, single spaces)
+ALIASES = {"t": ("t", "time", "timestamp", "datetime", "date time"), "heave": ("heave", "z_h", "zh"),
+           "stroke": ("stroke", "s"), "pressure": ("pressure", "p"), "wob": ("wob", "weight on bit")}
+#: largest file read (decompressed) [bytes]: a bigger one is refused before it fills the memory
+MAX_BYTES = 1 << 30
+DELIMITERS = (",", ";", "\t", "|")
+NA = {"", "nan", "na", "n/a", "null", "none", "-"}
+
+
+@dataclasses.dataclass
+class Series:
+    """Named float columns in SI units, with how they were read.
+
+    Attributes
+    ----------
+    columns : dict of str to ndarray
+        Contract names (``t`` [s] from the first sample's absolute value, ``heave`` [m], ...)
+        for the columns found, plus every other numeric column under its header name (raw).
+    source : str
+        The file (shortened when very long).
+    measurement : dict
+        ``format``, ``delimiter``, ``decimal``, ``columns`` (contract -> source header),
+        ``units`` (contract -> unit as read), ``conversions`` (one string each).
+    warnings : list of str
+    rows : ndarray of int
+        Line number in the file of each sample (for messages).
+    """
+
+    columns: dict
+    source: str
+    measurement: dict
+    warnings: list
+    rows: np.ndarray
+
+    def __getitem__(self, name):
+        return self.columns[name]
+
+
+def short(path, limit=80) -> str:
+    """A path for a one-line message: long ones cut in the middle."""
+    s = str(path)
+    return s if len(s) <= limit else s[: limit // 2 - 2] + "..." + s[-(limit // 2 - 1):]
+
+
+def parse_mapping(text, option="--columns") -> dict:
+    """``"t=Time,heave=MRU_heave"`` -> ``{"t": "Time", "heave": "MRU_heave"}`` (one-line errors)."""
+    out = {}
+    if text is None:
+        return out
+    for part in str(text).split(","):
+        if not part.strip():
+            continue
+        if "=" not in part:
+            raise InputError(f"{option}: expected NAME=VALUE, got {part.strip()!r}")
+        k, v = (x.strip() for x in part.split("=", 1))
+        if not k or not v:
+            raise InputError(f"{option}: expected NAME=VALUE, got {part.strip()!r}")
+        out[k] = v
+    return out
+
+
+def check_spec(columns: dict | None, units: dict | None, where: str) -> tuple[dict, dict]:
+    """Validate a column mapping and units (``[measurement]`` or the command line).
+
+    Keys must be contract names; units must be known and of the contract name's kind.
+    ``where`` is ``"cli"`` (messages name ``--units t``) or a table name (``measurement.units.t``).
+    """
+    from heavecomp.errors import did_you_mean
+
+    columns, units = dict(columns or {}), dict(units or {})
+
+    def key(label, k):
+        return f"--{label} {k}" if where == "cli" else f"{where}.{label}.{k}"
+
+    for label, table in (("columns", columns), ("units", units)):
+        for k, v in table.items():
+            if k not in KINDS:
+                raise InputError(f"{key(label, k)}: not a contract column{did_you_mean(k, KINDS)}; "
+                                 f"known: {', '.join(KINDS)}")
+            if not isinstance(v, str) or not v.strip():
+                raise InputError(f"{key(label, k)}: expected a non-empty string, got {v!r}")
+    for k, u in units.items():
+        spec = UNITS.get(u.strip().lower())
+        if spec is None:
+            ok = [x for x, s in UNITS.items() if s[0] == KINDS[k]]
+            raise InputError(f"{key('units', k)}: unknown unit {u!r}{did_you_mean(u.lower(), ok)}; "
+                             f"{KINDS[k]} units: {', '.join(ok)}")
+        if spec[0] != KINDS[k]:
+            raise InputError(f"{key('units', k)}: {u!r} is a {spec[0]} unit, '{k}' is a {KINDS[k]}")
+    return columns, units
+
+
+# ---------------------------------------------------------------- raw bytes -> table
+def _read_bytes(path: Path, src: str) -> bytes:
+    try:
+        if not path.is_file():
+            raise DataError(f"{src}: file not found" if not path.exists() else f"{src}: not a file")
+        with path.open("rb") as fh:
+            data = fh.read(MAX_BYTES + 1)
+    except OSError as exc:
+        raise DataError(f"{src}: cannot read ({exc.strerror or type(exc).__name__})") from None
+    if len(data) > MAX_BYTES:
+        raise DataError(f"{src}: larger than {MAX_BYTES >> 20} MB; cut the log into parts")
+    return data
+
+
+def _inflate(dec, data: bytes, src: str) -> bytes:
+    """Run a streaming decompressor with a size cap; a truncated stream is an error."""
+    out = dec.decompress(data, MAX_BYTES + 1)
+    if len(out) > MAX_BYTES:
+        raise DataError(f"{src}: decompresses to more than {MAX_BYTES >> 20} MB")
+    if not dec.eof:
+        raise DataError(f"{src}: corrupt compressed file (truncated)")
+    return out
+
+
+def _decompress(data: bytes, src: str) -> tuple[bytes, str | None]:
+    """(decompressed bytes, method) for gzip / bzip2 / xz / zip content, else ``(data, None)``."""
+    import bz2
+    import lzma
+    import zipfile
+    import zlib
+
+    try:
+        if data[:2] == b"\x1f\x8b":
+            return _inflate(zlib.decompressobj(wbits=47), data, src), "gzip"
+        if data[:3] == b"BZh":
+            return _inflate(bz2.BZ2Decompressor(), data, src), "bzip2"
+        if data[:6] == b"\xfd7zXZ\x00":
+            return _inflate(lzma.LZMADecompressor(), data, src), "xz"
+        if data[:4] == b"PK\x03\x04":
+            with zipfile.ZipFile(io.BytesIO(data)) as zf:
+                names = [n for n in zf.namelist() if not n.endswith("/")]
+                if any(n.startswith("xl/") for n in names):
+                    raise DataError(f"{src}: an Excel workbook; export the sheet as CSV")
+                if len(names) != 1:
+                    raise DataError(f"{src}: zip archive with {len(names)} files; expected exactly one CSV")
+                if zf.getinfo(names[0]).file_size > MAX_BYTES:
+                    raise DataError(f"{src}: decompresses to more than {MAX_BYTES >> 20} MB")
+                return zf.read(names[0]), "zip"
+    except DataError:
+        raise
+    except (OSError, EOFError, ValueError, zipfile.BadZipFile, lzma.LZMAError, zlib.error) as exc:
+        raise DataError(f"{src}: corrupt compressed file ({type(exc).__name__})") from None
+    return data, None
+
+
+def _decode(data: bytes, src: str, warnings: list) -> str:
+    head = data[:65536]
+    if b"\x00" in head:
+        if head[:2] in (b"\xff\xfe", b"\xfe\xff"):
+            try:
+                text = data.decode("utf-16")
+            except UnicodeDecodeError:
+                text = ""
+            if text and sum(1 for c in text[:4096] if not (c.isprintable() or c in "\r\n\t")) < 0.01 * len(text[:4096]) \
+                    and text[:4096].isascii():
+                return text
+        raise DataError(f"{src}: binary file, not a recognised format (CSV text, gzip/bz2/xz/zip CSV, "
+                        "Parquet, MATLAB .mat)")
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        text = data.decode("latin-1")
+        ctrl = sum(1 for c in text[:65536] if ord(c) < 32 and c not in "\r\n\t")
+        if ctrl > 0.01 * min(len(text), 65536):
+            raise DataError(f"{src}: binary file, not a recognised format (CSV text, gzip/bz2/xz/zip CSV, "
+                            "Parquet, MATLAB .mat)") from None
+        warnings.append(f"not UTF-8 (byte {exc.start}); read as Latin-1")
+        return text
+
+
+def read_text(path) -> tuple[str, list]:
+    """Text of a plain or compressed (gzip/bz2/xz/zip) text file, for readers with their own layout.
+
+    Returns ``(text, warnings)``; a missing, unreadable, binary or corrupt file is a one-line
+    :class:`DataError` (never a ``UnicodeDecodeError``).
+    """
+    path = Path(path)
+    src = short(path)
+    warnings: list[str] = []
+    raw, _ = _decompress(_read_bytes(path, src), src)
+    return _decode(raw, src, warnings), warnings
+
+
+_NUM = re.compile(r"^[+-]?(\d+([.,]\d*)?|[.,]\d+)([eE][+-]?\d+)?$")
+
+
+def _is_number(cell: str) -> bool:
+    c = cell.strip().strip('"')
+    return bool(_NUM.match(c)) or c.lower() in ("nan", "inf", "-inf", "+inf")
+
+
+def _split(line: str, sep: str | None) -> list[str]:
+    return line.split() if sep is None else line.split(sep)
+
+
+def _sniff(lines: list[str]) -> tuple[str | None, str]:
+    """(delimiter or None for whitespace, decimal mark) from the first lines."""
+    sample = lines[:50]
+    best, best_n = None, 0
+    for sep in DELIMITERS:
+        counts = {ln.count(sep) for ln in sample}
+        if len(counts) == 1:
+            n = counts.pop()
+            if n > best_n:
+                best, best_n = sep, n
+    if best is None:
+        # whitespace separated (or one column)
+        counts = {len(ln.split()) for ln in sample[1:] or sample}
+        best = None if (len(counts) == 1 and counts.pop() > 1) else ","
+        if best == "," and not any("," in ln for ln in sample):
+            best = None
+    decimal = "."
+    if best != ",":
+        body = [c.strip() for ln in sample[1:] for c in _split(ln, best)]
+        commas = sum(1 for c in body if re.match(r"^[+-]?\d*,\d+([eE][+-]?\d+)?$", c))
+        dots = sum(1 for c in body if re.match(r"^[+-]?\d*\.\d+([eE][+-]?\d+)?$", c))
+        if commas > dots:
+            decimal = ","
+    return best, decimal
+
+
+_UNIT_RE = re.compile(r"^(.*?)\s*[\[(]\s*([^\])]*)\s*[\])]\s*$")
+
+
+def split_header(name: str) -> tuple[str, str | None]:
+    """``"Time [ms]"`` -> ``("time", "ms")``; ``"WOB_kN"`` -> ``("wob", "kN")``; ``"Heave"`` -> ``("heave", None)``."""
+    raw = " ".join(str(name).replace("\ufeff", "").split())
+    m = _UNIT_RE.match(raw)
+    base, unit = (m.group(1), m.group(2).strip()) if m else (raw, None)
+    base = base.strip().lower()
+    if unit is None:
+        for sep in ("_", " "):
+            if sep in base:
+                head, tail = base.rsplit(sep, 1)
+                if tail in UNITS and head:
+                    orig = raw.rsplit(sep, 1)[1]
+                    return head.strip(), orig
+    return base, (unit or None)
+
+
+def _text_table(text: str, src: str):
+    """Header names, raw string columns (one list per column), line numbers, delimiter, decimal."""
+    lines = text.splitlines()
+    idx = [i for i, ln in enumerate(lines) if ln.strip() and not ln.lstrip().startswith("#")]
+    if not idx:
+        raise DataError(f"{src}: empty file (no header, no data)")
+    content = [lines[i] for i in idx]
+    sep, decimal = _sniff(content)
+    first = [c.strip().strip('"') for c in _split(content[0], sep)]
+    has_header = not all(_is_number(c) for c in first if c)
+    if has_header:
+        header, body, body_idx = first, content[1:], idx[1:]
+    else:
+        header, body, body_idx = [str(i + 1) for i in range(len(first))], content, idx
+    n = len(header)
+    if sep is not None and '"' in text:  # quoted cells may hold the delimiter: let csv split them
+        import csv
+
+        cells = [next(csv.reader([ln], delimiter=sep)) for ln in body]
+    else:
+        cells = [_split(ln, sep) for ln in body]
+    for k, row in enumerate(cells):
+        if len(row) != n:
+            line = body_idx[k] + 1
+            extra = ("a stray delimiter or a decimal comma in a comma-separated file?" if len(row) > n
+                     else "a cell or delimiter missing?")
+            shown = repr(sep) if sep else "whitespace"
+            raise DataError(f"{src}: row {line} has {len(row)} fields, the header has {n} ({shown} separated; "
+                            f"{extra})")
+    cols = [[row[j] for row in cells] for j in range(n)]
+    return header, cols, np.asarray(body_idx, dtype=int) + 1, sep, decimal
+
+
+def _to_float(values, name, lines, src, decimal, required):
+    """Strings -> floats; NaN for empty / NA; other text: DataError naming ``name`` (quoted label) if
+    ``required``, else None (a text column carried along is dropped)."""
+    import pandas as pd
+
+    s = pd.Series(values, dtype="string").str.strip()
+    if decimal == ",":
+        s = s.str.replace(",", ".", regex=False)
+    num = pd.to_numeric(s, errors="coerce").to_numpy(dtype=float, na_value=np.nan)
+    bad = np.isnan(num) & ~s.str.lower().isin(NA).to_numpy(dtype=bool, na_value=True)
+    if bad.any():
+        k = int(np.flatnonzero(bad)[0])
+        cell = str(values[k]).strip()
+        if not required:
+            return None
+        hint = ""
+        if re.match(r"^[+-]?\d+,\d+$", cell):
+            hint = " (a decimal comma? use a ';' or tab delimiter, or a decimal point)"
+        elif cell.startswith("\ufeff"):
+            hint = " (a byte-order mark inside the file)"
+        raise DataError(f"{src}: column {name}, row {lines[k]}: not a number: {cell[:40]!r}{hint}")
+    return num
+
+
+def _time_from_strings(values, name, lines, src):
+    """ISO 8601 timestamps -> seconds from the first sample, or None if they are not timestamps."""
+    import pandas as pd
+
+    s = pd.Series(values, dtype="string").str.strip()
+    try:
+        ts = pd.to_datetime(s, format="ISO8601", errors="coerce", utc=True)
+    except (ValueError, TypeError):
+        return None
+    ok = ts.notna().to_numpy()
+    if ok.sum() < max(1, 0.5 * len(values)):
+        return None
+    if not ok.all():
+        k = int(np.flatnonzero(~ok)[0])
+        raise DataError(f"{src}: column '{name}', row {lines[k]}: not a timestamp: {str(values[k])[:40]!r}")
+    return (ts - ts.iloc[0]).dt.total_seconds().to_numpy(dtype=float)
+
+
+def _parquet_table(data: bytes, src: str):
+    try:
+        import pyarrow.parquet as pq
+    except ImportError:  # pragma: no cover - pyarrow is a dependency
+        raise DataError(f"{src}: Parquet needs pyarrow (pip install pyarrow)") from None
+    try:
+        table = pq.read_table(io.BytesIO(data))
+    except Exception as exc:  # noqa: BLE001 - pyarrow raises several types for a bad file
+        raise DataError(f"{src}: unreadable Parquet file ({type(exc).__name__})") from None
+    header = list(table.column_names)
+    cols = []
+    for j, name in enumerate(header):
+        col = table.column(j)
+        import pyarrow as pa
+
+        if pa.types.is_timestamp(col.type) or pa.types.is_date(col.type):
+            cols.append(np.asarray(col.cast(pa.timestamp("ns")).to_numpy(zero_copy_only=False)).astype("datetime64[ns]"))
+        elif pa.types.is_integer(col.type) or pa.types.is_floating(col.type) or pa.types.is_boolean(col.type):
+            cols.append(np.asarray(col.to_numpy(zero_copy_only=False), dtype=float))
+        else:
+            cols.append([None if v is None else str(v) for v in col.to_pylist()])
+    return header, cols
+
+
+def _mat_table(data: bytes, src: str):
+    if data[:4] == b"\x89HDF" or data[512:516] == b"\x89HDF":
+        raise DataError(f"{src}: MATLAB v7.3 (HDF5) file; save it with save(..., '-v7') or export CSV")
+    import scipy.io
+
+    try:
+        mat = scipy.io.loadmat(io.BytesIO(data), squeeze_me=False)
+    except Exception as exc:  # noqa: BLE001 - scipy raises several types for a bad file
+        raise DataError(f"{src}: unreadable MATLAB file ({type(exc).__name__})") from None
+    vecs = {}
+    for k, v in mat.items():
+        if k.startswith("__") or not isinstance(v, np.ndarray) or v.dtype.kind not in "iufb":
+            continue
+        if v.ndim == 2 and 1 in v.shape and v.size > 1:
+            vecs[k] = np.asarray(v, dtype=float).ravel()
+    if not vecs:
+        raise DataError(f"{src}: MATLAB file without any numeric vector variable")
+    lengths = [v.size for v in vecs.values()]
+    n = max(set(lengths), key=lengths.count)
+    header = [k for k, v in vecs.items() if v.size == n]
+    return header, [vecs[k] for k in header], {k: v for k, v in mat.items() if not k.startswith("__")}
+
+
+# ---------------------------------------------------------------- table -> Series
+def read_series(path, required=("t",), *, optional=(), columns=None, units=None, what="measured series") -> Series:
+    """Read a measured series from a file in any supported format (see the module docstring).
+
+    Parameters
+    ----------
+    path : str or Path
+    required : tuple of str
+        Contract names that must be present (``t``, ``heave``, ``stroke``, ``pressure``, ``wob``).
+    optional : tuple of str
+        Contract names used when present.
+    columns : dict, optional
+        Contract name -> header of the source column (``--columns`` / ``[measurement] columns``).
+    units : dict, optional
+        Contract name -> unit of the source column (``--units`` / ``[measurement] units``);
+        a unit in the header (``Time [ms]``) counts as declared too.
+    what : str
+        What the file is, for messages.
+
+    Returns
+    -------
+    Series
+        ``t`` in s as read (timestamps: from the first sample), other contract columns in SI units.
+
+    Raises
+    ------
+    DataError
+        One line naming the column (and row) for every problem.
+    """
+    path = Path(path)
+    src = short(path)
+    columns, units = check_spec(columns, units, "measurement")
+    warnings: list[str] = []
+    data = _read_bytes(path, src)
+    info = {"format": "csv"}
+    scalars = {}
+    if data[:4] == b"PAR1":
+        header, cols = _parquet_table(data, src)
+        lines = np.arange(len(cols[0]) if cols else 0) + 1
+        info["format"] = "parquet"
+    elif data[:19] == b"MATLAB 5.0 MAT-file" or data[:4] == b"\x89HDF" or path.suffix.lower() == ".mat":
+        header, cols, scalars = _mat_table(data, src)
+        lines = np.arange(cols[0].size) + 1
+        info["format"] = "mat"
+    else:
+        raw, comp = _decompress(data, src)
+        if comp:
+            info["compression"] = comp
+            if raw[:4] == b"PAR1":
+                header, cols = _parquet_table(raw, src)
+                lines = np.arange(len(cols[0]) if cols else 0) + 1
+                info["format"] = "parquet"
+        if info["format"] == "csv":
+            text = _decode(raw, src, warnings)
+            header, cols, lines, sep, decimal = _text_table(text, src)
+            info.update(delimiter="whitespace" if sep is None else sep, decimal=decimal)
+    decimal = info.get("decimal", ".")
+    # duplicate names
+    seen = {}
+    for j, h in enumerate(header):
+        key = str(h).strip()
+        if key in seen:
+            raise DataError(f"{src}: column '{key}' appears twice in the header (columns {seen[key] + 1} and {j + 1}); "
+                            "rename one")
+        seen[key] = j
+    # which source column is which contract column
+    norm = [split_header(h) for h in header]
+    chosen: dict[str, int] = {}
+    for name in tuple(required) + tuple(optional):
+        if name in columns:
+            want = columns[name]
+            hits = [j for j, h in enumerate(header) if str(h).strip() == want]
+            if not hits:
+                wb, _ = split_header(want)
+                hits = [j for j, (b, _u) in enumerate(norm) if b == wb]
+            if not hits:
+                from heavecomp.errors import did_you_mean
+
+                raise DataError(f"{src}: column '{name}' mapped to {want!r}: no such column"
+                                f"{did_you_mean(want, [str(h) for h in header])}; header: {_hdr(header)}")
+            if len(hits) > 1:
+                raise DataError(f"{src}: column '{name}' mapped to {want!r} matches columns "
+                                f"{', '.join(repr(str(header[j])) for j in hits)}; name one exactly")
+        else:
+            hits = [j for j, (b, _u) in enumerate(norm) if b in ALIASES[name] and j not in chosen.values()]
+            if len(hits) > 1:
+                raise DataError(f"{src}: columns {', '.join(repr(str(header[j])) for j in hits)} all look like "
+                                f"'{name}'; choose one with --columns {name}=NAME")
+        if not hits:
+            if name in required:
+                hint = ""
+                if len(header) == 1:
+                    hint = " (only one column found: delimiter not recognised?)"
+                raise DataError(f"{src}: missing column '{name}' (header: {_hdr(header)}); map it with "
+                                f"--columns {name}=NAME or [measurement] columns{hint}")
+            continue
+        chosen[name] = hits[0]
+    out: dict[str, np.ndarray] = {}
+    used_units: dict[str, str] = {}
+    conversions: list[str] = []
+    for name, j in chosen.items():
+        vals = cols[j]
+        head_unit = norm[j][1]
+        decl = units.get(name)
+        if decl and head_unit and UNITS.get(head_unit.lower(), (None,))[0] == KINDS[name] \
+                and UNITS[head_unit.lower()][1:] != UNITS[decl.lower()][1:]:
+            raise DataError(f"{src}: column '{name}' ({header[j]!r}): the header says {head_unit}, "
+                            f"the declared unit is {decl}; drop one")
+        unit = decl or head_unit
+        if unit is not None and unit.lower() not in UNITS:
+            raise DataError(f"{src}: column '{name}' ({header[j]!r}): unknown unit {unit!r} in the header; "
+                            f"declare it with --units {name}=UNIT")
+        if unit is not None and UNITS[unit.lower()][0] != KINDS[name]:
+            raise DataError(f"{src}: column '{name}' ({header[j]!r}): unit {unit!r} is a "
+                            f"{UNITS[unit.lower()][0]} unit, '{name}' is a {KINDS[name]}")
+        if isinstance(vals, np.ndarray) and vals.dtype.kind == "M":
+            ns = vals.astype("int64")
+            arr = (ns - ns[0]) * 1e-9
+            if name != "t":
+                raise DataError(f"{src}: column '{name}': timestamps, expected numbers")
+            conversions.append("t: timestamps -> s from the first sample")
+            unit = "timestamp"
+        elif isinstance(vals, np.ndarray):
+            arr = np.asarray(vals, dtype=float)
+        else:
+            arr = None
+            if name == "t" and not all(_is_number(str(v)) or str(v).strip().lower() in NA for v in vals[:20]):
+                arr = _time_from_strings(vals, header[j], lines, src)
+                if arr is not None:
+                    conversions.append("t: ISO 8601 timestamps -> s from the first sample")
+                    unit = "timestamp"
+            if arr is None:
+                label = f"'{name}'" if str(header[j]) == name else f"'{name}' ({str(header[j])!r})"
+                arr = _to_float(vals, label, lines, src, decimal, True)
+        if unit is not None and unit != "timestamp":
+            kind, factor, offset = UNITS[unit.lower()]
+            if factor != 1.0 or offset != 0.0:
+                arr = arr * factor + offset
+                conversions.append(f"{name}: {unit} -> {SI[kind]} (x {factor:g}"
+                                   + (f", {offset:+g} {SI[kind]} absolute -> gauge" if offset else "") + ")")
+        used_units[name] = unit if unit is not None else f"{SI[KINDS[name]]} (assumed)"
+        out[name] = arr
+    # other columns carried along (numeric only)
+    for j, h in enumerate(header):
+        if j in chosen.values() or str(h) in out:
+            continue
+        vals = cols[j]
+        if isinstance(vals, np.ndarray):
+            arr = np.asarray(vals, dtype=float) if vals.dtype.kind != "M" else None
+        else:
+            arr = _to_float(vals, repr(str(h)), lines, src, decimal, False)
+        if arr is not None:
+            out[str(h)] = arr
+    info["columns"] = {name: str(header[j]) for name, j in chosen.items()}
+    info["units"] = used_units
+    info["conversions"] = conversions
+    if scalars:
+        info["mat_scalars"] = sorted(k for k, v in scalars.items()
+                                     if isinstance(v, np.ndarray) and v.size == 1 and v.dtype.kind in "iuf")
+    if warnings:
+        for w in warnings:
+            log.warning("%s: %s", src, w)
+    if "t" in out:
+        _check_time_unit(out["t"], "t" in units or (norm[chosen["t"]][1] is not None)
+                         or used_units["t"] == "timestamp", src, header[chosen["t"]])
+    return Series(columns=out, source=src, measurement=info, warnings=warnings, rows=np.asarray(lines))
+
+
+def _hdr(header) -> str:
+    s = ", ".join(str(h) for h in header)
+    return s if len(s) < 200 else s[:200] + "..."
+
+
+#: largest plausible sampling interval of undeclared time [s] (waves of 5-20 s need > 1 Hz)
+MAX_DT_S = 1.0
+#: longest plausible log of undeclared time [s]
+MAX_SPAN_S = 2 * 86400.0
+
+
+def _check_time_unit(t, declared: bool, src: str, header) -> None:
+    """Undeclared time that looks like milliseconds (interval > 1 s or span > 2 days) is an error."""
+    if declared:
+        return
+    d = np.diff(t[np.isfinite(t)])
+    d = d[d > 0]
+    if d.size == 0:
+        return
+    dt = float(np.median(d))
+    span = float(np.nanmax(t) - np.nanmin(t))
+    if dt > MAX_DT_S or span > MAX_SPAN_S:
+        raise DataError(f"{src}: column 't' ({header!r}): median interval {dt:.4g} and span {span:.4g} in "
+                        f"seconds is implausible for a heave log — time in milliseconds? declare it with "
+                        "--units t=ms (or name the column 'Time [ms]')")
+
+
+def gaps(t, max_gap: float, factor: float = 3.0):
+    """Indices i where ``t[i+1] - t[i]`` exceeds both ``factor`` median intervals and ``max_gap`` [s]."""
+    d = np.diff(t)
+    if d.size == 0:
+        return np.array([], dtype=int)
+    lim = max(max_gap, factor * float(np.median(d)))
+    return np.flatnonzero(d > lim)
+
+
+__all__ = ["Series", "read_series", "read_text", "parse_mapping", "check_spec", "split_header", "UNITS", "KINDS", "short",
+           "gaps"]
