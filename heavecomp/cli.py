@@ -111,9 +111,6 @@ def main(argv: list[str] | None = None) -> int:
 
     parser, modules = build_parser()
     _Parser.argv = list(sys.argv[1:] if argv is None else argv)
-    from heavecomp.report import provenance
-
-    provenance.COMMAND = ["heavecomp", *_Parser.argv]
     args, extra = parser.parse_known_args(argv)
     if not args.command:
         parser.print_help()
@@ -121,6 +118,9 @@ def main(argv: list[str] | None = None) -> int:
     if extra:
         print(f"heavecomp {args.command}: error: {_unknown_arguments(parser, args, extra)}", file=sys.stderr)
         return 2
+    from heavecomp.report import provenance
+
+    provenance.COMMAND = ["heavecomp", *_Parser.argv]
     try:
         _check_outputs(args)
         if getattr(args, "quiet", False):
