@@ -97,7 +97,9 @@ UNITS: dict[str, str] = {
 }
 
 #: key patterns -> unit (Fourier coefficients of a position-dependent force: f_cos1, fc_sin2, ...)
-PATTERN_UNITS = [(re.compile(r"^fc?_(cos|sin)\d+$"), "N")]
+PATTERN_UNITS = [(re.compile(r"^fc?_(cos|sin)\d+$"), "N"),
+                 # a campaign's histogram columns: samples (dev_*) or cycle peaks (peak_*) per bin
+                 (re.compile(r"^(dev|peak)_(\d+|under|over)$"), "count")]
 
 #: statistics that carry the unit of the channel named among their parents (gap.channels.stroke.rms = m)
 _CHANNEL_STATS = ("rms", "rms_before", "rms_after", "rms_validate", "noise_floor")
@@ -120,9 +122,12 @@ def _param_units() -> dict[str, str]:
     also merges the CMC's channel units into :data:`UNITS` (imported here, not at start-up)."""
     import dataclasses
 
+    from heavecomp.campaign.tables import UNITS as RUNS_CSV_UNITS
     from heavecomp.simulate.core import CHANNEL_UNITS
 
     UNITS.update(CHANNEL_UNITS)
+    for k, u in RUNS_CSV_UNITS.items():  # the campaign's runs.csv columns (said once, in campaign/tables.py)
+        UNITS.setdefault(k, u)
     out: dict[str, str] = {}
     try:
         from heavecomp.params.cmc import TABLES
