@@ -53,7 +53,7 @@ def main(argv=None) -> int:
                  + " Scatter diagram and tolerance are illustrative (platform heave terms), not site data.\n")
     from heavecomp.report.provenance import finish
 
-    finish(args.out, json_files=("statistics.json",), params_file="campaign.toml")
+    finish(args.out, json_files=("statistics.json",), params_file="campaign.toml", csv_files=("runs.csv",))
     return 0
 
 

@@ -186,3 +186,20 @@ def test_json_results_rounded_above_last_bit_noise():
     a, b = 97202.81366735144, 97202.8136673514  # the same WOB mean from two machines
     assert a != b and round_floats({"x": [a]}) == round_floats({"x": [b]})
     assert round_floats(0.1 + 0.2) == 0.3 and round_floats(3) == 3 and round_floats(True) is True
+
+
+def test_campaign_runs_csv_has_a_unit_per_column(tmp_path):
+    import shutil
+    from pathlib import Path
+
+    import pandas as pd
+
+    from heavecomp.report.provenance import write_units_csv
+
+    src = Path(__file__).resolve().parents[1] / "reports" / "campaign_default" / "runs.csv"
+    shutil.copy(src, tmp_path / "runs.csv")
+    head = pd.read_csv(tmp_path / "runs.csv", nrows=1).columns
+    write_units_csv(tmp_path / "runs.csv", list(head))
+    u = pd.read_csv(tmp_path / "runs.units.csv", index_col="column", keep_default_na=False)["unit"]
+    assert list(u.index) == list(head)
+    assert u["wob_std"] == "N" and u["n_stick"] == "count" and u["dev_000"] == "count" and u["hs"] == "m"

@@ -32,6 +32,7 @@ from pathlib import Path
 
 from heavecomp.errors import InputError
 from heavecomp.simulate.layout import source_hash
+from heavecomp.io.series import short
 
 log = logging.getLogger(__name__)
 
@@ -108,7 +109,6 @@ def finished_ids(path: Path) -> tuple[set, list | None]:
 def _table_text(path: Path) -> str:
     """Text of ``runs.csv`` (heavecomp writes plain UTF-8); a compressed, binary or non-UTF-8 file is a
     one-line InputError, not a traceback."""
-    from heavecomp.io.series import short
 
     try:
         raw = path.read_bytes()

@@ -1,8 +1,7 @@
 """Controller-design experiments: compare controllers, sweep horizon/weights/actuator, robustness.
 
-Compute functions return plain dicts of metrics (and results for figures);
-figure functions take them and return matplotlib figures (save with
-:func:`heavecomp.report.figures.save`).  Used by ``scenarios/controller_design.py``.
+Compute functions return plain dicts of metrics (and results for figures); the figures are
+drawn by :mod:`heavecomp.report.controllers`.  Used by ``scenarios/controller_design.py``.
 """
 
 from __future__ import annotations

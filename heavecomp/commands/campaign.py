@@ -33,7 +33,8 @@ def run(args) -> int:
                               progress=lambda done, total: bar(done / total if total else 1.0))
     from heavecomp.report.provenance import finish
 
-    finish(info.out_dir, json_files=("metrics.json", "statistics.json"), params_file="campaign.toml")
+    finish(info.out_dir, json_files=("metrics.json", "statistics.json"), params_file="campaign.toml",
+           csv_files=("runs.csv",))
     print(f"{info.n_simulated} runs simulated, {info.n_skipped} resumed, {info.wall_time:.1f} s "
           f"({info.executor}, {info.workers} workers) -> {info.table_path}")
     if st is not None:

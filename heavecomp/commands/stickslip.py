@@ -64,9 +64,13 @@ def run(args) -> int:
         print(f"simulation {args.duration:g} s: breakaway {st['t_first_breakaway']:.3f} s, sticks {int(st['n_stick'])}, "
               f"first stick {st['t_first_stick']:.3f} s, restart {st['t_second_breakaway']:.3f} s")
         if out:
-            cols = [c for c in PS.CHANNELS]
-            np.savetxt(out / "timeseries.csv", np.column_stack([r[c] for c in cols]), delimiter=",",
-                       header=",".join(cols), comments="", fmt="%.10g")
+            from heavecomp.commands._progress import Progress
+            from heavecomp.simulate.core import write_csv
+
+            cols = list(PS.CHANNELS)
+            data = np.column_stack([r[c] for c in cols])
+            write_csv(out / "timeseries.csv", data, cols,
+                      progress=Progress("writing timeseries.csv") if data.shape[0] > 200_000 else None)
     if args.map is not None:
         n = args.map
         g = SS.grid_map(p, "viscous_coefficient", np.geomspace(8.0, 250.0, n), "friction_drop",

@@ -27,6 +27,7 @@ from heavecomp.controllers.model import FRAMES
 from heavecomp.errors import InputError, did_you_mean
 from heavecomp.params.cmc import active
 from heavecomp.params.core import q
+from heavecomp.params.core import check_value
 
 #: ControllerConfig fields that take one of a few names
 CHOICES = {"nlp_solver": ("sqp", "ipopt"), "model_frame": FRAMES}
@@ -140,7 +141,6 @@ class ControllerConfig:
     model_frame: str = "earth"
 
     def __post_init__(self):
-        from heavecomp.params.core import check_value
 
         for f in dataclasses.fields(self):
             if "kind" in f.metadata:

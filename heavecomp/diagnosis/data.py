@@ -28,6 +28,8 @@ import numpy as np
 
 from heavecomp.errors import DataError
 from heavecomp.simulate.excitation import HeaveSamples
+from heavecomp.io.series import MAX_DT_S, gaps
+from heavecomp.io.series import read_series
 
 P_ATM = 101325.0  #: atmospheric pressure [Pa] (cmc-reference.md)
 
@@ -95,7 +97,6 @@ def load_run(path, params=None, *, columns=None, units=None) -> MeasuredRun:
     DataError
         One line naming the column (and row) for every problem.
     """
-    from heavecomp.io.series import read_series
 
     spec = getattr(params, "extra", {}).get("measurement") if params is not None else None
     cols = {**(spec.columns if spec else {}), **(columns or {})}
@@ -115,7 +116,6 @@ def check_run(t, columns: dict, *, params=None, source="<array>", rows=None) -> 
     ``rows`` (optional) gives the file line of each sample, for messages (default: header on
     line 1, one sample per line).
     """
-    from heavecomp.io.series import MAX_DT_S, gaps
 
     t = np.asarray(t, dtype=float)
     columns = {k: np.asarray(v, dtype=float) for k, v in columns.items()}
@@ -158,8 +158,8 @@ def check_run(t, columns: dict, *, params=None, source="<array>", rows=None) -> 
     z = columns["heave"]
     miss = ~np.isfinite(z)
     if miss.any():
-        gaps = _runs(miss)
-        for a, b in gaps:
+        holes = _runs(miss)
+        for a, b in holes:
             lo = t[max(a - 1, 0)]
             hi = t[min(b, t.size - 1)]
             if hi - lo > MAX_GAP:

@@ -37,6 +37,7 @@ import numpy as np
 from heavecomp.errors import DataError, ParameterError
 from heavecomp.identification.inverse import least_squares
 from heavecomp.signals import differentiate
+from heavecomp.io.series import read_text
 
 log = logging.getLogger(__name__)
 
@@ -72,7 +73,6 @@ def load_seal_csv(path) -> SealRecord:
         Missing file, wrong number of columns, non-numeric or non-finite cells,
         or a time column (``time [ms]``) that is not strictly increasing.
     """
-    from heavecomp.io.series import read_text
 
     path = Path(path)
     try:

@@ -35,6 +35,7 @@ from pathlib import Path
 import numpy as np
 
 from heavecomp.errors import DataError, InputError
+from heavecomp.errors import did_you_mean
 
 log = logging.getLogger(__name__)
 
@@ -125,7 +126,6 @@ def check_spec(columns: dict | None, units: dict | None, where: str) -> tuple[di
     Keys must be contract names; units must be known and of the contract name's kind.
     ``where`` is ``"cli"`` (messages name ``--units t``) or a table name (``measurement.units.t``).
     """
-    from heavecomp.errors import did_you_mean
 
     columns, units = dict(columns or {}), dict(units or {})
 
@@ -498,7 +498,6 @@ def read_series(path, required=("t",), *, optional=(), columns=None, units=None,
                 wb, _ = split_header(want)
                 hits = [j for j, (b, _u) in enumerate(norm) if b == wb]
             if not hits:
-                from heavecomp.errors import did_you_mean
 
                 raise DataError(f"{src}: column '{name}' mapped to {want!r}: no such column"
                                 f"{did_you_mean(want, [str(h) for h in header])}; header: {_hdr(header)}")

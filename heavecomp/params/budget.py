@@ -23,6 +23,7 @@ import math
 from typing import Callable
 
 from heavecomp.errors import ParameterError
+from heavecomp.errors import InputError
 
 MAX_STEPS = 200_000_000  #: largest number of RK4 steps of one run
 MAX_BYTES = 4 * 2 ** 30  #: largest memory for heave samples + output rows [bytes]
@@ -37,7 +38,6 @@ def _gb(n: float) -> str:
 def step_drivers(params, rate_fn: Callable, *, top: int = 3) -> list[str]:
     """``["friction.stribeck_velocity = 0.0001 m/s", ...]``: the keys the plant rate ``rate_fn(params)`` [1/s]
     depends on most (elasticity d ln rate / d ln value over a 10 % change, largest first)."""
-    from heavecomp.errors import InputError
 
     r0 = rate_fn(params)
     found = []

@@ -25,10 +25,9 @@ from pathlib import Path
 from typing import Any, Mapping
 
 from heavecomp.errors import ParameterError, did_you_mean
-from heavecomp.params.core import choice, dump_toml, from_table, q, read_text, text, to_table, toml_error_message
+from heavecomp.params.core import G, P_ATM, choice, dump_toml, from_table, q, read_text, text, to_table, toml_error_message
+from heavecomp.params import measurement, plausibility
 
-G = 9.81  #: gravity [m/s^2] (contract value)
-P_ATM = 101325.0  #: atmospheric pressure [Pa] (contract value)
 
 FRICTION_MODELS = ("none", "stribeck", "rotating_eq6", "rotating_eq7")
 V_T_MIN = 1e-3  #: smallest non-zero friction.tangential_velocity [m/s]
@@ -215,9 +214,8 @@ class CMCParams:
             raise ParameterError(
                 f"operating_point.wob_setpoint = {self.operating_point.wob_setpoint:g} N must be below the "
                 f"suspended weight (M_c + m_b) g = {g_load:g} N (the cylinder pressure would be <= 0)")
-        from heavecomp.params.plausibility import check
 
-        check(self)  # cross-key plausibility: unit slips inside each key's bounds
+        plausibility.check(self)  # cross-key plausibility: unit slips inside each key's bounds
 
     # ---- derived quantities (cmc-reference.md) ---------------------------------
     @property
@@ -357,9 +355,8 @@ def active(params: CMCParams) -> Active:
 
 
 def _measurement(table):
-    from heavecomp.params.measurement import from_table as _from
 
-    return _from(table)
+    return measurement.from_table(table)
 
 
 OPTIONAL_EXTRA["measurement"] = _measurement  # [measurement]: columns/units of measured series

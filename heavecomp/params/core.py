@@ -17,6 +17,9 @@ from typing import Any, Mapping
 
 from heavecomp.errors import ParameterError, did_you_mean
 
+G = 9.81  #: gravity [m/s^2] (contract value)
+P_ATM = 101325.0  #: atmospheric pressure [Pa] (contract value)
+
 _MISSING = dataclasses.MISSING
 
 

@@ -16,6 +16,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from heavecomp.errors import ParameterError, did_you_mean
+from heavecomp.io.series import check_spec
+from heavecomp.errors import InputError
 
 KEYS = ("columns", "units")
 
@@ -30,8 +32,6 @@ class Measurement:
 
 def from_table(table) -> Measurement:
     """Validate a ``[measurement]`` table; one-line ParameterError naming the key."""
-    from heavecomp.errors import InputError
-    from heavecomp.io.series import check_spec
 
     for k in table:
         if k not in KEYS:

@@ -44,6 +44,7 @@ import math
 import numpy as np
 
 from heavecomp.errors import ParameterError
+from heavecomp.params.core import G
 
 #: reference stroke velocity for the viscous-friction check [m/s] (peak stroke velocity of a 5 m, 15 s heave ~ 1 m/s)
 V_REF = 1.0
@@ -63,8 +64,6 @@ def _g(x: float) -> str:
 
 def check(p) -> None:
     """Raise :class:`ParameterError` for the first implausible relation between keys of ``p`` (a CMCParams)."""
-    from heavecomp.params.cmc import G
-
     c, f, ds, fo, op = p.compensator, p.friction, p.drill_string, p.formation, p.operating_point
     mb_g = ds.lower_mass * G
     if op.wob_setpoint >= mb_g:

@@ -26,6 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from heavecomp.errors import DataError
+from heavecomp.io.series import short
 
 #: Published inverse-model parameters of the EMPS benchmark (Janot et al. 2019), SI.
 EMPS_PUBLISHED = {"mass": 95.1089, "viscous": 203.5034, "coulomb": 20.3935, "offset": -3.1648}
@@ -140,7 +141,6 @@ def load_emps(path) -> AxisRecord:
     """
     import scipy.io
 
-    from heavecomp.io.series import short
 
     path = Path(path)
     try:

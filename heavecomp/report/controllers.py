@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
-from heavecomp.report.figures import _plt
+
 from heavecomp.report.figures import REGIME_LABELS, _plt
 
 

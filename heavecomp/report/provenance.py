@@ -29,6 +29,7 @@ from heavecomp.params import dumps
 from heavecomp import __version__
 from heavecomp.effects import CANDIDATES
 from heavecomp.params.cmc import TABLES
+from heavecomp.campaign.tables import UNITS as RUNS_CSV_UNITS
 from heavecomp.simulate.core import CHANNEL_UNITS
 
 log = logging.getLogger(__name__)
@@ -102,7 +103,9 @@ UNITS: dict[str, str] = {
 }
 
 #: key patterns -> unit (Fourier coefficients of a position-dependent force: f_cos1, fc_sin2, ...)
-PATTERN_UNITS = [(re.compile(r"^fc?_(cos|sin)\d+$"), "N")]
+PATTERN_UNITS = [(re.compile(r"^fc?_(cos|sin)\d+$"), "N"),
+                 # a campaign's histogram columns: samples (dev_*) or cycle peaks (peak_*) per bin
+                 (re.compile(r"^(dev|peak)_(\d+|under|over)$"), "count")]
 
 #: statistics that carry the unit of the channel named among their parents (gap.channels.stroke.rms = m)
 _CHANNEL_STATS = ("rms", "rms_before", "rms_after", "rms_validate", "noise_floor")
@@ -127,6 +130,8 @@ def _param_units() -> dict[str, str]:
 
 
     UNITS.update(CHANNEL_UNITS)
+    for k, u in RUNS_CSV_UNITS.items():  # the campaign's runs.csv columns (said once, in campaign/tables.py)
+        UNITS.setdefault(k, u)
     out: dict[str, str] = {}
     try:
 

@@ -16,6 +16,8 @@ from pathlib import Path
 import numpy as np
 
 from heavecomp.errors import DataError, ParameterError
+from heavecomp.io.series import gaps
+from heavecomp.io.series import read_series, short
 
 G = 9.81
 log = logging.getLogger(__name__)
@@ -182,7 +184,6 @@ def read_heave_csv(path, measurement=None) -> tuple[np.ndarray, np.ndarray]:
     -------
     (t, z) : ndarray [s], ndarray [m]
     """
-    from heavecomp.io.series import read_series, short
 
     path = Path(path)
     try:
@@ -219,7 +220,6 @@ def _check_series(t, z, src, rows=None):
     with the advice "reduce --dt"), or a hole longer than ``max(MAX_HEAVE_GAP, 3 median intervals)``
     (a spline would invent heave there).
     """
-    from heavecomp.io.series import gaps
 
     line = (lambda i: int(rows[i])) if rows is not None else (lambda i: f"{int(i) + 1} (data)")
     if t.size < 4:
