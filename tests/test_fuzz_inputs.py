@@ -38,12 +38,11 @@ from unittest import mock
 import numpy as np
 import pytest
 
-hypothesis = pytest.importorskip("hypothesis")
-from hypothesis import HealthCheck, given, settings  # noqa: E402
-from hypothesis import strategies as st  # noqa: E402
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
-from heavecomp.cli import main  # noqa: E402
-from heavecomp.params import dumps, paper_a  # noqa: E402
+from heavecomp.cli import main
+from heavecomp.params import dumps, paper_a
 
 P = paper_a()
 W0 = P.operating_point.wob_setpoint

@@ -234,11 +234,20 @@ def _check_series(t, z, src, rows=None):
                         f"({t[back[0]]:g} -> {t[back[0] + 1]:g} s; duplicate or backwards)")
     if np.max(np.abs(z - z[0])) > 50:
         raise DataError(f"{src}: column 'heave': excursions over 50 m — is it in metres?")
+    hole = gaps(t, MAX_HEAVE_GAP)
+    if hole.size:
+        i = hole[0]
+        raise DataError(f"{src}: column 't', row {line(i + 1)}: {t[i + 1] - t[i]:.3g} s without heave samples "
+                        f"({t[i]:g} -> {t[i + 1]:g} s); holes up to {MAX_HEAVE_GAP:g} s (or 3 sampling "
+                        "intervals) are bridged — fill the record or cut it there")
     if z.size >= 5:
         # a spike: one sample far off the line through its neighbours, beyond what a sea (and the noise) makes
-        dev = z[1:-1] - 0.5 * (z[:-2] + z[2:])
+        d = np.diff(t)
+        dt = float(np.median(d))
+        w = d[:-1] / (d[:-1] + d[1:])  # the line through the neighbours, at the sample's own time
+        dev = z[1:-1] - ((1.0 - w) * z[:-2] + w * z[2:])
+        dev[(d[:-1] > GAP_FACTOR * dt) | (d[1:] > GAP_FACTOR * dt)] = 0.0  # beside a bridged hole: no line
         noise = 1.4826 * float(np.median(np.abs(dev - np.median(dev))))
-        dt = float(np.median(np.diff(t)))
         limit = max(SPIKE_MIN, G * dt * dt, SPIKE_NOISE * noise)
         bad = np.flatnonzero(np.abs(dev) > limit)
         if bad.size:
@@ -246,12 +255,6 @@ def _check_series(t, z, src, rows=None):
             i = int(first[np.argmax(np.abs(dev[first]))]) + 1
             raise DataError(f"{src}: column 'heave', row {line(i)}: a spike of {dev[i - 1]:+.3g} m off its neighbours "
                             f"(more than {limit:.3g} m: a glitch or a dropout value?); remove or fill that sample")
-    hole = gaps(t, MAX_HEAVE_GAP)
-    if hole.size:
-        i = hole[0]
-        raise DataError(f"{src}: column 't', row {line(i + 1)}: {t[i + 1] - t[i]:.3g} s without heave samples "
-                        f"({t[i]:g} -> {t[i + 1]:g} s); holes up to {MAX_HEAVE_GAP:g} s (or 3 sampling "
-                        "intervals) are bridged — fill the record or cut it there")
 
 
 def _bridge(t, z, src):
