@@ -38,8 +38,8 @@ def _alive(pid: int) -> bool:
 @pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGKILL])
 def test_killed_simulate_leaves_no_child(paper_a_toml, tmp_path, sig):
     env = {k: v for k, v in os.environ.items() if k != "HEAVECOMP_NO_FORK"}
-    # a run long enough (weeks of sea) to still be simulating when it is killed
-    proc = subprocess.Popen([sys.executable, "-m", "heavecomp", "simulate", str(paper_a_toml), "--duration", "3e6",
+    # a run long enough (a day of sea, inside the run-size budget) to still be simulating when killed
+    proc = subprocess.Popen([sys.executable, "-m", "heavecomp", "simulate", str(paper_a_toml), "--duration", "86400",
                              "--out", str(tmp_path / "run"), "--quiet"], env=env,
                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     kids = []

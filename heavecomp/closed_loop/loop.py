@@ -23,7 +23,6 @@ A controller is a name or any object with ``step(t, measurement, preview=None)
 from __future__ import annotations
 
 import dataclasses
-import json
 import logging
 import math
 import time
@@ -291,20 +290,3 @@ def output_every(rate: float | None, control_rate: float) -> int:
         raise InputError(f"--rate {rate:g} Hz: a closed-loop run writes at the control rate "
                          f"[active].control_rate = {control_rate:g} Hz or an integer fraction of it")
     return every
-
-
-def write_closed_loop_outputs(res: ClosedLoopResult, out_dir, *, title: str | None = None,
-                              rate: float | None = None) -> dict:
-    """Write ``timeseries.csv`` (with ``u_active``; at ``rate`` [Hz], which must divide
-    the control rate; default the control rate), ``metrics.json`` and ``wob.png``."""
-    every = output_every(rate, res.control["control_rate"])
-    out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
-    res.to_csv(out_dir / "timeseries.csv", every=every)
-    metrics = res.metrics()
-    metrics["heave"] = {k: v for k, v in res.heave_info.items() if isinstance(v, (int, float, str))}
-    (out_dir / "metrics.json").write_text(json.dumps(metrics, indent=2) + "\n")
-    from heavecomp.report.figures import plot_wob, save
-
-    save(plot_wob({res.controller: res}, title=title), out_dir / "wob.png")
-    return metrics

@@ -73,7 +73,8 @@ def _run_closed_loop(args, params, Progress) -> int:
 
     from heavecomp.controllers.base import parse_options
     from heavecomp.params.cmc import active
-    from heavecomp.closed_loop.loop import Noise, output_every, simulate_closed_loop, write_closed_loop_outputs
+    from heavecomp.closed_loop.loop import Noise, output_every, simulate_closed_loop
+    from heavecomp.report.simulation import write_closed_loop_outputs
 
     output_every(args.rate, active(params).control_rate)  # bad --rate fails before the run
     options = parse_options(args.controller_option)

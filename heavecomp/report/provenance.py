@@ -93,6 +93,7 @@ UNITS: dict[str, str] = {
     "theta": "-", "n_parameters": "count", "coulomb_negative": "N", "coulomb_positive": "N",
     "viscous_negative": "N s/m", "viscous_positive": "N s/m", "viscous_asymmetry": "N s/m", "lag_force": "N",
     "presliding_length": "m", "stribeck_excess": "N", "stribeck_velocity": "m/s",
+    "v_min": "m/s", "area": "m^2", "change_in_uncertainties": "-",  # seal study settings, method sensitivity
     # closed loop (heavecomp.controllers.ControllerConfig documents these units)
     "u_max": "N", "rate_max": "N/s", "horizon": "count", "q_wob": "1/N^2", "r_u": "1/N^2", "r_du": "1/N^2",
     "friction_eps": "m/s", "friction_scale": "-", "gas_stiffness_scale": "-", "kp": "-", "ki": "1/s", "kd": "s",

@@ -1,4 +1,4 @@
-"""Outputs of ``heavecomp simulate`` (open loop): the contract CSV, metrics and the WOB figure."""
+"""Outputs of ``heavecomp simulate`` (open and closed loop): the contract CSV, metrics and the WOB figure."""
 
 from __future__ import annotations
 
@@ -6,7 +6,8 @@ import json
 from pathlib import Path
 from typing import Callable
 
-from heavecomp.report.figures import plot_wob_run, save
+from heavecomp.closed_loop.loop import ClosedLoopResult, output_every
+from heavecomp.report.figures import plot_wob, plot_wob_run, save
 from heavecomp.simulate.core import SimulationResult
 
 
@@ -30,4 +31,18 @@ def write_outputs(res: SimulationResult, out_dir, *, title: str | None = None, f
         save(plot_wob_run(res, title=title), out_dir / "wob.png", tight=False, dpi=100)
     else:
         figure.wait()
+    return metrics
+
+def write_closed_loop_outputs(res: ClosedLoopResult, out_dir, *, title: str | None = None,
+                              rate: float | None = None) -> dict:
+    """Write ``timeseries.csv`` (with ``u_active``; at ``rate`` [Hz], which must divide
+    the control rate; default the control rate), ``metrics.json`` and ``wob.png``."""
+    every = output_every(rate, res.control["control_rate"])
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    res.to_csv(out_dir / "timeseries.csv", every=every)
+    metrics = res.metrics()
+    metrics["heave"] = {k: v for k, v in res.heave_info.items() if isinstance(v, (int, float, str))}
+    (out_dir / "metrics.json").write_text(json.dumps(metrics, indent=2) + "\n")
+    save(plot_wob({res.controller: res}, title=title), out_dir / "wob.png")
     return metrics
