@@ -5,7 +5,8 @@ at the start of the sub-step until the 8-event cap finishes the step without eve
 Before the fix the zero of v was "found" at t = 0 of the remaining sub-step (the cubic
 guess returned its trivial root), the same reversal was taken again and again, the cap
 ended the step sliding the wrong way and left a sample with F_f v < 0
-(24 h JONSWAP, H_s 1 m, T_p 12 s: 80 cap hits at the default step, down to -12 W).
+(24 h JONSWAP, H_s 1 m, T_p 12 s: 8 cap hits at the default step, F_f v down to -11.3 W;
+H_s 2 m: 57; docs/numerics.md).
 The two reproducers below hit the cap before the fix (checked against the previous
 kernel: 8 reversals in one step; a 41 s sine run with F_f v = -0.10 W at t = 36.15 s).
 """

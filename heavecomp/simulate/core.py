@@ -244,11 +244,38 @@ def run_kernel(law, PP, hs, h, n_steps, out_every, *, u_active=0.0, progress=Non
     data = out[:pos]
     if not np.isfinite(data).all():
         row = int(np.argmax(~np.isfinite(data).all(axis=1)))
-        raise SimulationError(f"the stepper diverged near t = {data[max(row - 1, 0), 0]:g} s (non-finite state); "
+        t_div = data[max(row - 1, 0), 0]
+        spike = heave_accel_outlier(hs, data[row, 0] + 1.0)  # + 1 s: a spline rings ahead of a spike
+        if spike is not None:  # the input, not the step: a smaller step would integrate the same garbage
+            raise SimulationError(f"the stepper diverged near t = {t_div:g} s (non-finite state): the heave input "
+                                  f"({hs.info.get('source', hs.info.get('kind', 'heave'))}) accelerates at "
+                                  f"{spike[0]:.3g} m/s^2 at t = {spike[1]:g} s, beyond the {HEAVE_ACCEL_MAX:g} m/s^2 "
+                                  f"a rig floor can reach: check the heave input for a spike or a gap there")
+        raise SimulationError(f"the stepper diverged near t = {t_div:g} s (non-finite state); "
                               f"reduce --dt (now {h:g} s) or check the parameters")
+    spike = heave_accel_outlier(hs, data[-1, 0] if len(data) else 0.0)
+    if spike is not None:
+        log.warning("the heave input accelerates at %.3g m/s^2 at t = %g s, beyond the %g m/s^2 a rig floor can "
+                    "reach: check it for a spike or a gap there", spike[0], spike[1], HEAVE_ACCEL_MAX)
     st = dict(zip(STATS, stats.tolist()))
     check_events(data, st)
     return data, st, wall
+
+
+#: largest heave acceleration of a rig floor [m/s^2]: g (a floating rig's heave stays far below;
+#: beyond it the input, e.g. a spike in a heave record, is not a platform motion)
+HEAVE_ACCEL_MAX = 9.81
+
+
+def heave_accel_outlier(hs, t_end: float):
+    """``(|d2z_h/dt2|, t)`` of the largest heave acceleration [m/s^2, s] of the samples ``hs``
+    up to ``t_end`` when it exceeds :data:`HEAVE_ACCEL_MAX`, else None."""
+    n = min(hs.ddz.size, int(t_end / hs.spacing) + 2)
+    if n <= 0:
+        return None
+    a = np.abs(hs.ddz[:n])
+    k = int(np.argmax(a))
+    return (float(a[k]), k * hs.spacing) if a[k] > HEAVE_ACCEL_MAX else None
 
 
 def check_events(data, stats: dict) -> int:
