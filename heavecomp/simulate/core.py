@@ -127,7 +127,7 @@ class SimulationResult:
             "n_reversal": int(st["n_reversal"]),
             "event_cap_hits": int(st.get("event_cap_hits", 0)),
             "event_cap_first_t": st["event_cap_first_t"] if st.get("event_cap_hits", 0) else None,
-            "friction_power_min": float(np.min(self.friction_power())) if len(self.data) else 0.0,
+            "friction_power_min": float(np.min(self.friction_power())) + 0.0 if len(self.data) else 0.0,  # no -0.0
             "n_negative_friction_power": int(np.count_nonzero(self.friction_power() < 0.0)),
             "stroke_max": float(np.max(np.abs(self["stroke"][m]))),
             "pressure_min": float(np.min(self["pressure"][m])),
