@@ -45,8 +45,8 @@ class Heave:
                       why="sea states are 3-25 s; wider for sweeps and slow quasi-static checks")
     ramp: float = q(None, "s", bounds=(0.0, 1e5), symbol="T_r", unit_high="ms",
                     doc="fade-in time; default 2 periods (sine) / 2 peak periods (jonswap)",
-                    why="0 (no fade-in) or 0.5-100 periods (checked against the period): shorter is a jolt, "
-                        "longer never reaches the sea state")
+                    why="0 (no fade-in) or 0.1-100 periods (checked against the period): a shorter non-zero fade-in "
+                        "is a unit slip (e.g. 1e-300 s), a longer one never reaches the sea state")
     hs: float = q(None, "m", bounds=(0.0, 30.0), symbol="H_s", unit_high="mm",
                   doc="significant wave height of the platform heave (jonswap)",
                   why="the highest recorded sea states are ~20 m; platform heave is less")

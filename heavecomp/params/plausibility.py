@@ -23,7 +23,7 @@ Stribeck ratio             F_S / F_C                                          1.
 lower-mass damping ratio   (c_ds + c_F) / (2 sqrt((k_ds + k_F) m_b))          0.033        <= 10
 top-mass damping ratio     c_ds / (2 sqrt((k_gas + k_ds) M_c))                0            <= 10
 natural frequencies        frictionless, two masses                           0.44, 1.8 Hz 0.002 - 25 Hz
-fade-in                    heave.ramp / period                                2            0, or 0.5-100
+fade-in                    heave.ramp / period                                2            0, or 0.1-100
 active force               [active].u_max / ((M_c + m_b) g)                   5.6 %        <= 100 %
 active force rate          [active].u_max / rate_max                          0.2 s        1 ms - 60 s
 ========================  =================================================  ===========  ==============
@@ -54,7 +54,7 @@ VISCOUS_SHARE = 0.50  #: largest C_v V_REF as a share of p_0 A
 STRIBECK_RATIO = 100.0  #: largest F_S / F_C
 DAMPING_RATIO = 10.0  #: largest damping ratio of either mass on its springs
 MODES_HZ = (0.002, 25.0)  #: natural frequencies of the frictionless rig [Hz]
-RAMP_PERIODS = (0.5, 100.0)  #: heave.ramp in periods (or 0)
+RAMP_PERIODS = (0.1, 100.0)  #: heave.ramp in periods (or 0)
 FULL_FORCE_TIME = (1e-3, 60.0)  #: [active] u_max / rate_max [s]
 
 

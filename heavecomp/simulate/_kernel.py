@@ -270,7 +270,14 @@ def hold(t, X, u, PP, EP, sp, Z, DZ, DDZ):
 
 @_jit
 def _cubic_root(v0, a0, v1, a1, H):
-    """Root in (0, H) of the cubic Hermite through (0, v0, a0), (H, v1, a1); v0 v1 <= 0."""
+    """Root in (0, H) of the cubic Hermite through (0, v0, a0), (H, v1, a1); v0 v1 <= 0.
+
+    When ``v0 == 0`` (a sub-step that starts at rest, right after a reversal or a
+    breakaway) the root at 0 is the event already handled: the root of the cubic
+    divided by ``t`` is returned, the instant the motion that just started stops again.
+    """
+    if v0 == 0.0:
+        return _rest_root(a0, v1, a1, H)
     lo, hi = 0.0, 1.0
     flo = v0
     th = v0 / (v0 - v1) if v0 != v1 else 0.5
@@ -294,6 +301,26 @@ def _cubic_root(v0, a0, v1, a1, H):
             break
         th = nt
     return th * H
+
+
+@_jit
+def _rest_root(a0, v1, a1, H):
+    """Root in (0, H) of the cubic Hermite through (0, 0, a0), (H, v1, a1) divided by t:
+    ``q(th) = H a0 (1 - th)^2 + v1 th (3 - 2 th) + H a1 th (th - 1)``, with ``q(0) = H a0``
+    and ``q(1) = v1`` of opposite signs, so exactly one root in (0, 1) (H when they are not)."""
+    c0 = H * a0
+    c1 = 3.0 * v1 - 2.0 * H * a0 - H * a1
+    c2 = H * a0 - 2.0 * v1 + H * a1
+    if not ((c0 > 0.0 and v1 < 0.0) or (c0 < 0.0 and v1 > 0.0)):
+        return H
+    if c2 == 0.0:
+        return -c0 / c1 * H
+    # the two roots without cancellation (c1^2 - 4 c2 c0 > 0: q changes sign on (0, 1))
+    qq = -0.5 * (c1 + np.copysign(np.sqrt(c1 * c1 - 4.0 * c2 * c0), c1))
+    th = qq / c2
+    if not (0.0 < th < 1.0):
+        th = c0 / qq
+    return min(max(th, 0.0), 1.0) * H
 
 
 @_jit
@@ -460,14 +487,17 @@ def _advance(X, tau, mode, d, t0, n_steps, h, code, FP, PP, EP, smooth, u, sp, Z
                 if left <= 0.0:
                     break
         else:
-            # more than 8 events inside one step (never seen in practice): finish the
-            # step in the current mode without further event checks, and count it
+            # more than 8 events inside one step (chattering; not expected): finish the
+            # step in the current mode without further event checks, count it and keep
+            # the time of the first (STATS "event_cap_hits", "event_cap_first_t")
             if left > 0.0:
                 X = rk4(tc, left, X, mode, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ)
                 if mode == STUCK:
                     X = _at_rest(X)
                     stats[0] += left
                     tau += left
+                if stats[4] == 0.0:
+                    stats[6] = tc
                 stats[4] += 1.0
         if (i + 1) % out_every == 0 and pos < out.shape[0]:
             _record(out, pos, t0 + (i + 1) * h, X, mode, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ)

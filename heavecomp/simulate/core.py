@@ -11,7 +11,7 @@ from typing import Callable
 
 import numpy as np
 
-from heavecomp.errors import InputError, ParameterError
+from heavecomp.errors import InputError
 from heavecomp.params.budget import check_run_size
 
 
@@ -139,7 +139,10 @@ class SimulationResult:
             "n_stick": int(st["n_stick"]),
             "n_breakaway": int(st["n_breakaway"]),
             "n_reversal": int(st["n_reversal"]),
-            "n_event_overflow": int(st.get("n_event_overflow", 0)),
+            "event_cap_hits": int(st.get("event_cap_hits", 0)),
+            "event_cap_first_t": st["event_cap_first_t"] if st.get("event_cap_hits", 0) else None,
+            "friction_power_min": float(np.min(self.friction_power())) + 0.0 if len(self.data) else 0.0,  # no -0.0
+            "n_negative_friction_power": int(np.count_nonzero(self.friction_power() < 0.0)),
             "stroke_max": float(np.max(np.abs(self["stroke"][m]))),
             "pressure_min": float(np.min(self["pressure"][m])),
             "pressure_max": float(np.max(self["pressure"][m])),
@@ -151,6 +154,15 @@ class SimulationResult:
             "friction_model": self.params.friction.model,
             "wall_time_s": self.wall_time,
         }
+
+    def friction_power(self) -> np.ndarray:
+        """Friction power F_f v [W] at each sample: >= 0 (friction only dissipates), exactly 0 while stuck."""
+        return self["friction"] * self["stroke_velocity"]
+
+    @property
+    def event_cap_hits(self) -> int:
+        """Steps that hit the stepper's event cap (finished without event location; should be 0)."""
+        return int(self.stats.get("event_cap_hits", 0))
 
     def to_csv(self, path, columns=CSV_COLUMNS, progress: Callable[[float], None] | None = None) -> Path:
         idx = [CHANNELS.index(c) for c in columns]
@@ -272,9 +284,57 @@ def run_kernel(law, PP, hs, h, n_steps, out_every, *, u_active=0.0, progress=Non
     data = out[:pos]
     if not np.isfinite(data).all():
         row = int(np.argmax(~np.isfinite(data).all(axis=1)))
-        raise SimulationError(f"the stepper diverged near t = {data[max(row - 1, 0), 0]:g} s (non-finite state); "
+        t_div = data[max(row - 1, 0), 0]
+        spike = heave_accel_outlier(hs, data[row, 0] + 1.0)  # + 1 s: a spline rings ahead of a spike
+        if spike is not None:  # the input, not the step: a smaller step would integrate the same garbage
+            raise SimulationError(f"the stepper diverged near t = {t_div:g} s (non-finite state): the heave input "
+                                  f"({hs.info.get('source', hs.info.get('kind', 'heave'))}) accelerates at "
+                                  f"{spike[0]:.3g} m/s^2 at t = {spike[1]:g} s, beyond the {HEAVE_ACCEL_MAX:g} m/s^2 "
+                                  f"a rig floor can reach: check the heave input for a spike or a gap there")
+        raise SimulationError(f"the stepper diverged near t = {t_div:g} s (non-finite state); "
                               f"reduce --dt (now {h:g} s) or check the parameters")
-    return data, dict(zip(STATS, stats.tolist())), wall
+    spike = heave_accel_outlier(hs, data[-1, 0] if len(data) else 0.0)
+    if spike is not None:
+        log.warning("the heave input accelerates at %.3g m/s^2 at t = %g s, beyond the %g m/s^2 a rig floor can "
+                    "reach: check it for a spike or a gap there", spike[0], spike[1], HEAVE_ACCEL_MAX)
+    st = dict(zip(STATS, stats.tolist()))
+    check_events(data, st)
+    return data, st, wall
+
+
+#: largest heave acceleration of a rig floor [m/s^2]: g (a floating rig's heave stays far below;
+#: beyond it the input, e.g. a spike in a heave record, is not a platform motion)
+HEAVE_ACCEL_MAX = 9.81
+
+
+def heave_accel_outlier(hs, t_end: float):
+    """``(|d2z_h/dt2|, t)`` of the largest heave acceleration [m/s^2, s] of the samples ``hs``
+    up to ``t_end`` when it exceeds :data:`HEAVE_ACCEL_MAX`, else None."""
+    n = min(hs.ddz.size, int(t_end / hs.spacing) + 2)
+    if n <= 0:
+        return None
+    a = np.abs(hs.ddz[:n])
+    k = int(np.argmax(a))
+    return (float(a[k]), k * hs.spacing) if a[k] > HEAVE_ACCEL_MAX else None
+
+
+def check_events(data, stats: dict) -> int:
+    """The stepper's own diagnostics: log a warning when a step hit the event cap (more
+    than 8 mode switches in one step, finished without event location) or when a recorded
+    sample has friction power F_f v < 0 (friction driving the stroke: a stepper fault).
+    Returns the number of such samples."""
+    if stats.get("event_cap_hits", 0) > 0:
+        log.warning("stepper event cap hit in %d step(s), first at t = %.6g s: more than 8 stick-slip/contact "
+                    "events inside one step, finished without event location (please report)",
+                    int(stats["event_cap_hits"]), stats["event_cap_first_t"])
+    power = data[:, CHANNELS.index("friction")] * data[:, CHANNELS.index("stroke_velocity")]
+    bad = np.flatnonzero(power < 0.0)
+    if bad.size:
+        i = int(bad[np.argmin(power[bad])])
+        log.warning("friction power F_f v < 0 at %d recorded sample(s), down to %.3g W at t = %.6g s: "
+                    "friction opposed by the stroke velocity (stepper fault, please report)",
+                    bad.size, power[i], data[i, 0])
+    return int(bad.size)
 
 
 def drive(step, hs, h, n_steps, out_every, *, progress=None, chunk_steps=200_000) -> int:

@@ -9,8 +9,11 @@ CHANNELS = ("t", "heave", "stroke", "pressure", "wob", "stroke_velocity", "frict
 NCH = len(CHANNELS)
 #: extra channels written by ``_kernel.advance_fx`` when ``out`` has room (after CHANNELS)
 FX_CHANNELS = ("gas_pressure", "theta")
-#: slots of the ``stats`` array
-STATS = ("stuck_time", "n_stick", "n_breakaway", "n_reversal", "n_event_overflow", "n_contact_switch")
+#: slots of the ``stats`` array: time stuck [s]; counts of stick, breakaway, reversal events;
+#: steps that hit the event cap (more than 8 events in one step, finished without event
+#: checks) and the time [s] of the first such step (0 while there is none); bit contact switches
+STATS = ("stuck_time", "n_stick", "n_breakaway", "n_reversal", "event_cap_hits", "n_contact_switch",
+         "event_cap_first_t")
 NSTATS = len(STATS)
 
 #: files whose source the compiled stepper is built from (the AOT build is keyed to them)
