@@ -29,19 +29,40 @@ Plant parameter vector ``PP`` (see :func:`plant_vector` for the layout).
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 
-from heavecomp.friction.laws import friction_cont, friction_jump, friction_smooth
+from heavecomp.friction.laws import friction_cont, friction_jump
 
-# PP layout
-A, MC, MB, PATM, P0ABS, V0, N, KDS, CDS, T0, KF, CF, D0, G = range(14)
+#: PP layout: names in vector order; the index constants below are generated from it
 PP_NAMES = ("A", "M_c", "m_b", "p_atm", "p0_abs", "V_0", "n", "k_ds", "c_ds", "T_0", "k_F", "c_F",
             "delta_0", "g")
+A, MC, MB, PATM, P0ABS, V0, N, KDS, CDS, T0, KF, CF, D0, G = range(len(PP_NAMES))
 STATE_NAMES = ("stroke", "stroke_velocity", "lower_displacement", "lower_velocity")
 
 
+class PlantVectors(NamedTuple):
+    """The CMC's parameters as the compiled kernel takes them: friction law code, friction
+    vector FP (:data:`heavecomp.friction.laws.FP_NAMES`) and plant vector PP (:data:`PP_NAMES`)."""
+
+    code: int
+    FP: np.ndarray
+    PP: np.ndarray
+    has_stiction: bool
+
+
+def plant_vectors(params) -> PlantVectors:
+    """``(code, FP, PP, has_stiction)`` of a :class:`heavecomp.params.CMCParams` — the one
+    params -> vectors conversion (simulate, closed loop, diagnosis, generator use it)."""
+    from heavecomp.friction.laws import FrictionLaw
+
+    law = FrictionLaw.from_params(params.friction)
+    return PlantVectors(int(law.code), law.FP, plant_vector(params), bool(law.has_stiction))
+
+
 def plant_vector(params) -> np.ndarray:
-    """Plant parameter vector PP from a :class:`heavecomp.params.CMCParams`."""
+    """Plant parameter vector PP (layout :data:`PP_NAMES`) from a :class:`heavecomp.params.CMCParams`."""
     from heavecomp.params.cmc import G as g, P_ATM
 
     c, ds, f, op = params.compensator, params.drill_string, params.formation, params.operating_point
@@ -89,16 +110,26 @@ def contact_switch(yb, vb, PP):
     return np.minimum(PP[KF] * pen, PP[KF] * pen - PP[CF] * vb)
 
 
+def net_force(p, T, ddzh, u, PP):
+    """Net non-friction force on the top mass in the platform frame for a cylinder pressure ``p``
+    and string tension ``T`` [N]: ``p A - M_c g - T_ds + u - M_c ddz_h``."""
+    return p * PP[A] - PP[MC] * PP[G] - T + u - PP[MC] * ddzh
+
+
 def holding_force(s, v, yb, vb, zh, dzh, ddzh, u, PP):
     """Net non-friction force on the top mass in the platform frame [N]:
-    ``p A - M_c g - T_ds + u - M_c ddz_h``.  While stuck the friction equals it."""
-    p = gas_pressure(s, PP)
-    return p * PP[A] - PP[MC] * PP[G] - tension(s, v, yb, vb, zh, dzh, PP) + u - PP[MC] * ddzh
+    :func:`net_force` of the gas pressure and the tension.  While stuck the friction equals it."""
+    return net_force(gas_pressure(s, PP), tension(s, v, yb, vb, zh, dzh, PP), ddzh, u, PP)
 
 
 def lower_accel(s, v, yb, vb, zh, dzh, PP):
     """dv_b/dt of the lower mass [m/s^2]."""
-    return (tension(s, v, yb, vb, zh, dzh, PP) - PP[MB] * PP[G] + wob(yb, vb, PP)) / PP[MB]
+    return lower_accel_wob(tension(s, v, yb, vb, zh, dzh, PP), yb, vb, PP)
+
+
+def lower_accel_wob(T, yb, vb, PP):
+    """dv_b/dt for a string tension ``T`` with the clamped contact law :func:`wob` [m/s^2]."""
+    return (T - PP[MB] * PP[G] + wob(yb, vb, PP)) / PP[MB]
 
 
 def lower_accel_contact(s, v, yb, vb, zh, dzh, contact, PP):
@@ -108,7 +139,13 @@ def lower_accel_contact(s, v, yb, vb, zh, dzh, contact, PP):
     holds the state through a step and flips it at the located lift-off / touchdown, so
     its RK4 stages never straddle the kink or the touchdown jump of W.
     """
-    return (tension(s, v, yb, vb, zh, dzh, PP) - PP[MB] * PP[G] + contact * contact_force(yb, vb, PP)) / PP[MB]
+    return lower_accel_tension(tension(s, v, yb, vb, zh, dzh, PP), yb, vb, contact, PP)
+
+
+def lower_accel_tension(T, yb, vb, contact, PP):
+    """dv_b/dt for a string tension ``T`` with the contact state held [m/s^2]:
+    ``(T - m_b g + contact k_F (delta_0 - y_b) - c_F v_b) / m_b``."""
+    return (T - PP[MB] * PP[G] + contact * contact_force(yb, vb, PP)) / PP[MB]
 
 
 def stroke_accel(s, v, yb, vb, zh, dzh, ddzh, u, Ff, PP):
@@ -128,9 +165,53 @@ def static_limit(code, s, FP, PP):
 
 
 # ----------------------------------------------------------------------------
+# the linear model (eigenvalues, default step sizes, band edges)
+# ----------------------------------------------------------------------------
+def modal_matrices(params, friction_slope: float = 0.0):
+    """Mass, damping and stiffness matrices ``(M, C, K)`` of the CMC linearised at the operating
+    point, coordinates (top-mass stroke, lower-mass displacement), the bit on the rock [SI].
+
+    ``K = [[k_gas + k_ds, -k_ds], [-k_ds, k_ds + k_F]]``,
+    ``C = [[c_ds + slope, -c_ds], [-c_ds, c_ds + c_F]]``, ``M = diag(M_c, m_b)``, with
+    ``slope`` a friction slope dF_f/dv [N s/m] added on the stroke.  The one linear model the
+    default step (:func:`eigen_rate`) and the diagnosis' band edges (:func:`eigenfrequencies`) are
+    derived from; ``tests/test_conformance.py`` pins it to the jacobian of :func:`casadi_model`.
+    """
+    c, ds, fo = params.compensator, params.drill_string, params.formation
+    K = np.array([[c.gas_stiffness + ds.stiffness, -ds.stiffness], [-ds.stiffness, ds.stiffness + fo.stiffness]])
+    C = np.array([[ds.damping + friction_slope, -ds.damping], [-ds.damping, ds.damping + fo.damping]])
+    M = np.diag([c.moving_mass, ds.lower_mass])
+    return M, C, K
+
+
+def eigen_rate(params) -> float:
+    """Largest |eigenvalue| [1/s] of the linear model (stroke stuck or free), including the
+    steepest friction slope near v = 0 (:func:`heavecomp.friction.laws.steepest_slope`)."""
+    from heavecomp.friction.laws import steepest_slope
+
+    plant = plant_vectors(params)
+    M, C, K = modal_matrices(params, steepest_slope(plant.code, plant.FP))
+    Minv = np.diag([1 / M[0, 0], 1 / M[1, 1]])
+    Asys = np.block([[np.zeros((2, 2)), np.eye(2)], [-Minv @ K, -Minv @ C]])
+    lam = np.abs(np.linalg.eigvals(Asys)).max()
+    ds, fo = params.drill_string, params.formation
+    return float(max(lam, np.sqrt((ds.stiffness + fo.stiffness) / M[1, 1]), (ds.damping + fo.damping) / M[1, 1]))
+
+
+def eigenfrequencies(params) -> list[float]:
+    """Undamped eigenfrequencies [Hz] of the linear model: sliding (2 DOF: top mass on the gas
+    spring, lower mass on string and formation) and stuck (lower mass on k_ds + k_F)."""
+    M, C, K = modal_matrices(params)
+    lam = np.linalg.eigvals(np.linalg.solve(M, K)).real
+    f = sorted(float(np.sqrt(max(x, 0.0)) / (2 * np.pi)) for x in lam)
+    f.append(float(np.sqrt(K[1, 1] / M[1, 1]) / (2 * np.pi)))
+    return f
+
+
+# ----------------------------------------------------------------------------
 # symbolic model
 # ----------------------------------------------------------------------------
-def casadi_model(params, *, eps: float | None = None, sym: str = "SX"):
+def casadi_model(params, *, eps: float | None = None, sym: str = "SX", effects=()):
     """The CMC as a casadi Function ``f(x, u) -> (xdot, y)`` with smooth friction.
 
     Parameters
@@ -138,34 +219,59 @@ def casadi_model(params, *, eps: float | None = None, sym: str = "SX"):
     params : CMCParams
     eps : float, optional
         Regularisation width of the friction's sign [m/s]; required when the
-        friction law has stiction (there is no smooth exact law).  Ignored for
-        ``model = "none"``.
+        friction law or an effect has stiction (there is no smooth exact law).
+        Ignored without.
     sym : {"SX", "MX"}
+    effects : sequence, optional
+        Effects at the plant's hooks (:mod:`heavecomp.effects`: instances, registered names or
+        ``(name, values)``).  Their hook methods are traced by casadi from the same source the
+        stepper compiles (:mod:`heavecomp.effects.compose`); their states follow the four
+        plant states.  The seal-friction ``static`` hook (e.g. a dwell gain) has no part in a
+        regularised model, which never sticks.
 
     Returns
     -------
     casadi.Function
-        Inputs ``x`` (4: s, v, y_b, v_b) and ``u`` (4: z_h, dz_h, ddz_h, u_active);
-        outputs ``xdot`` (4) and ``y`` (5: wob, stroke, pressure, tension, friction).
+        Inputs ``x`` (4 + effect states: s, v, y_b, v_b, ...) and ``u`` (4: z_h, dz_h, ddz_h,
+        u_active); outputs ``xdot`` and ``y`` (5: wob, stroke, pressure, tension, friction).
     """
-    from heavecomp.friction.laws import FrictionLaw
+    from heavecomp.effects.compose import composition
+    from heavecomp.effects.registry import resolve
     from heavecomp.plants.symbolic import casadi
 
     ca = casadi()
-
-    law = FrictionLaw.from_params(params.friction)
-    if law.has_stiction and not (eps and eps > 0):
+    plant = plant_vectors(params)
+    effects = resolve(effects)
+    comp = composition(tuple(dict.fromkeys(type(e) for e in effects)))
+    EP = comp.ep(effects)
+    if (plant.has_stiction or comp.adds_stiction(EP)) and not (eps and eps > 0):
         raise ValueError("casadi_model: friction with stiction needs an explicit eps > 0 [m/s]")
-    PP = plant_vector(params)
+    code, FP, PP = plant.code, plant.FP, plant.PP
+    n_eff = sum(len(c.states) for c in comp.classes)
     S = getattr(ca, sym)
-    x = S.sym("x", 4)
+    x = S.sym("x", 4 + n_eff)
     u = S.sym("u", 4)
     s, v, yb, vb = x[0], x[1], x[2], x[3]
+    xe = [x[4 + i] for i in range(n_eff)] + [0.0] * (3 - n_eff)  # the effects' state slots x4..x6
     zh, dzh, ddzh, ua = u[0], u[1], u[2], u[3]
-    p = gas_pressure(s, PP)
-    Ff = friction_smooth(law.code, v, p, law.FP, eps or 1.0)
-    dv = stroke_accel(s, v, yb, vb, zh, dzh, ddzh, ua, Ff, PP)
-    dvb = lower_accel(s, v, yb, vb, zh, dzh, PP)
-    xdot = ca.vertcat(v, dv, vb, dvb)
-    y = ca.vertcat(wob(yb, vb, PP), s, p, tension(s, v, yb, vb, zh, dzh, PP), Ff)
+    fn = comp.functions
+    p, T, hold, dvb = fn["plant_fx"](s, v, yb, vb, *xe, zh, dzh, ddzh, ua, 1.0, PP, EP)
+    dvb = lower_accel_wob(T, yb, vb, PP)  # the clamped contact law (smooth model)
+    Ff = fn["jump_fx"](code, np.abs(v), p, *xe, FP, EP) * np.tanh(v / (eps or 1.0)) + friction_cont(code, v, p, FP)
+    dv = (hold - Ff) / PP[MC]
+    rates = fn["effect_rates"](s, v, p, *xe, PP, FP, EP)[:n_eff]
+    xdot = ca.vertcat(v, dv, vb, dvb, *rates)
+    y = ca.vertcat(wob(yb, vb, PP), s, p, T, Ff)
     return ca.Function("cmc", [x, u], [xdot, y], ["x", "u"], ["xdot", "y"])
+
+
+def initial_effect_states(params, effects=()) -> np.ndarray:
+    """The effect states of :func:`casadi_model` at rest at the operating point (its x[4:])."""
+    from heavecomp.effects.compose import composition
+    from heavecomp.effects.registry import resolve
+
+    plant = plant_vectors(params)
+    effects = resolve(effects)
+    comp = composition(tuple(dict.fromkeys(type(e) for e in effects)))
+    n_eff = sum(len(c.states) for c in comp.classes)
+    return comp.initial_state(plant.FP, plant.PP, comp.ep(effects))[4:4 + n_eff]
