@@ -18,6 +18,7 @@ MODULES = (
     "flow_loss",
     "string_damping",
     "sensor_delay",
+    "charge_drift",
 )
 
 _LIBRARY: dict = {}
