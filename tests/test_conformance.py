@@ -180,3 +180,35 @@ def test_numba_equals_casadi_at_sampled_states(model, name):
         xc = np.asarray(f(X, [zh, dzh, ddzh, u])[0]).ravel()
         scale = np.r_[1.0, 1.0, 1.0, 1.0, np.abs(xc[4:]) + 1.0]
         assert np.all(np.abs(xk - xc) <= RTOL * np.maximum(np.abs(xc), scale)), (xk, xc)
+
+
+# ------------------------------------------------- the one linear model, pinned
+@pytest.mark.parametrize("change", [{}, {"drill_string": {"damping": 5e4}}, {"formation": {"stiffness": 4e5}}])
+def test_linear_model_is_the_casadi_jacobian(change):
+    """cmc.modal_matrices (eigenvalues, default steps, band edges) = the jacobian of the casadi
+    model at the operating point, frictionless, bit on the rock."""
+    import casadi as ca
+
+    p = paper_a("none").replace(**change)
+    f = cmc.casadi_model(p)
+    x, u = ca.SX.sym("x", 4), ca.SX.sym("u", 4)
+    A = np.array(ca.Function("A", [x, u], [ca.jacobian(f(x, u)[0], x)])(np.zeros(4), np.zeros(4)))
+    M, C, Kk = cmc.modal_matrices(p)
+    Minv = np.linalg.inv(M)
+    ref = np.block([[np.zeros((2, 2)), np.eye(2)], [-Minv @ Kk, -Minv @ C]])
+    A2 = A[np.ix_([0, 2, 1, 3], [0, 2, 1, 3])]  # (s, y_b, v, v_b)
+    np.testing.assert_allclose(A2, ref, rtol=1e-6, atol=1e-9 * np.abs(ref).max())
+
+
+@pytest.mark.parametrize("model", ["stribeck", "rotating_eq7"])
+def test_steepest_slope_is_the_laws_derivative_at_rest(model):
+    """laws.steepest_slope (sets the default step) bounds the slope of the law itself near v = 0+
+    tightly: |dF/dv| <= it <= |dF/dv| + C_v (eq. 4: the Stribeck drop (F_S - F_C)/v_S less C_v)."""
+    law = laws.FrictionLaw.from_params(paper_a(model).friction)
+    d = 1e-7
+    v = np.array([d, 2 * d])
+    F = law.force(v, 0.0)
+    slope = abs(F[1] - F[0]) / d
+    bound = laws.steepest_slope(law.code, law.FP)
+    assert slope <= bound * (1 + 1e-3)
+    assert bound <= (slope + law.FP[laws.CV]) * (1 + 1e-3)
