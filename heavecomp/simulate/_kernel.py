@@ -53,6 +53,7 @@ samples they are interpolated with quintic Hermite polynomials.
 
 from __future__ import annotations
 
+import threading
 import types
 
 import numba as nb
@@ -572,6 +573,7 @@ _KERNELS: dict = {}
 
 
 _HOOK_ENVS: dict = {}
+_LOCK = threading.Lock()
 
 
 def _hook_env(comp) -> dict:
@@ -594,13 +596,14 @@ def kernel_for(comp):
     """
     if not comp.classes:
         return advance_fx
-    if comp.key not in _KERNELS:
-        env = dict(_hook_env(comp))
-        for fname in _PER_COMPOSITION:
-            f = globals()[fname]
-            _compile(f.py_func, inline=fname == "rhs", env=env, name=f"{fname}__fx_{comp.key}",
-                     nogil=fname == "advance_fx")
-        _KERNELS[comp.key] = env["advance_fx"]
+    with _LOCK:  # the diagnosis fits in threads: one dispatcher per composition, so one compile
+        if comp.key not in _KERNELS:
+            env = dict(_hook_env(comp))
+            for fname in _PER_COMPOSITION:
+                f = globals()[fname]
+                _compile(f.py_func, inline=fname == "rhs", env=env, name=f"{fname}__fx_{comp.key}",
+                         nogil=fname == "advance_fx")
+            _KERNELS[comp.key] = env["advance_fx"]  # numba compiles it once on the first call (its own lock)
     return _KERNELS[comp.key]
 
 
