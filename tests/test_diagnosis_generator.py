@@ -11,38 +11,29 @@ import numpy as np
 import pytest
 
 from heavecomp.diagnosis import generator as G
-from heavecomp.diagnosis.estimator import _vectors
 from heavecomp.diagnosis.stepper import CHANNELS as SC, replay_dt, run_fx
-from heavecomp.effects import terms as T
+from heavecomp.diagnosis.truth import TRUTH, truth_composition
+from heavecomp.effects.registry import library
+from heavecomp.plants.cmc import plant_vectors
 from heavecomp.simulate import excitation
 
 DUR = 120.0
 OUT = ("stroke", "pressure", "wob")
-CAND_SLOTS = (T.LAG_T_CAND, T.LAG_TDOWN_CAND, T.DWELL_A_CAND, T.DWELL_BETA_CAND, T.PF_DCP_CAND, T.GAS_N_CAND,
-              T.GAS_LOSS_CAND, T.FLOW_R_CAND, T.SD_C_CAND)
 
 
-def _truth_ep(name, prm):
-    """EP of a truth effect written from its recorded parameters (plant effects only)."""
-    EP = T.zero_ep()
-    slots = {"friction_lag": {"lag_time_speed": T.LAG_T_TRUTH},
-             "dwell_stiction": {"dF": T.DWELL_DF_TRUTH, "tau_d": T.DWELL_TAU_TRUTH},
-             "pressure_friction": {"k": T.PF_K_TRUTH, "p_th": T.PF_PTH_TRUTH},
-             "gas_heat_transfer": {"gamma": T.TH_GAMMA_TRUTH, "tau_th": T.TH_TAU_TRUTH},
-             "flow_loss": {"K": T.FLOW_K_TRUTH}, "string_damping": {"c_q": T.SD_CQ_TRUTH}}[name]
-    for key, i in slots.items():
-        EP[i] = prm[key]
-    return EP
+def _truth(name, prm):
+    """The truth effect built from its recorded parameters (plant effects only)."""
+    return [TRUTH[name](**prm)]
 
 
-def _clean(tr, EP):
-    """Clean truth channels of the recorded sea with effects EP on the nominal parameters."""
+def _clean(tr, effects):
+    """Clean truth channels of the recorded sea with the truth ``effects`` on the nominal parameters."""
     nominal, sea = tr.nominal, tr.truth["sea"]
     h = replay_dt(nominal, 50.0)
     n = int(math.ceil(DUR / h - 1e-9))
     hs = excitation.jonswap(sea["hs"], sea["tp"], 3.3, sea["phase_seed"], 2 * sea["tp"], n * h, 0.5 * h)
-    code, FP, PP = _vectors(nominal)
-    out = run_fx(code, FP, PP, EP, hs, h, n, int(round(0.02 / h)))
+    comp = truth_composition()
+    out = run_fx(plant_vectors(nominal), comp, comp.ep(effects), hs, h, n, int(round(0.02 / h)))
     return out[:, 0], {c: out[:, SC.index(c)] for c in OUT + ("stuck",)}
 
 
@@ -54,8 +45,8 @@ def test_planted_effect_is_above_the_noise_floor(name, pset, seed):
     recorded truth, the effect moves some channel by >= GAP_MIN x the recorded noise floor in each
     half of the run; the floor is itself at least the output noise."""
     tr = G.generate(name, seed=seed, duration=DUR, param_set=pset)
-    t, base = _clean(tr, T.zero_ep())
-    _, with_effect = _clean(tr, _truth_ep(name, tr.truth["parameters"][name]))
+    t, base = _clean(tr, [])
+    _, with_effect = _clean(tr, _truth(name, tr.truth["parameters"][name]))
     floor = tr.truth["noise_floor"]
     m = t >= 0.1 * DUR
 
@@ -89,7 +80,7 @@ def test_two_effect_run_second_is_a_real_fraction():
 
 def test_no_effect_run_has_no_planted_gap():
     tr = G.generate("none", seed=2, duration=DUR, param_set="paper_a")
-    t, base = _clean(tr, T.zero_ep())
+    t, base = _clean(tr, [])
     assert tr.truth["gap_alone"] == {} and tr.truth["parameters"] == {}
     for c in OUT:  # the measured channels are the no-effect truth plus white noise of the stated level
         r = tr.columns[c] - base[c]
@@ -97,12 +88,19 @@ def test_no_effect_run_has_no_planted_gap():
 
 
 @pytest.mark.parametrize("name", [e for e in G.CASES if e not in ("none", "sensor_delay", "parameter_mismatch")])
-def test_truth_terms_leave_the_candidate_slots_empty(name):
-    """The generator writes only the truth side of the effect vector: no candidate equation is used."""
+def test_truth_laws_are_the_generators_own_classes(name):
+    """The generator plants its own truth classes (outside the library): never a registered
+    candidate class, and no truth class shares a hook method with the library's effect of that name."""
     desc, _, _ = G._draw_effect(name, np.random.default_rng(0), G.parameter_sets()["paper_a"])
-    EP, extra = G._effect_terms(name, desc, G.parameter_sets()["paper_a"])
-    assert extra is None and np.any(EP != 0)
-    assert np.all(EP[list(CAND_SLOTS)] == 0)
+    effects, extra = G._effect_terms(name, desc, G.parameter_sets()["paper_a"])
+    lib = library()
+    assert extra is None and len(effects) == 1
+    (e,) = effects
+    assert type(e) is TRUTH[name] and type(e) not in lib.values()
+    cand = lib[name]
+    for m in type(e).methods():
+        assert getattr(type(e), m) is not getattr(cand, m, None)
+    assert cand not in truth_composition().classes
 
 
 def test_benchmark_meets_every_case_on_two_parameter_sets():

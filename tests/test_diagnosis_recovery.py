@@ -7,9 +7,11 @@ import numpy as np
 import pytest
 
 from heavecomp.diagnosis.data import check_run
-from heavecomp.diagnosis.estimator import GapDiagnoser, _vectors
+from heavecomp.diagnosis.estimator import GapDiagnoser
 from heavecomp.diagnosis.stepper import CHANNELS as SC, run_fx
-from heavecomp.effects import get, terms as T
+from heavecomp.effects import get
+from heavecomp.effects.compose import library_composition
+from heavecomp.plants.cmc import plant_vectors
 from heavecomp.params import paper_a
 from heavecomp.simulate import excitation
 from heavecomp.diagnosis.stepper import replay_dt
@@ -20,15 +22,13 @@ DUR = 90.0
 def _planted(name, values, *, amplitude_hs=2.5, seed=4, params=None):
     nominal = paper_a()
     truth = nominal if params is None else params
-    EP = T.zero_ep()
     cls = get(name)
-    if cls.kind == "plant":
-        cls.write_ep(values, EP)
+    comp = library_composition()
+    EP = comp.ep([cls(**values)] if cls.kind == "plant" else [])
     h = replay_dt(truth, 50.0)
     n = int(math.ceil(DUR / h))
     hs = excitation.jonswap(amplitude_hs, 10.0, 3.3, seed, 20.0, n * h, 0.5 * h)
-    code, FP, PP = _vectors(truth)
-    out = run_fx(code, FP, PP, EP, hs, h, n, int(round(0.02 / h)))
+    out = run_fx(plant_vectors(truth), comp, EP, hs, h, n, int(round(0.02 / h)))
     t = out[:, 0]
     cols = {c: out[:, SC.index(c)].copy() for c in ("heave", "stroke", "pressure", "wob")}
     if cls.kind == "output":

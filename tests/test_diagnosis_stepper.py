@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 from heavecomp.diagnosis.stepper import CHANNELS, replay_dt, simulate_fx
-from heavecomp.effects import terms as T
+from heavecomp.diagnosis.truth import TruthDwell, TruthOrifice, TruthThermalGas, truth_composition
+from heavecomp.effects.registry import effect_class
 from heavecomp.params import paper_a
 from heavecomp.simulate import simulate
 from heavecomp.simulate.layout import CHANNELS as SIM_CHANNELS
@@ -22,7 +23,14 @@ def test_no_effect_is_foundation_simulate_bit_for_bit(model):
     for c in SIM_CHANNELS:
         np.testing.assert_array_equal(fx[c], ref[c], err_msg=c)
     np.testing.assert_array_equal(fx["gas_pressure"], ref["pressure"])  # no line drop
-    assert np.all(fx["theta"] == 1.0)
+    lib = simulate_fx(p, 120.0, ["flow_loss"], rate=50.0, dt=0.01)  # the library's stepper ...
+    from heavecomp.effects.compose import library_composition
+    from heavecomp.simulate import _kernel as K
+    assert K.kernel_for(library_composition()) is not K.advance_fx
+    off = simulate_fx(p, 120.0, [effect_class("flow_loss")(resistance=0.0)], rate=50.0, dt=0.01)
+    for c in SIM_CHANNELS:  # ... with its line effect at zero size is simulate() bit for bit as well
+        np.testing.assert_array_equal(off[c], ref[c], err_msg=c)
+    assert np.max(np.abs(lib["wob"] - ref["wob"])) > 10.0
 
 
 def test_replay_locates_bit_lift_off_and_touchdown_with_effects():
@@ -30,13 +38,12 @@ def test_replay_locates_bit_lift_off_and_touchdown_with_effects():
     touchdown are events of the shared stepper.  (The former diagnosis-only stepper stepped over
     them: 10-30 N rms at these steps, no convergence.)  EP = 0 still equals simulate() there."""
     p = paper_a("stribeck").replace(heave={"amplitude": 3.0})
-    EP = T.zero_ep()
-    EP[T.FLOW_K_TRUTH] = 3e5  # orifice line loss: acts through the pressure, in every regime
-    ref = simulate_fx(p, 60.0, EP, rate=10.0, dt=0.000625)
+    EP = [TruthOrifice(K=3e5)]  # orifice line loss: acts through the pressure, in every regime
+    ref = simulate_fx(p, 60.0, EP, rate=10.0, dt=0.000625, comp=truth_composition())
     assert np.count_nonzero(ref["wob"] == 0.0) > 100  # the bit really lifts off, repeatedly
     errs = []
     for dt in (0.02, 0.01, 0.005):
-        r = simulate_fx(p, 60.0, EP, rate=10.0, dt=dt)
+        r = simulate_fx(p, 60.0, EP, rate=10.0, dt=dt, comp=truth_composition())
         errs.append(float(np.sqrt(np.mean((r["wob"] - ref["wob"]) ** 2))))
     orders = np.log2(np.array(errs[:-1]) / np.array(errs[1:]))
     assert np.all(orders >= 3.5), (errs, orders)  # measured 3.98, 3.99
@@ -50,9 +57,7 @@ def test_replay_locates_bit_lift_off_and_touchdown_with_effects():
 
 def test_flow_loss_candidate_is_exactly_the_line_drop():
     """p_cyl = p_gas - R v at every recorded sample."""
-    EP = T.zero_ep()
-    EP[T.FLOW_R_CAND] = 1e5
-    r = simulate_fx(paper_a(), 60.0, EP, rate=50.0)
+    r = simulate_fx(paper_a(), 60.0, [("flow_loss", {"resistance": 1e5})], rate=50.0)
     np.testing.assert_allclose(r["pressure"], r["gas_pressure"] - 1e5 * r["stroke_velocity"], atol=1e-6)
     assert np.max(np.abs(r["stroke_velocity"])) > 0.1
 
@@ -61,9 +66,7 @@ def test_dwell_stiction_lengthens_sticking():
     """Static friction growing with the time at rest holds the cylinder longer."""
     p = paper_a().replace(heave={"amplitude": 0.3})
     base = simulate_fx(p, 120.0, rate=50.0)
-    EP = T.zero_ep()
-    EP[T.DWELL_DF_TRUTH], EP[T.DWELL_TAU_TRUTH] = 15e3, 0.5
-    dw = simulate_fx(p, 120.0, EP, rate=50.0)
+    dw = simulate_fx(p, 120.0, [TruthDwell(dF=15e3, tau_d=0.5)], rate=50.0, comp=truth_composition())
     m = base["t"] > 24
     assert dw["stuck"][m].mean() > base["stuck"][m].mean() + 0.02
     assert np.std(dw["wob"][m]) > np.std(base["wob"][m])  # larger breakaway jumps reach the bit
@@ -72,9 +75,9 @@ def test_dwell_stiction_lengthens_sticking():
 def test_thermal_gas_at_rest_relaxes_to_the_isothermal_pressure():
     """Truth thermal model: stuck at rest the gas temperature relaxes to the wall's (theta -> 1)."""
     p = paper_a().replace(heave={"amplitude": 1e-6})  # essentially no heave: stays stuck at s = 0
-    EP = T.zero_ep()
-    EP[T.TH_GAMMA_TRUTH], EP[T.TH_TAU_TRUTH] = 1.4, 2.0
-    r = simulate_fx(p, 20.0, EP, rate=50.0)
+    r = simulate_fx(p, 20.0, [TruthThermalGas(gamma=1.4, tau_th=2.0)], rate=50.0,
+                    comp=truth_composition())
     assert np.all(r["stuck"] == 1.0)
-    np.testing.assert_allclose(r["theta"], 1.0, atol=1e-9)
+    slot = truth_composition().slots["gas_heat_transfer"][0]
+    np.testing.assert_allclose(r[f"effect_state_{slot}"], 1.0, atol=1e-9)  # theta, the effect's state  # theta, the effect's state
     np.testing.assert_allclose(r["pressure"], p.p0, rtol=1e-9)

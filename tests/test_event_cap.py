@@ -21,7 +21,8 @@ import pytest
 from heavecomp.params import paper_a
 from heavecomp.simulate import _kernel as K
 from heavecomp.simulate import simulate
-from heavecomp.simulate.core import _friction_vectors, check_events, default_dt
+from heavecomp.plants.cmc import plant_vectors
+from heavecomp.simulate.core import check_events, default_dt
 from heavecomp.simulate.excitation import make_heave
 from heavecomp.simulate.layout import SLIDING, STATS, STUCK
 
@@ -62,12 +63,12 @@ def test_one_step_from_a_saved_jonswap_state_reverses_then_sticks():
                                            "amplitude": None, "period": None, "ramp": None})
     h = 0.025
     hs = make_heave(p.heave, 3600.0, 0.5 * h)
-    law, PP = _friction_vectors(p)
+    pv = plant_vectors(p)
     state = np.array([-0.4330494954617954, -0.0038108388064242715, 0.020136018167088973, 0.05464465285339529])
     mode_dir = np.array([float(SLIDING), -1.0])
     stats = np.zeros(len(STATS))
     out = np.zeros((2, K.NCH))
-    K.advance(state, mode_dir, 479.625, 1, h, int(law.code), law.FP, PP, False, 0.0, 0.5 * h,
+    K.advance(state, mode_dir, 479.625, 1, h, pv.code, pv.FP, pv.PP, False, 0.0, 0.5 * h,
               hs.z, hs.dz, hs.ddz, out, 1, 0, stats)
     st = dict(zip(STATS, stats))
     assert st["event_cap_hits"] == 0

@@ -11,6 +11,7 @@ import pytest
 from heavecomp.friction import laws
 from heavecomp.friction.laws import FrictionLaw
 from heavecomp.params import paper_a
+from heavecomp.effects import model as effects_model
 from heavecomp.plants import cmc
 from heavecomp.simulate import _kernel as K
 from heavecomp.simulate import simulate
@@ -72,7 +73,7 @@ def test_kernel_rhs_equals_casadi_model_away_from_zero_velocity(model):
     PP = cmc.plant_vector(p)
     law = FrictionLaw.from_params(p.friction)
     eps = 1e-8  # |v| >= 1 mm/s >> eps: tanh(v/eps) is +-1 to the last bit
-    f = cmc.casadi_model(p, eps=eps)
+    f = effects_model.casadi_model(p, eps=eps)
     smooth = not law.has_stiction
     for s, v, yb, vb, zh, dzh, ddzh, u in _states(100, 2):
         xdot, y = f([s, v, yb, vb], [zh, dzh, ddzh, u])
@@ -108,64 +109,73 @@ def test_kernel_rhs_equals_casadi_model_away_from_zero_velocity(model):
         assert _close(k0[3], K.lower_accel(s, 0.0, yb, vb, zh, dzh, PP), 1.0)
 
 
-@pytest.mark.parametrize("model", MODELS)
-def test_effect_plant_without_effects_is_the_cmc_bit_for_bit(model):
-    """One stepper serves simulate() and the diagnosis: the effect-aware plant of
-    heavecomp.effects.terms (what the kernel integrates) with EP = 0 is the CMC of plants/cmc.py
-    exactly, so simulate() did not change when the effect hooks were added."""
-    from heavecomp.effects import terms
-
-    p = paper_a(model)
-    PP = cmc.plant_vector(p)
-    law = FrictionLaw.from_params(p.friction)
-    code, FP = law.code, law.FP
-    EP = terms.zero_ep()
+def _check_nominal_hooks(fn, code, FP, PP, EP):
+    """The composed hook functions ``fn`` with effect parameters EP are the CMC exactly."""
     for s, v, yb, vb, zh, dzh, ddzh, u in _states(200, 3):
         for cm in (0.0, 1.0):
-            for f in (terms.plant_fx, K.plant_fx):
-                pr, T, hold, dvb = f(s, v, yb, vb, 1.0, zh, dzh, ddzh, u, cm, PP, EP)
-                assert pr == cmc.gas_pressure(s, PP)
-                assert T == cmc.tension(s, v, yb, vb, zh, dzh, PP)
-                assert hold == cmc.holding_force(s, v, yb, vb, zh, dzh, ddzh, u, PP)
-                assert dvb == cmc.lower_accel_contact(s, v, yb, vb, zh, dzh, cm, PP)
+            pr, T, hold, dvb = fn["plant_fx"](s, v, yb, vb, 0.7, 0.3, 0.1, zh, dzh, ddzh, u, cm, PP, EP)
+            assert pr == cmc.gas_pressure(s, PP)
+            assert T == cmc.tension(s, v, yb, vb, zh, dzh, PP)
+            assert hold == cmc.holding_force(s, v, yb, vb, zh, dzh, ddzh, u, PP)
+            assert dvb == cmc.lower_accel_contact(s, v, yb, vb, zh, dzh, cm, PP)
         pr = cmc.gas_pressure(s, PP)
         for d in (1.0, -1.0):
             for a in (d * v, -1e-3):  # also a trial step past a reversal (a < 0)
-                assert K.friction_jump_fx(code, a, pr, 0.0, 0.0, FP, EP) == laws.friction_jump(code, a, pr, FP)
-            assert (K.sliding_friction_fx(code, d, v, pr, 0.0, 0.0, FP, EP)
+                assert fn["jump_fx"](code, a, pr, 0.7, 0.3, 0.1, FP, EP) == laws.friction_jump(code, a, pr, FP)
+            assert (fn["sliding_friction_fx"](code, d, v, pr, 0.7, 0.3, 0.1, FP, EP)
                     == cmc.sliding_friction(code, d, s, v, FP, PP))
-        assert K.static_limit_fx(code, pr, 0.0, 0.0, 3.0, FP, EP) == cmc.static_limit(code, s, FP, PP)
+        assert fn["static_limit_fx"](code, pr, 0.7, 0.3, 0.1, 3.0, FP, EP) == cmc.static_limit(code, s, FP, PP)
 
 
-def test_compiled_effect_terms_equal_python_originals():
-    """The kernel's compiled effect terms evaluate heavecomp.effects.terms (each effect on)."""
-    from heavecomp.effects import terms
+@pytest.mark.parametrize("model", MODELS)
+def test_effect_plant_without_effects_is_the_cmc_bit_for_bit(model):
+    """One stepper serves simulate() and the diagnosis: the plant's hook functions with no effect
+    (compiled: what simulate() integrates) and the library's with every effect off are the CMC of
+    plants/cmc.py exactly, so simulate() did not change when the effect hooks were added."""
+    from heavecomp.effects.compose import composition, library_composition
+
+    p = paper_a(model)
+    plant = cmc.plant_vectors(p)
+    none = composition(())
+    _check_nominal_hooks(K.compiled_hooks(none), plant.code, plant.FP, plant.PP, K.NO_EFFECTS)
+    lib = library_composition()
+    _check_nominal_hooks(lib.functions, plant.code, plant.FP, plant.PP, lib.ep([]))
+
+
+def test_compiled_effect_hooks_equal_python_originals():
+    """The kernel's compiled hook functions of the library (every effect on) and of the generator's
+    truth laws evaluate the same generated source as the numpy functions."""
+    from heavecomp.diagnosis.truth import TRUTH, truth_composition
+    from heavecomp.effects.compose import library_composition
+    from heavecomp.effects.registry import library
 
     p = paper_a("stribeck")
-    PP = cmc.plant_vector(p)
-    FP = FrictionLaw.from_params(p.friction).FP
+    plant = cmc.plant_vectors(p)
+    PP = plant.PP
     rng = np.random.default_rng(4)
-    EP = terms.zero_ep()
-    EP[[terms.LAG_T_TRUTH, terms.LAG_T_CAND, terms.LAG_TDOWN_CAND]] = 1.5, 0.5, 0.2
-    EP[[terms.DWELL_DF_TRUTH, terms.DWELL_TAU_TRUTH, terms.DWELL_A_CAND, terms.DWELL_BETA_CAND]] = 1e4, 1.0, 5e3, 0.3
-    EP[[terms.PF_K_TRUTH, terms.PF_PTH_TRUTH, terms.PF_DCP_CAND]] = 0.03, 0.9 * p.p0, 0.01
-    EP[[terms.FLOW_K_TRUTH, terms.FLOW_R_CAND, terms.GAS_LOSS_CAND]] = 3e5, 1e5, 5e4
-    EP[[terms.SD_CQ_TRUTH, terms.SD_C_CAND]] = 5e5, 2e4
-    for thermal in (False, True):
-        EP[[terms.TH_GAMMA_TRUTH, terms.TH_TAU_TRUTH, terms.GAS_N_CAND]] = (1.4, 4.0, 0.0) if thermal else (0, 0, 1.2)
+    lib_effects = [c(**c.from_x(c.x0())) for c in library().values() if c.kind == "plant"]
+    truth = [TRUTH["friction_lag"](lag_time_speed=1.5), TRUTH["dwell_stiction"](dF=1e4, tau_d=1.0),
+             TRUTH["pressure_friction"](k=0.03, p_th=0.9 * p.p0), TRUTH["gas_heat_transfer"](gamma=1.4, tau_th=4.0),
+             TRUTH["flow_loss"](K=3e5), TRUTH["string_damping"](c_q=5e5)]
+    for comp, effects in ((library_composition(), lib_effects), (truth_composition(), truth)):
+        EP = comp.ep(effects)
+        fc, fp = K.compiled_hooks(comp), comp.functions
         for s, v, yb, vb, zh, dzh, ddzh, u in _states(100, 5):
-            th, w, el, tau = rng.uniform(0.9, 1.1), abs(v) * rng.uniform(0.5, 1.5), rng.uniform(0, 2e4), rng.uniform(0, 5)
-            for a, b in zip(K.plant_fx(s, v, yb, vb, th, zh, dzh, ddzh, u, 1.0, PP, EP),
-                            terms.plant_fx(s, v, yb, vb, th, zh, dzh, ddzh, u, 1.0, PP, EP)):
+            x = (rng.uniform(0.9, 1.1), abs(v) * rng.uniform(0.5, 1.5), rng.uniform(0, 2e4))
+            tau = rng.uniform(0, 5)
+            for a, b in zip(fc["plant_fx"](s, v, yb, vb, *x, zh, dzh, ddzh, u, 1.0, PP, EP),
+                            fp["plant_fx"](s, v, yb, vb, *x, zh, dzh, ddzh, u, 1.0, PP, EP)):
                 assert _close(a, b, 1e5)
-            pr = terms.cylinder_pressure_fx(s, v, th, PP, EP)
+            pr = fp["cylinder_pressure_fx"](s, v, *x, PP, EP)
             for code in (laws.NONE, laws.STRIBECK, laws.EQ7):
-                assert _close(K.sliding_friction_fx(code, np.sign(v), v, pr, w, el, FP, EP),
-                              terms.sliding_friction_fx(code, np.sign(v), v, pr, w, el, FP, EP), 1e5)
-                assert _close(K.static_limit_fx(code, pr, w, el, tau, FP, EP),
-                              terms.static_limit_fx(code, pr, w, el, tau, FP, EP), 1e5)
-            assert _close(K.truth_thermal_rate(s, v, th, PP, EP), terms.truth_thermal_rate(s, v, th, PP, EP), 1.0)
-            for a, b in zip(K.lag_rates(v, w, el, FP, EP), terms.lag_rates(v, w, el, FP, EP)):
+                FP = plant.FP.copy()
+                FP[laws.VT] = 0.05 if code == laws.EQ7 else 0.0
+                assert _close(fc["sliding_friction_fx"](code, np.sign(v), v, pr, *x, FP, EP),
+                              fp["sliding_friction_fx"](code, np.sign(v), v, pr, *x, FP, EP), 1e5)
+                assert _close(fc["static_limit_fx"](code, pr, *x, tau, FP, EP),
+                              fp["static_limit_fx"](code, pr, *x, tau, FP, EP), 1e5)
+            for a, b in zip(fc["effect_rates"](s, v, pr, *x, PP, plant.FP, EP),
+                            fp["effect_rates"](s, v, pr, *x, PP, plant.FP, EP)):
                 assert _close(a, b, 1e4)
 
 
@@ -192,7 +202,7 @@ def _smooth_trajectory(p, eps, T, rate):
     import casadi as ca
     from scipy.integrate import solve_ivp
 
-    f = cmc.casadi_model(p, eps=eps)
+    f = effects_model.casadi_model(p, eps=eps)
     x, u = ca.SX.sym("x", 4), ca.SX.sym("u", 4)
     xdot, y = f(x, u)
     F = ca.Function("F", [x, u], [xdot, ca.jacobian(xdot, x), y[0]])
@@ -240,17 +250,17 @@ def test_advance_in_pieces_equals_one_call():
     """``K.advance`` may be called repeatedly (once per control interval): the mode and
     direction carried in ``mode_dir`` make the result independent of where the run is
     cut, also when a cut falls inside a stick phase."""
-    from heavecomp.simulate.core import _friction_vectors, run_kernel
+    from heavecomp.simulate.core import run_kernel
     from heavecomp.simulate.excitation import make_heave
 
     p = paper_a("stribeck")
     h, T, out_every = 0.01, 60.0, 5
     n = int(round(T / h))
     hs = make_heave(p.heave, n * h, 0.5 * h)
-    law, PP = _friction_vectors(p)
-    whole, st_whole, _ = run_kernel(law, PP, hs, h, n, out_every)
+    plant = cmc.plant_vectors(p)
+    whole, st_whole, _ = run_kernel(plant, hs, h, n, out_every)
     # 0.1 s pieces (a control interval); 600 cuts, many of them while stuck
-    parts, st_parts, _ = run_kernel(law, PP, hs, h, n, out_every, chunk_steps=10)
+    parts, st_parts, _ = run_kernel(plant, hs, h, n, out_every, chunk_steps=10)
     assert whole.shape == parts.shape
     assert np.count_nonzero(whole[:, K.CHANNELS.index("stuck")]) > 50
     np.testing.assert_allclose(parts, whole, rtol=1e-9, atol=1e-9)

@@ -1,7 +1,7 @@
 """Operating point and linearisation of the CMC -> ``control.StateSpace``.
 
 The linear model is obtained from the same symbolic equations the rest of the
-toolbox uses (:func:`heavecomp.plants.cmc.casadi_model`, casadi jacobians); no
+toolbox uses (:func:`heavecomp.effects.model.casadi_model`, casadi jacobians); no
 equation is restated here.
 
 The nonlinear model is driven by the heave *and its derivatives*,
@@ -42,8 +42,10 @@ import numpy as np
 
 from heavecomp.errors import ParameterError
 from heavecomp.friction.laws import FrictionLaw
-from heavecomp.plants.cmc import casadi_model
+from heavecomp.effects.model import casadi_model
 from heavecomp.plants.symbolic import casadi
+from heavecomp.effects.registry import resolve
+from heavecomp.effects.model import initial_effect_states
 
 log = logging.getLogger(__name__)
 
@@ -179,9 +181,11 @@ def _friction_params(params, friction: str):
         if cv is None:
             raise ParameterError("friction.viscous_coefficient: needed for the viscous linearisation "
                                  f"(friction.model = \"{params.friction.model}\" has none)")
-        # eq. 4 with F_S = F_C = C_p = 0 is the viscous law C_v v
+        # eq. 4 with F_S = F_C = C_p = 0 is the viscous law C_v v; v_S then multiplies nothing
+        # (F_S - F_C = 0): the set's own, or 1 m/s when the set's model has none
+        vs = params.friction.stribeck_velocity
         return params.replace(friction={"model": "stribeck", "static_force": 0.0, "coulomb_force": 0.0,
-                                        "stribeck_velocity": params.friction.stribeck_velocity or 1.0,
+                                        "stribeck_velocity": 1.0 if vs is None else vs,
                                         "viscous_coefficient": cv, "pressure_coefficient": 0.0,
                                         "tangential_velocity": None})
     if friction == "sliding":
@@ -191,11 +195,12 @@ def _friction_params(params, friction: str):
     raise ParameterError(f"friction = {friction!r}: must be one of {', '.join(FRICTION_MODES)}")
 
 
-def _eval_model(params, x, u, eps):
-    """Values and jacobians of the casadi model at (x, u)."""
+def _eval_model(params, x, u, eps, effects=()):
+    """Values and jacobians of the casadi model (with ``effects`` at its hooks) at (x, u)."""
+
     ca = casadi()
-    f = casadi_model(params, eps=eps)
-    X = ca.SX.sym("X", 4)
+    f = casadi_model(params, eps=eps, effects=effects)
+    X = ca.SX.sym("X", f.size1_in(0))
     U = ca.SX.sym("U", 4)
     xdot, y = f(X, U)
     J = ca.Function("J", [X, U], [xdot, y, ca.jacobian(xdot, X), ca.jacobian(xdot, U),
@@ -211,7 +216,8 @@ def _default_eps(params, velocity):
     return abs(velocity) / 25.0
 
 
-def operating_point(params, *, velocity: float | None = None, eps: float | None = None) -> OperatingPoint:
+def operating_point(params, *, velocity: float | None = None, eps: float | None = None,
+                    effects=()) -> OperatingPoint:
     """The CMC operating point (cmc-reference.md): s = 0, y_b = 0, at rest, WOB = W_0.
 
     Parameters
@@ -222,6 +228,8 @@ def operating_point(params, *, velocity: float | None = None, eps: float | None 
         platform moves with dz_h = -v0, so that the stroke velocity is v0.
     eps : float [m/s], optional
         Friction regularisation width (default |v0|/25 for laws with stiction).
+    effects : sequence, optional
+        Effects at the plant's hooks (:mod:`heavecomp.effects`); their states at rest follow x.
 
     Returns
     -------
@@ -231,16 +239,17 @@ def operating_point(params, *, velocity: float | None = None, eps: float | None 
     v0 = float(velocity or 0.0)
     if eps is None:
         eps = _default_eps(params, v0) if v0 != 0.0 else 1e-3
-    x = np.array([0.0, v0, 0.0, 0.0])
+
+    x = np.r_[0.0, v0, 0.0, 0.0, initial_effect_states(params, effects)]
     u = np.array([0.0, -v0, 0.0, 0.0])
-    xdot, y, *_ = _eval_model(params, x, u, eps)
+    xdot, y, *_ = _eval_model(params, x, u, eps, effects)
     xdot, y = xdot.ravel(), y.ravel()
     scale = params.k_eff * 1e-12 + 1e-9
     return OperatingPoint(x=x, u=u, y=y, xdot=xdot, equilibrium=bool(np.all(np.abs(xdot) < scale)), velocity=v0)
 
 
 def linearise_details(params, *, friction: str = "none", velocity: float | None = None,
-                      eps: float | None = None) -> Linearisation:
+                      eps: float | None = None, effects=()) -> Linearisation:
     """Linearise the CMC; returns the LTI model with the raw jacobians and the state shift.
 
     See :func:`linearise` for the parameters.
@@ -262,8 +271,10 @@ def linearise_details(params, *, friction: str = "none", velocity: float | None 
     if eps is not None and not (eps > 0 and math.isfinite(eps)):
         raise ParameterError(f"eps = {eps!r}: the friction regularisation width must be > 0 m/s")
 
-    op = operating_point(pl, velocity=v0, eps=eps)
-    _, _, A, B, C, D = _eval_model(pl, op.x, op.u, eps)
+
+    effects = resolve(effects)
+    op = operating_point(pl, velocity=v0, eps=eps, effects=effects)
+    _, _, A, B, C, D = _eval_model(pl, op.x, op.u, eps, effects)
     B0, B1, B2, Bu = B[:, 0], B[:, 1], B[:, 2], B[:, 3]
     N1 = B2.copy()
     N0 = B1 + A @ B2
@@ -275,21 +286,32 @@ def linearise_details(params, *, friction: str = "none", velocity: float | None 
     # the derivative inputs must have disappeared from the chosen outputs
     improper = np.abs(Cz @ N1 + D[idx, 1]) + np.abs(D[idx, 2])
     ref = np.abs(Cz).sum(axis=1) + np.abs(D[idx]).sum(axis=1) + 1e-30
+    outputs = list(OUTPUTS)
     if np.any(improper > 1e-9 * ref):
         bad = [OUTPUTS[i] for i in np.nonzero(improper > 1e-9 * ref)[0]]
-        raise RuntimeError(f"outputs {bad} depend on heave derivatives: no proper realisation")
+        if not effects:
+            raise RuntimeError(f"outputs {bad} depend on heave derivatives: no proper realisation")
+        # an effect can make an output follow the heave velocity directly (a laminar line: the
+        # pressure moves with R v = R (V - dz_h)): heave -> that output is improper; left out
+        log.warning("linearise: outputs %s follow the heave's derivatives with %s (improper); left out",
+                    ", ".join(bad), ", ".join(e.name for e in effects))
+        keep = [i for i, o in enumerate(OUTPUTS) if o not in bad]
+        outputs = [OUTPUTS[i] for i in keep]
+        Cz, Dz, Du = Cz[keep], Dz[keep], Du[keep]
     MC = pl.compensator.moving_mass
     friction_slope = float(-A[1, 1] * MC - pl.drill_string.damping)
     states = ["top_displacement", "top_velocity" if abs(N0[1]) < 1e-15 else "top_velocity_shifted",
               "lower_displacement", "lower_velocity"]
+    states += [f"{c.name}.{st}" for c in dict.fromkeys(type(e) for e in effects) for st in c.states]
     sys = ct.ss(A, np.column_stack([Bz, Bu]), Cz, np.column_stack([Dz, Du]),
-                states=states, inputs=list(INPUTS), outputs=list(OUTPUTS),
+                states=states, inputs=list(INPUTS), outputs=outputs,
                 name=f"cmc_linear_{friction}")
     return Linearisation(sys=sys, op=op, A=A, B=B, C=C, D=D, N0=N0, N1=N1,
                          friction_slope=friction_slope, params=pl)
 
 
-def linearise(params, *, friction: str = "none", velocity: float | None = None, eps: float | None = None):
+def linearise(params, *, friction: str = "none", velocity: float | None = None, eps: float | None = None,
+              effects=()):
     """Linearised CMC as a ``control.StateSpace`` with named signals.
 
     Parameters
@@ -305,6 +327,10 @@ def linearise(params, *, friction: str = "none", velocity: float | None = None, 
     eps : float [m/s], optional
         Regularisation width of sign(v) (default |v0|/25, so that tanh(v0/eps) is
         the exact sign to 1e-21 and the slope is the exact law's).
+    effects : sequence, optional
+        Effects at the plant's hooks (:mod:`heavecomp.effects`: instances, registered names or
+        ``(name, values)``), traced by casadi from the same source the stepper compiles; their
+        states follow the four plant states.
 
     Returns
     -------
@@ -322,7 +348,7 @@ def linearise(params, *, friction: str = "none", velocity: float | None = None, 
     with ``M = diag(M_c, m_b)``, ``K = [[k_gas + k_ds, -k_ds], [-k_ds, k_ds + k_F]]``;
     its DC gain heave -> WOB is ``-k_eff`` of paper A eq. 14.
     """
-    return linearise_details(params, friction=friction, velocity=velocity, eps=eps).sys
+    return linearise_details(params, friction=friction, velocity=velocity, eps=eps, effects=effects).sys
 
 
 # ----------------------------------------------------------------------------
@@ -357,7 +383,7 @@ def batch_matrices(*, gas_stiffness, moving_mass, lower_mass, string_stiffness, 
                    friction_stiffness=0.0):
     """LTI matrices of the linearised CMC for many parameter sets at once.
 
-    A vectorised restatement of the jacobians of :func:`heavecomp.plants.cmc.casadi_model`
+    A vectorised restatement of the jacobians of :func:`heavecomp.effects.model.casadi_model`
     at the operating point (pinned to :func:`linearise_details` by
     ``tests/test_analysis_frequency.py``), for sweeps where a casadi call per
     variation would dominate.  All arguments broadcast against each other.

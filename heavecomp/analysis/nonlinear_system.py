@@ -1,6 +1,6 @@
 """The CMC as a python-control nonlinear system (``control.nlsys``) with smooth friction and named signals.
 
-The right-hand side and the outputs are the casadi model of :func:`heavecomp.plants.cmc.casadi_model`
+The right-hand side and the outputs are the casadi model of :func:`heavecomp.effects.model.casadi_model`
 (the plant equations written once), evaluated numerically: nothing is restated here.  Use it to
 simulate with ``control.input_output_response``, to interconnect with your own controller
 (``control.interconnect`` by signal name) or to linearise with ``control.linearize``; the latter
@@ -31,7 +31,7 @@ from __future__ import annotations
 import numpy as np
 
 from heavecomp.analysis.linear import RAW_INPUTS, RAW_OUTPUTS, RAW_STATES
-from heavecomp.plants.cmc import casadi_model
+from heavecomp.effects.model import casadi_model
 from heavecomp.friction.laws import FrictionLaw
 from heavecomp.errors import ParameterError
 

@@ -35,9 +35,10 @@ from heavecomp.errors import InputError
 from heavecomp.friction.laws import FrictionLaw
 from heavecomp.params.budget import check_run_size
 from heavecomp.params.cmc import active
-from heavecomp.plants.cmc import plant_vector
+from heavecomp.effects.registry import resolve
+from heavecomp.plants.cmc import eigen_rate, plant_vector, plant_vectors
 from heavecomp.simulate import excitation
-from heavecomp.simulate.core import CSV_COLUMNS, SimulationResult, default_dt, plant_eigen_rate
+from heavecomp.simulate.core import CSV_COLUMNS, SimulationResult, default_dt, plant_stepper
 
 log = logging.getLogger(__name__)
 
@@ -107,7 +108,7 @@ def _percentile_ms(x, q):
 
 def simulate_closed_loop(params, controller="passive", duration: float = 120.0, *, dt: float | None = None,
                          heave=None, noise: Noise | None = Noise(), preview: str = "predicted",
-                         stats_start: float | None = None, progress=None, **options) -> ClosedLoopResult:
+                         stats_start: float | None = None, progress=None, effects=(), **options) -> ClosedLoopResult:
     """Simulate the CMC with an active cylinder under ``controller``.
 
     Parameters
@@ -126,6 +127,9 @@ def simulate_closed_loop(params, controller="passive", duration: float = 120.0, 
     preview : {"predicted", "perfect"}
         ``predicted``: the controller predicts heave from its measurements (AR);
         ``perfect``: it is given the true future heave (an upper bound).
+    effects : sequence, optional
+        Effects at the true plant's hooks (:mod:`heavecomp.effects`; the controller knows
+        them only if it was built with them).
     options
         :class:`~heavecomp.controllers.ControllerConfig` overrides (when
         ``controller`` is a name).
@@ -158,7 +162,7 @@ def simulate_closed_loop(params, controller="passive", duration: float = 120.0, 
         log.warning("dt = %g s does not divide the control interval %g s; using %g s", dt, Tc, Tc / n_sub)
     h = Tc / n_sub
     n_ctrl = int(math.ceil(duration / Tc - 1e-9))
-    check_run_size(params, duration=duration, h=h, n_steps=n_ctrl * n_sub, n_rows=n_ctrl + 1, n_cols=K.NCH, dt=dt, rate=act.control_rate, rate_fn=plant_eigen_rate)
+    check_run_size(params, duration=duration, h=h, n_steps=n_ctrl * n_sub, n_rows=n_ctrl + 1, n_cols=K.NCH, dt=dt, rate=act.control_rate, rate_fn=eigen_rate)
     sp = 0.5 * h
     # the true future heave is only needed for a perfect preview (a record must then reach past the end)
     horizon_t = (cfg.horizon + 2) * Tc if preview == "perfect" else 0.0
@@ -174,11 +178,10 @@ def simulate_closed_loop(params, controller="passive", duration: float = 120.0, 
         hs = excitation.from_series(t_in, z_in, n_ctrl * Tc + horizon_t, sp, src="heave")
     law = FrictionLaw.from_params(params.friction)
     PP = plant_vector(params)
-    smooth = not law.has_stiction
+    advance, state, smooth = plant_stepper(plant_vectors(params), resolve(effects))
     rng = np.random.default_rng(noise.seed if noise else 0)
     sig = np.array([noise.stroke, noise.pressure, noise.wob, noise.heave]) if noise else np.zeros(4)
 
-    state = np.zeros(4)
     mode_dir = np.array([float(K.STUCK), 1.0])
     stats = np.zeros(len(K.STATS))
     rows = np.empty((n_ctrl + 1, K.NCH))
@@ -197,7 +200,7 @@ def simulate_closed_loop(params, controller="passive", duration: float = 120.0, 
     t_wall = time.perf_counter()
     for k in range(n_ctrl + 1):
         t = k * Tc
-        K.advance(state, mode_dir, t, 0, h, law.code, law.FP, PP, smooth, u, sp, hs.z, hs.dz, hs.ddz,
+        advance(state, mode_dir, t, 0, h, law.code, law.FP, PP, smooth, u, sp, hs.z, hs.dz, hs.ddz,
                   rec, 1, 0, stats)
         rows[k] = rec[0]
         if k == n_ctrl:
@@ -230,7 +233,7 @@ def simulate_closed_loop(params, controller="passive", duration: float = 120.0, 
             previews.append(lp)
         for j in range(n_sub):
             u = u + min(max(u_cmd - u, -du_step), du_step)
-            K.advance(state, mode_dir, t + j * h, 1, h, law.code, law.FP, PP, smooth, u, sp, hs.z, hs.dz,
+            advance(state, mode_dir, t + j * h, 1, h, law.code, law.FP, PP, smooth, u, sp, hs.z, hs.dz,
                       hs.ddz, none_out, 1, 0, stats)
         if progress is not None and k % 200 == 0:
             progress(k / n_ctrl)

@@ -29,10 +29,11 @@ def run(args) -> int:
             params = params.replace(friction={"model": args.friction})
         header = f"checked copy of {args.source}"
         from heavecomp.params.budget import check_default_step
-        from heavecomp.simulate.core import default_dt, plant_eigen_rate
+        from heavecomp.plants.cmc import eigen_rate
+        from heavecomp.simulate.core import default_dt
 
         h = default_dt(params)
-        check_default_step(params, h, plant_eigen_rate)
+        check_default_step(params, h, eigen_rate)
         if not getattr(args, "quiet", False):
             print(f"{args.source}: valid (k_eff = {params.k_eff:.6g} N/m, p_0 = {params.p0:.6g} Pa, "
                   f"V_0 = {params.gas_volume:.4g} m^3, default step {h:.3g} s)", file=sys.stderr)

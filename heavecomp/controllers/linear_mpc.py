@@ -33,17 +33,16 @@ from heavecomp.controllers.base import Controller, ControllerConfig
 from heavecomp.controllers.estimation import DisturbanceObserver, HeavePredictor
 from heavecomp.controllers.model import controller_params, discrete_model
 from heavecomp.friction.laws import FrictionLaw
+from heavecomp.effects.registry import resolve
 
 log = logging.getLogger(__name__)
 KN = 1e3
 
 
-def controller_friction(params, config):
-    """The friction law the controller believes: forces scaled by ``friction_scale``."""
-    law = FrictionLaw.from_params(params.friction)
-    law.FP = law.FP.copy()
-    law.FP[[0, 1, 3, 4]] *= config.friction_scale  # F_S, F_C, C_v, C_p
-    return law
+def controller_friction(cparams):
+    """The friction law the controller believes (of :func:`controller_params`: forces scaled)."""
+
+    return FrictionLaw.from_params(cparams.friction)
 
 
 class LinearMPC(Controller):
@@ -51,15 +50,17 @@ class LinearMPC(Controller):
 
     name = "linear-mpc"
 
-    def __init__(self, params, config=None):
+    def __init__(self, params, config=None, effects=()):
         import osqp
         import scipy.sparse as sp
 
         config = config or ControllerConfig.from_params(params)
         self.params, self.config = params, config
         self.cparams = controller_params(params, config)
-        self.model = m = discrete_model(self.cparams, config.dt, config.model_frame)
-        self.law = controller_friction(self.cparams, config)
+
+        self.effects = resolve(effects)  # effects at the plant's hooks the controller's model knows
+        self.model = m = discrete_model(self.cparams, config.dt, config.model_frame, self.effects)
+        self.law = controller_friction(self.cparams)
         N, n = config.horizon, m.Ad.shape[0]
         self.N = N
         # condensed prediction x_k (k = 1..N) = Sx x0 + Su U + Sd Wd

@@ -1,6 +1,6 @@
 """The controller's discrete linear model, from the plant's casadi jacobians.
 
-No plant equation is restated: :func:`heavecomp.plants.cmc.casadi_model`
+No plant equation is restated: :func:`heavecomp.effects.model.casadi_model`
 (friction ``none``; the friction is a force input handled as a disturbance) is
 differentiated at the operating point (x = 0, heave 0, u = 0) and discretised
 exactly for piecewise-constant inputs (zero-order hold) with the control
@@ -35,7 +35,8 @@ import dataclasses
 
 import numpy as np
 
-from heavecomp.plants.cmc import casadi_model
+from heavecomp.effects.model import casadi_model, initial_effect_states
+from heavecomp.friction.laws import FORCE_KEYS
 from heavecomp.plants.symbolic import casadi
 
 OUT = ("wob", "stroke", "pressure")
@@ -58,10 +59,16 @@ class DiscreteModel:
 
 
 def controller_params(params, config):
-    """The parameters the controller *believes* (gas stiffness scaled for robustness studies)."""
+    """The parameters the controller *believes*: gas stiffness scaled by ``gas_stiffness_scale``
+    and the friction forces (:data:`heavecomp.friction.laws.FORCE_KEYS`) by ``friction_scale``,
+    for robustness studies; the one place both MPCs take them from."""
+
     if config.gas_stiffness_scale != 1.0:
-        return params.replace(compensator={"gas_stiffness": params.compensator.gas_stiffness
-                                           * config.gas_stiffness_scale})
+        params = params.replace(compensator={"gas_stiffness": params.compensator.gas_stiffness
+                                             * config.gas_stiffness_scale})
+    f = params.friction
+    if f.model != "none" and config.friction_scale != 1.0:
+        params = params.replace(friction={k: getattr(f, k) * config.friction_scale for k in FORCE_KEYS})
     return params
 
 
@@ -78,26 +85,28 @@ def earth_frame(f):
     coordinates).
     """
     ca = casadi()
-    xe = ca.SX.sym("xe", 4)
+    n = f.size1_in(0)  # 4 plant states, then the effects' states (unchanged by the frame)
+    xe = ca.SX.sym("xe", n)
     u = ca.SX.sym("u", 4)
-    x = ca.vertcat(xe[0] - u[0], xe[1] - u[1], xe[2], xe[3])
+    x = ca.vertcat(xe[0] - u[0], xe[1] - u[1], xe[2:])
     xdot, y = f(x, u)
-    xedot = xdot + ca.vertcat(u[1], u[2], 0, 0)
-    dep = ca.Function("d", [xe, u], [ca.jacobian(xedot, u[2])])(np.zeros(4), np.zeros(4))
+    xedot = xdot + ca.vertcat(u[1], u[2], ca.SX.zeros(n - 2))
+    dep = ca.Function("d", [xe, u], [ca.jacobian(xedot, u[2])])(np.zeros(n), np.zeros(4))
     if np.max(np.abs(np.array(dep))) > 1e-9:
         raise ValueError("earth_frame: the model's dynamics depend on the heave acceleration in the earth frame")
     return ca.Function("cmc_earth", [xe, u], [xedot, y], ["x", "u"], ["xdot", "y"])
 
 
-def controller_model(params, *, eps=None, frame: str = "earth"):
-    """The casadi model the controllers predict with (``frame``: see the module docstring)."""
+def controller_model(params, *, eps=None, frame: str = "earth", effects=()):
+    """The casadi model the controllers predict with (``frame``: see the module docstring;
+    ``effects``: effects at the plant's hooks the controller knows, :mod:`heavecomp.effects`)."""
     if frame not in FRAMES:
         raise ValueError(f"model frame {frame!r}: not one of {', '.join(FRAMES)}")
-    f = casadi_model(params, eps=eps)
+    f = casadi_model(params, eps=eps, effects=effects)
     return earth_frame(f) if frame == "earth" else f
 
 
-def discrete_model(params, Ts: float, frame: str = "earth") -> DiscreteModel:
+def discrete_model(params, Ts: float, frame: str = "earth", effects=()) -> DiscreteModel:
     """Linearise the frictionless CMC at the operating point and discretise (ZOH).
 
     Parameters
@@ -107,16 +116,22 @@ def discrete_model(params, Ts: float, frame: str = "earth") -> DiscreteModel:
         Control interval.
     frame : {"earth", "stroke"}
         Coordinates of the top mass (module docstring).
+    effects : sequence, optional
+        Effects at the plant's hooks the model includes (their states follow the plant's four,
+        linearised about their values at rest, :func:`heavecomp.effects.model.initial_effect_states`).
     """
     from scipy.linalg import expm
 
+
     ca = casadi()
-    f = controller_model(params.replace(friction={"model": "none"}), frame=frame)
-    x = ca.SX.sym("x", 4)
+    nominal = params.replace(friction={"model": "none"})
+    f = controller_model(nominal, frame=frame, effects=effects)
+    nx = f.size1_in(0)
+    x = ca.SX.sym("x", nx)
     u = ca.SX.sym("u", 4)
     xdot, y = f(x, u)
     J = ca.Function("J", [x, u], [ca.jacobian(xdot, x), ca.jacobian(xdot, u), ca.jacobian(y, x), ca.jacobian(y, u)])
-    x0, u0 = np.zeros(4), np.zeros(4)
+    x0, u0 = np.r_[np.zeros(4), initial_effect_states(nominal, effects)], np.zeros(4)
     Ac, Bfull, Cy, Dy = (np.array(M) for M in J(x0, u0))
     y0 = np.array(f(x0, u0)[1]).ravel()
     Bu = Bfull[:, 3:4]

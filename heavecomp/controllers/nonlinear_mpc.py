@@ -1,6 +1,6 @@
 """Nonlinear MPC (casadi: SQP with qrqp, or ipopt) on the smooth-friction CMC, warm-started.
 
-Prediction model: :func:`heavecomp.plants.cmc.casadi_model` (through
+Prediction model: :func:`heavecomp.effects.model.casadi_model` (through
 :func:`heavecomp.controllers.model.controller_model`: the top mass in the earth
 frame by default) with the friction law of the parameter file (paper A eq. 4/6/7) regularised with width
 ``friction_eps`` (``sign(v) -> tanh(v/eps)``), integrated by RK4 with two
@@ -37,6 +37,7 @@ import numpy as np
 from heavecomp.controllers.linear_mpc import KN, LinearMPC
 from heavecomp.controllers.model import controller_model
 from heavecomp.plants.symbolic import casadi
+from heavecomp.effects.model import initial_effect_states
 
 log = logging.getLogger(__name__)
 
@@ -66,37 +67,32 @@ class NonlinearMPC(LinearMPC):
     name = "nonlinear-mpc"
     substeps = 2
 
-    def __init__(self, params, config=None):
-        super().__init__(params, config)
+    def __init__(self, params, config=None, effects=()):
+        super().__init__(params, config, effects)
         self._build()
-
-    def _model_params(self):
-        p, c = self.cparams, self.config
-        if p.friction.model == "none" or c.friction_scale == 1.0:
-            return p
-        f = p.friction
-        return p.replace(friction={k: getattr(f, k) * c.friction_scale for k in
-                                   ("static_force", "coulomb_force", "viscous_coefficient", "pressure_coefficient")})
 
     def _build(self):
         ca = casadi()
         cfg, N = self.config, self.N
-        mp = self._model_params()
-        f = controller_model(mp, eps=cfg.friction_eps, frame=cfg.model_frame)
+
+        mp = self.cparams
+        f = controller_model(mp, eps=cfg.friction_eps, frame=cfg.model_frame, effects=self.effects)
         self._f = f
+        n = f.size1_in(0)  # 4 plant states, then the known effects' states
+        self._x_op = np.r_[np.zeros(4), initial_effect_states(mp, self.effects)]  # operating point
         W0 = mp.operating_point.wob_setpoint
         Ts, M = cfg.dt, self.substeps
         h = Ts / M
-        x = ca.SX.sym("x", 4)
+        x = ca.SX.sym("x", n)
         uu = ca.SX.sym("u", 4)  # [z, dz, ddz, force]
         F = ca.Function("F", [x, uu], [rk4_steps(f, x, uu, h, M)])
         Y = ca.Function("Y", [x, uu], [f(x, uu)[1][0]])
 
-        X = ca.SX.sym("X", 4, N + 1)
+        X = ca.SX.sym("X", n, N + 1)
         U = ca.SX.sym("U", N)              # kN
-        P = ca.SX.sym("P", 4 + 3 * (N + 1) + 2)  # x0, heave (N+1 x 3), d [kN], u_prev [kN]
-        x0 = P[0:4]
-        H = ca.reshape(P[4:4 + 3 * (N + 1)], 3, N + 1)
+        P = ca.SX.sym("P", n + 3 * (N + 1) + 2)  # x0, heave (N+1 x 3), d [kN], u_prev [kN]
+        x0 = P[0:n]
+        H = ca.reshape(P[n:n + 3 * (N + 1)], 3, N + 1)
         d = P[-2]
         up = P[-1]
         g = [X[:, 0] - x0]
@@ -134,14 +130,14 @@ class NonlinearMPC(LinearMPC):
             # "Search_Direction_Becomes_Too_Small": the SQP step is negligible (converged/stalled)
             self._ok = _OK + ("Maximum_Iterations_Exceeded", "SOLVER_RET_LIMITED",
                               "Search_Direction_Becomes_Too_Small")
-        nx = 4 * (N + 1)
+        nx = n * (N + 1)
         umax, dumax = cfg.u_max / KN, cfg.du_max / KN
         self._lbx = np.r_[-np.inf * np.ones(nx), -umax * np.ones(N)]
         self._ubx = np.r_[np.inf * np.ones(nx), umax * np.ones(N)]
-        ng = 4 + N * 5
+        ng = n + N * (n + 1)
         lbg, ubg = np.zeros(ng), np.zeros(ng)
         for k in range(N):
-            i = 4 + 5 * k + 4
+            i = n + (n + 1) * k + n
             lbg[i], ubg[i] = -dumax, dumax
         self._lbg, self._ubg = lbg, ubg
         self._nx = nx
@@ -158,11 +154,11 @@ class NonlinearMPC(LinearMPC):
         H, fff = self._estimate(t, meas, preview)
         self._last = (meas.u_active, H[0].copy(), float(fff[0]))
         N = self.N
-        xh = self.observer.x.copy()
+        xh = self.observer.x + self._x_op
         # the friction the observer attributes to the top mass minus what the smooth model predicts now
         f_model = float(self._fric(xh, np.r_[H[0], 0.0]))
         d_res = self.observer.d + float(fff[0]) - f_model
-        lim = 2.0 * (self.law.FP[0] + self.law.FP[4] * abs(meas.pressure)) + 5e3
+        lim = 2.0 * float(self.law.static_limit(meas.pressure)) + 5e3  # twice the law's static limit
         d_res = float(np.clip(d_res, -lim, lim))
         P = np.r_[xh, H.ravel(), d_res / KN, self.u_prev / KN]
         if self._w0 is None:
@@ -180,7 +176,7 @@ class NonlinearMPC(LinearMPC):
         except RuntimeError as exc:  # casadi raises on evaluation errors
             status, ok = f"error: {exc}", False
         if ok:
-            Xs = wsol[:self._nx].reshape(4, N + 1, order="F")
+            Xs = wsol[:self._nx].reshape(-1, N + 1, order="F")
             Us = wsol[self._nx:]
             # warm start: shift the plan one interval
             Xn = np.hstack([Xs[:, 1:], Xs[:, -1:]])

@@ -40,8 +40,9 @@ import time
 
 import numpy as np
 
-from heavecomp.effects import terms as T
 from heavecomp.effects.candidates import CANDIDATES, ParameterMismatch, get
+from heavecomp.effects.compose import library_composition
+from heavecomp.plants.cmc import plant_vectors
 from heavecomp.errors import InputError
 from heavecomp.estimator import GapEstimator
 from heavecomp.diagnosis import where as W
@@ -62,14 +63,7 @@ class Replay:
     h: float
     n_steps: int
     hs: object
-    code: int
-    FP: np.ndarray
-    PP: np.ndarray
-
-
-def _vectors(params):
-    law = FrictionLaw.from_params(params.friction)
-    return law.code, law.FP.copy(), plant_vector(params)
+    plant: object  # PlantVectors of the nominal parameters
 
 
 class GapDiagnoser(GapEstimator):
@@ -167,8 +161,8 @@ class GapDiagnoser(GapEstimator):
         h = replay_dt(self.nominal)
         n_steps = int(math.ceil(run.t[-1] / h - 1e-9))
         hs = heave_samples(run, h, n_steps)
-        code, FP, PP = _vectors(self.nominal)
-        rp = Replay(run.t, h, n_steps, hs, code, FP, PP)
+        rp = Replay(run.t, h, n_steps, hs, plant_vectors(self.nominal))
+        PP = rp.plant.PP
         rp.bounds, rp.starts, rp.reinit = [(0, n_steps)], [None], np.zeros(run.t.size, bool)
         if self.segment:
             rp.bounds, rp.starts, rp.reinit = self._segments(run, h, n_steps, PP)
@@ -213,22 +207,24 @@ class GapDiagnoser(GapEstimator):
 
         rp = self._rp
         hs = rp.hs if hs is None else hs
-        code, FP, PP = rp.code, rp.FP, rp.PP
-        EP = T.zero_ep()
+        plant = rp.plant
+        comp = library_composition()
+        effects = []
         shift = None
         for name, values in config:
             cls = get(name)
             if cls.kind == "plant":
-                cls.write_ep(values, EP)
+                effects.append(cls(**values))
             elif cls.kind == "nominal":
-                code, FP, PP = _vectors(ParameterMismatch.apply(self.nominal, values))
+                plant = plant_vectors(ParameterMismatch.apply(self.nominal, values))
             else:
                 shift = (values["channel"], values["delay"])
+        EP = comp.ep(effects)
         n = rp.n_steps if t_end is None else min(rp.n_steps, int(math.ceil(t_end / rp.h)) + 2)
         if self.segment:
-            out = run_segments(code, FP, PP, EP, hs, rp.h, rp.bounds, rp.starts, n + 1)
+            out = run_segments(plant, comp, EP, hs, rp.h, rp.bounds, rp.starts, n + 1)
         else:
-            out = run_fx(code, FP, PP, EP, hs, rp.h, n, 1)
+            out = run_fx(plant, comp, EP, hs, rp.h, n, 1)
         tg = out[:, 0]
         t = rp.t if t_end is None else rp.t[rp.t <= tg[-1]]
         res = {}
@@ -236,7 +232,7 @@ class GapDiagnoser(GapEstimator):
             res[c] = np.interp(t, tg, out[:, SC.index(c)])
         if shift is not None:
             c, dly = shift
-            res[c] = np.interp(t - dly, tg, out[:, SC.index(c)])
+            res[c] = get("sensor_delay").apply(t, tg, out[:, SC.index(c)], dly)
         res["t"] = t
         res["_grid"] = out
         return res

@@ -1,7 +1,8 @@
 """Withheld-effect benchmark: runs generated with an effect the diagnosis does not know.
 
-Each effect is generated with its *truth* law (``truth_*`` terms of
-:mod:`heavecomp.effects.terms`), never with the candidate's equations:
+Each effect is generated with its *truth* law (the generator's own effect classes,
+:mod:`heavecomp.diagnosis.truth`, plugged into the plant's hooks), never with the candidate's
+equations:
 
 ======================  =====================================  ===========================================
 effect                  generated with                          fitted with (candidate)
@@ -28,11 +29,12 @@ import math
 
 import numpy as np
 
-from heavecomp.effects import terms as T
 from heavecomp.diagnosis.data import check_run, heave_samples, MeasuredRun
-from heavecomp.diagnosis.estimator import _vectors, GapDiagnoser
+from heavecomp.diagnosis.estimator import GapDiagnoser
 from heavecomp.params import paper_a
 from heavecomp.simulate import excitation
+from heavecomp.diagnosis.truth import TRUTH, truth_composition
+from heavecomp.plants.cmc import plant_vectors
 
 NOISE = {"heave": 0.002, "stroke": 0.002, "pressure": 2e3, "wob": 400.0}  #: 1-sigma noise [SI]
 CASES = ("none", "friction_lag", "dwell_stiction", "pressure_friction", "gas_heat_transfer", "flow_loss",
@@ -80,7 +82,7 @@ STICK_MIN = 0.15  #: dwell stiction is planted only where the compensator is stu
 
 
 def _draw_effect(name, rng, params):
-    """Random truth parameters of one effect (its truth law, :mod:`heavecomp.effects.terms` ``truth`` side).
+    """Random truth parameters of one effect (its truth law, :mod:`heavecomp.diagnosis.truth`).
 
     Returns ``(parameters, magnitude, cap)``: ``magnitude`` names the parameter that sets the size of
     the effect (``None``: no size knob, only a redraw changes it) and ``cap`` its largest plausible value.
@@ -122,30 +124,17 @@ def _scaled(desc, magnitude, factor, cap):
 
 
 def _effect_terms(name, desc, params):
-    """(EP, extra) of a truth effect: extra is ("lag", channel, tau) for a sensor lag, ("params", changes)
-    for wrong nominal parameters, else None."""
-    EP = T.zero_ep()
-    if name == "friction_lag":
-        EP[T.LAG_T_TRUTH] = desc["lag_time_speed"]
-    elif name == "dwell_stiction":
-        EP[T.DWELL_DF_TRUTH], EP[T.DWELL_TAU_TRUTH] = desc["dF"], desc["tau_d"]
-    elif name == "pressure_friction":
-        EP[T.PF_K_TRUTH], EP[T.PF_PTH_TRUTH] = desc["k"], desc["p_th"]
-    elif name == "gas_heat_transfer":
-        EP[T.TH_GAMMA_TRUTH], EP[T.TH_TAU_TRUTH] = desc["gamma"], desc["tau_th"]
-    elif name == "flow_loss":
-        EP[T.FLOW_K_TRUTH] = desc["K"]
-    elif name == "string_damping":
-        EP[T.SD_CQ_TRUTH] = desc["c_q"]
-    elif name == "sensor_delay":
-        return EP, ("lag", desc["channel"], desc["lag_time"])
-    elif name == "parameter_mismatch":
+    """(truth effects, extra) of an effect: the truth-law instances at the plant's hooks; extra is
+    ("lag", channel, tau) for a sensor lag, ("params", changes) for wrong nominal parameters, else None."""
+    if name == "sensor_delay":
+        return [], ("lag", desc["channel"], desc["lag_time"])
+    if name == "parameter_mismatch":
         ch = {}
         for path, f in desc.items():
             table, key = path.split(".")
             ch.setdefault(table, {})[key] = getattr(getattr(params, table), key) * (1 + f)
-        return EP, ("params", ch)
-    return EP, None
+        return [], ("params", ch)
+    return [TRUTH[name](**desc)], None
 
 
 def _public(name, desc, params):
@@ -185,22 +174,23 @@ class _Sea:
                       "median_dwell": float(np.median(dwell)) if dwell.size else 0.0}
 
     def sim(self, parts, hs=None, grid=False):
-        """Clean channels of the truth model with the effects ``[(name, EP, extra), ...]``."""
+        """Clean channels of the truth model with the effects ``[(name, truth effects, extra), ...]``."""
         from scipy.signal import lfilter
 
         from heavecomp.diagnosis.stepper import CHANNELS as SC, run_fx
 
-        EPs = T.zero_ep()
+        effects = []
         prm = self.nominal
         post = []
-        for _, EPe, extra in parts:
-            EPs += EPe
+        for _, eff, extra in parts:
+            effects += eff
             if extra is not None and extra[0] == "params":
                 prm = prm.replace(**extra[1])
             elif extra is not None:
                 post.append(extra)
-        code, FP, PP = _vectors(prm)
-        out = run_fx(code, FP, PP, EPs, self.hs if hs is None else hs, self.h, self.n_steps, self.out_every)
+        comp = truth_composition()
+        out = run_fx(plant_vectors(prm), comp, comp.ep(effects), self.hs if hs is None else hs, self.h,
+                     self.n_steps, self.out_every)
         cols = {c: out[:, SC.index(c)].copy() for c in ("heave",) + self.OUT}
         dt = out[1, 0] - out[0, 0]
         for _, ch, tau in post:  # first-order sensor lag (causal IIR)
@@ -249,8 +239,8 @@ def _plant(name, rng, sea, nominal, target=None):
         return None  # a dwell effect needs time at rest: redraw the sea
 
     def measure(d):
-        EP, extra = _effect_terms(name, d, nominal)
-        part = (name, EP, extra)
+        eff, extra = _effect_terms(name, d, nominal)
+        part = (name, eff, extra)
         return (part,) + sea.gap([part])
 
     part, g, weak = measure(desc)

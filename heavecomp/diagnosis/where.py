@@ -7,6 +7,7 @@ import math
 import numpy as np
 
 from heavecomp.diagnosis.data import uniform
+from heavecomp.plants.cmc import eigenfrequencies as _eigenfrequencies
 
 REGIMES = ("stuck", "breakaway", "sliding_accelerating", "sliding_decelerating")
 BANDS = ("below_wave", "wave", "resonance", "above")
@@ -15,16 +16,9 @@ SEGMENT_LENGTH = 5.0    #: s, window of the rolling residual power for "segments
 
 
 def eigenfrequencies(params) -> list[float]:
-    """Undamped eigenfrequencies [Hz] of the linearised frictionless CMC: sliding (2 DOF:
-    top mass on the gas spring, lower mass on string and formation) and stuck (lower mass on
-    k_ds + k_F)."""
-    c, ds, fo = params.compensator, params.drill_string, params.formation
-    K = np.array([[c.gas_stiffness + ds.stiffness, -ds.stiffness], [-ds.stiffness, ds.stiffness + fo.stiffness]])
-    M = np.diag([c.moving_mass, ds.lower_mass])
-    lam = np.linalg.eigvals(np.linalg.solve(M, K)).real
-    f = sorted(float(np.sqrt(max(x, 0.0)) / (2 * np.pi)) for x in lam)
-    f.append(float(np.sqrt((ds.stiffness + fo.stiffness) / ds.lower_mass) / (2 * np.pi)))
-    return f
+    """Undamped eigenfrequencies [Hz] of the plant's linear model (:func:`heavecomp.plants.cmc.eigenfrequencies`)."""
+
+    return _eigenfrequencies(params)
 
 
 def wave_band(t, z) -> tuple[float, float]:

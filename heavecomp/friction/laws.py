@@ -6,7 +6,7 @@ only.  The same source is
 - compiled by numba for the exact stick-slip time stepper
   (:mod:`heavecomp.simulate._kernel`),
 - traced by casadi (``np.exp`` on an ``SX`` calls ``casadi.exp``) for
-  linearisation, MPC and fitting (:func:`heavecomp.plants.cmc.casadi_model`),
+  linearisation, MPC and fitting (:func:`heavecomp.effects.model.casadi_model`),
 - vectorised over numpy arrays for plots and analysis.
 
 Every law with stiction is split as ``F_f(v, p) = J(v, p) sign(v) + K(v, p)``:
@@ -25,14 +25,21 @@ Law codes: ``NONE = 0``, ``STRIBECK = 1`` (eq. 4), ``EQ6 = 2``, ``EQ7 = 3``.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
-from heavecomp.errors import did_you_mean, ParameterError
+from heavecomp.errors import ParameterError, did_you_mean
 
 NONE, STRIBECK, EQ6, EQ7 = 0, 1, 2, 3
+#: the friction models, written once: parameter-file name -> law code
 CODES = {"none": NONE, "stribeck": STRIBECK, "rotating_eq6": EQ6, "rotating_eq7": EQ7}
+#: FP layout: parameter-file names in vector order; the index constants below are generated from it
 FP_NAMES = ("static_force", "coulomb_force", "stribeck_velocity", "viscous_coefficient",
             "pressure_coefficient", "tangential_velocity")
+FS, FC, VS, CV, CP, VT = range(len(FP_NAMES))
+#: the parameters that scale the friction force (a "friction x k" study scales exactly these)
+FORCE_KEYS = ("static_force", "coulomb_force", "viscous_coefficient", "pressure_coefficient")
 
 
 # ----------------------------------------------------------------------------
@@ -45,7 +52,12 @@ def stribeck_curve(speed, FS, FC, vS):
     ``speed`` is |v| for eq. 4 and the total sliding speed sqrt(v_a^2 + v_t^2)
     for eqs. 6-7 (paper A eq. 8).
     """
-    return FC + (FS - FC) * np.exp(-speed / vS)
+    return FC + stribeck_excess(speed, FS, FC, vS)
+
+
+def stribeck_excess(speed, FS, FC, vS):
+    """(F_S - F_C) exp(-speed / v_S) — the Stribeck curve's excess over Coulomb friction [N]."""
+    return (FS - FC) * np.exp(-speed / vS)
 
 
 def friction_jump(code, a, p, FP):
@@ -73,11 +85,11 @@ def friction_jump(code, a, p, FP):
     if code == STRIBECK:
         # beyond v = 0 (a < 0, only in the stepper's trial steps) the magnitude is held at its
         # v = 0 value: the analytic continuation exp(-a/v_S) explodes within a few v_S
-        return stribeck_curve(np.maximum(a, 0.0), FP[0], FP[1], FP[2]) + FP[4] * np.abs(p)
+        return stribeck_curve(np.maximum(a, 0.0), FP[FS], FP[FC], FP[VS]) + FP[CP] * np.abs(p)
     if code == EQ6:
-        return stribeck_curve(np.sqrt(a * a + FP[5] * FP[5]), FP[0], FP[1], FP[2]) + FP[4] * np.abs(p)
+        return stribeck_curve(np.sqrt(a * a + FP[VT] * FP[VT]), FP[FS], FP[FC], FP[VS]) + FP[CP] * np.abs(p)
     if code == EQ7:
-        return FP[4] * np.abs(p)
+        return FP[CP] * np.abs(p)
     return 0.0 * a
 
 
@@ -91,11 +103,11 @@ def friction_cont(code, v, p, FP):
     (viscous-like around v_a = 0, slope F_0(v_t)/v_t + C_v).
     """
     if code == EQ7:
-        speed = np.sqrt(v * v + FP[5] * FP[5])
-        return stribeck_curve(speed, FP[0], FP[1], FP[2]) * v / speed + FP[3] * v
+        speed = np.sqrt(v * v + FP[VT] * FP[VT])
+        return stribeck_curve(speed, FP[FS], FP[FC], FP[VS]) * v / speed + FP[CV] * v
     if code == NONE:
         return 0.0 * v
-    return FP[3] * v
+    return FP[CV] * v
 
 
 def friction_smooth(code, v, p, FP, eps):
@@ -113,6 +125,22 @@ def friction_exact(code, v, p, FP):
     return friction_jump(code, np.abs(v), p, FP) * np.sign(v) + friction_cont(code, v, p, FP)
 
 
+def steepest_slope(code, FP) -> float:
+    """Steepest slope |dF_f/dv| of the law near v = 0 [N s/m] (sets the stepper's default step).
+
+    Notes
+    -----
+    eqs. 4 and 6: max(C_v, (F_S - F_C)/v_S) (the Stribeck drop at 0+; for eq. 6 an upper bound);
+    eq. 7: F_0(v_t)/v_t + C_v (the viscous-like slope of K at v_a = 0); ``none``: 0.
+    ``tests/test_conformance.py`` pins it to the laws' numerical derivatives.
+    """
+    if code == NONE:
+        return 0.0
+    if code == EQ7:
+        return max(FP[CV], (FP[FC] + (FP[FS] - FP[FC]) * math.exp(-FP[VT] / FP[VS])) / FP[VT] + FP[CV])
+    return max(FP[CV], (FP[FS] - FP[FC]) / FP[VS])
+
+
 def hydromechanical_friction(F_p, v, eta):
     """Paper A eqs. 1-3: friction from a constant hydromechanical efficiency [N].
 
@@ -127,6 +155,37 @@ def hydromechanical_friction(F_p, v, eta):
     positive = F_p * v > 0
     mag = np.where(positive, (1.0 - eta) * np.abs(F_p), (1.0 / eta - 1.0) * np.abs(F_p))
     return mag * np.sign(v)
+
+
+# ----------------------------------------------------------------------------
+# parameters -> (code, FP), written once
+# ----------------------------------------------------------------------------
+#: the FP entries each friction model uses (the others must be absent, i.e. None, or are ignored)
+MODEL_KEYS = {"none": (), "stribeck": FP_NAMES[:VT], "rotating_eq6": FP_NAMES, "rotating_eq7": FP_NAMES}
+
+
+def law_vector(model, values):
+    """``(code, FP)`` of a friction model from its named parameters [SI].
+
+    Every key the model uses (:data:`MODEL_KEYS`) must be a number: a missing one raises
+    :class:`heavecomp.errors.ParameterError` naming it (no silent default).  Keys the model does
+    not use enter FP as 0 (their terms vanish; ``none`` computes no friction at all).  Rotating
+    models with ``v_t = 0`` reduce to eq. 4 and get its code (eq. 7's v/|v| needs v_t > 0).
+    """
+
+    used = MODEL_KEYS[model]
+    FP = np.zeros(len(FP_NAMES))
+    for i, key in enumerate(FP_NAMES):
+        val = values.get(key)
+        if val is None:
+            if key in used:
+                raise ParameterError(f"friction.{key}: missing required key for model = \"{model}\"")
+            continue
+        FP[i] = float(val)
+    code = CODES[model]
+    if code in (EQ6, EQ7) and FP[VT] == 0.0:
+        code = STRIBECK
+    return code, FP
 
 
 # ----------------------------------------------------------------------------
@@ -158,27 +217,26 @@ class FrictionLaw:
             raise ParameterError(f"friction.model = {model!r} is not one of {', '.join(CODES)}"
                                  f"{did_you_mean(model, CODES)}")
         self.model = model
-        vt = tangential_velocity or 0.0
-        # eqs. 6 and 7 reduce to eq. 4 at v_t = 0 (and eq. 7's v/|v| needs v_t > 0)
-        self.code = STRIBECK if (CODES[model] in (EQ6, EQ7) and vt == 0.0) else CODES[model]
-        self.FP = np.array([static_force or 0.0, coulomb_force or 0.0, stribeck_velocity or 1.0,
-                            viscous_coefficient or 0.0, pressure_coefficient or 0.0, vt], dtype=float)
+        self.code, self.FP = law_vector(model, dict(zip(FP_NAMES, (
+            static_force, coulomb_force, stribeck_velocity, viscous_coefficient, pressure_coefficient,
+            tangential_velocity))))
 
     @classmethod
     def from_params(cls, friction) -> "FrictionLaw":
         """From a :class:`heavecomp.params.cmc.Friction` table."""
-        return cls(friction.model, friction.static_force, friction.coulomb_force, friction.stribeck_velocity,
-                   friction.viscous_coefficient, friction.pressure_coefficient, friction.tangential_velocity)
+        law = object.__new__(cls)
+        law.model = friction.model
+        law.code, law.FP = law_vector(friction.model, {k: getattr(friction, k) for k in FP_NAMES})
+        return law
 
     @property
     def has_stiction(self) -> bool:
         """True when the law has a set-valued part at v = 0 for some pressure."""
-        FS, FC, vS, Cv, Cp, vt = self.FP
         if self.code == NONE:
             return False
         if self.code == EQ7:
-            return Cp > 0
-        return FS > 0 or Cp > 0
+            return self.FP[CP] > 0
+        return self.FP[FS] > 0 or self.FP[CP] > 0
 
     def force(self, v, p=0.0):
         """Exact friction for sliding velocity ``v`` [m/s] at pressure ``p`` [Pa]; 0 at v = 0."""

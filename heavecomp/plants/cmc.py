@@ -4,7 +4,8 @@ Reference structure: ``docs/contracts/parameter-file.md`` (paper A, section 4).
 The functions below are scalar and use ``np.*`` only, so one source serves
 
 - the compiled exact stick-slip stepper (:mod:`heavecomp.simulate._kernel`, numba),
-- the symbolic model (:func:`casadi_model`) for linearisation, MPC and fitting,
+- (the symbolic model for linearisation, MPC and fitting, with effects at the hooks, is
+  :func:`heavecomp.effects.model.casadi_model`),
 - vectorised numpy evaluation (diagnosis, plots).
 
 State ``x = [s, v, y_b, v_b]``: stroke, stroke velocity, lower-mass
@@ -29,21 +30,40 @@ Plant parameter vector ``PP`` (see :func:`plant_vector` for the layout).
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 
-from heavecomp.friction.laws import friction_cont, friction_jump, friction_smooth, FrictionLaw
+from heavecomp.friction.laws import FrictionLaw, friction_cont, friction_jump
 from heavecomp.params.cmc import G as g, P_ATM
-from heavecomp.plants.symbolic import casadi
+from heavecomp.friction.laws import steepest_slope
 
-# PP layout
-A, MC, MB, PATM, P0ABS, V0, N, KDS, CDS, T0, KF, CF, D0, G = range(14)
+#: PP layout: names in vector order; the index constants below are generated from it
 PP_NAMES = ("A", "M_c", "m_b", "p_atm", "p0_abs", "V_0", "n", "k_ds", "c_ds", "T_0", "k_F", "c_F",
             "delta_0", "g")
+A, MC, MB, PATM, P0ABS, V0, N, KDS, CDS, T0, KF, CF, D0, G = range(len(PP_NAMES))
 STATE_NAMES = ("stroke", "stroke_velocity", "lower_displacement", "lower_velocity")
 
 
+class PlantVectors(NamedTuple):
+    """The CMC's parameters as the compiled kernel takes them: friction law code, friction
+    vector FP (:data:`heavecomp.friction.laws.FP_NAMES`) and plant vector PP (:data:`PP_NAMES`)."""
+
+    code: int
+    FP: np.ndarray
+    PP: np.ndarray
+    has_stiction: bool
+
+
+def plant_vectors(params) -> PlantVectors:
+    """``(code, FP, PP, has_stiction)`` of a :class:`heavecomp.params.CMCParams` — the one
+    params -> vectors conversion (simulate, closed loop, diagnosis, generator use it)."""
+    law = FrictionLaw.from_params(params.friction)
+    return PlantVectors(int(law.code), law.FP, plant_vector(params), bool(law.has_stiction))
+
+
 def plant_vector(params) -> np.ndarray:
-    """Plant parameter vector PP from a :class:`heavecomp.params.CMCParams`."""
+    """Plant parameter vector PP (layout :data:`PP_NAMES`) from a :class:`heavecomp.params.CMCParams`."""
     c, ds, f, op = params.compensator, params.drill_string, params.formation, params.operating_point
     W0 = op.wob_setpoint
     return np.array([
@@ -89,16 +109,26 @@ def contact_switch(yb, vb, PP):
     return np.minimum(PP[KF] * pen, PP[KF] * pen - PP[CF] * vb)
 
 
+def net_force(p, T, ddzh, u, PP):
+    """Net non-friction force on the top mass in the platform frame for a cylinder pressure ``p``
+    and string tension ``T`` [N]: ``p A - M_c g - T_ds + u - M_c ddz_h``."""
+    return p * PP[A] - PP[MC] * PP[G] - T + u - PP[MC] * ddzh
+
+
 def holding_force(s, v, yb, vb, zh, dzh, ddzh, u, PP):
     """Net non-friction force on the top mass in the platform frame [N]:
-    ``p A - M_c g - T_ds + u - M_c ddz_h``.  While stuck the friction equals it."""
-    p = gas_pressure(s, PP)
-    return p * PP[A] - PP[MC] * PP[G] - tension(s, v, yb, vb, zh, dzh, PP) + u - PP[MC] * ddzh
+    :func:`net_force` of the gas pressure and the tension.  While stuck the friction equals it."""
+    return net_force(gas_pressure(s, PP), tension(s, v, yb, vb, zh, dzh, PP), ddzh, u, PP)
 
 
 def lower_accel(s, v, yb, vb, zh, dzh, PP):
     """dv_b/dt of the lower mass [m/s^2]."""
-    return (tension(s, v, yb, vb, zh, dzh, PP) - PP[MB] * PP[G] + wob(yb, vb, PP)) / PP[MB]
+    return lower_accel_wob(tension(s, v, yb, vb, zh, dzh, PP), yb, vb, PP)
+
+
+def lower_accel_wob(T, yb, vb, PP):
+    """dv_b/dt for a string tension ``T`` with the clamped contact law :func:`wob` [m/s^2]."""
+    return (T - PP[MB] * PP[G] + wob(yb, vb, PP)) / PP[MB]
 
 
 def lower_accel_contact(s, v, yb, vb, zh, dzh, contact, PP):
@@ -108,7 +138,13 @@ def lower_accel_contact(s, v, yb, vb, zh, dzh, contact, PP):
     holds the state through a step and flips it at the located lift-off / touchdown, so
     its RK4 stages never straddle the kink or the touchdown jump of W.
     """
-    return (tension(s, v, yb, vb, zh, dzh, PP) - PP[MB] * PP[G] + contact * contact_force(yb, vb, PP)) / PP[MB]
+    return lower_accel_tension(tension(s, v, yb, vb, zh, dzh, PP), yb, vb, contact, PP)
+
+
+def lower_accel_tension(T, yb, vb, contact, PP):
+    """dv_b/dt for a string tension ``T`` with the contact state held [m/s^2]:
+    ``(T - m_b g + contact k_F (delta_0 - y_b) - c_F v_b) / m_b``."""
+    return (T - PP[MB] * PP[G] + contact * contact_force(yb, vb, PP)) / PP[MB]
 
 
 def stroke_accel(s, v, yb, vb, zh, dzh, ddzh, u, Ff, PP):
@@ -128,41 +164,43 @@ def static_limit(code, s, FP, PP):
 
 
 # ----------------------------------------------------------------------------
-# symbolic model
+# the linear model (eigenvalues, default step sizes, band edges)
 # ----------------------------------------------------------------------------
-def casadi_model(params, *, eps: float | None = None, sym: str = "SX"):
-    """The CMC as a casadi Function ``f(x, u) -> (xdot, y)`` with smooth friction.
+def modal_matrices(params, friction_slope: float = 0.0):
+    """Mass, damping and stiffness matrices ``(M, C, K)`` of the CMC linearised at the operating
+    point, coordinates (top-mass stroke, lower-mass displacement), the bit on the rock [SI].
 
-    Parameters
-    ----------
-    params : CMCParams
-    eps : float, optional
-        Regularisation width of the friction's sign [m/s]; required when the
-        friction law has stiction (there is no smooth exact law).  Ignored for
-        ``model = "none"``.
-    sym : {"SX", "MX"}
-
-    Returns
-    -------
-    casadi.Function
-        Inputs ``x`` (4: s, v, y_b, v_b) and ``u`` (4: z_h, dz_h, ddz_h, u_active);
-        outputs ``xdot`` (4) and ``y`` (5: wob, stroke, pressure, tension, friction).
+    ``K = [[k_gas + k_ds, -k_ds], [-k_ds, k_ds + k_F]]``,
+    ``C = [[c_ds + slope, -c_ds], [-c_ds, c_ds + c_F]]``, ``M = diag(M_c, m_b)``, with
+    ``slope`` a friction slope dF_f/dv [N s/m] added on the stroke.  The one linear model the
+    default step (:func:`eigen_rate`) and the diagnosis' band edges (:func:`eigenfrequencies`) are
+    derived from; ``tests/test_conformance.py`` pins it to the jacobian of :func:`heavecomp.effects.model.casadi_model`.
     """
-    ca = casadi()
+    c, ds, fo = params.compensator, params.drill_string, params.formation
+    K = np.array([[c.gas_stiffness + ds.stiffness, -ds.stiffness], [-ds.stiffness, ds.stiffness + fo.stiffness]])
+    C = np.array([[ds.damping + friction_slope, -ds.damping], [-ds.damping, ds.damping + fo.damping]])
+    M = np.diag([c.moving_mass, ds.lower_mass])
+    return M, C, K
 
-    law = FrictionLaw.from_params(params.friction)
-    if law.has_stiction and not (eps and eps > 0):
-        raise ValueError("casadi_model: friction with stiction needs an explicit eps > 0 [m/s]")
-    PP = plant_vector(params)
-    S = getattr(ca, sym)
-    x = S.sym("x", 4)
-    u = S.sym("u", 4)
-    s, v, yb, vb = x[0], x[1], x[2], x[3]
-    zh, dzh, ddzh, ua = u[0], u[1], u[2], u[3]
-    p = gas_pressure(s, PP)
-    Ff = friction_smooth(law.code, v, p, law.FP, eps or 1.0)
-    dv = stroke_accel(s, v, yb, vb, zh, dzh, ddzh, ua, Ff, PP)
-    dvb = lower_accel(s, v, yb, vb, zh, dzh, PP)
-    xdot = ca.vertcat(v, dv, vb, dvb)
-    y = ca.vertcat(wob(yb, vb, PP), s, p, tension(s, v, yb, vb, zh, dzh, PP), Ff)
-    return ca.Function("cmc", [x, u], [xdot, y], ["x", "u"], ["xdot", "y"])
+
+def eigen_rate(params) -> float:
+    """Largest |eigenvalue| [1/s] of the linear model (stroke stuck or free), including the
+    steepest friction slope near v = 0 (:func:`heavecomp.friction.laws.steepest_slope`)."""
+
+    plant = plant_vectors(params)
+    M, C, K = modal_matrices(params, steepest_slope(plant.code, plant.FP))
+    Minv = np.diag([1 / M[0, 0], 1 / M[1, 1]])
+    Asys = np.block([[np.zeros((2, 2)), np.eye(2)], [-Minv @ K, -Minv @ C]])
+    lam = np.abs(np.linalg.eigvals(Asys)).max()
+    ds, fo = params.drill_string, params.formation
+    return float(max(lam, np.sqrt((ds.stiffness + fo.stiffness) / M[1, 1]), (ds.damping + fo.damping) / M[1, 1]))
+
+
+def eigenfrequencies(params) -> list[float]:
+    """Undamped eigenfrequencies [Hz] of the linear model: sliding (2 DOF: top mass on the gas
+    spring, lower mass on string and formation) and stuck (lower mass on k_ds + k_F)."""
+    M, C, K = modal_matrices(params)
+    lam = np.linalg.eigvals(np.linalg.solve(M, K)).real
+    f = sorted(float(np.sqrt(max(x, 0.0)) / (2 * np.pi)) for x in lam)
+    f.append(float(np.sqrt(K[1, 1] / M[1, 1]) / (2 * np.pi)))
+    return f

@@ -1,18 +1,20 @@
 """Compiled exact stick-slip stepper for the CMC (numba).
 
 The physics is not restated here: the equations are the functions of
-:mod:`heavecomp.plants.cmc`, :mod:`heavecomp.friction.laws` and
-:mod:`heavecomp.effects.terms`, compiled by numba from the same source
+:mod:`heavecomp.plants.cmc` and :mod:`heavecomp.friction.laws`, and the effects' methods at
+the plant's hooks (:mod:`heavecomp.effects`), compiled by numba from the same source
 (``tests/test_kernel_pins.py`` pins the compiled forces to the symbolic model anyway).
 
-One stepper serves the simulator and the gap diagnosis.  It integrates the CMC with
-the effect terms of :mod:`heavecomp.effects.terms` (:func:`heavecomp.effects.terms.plant_fx`;
-extra states: gas temperature ratio theta, friction memories w and E, dwell time tau),
-switched by the effect-parameter vector ``EP``.  :func:`advance` (used by
-:func:`heavecomp.simulate.simulate`, the closed loop, the campaigns, and compiled ahead
-of time) runs it with every effect off, ``EP = 0``, where the terms reduce to the
-plain CMC bit for bit; :func:`advance_fx` (the diagnosis,
-:mod:`heavecomp.diagnosis.stepper`) with effects.
+One stepper serves the simulator and the gap diagnosis.  It integrates the hook functions
+of an effect composition (:mod:`heavecomp.effects.compose`: ``plant_fx``,
+``sliding_friction_fx``, ``static_limit_fx``, ``effect_rates``; the effects' states in the
+slots x4-x6 of the state, the dwell time tau since the last stick event kept by the stepper),
+each effect switched on by its slot of the effect-parameter vector ``EP``.  This module's
+functions are compiled for the composition of no effect, where the hooks are the plain CMC:
+:func:`advance` (used by :func:`heavecomp.simulate.simulate`, the closed loop, the campaigns,
+and compiled ahead of time).  :func:`kernel_for` compiles the same functions again with the
+hooks of a composition (the library's effects for the diagnosis and ``simulate(effects=...)``,
+the generator's truth laws for the benchmark) and returns its ``advance_fx``.
 
 Scheme
 ------
@@ -36,9 +38,9 @@ with two modes:
   RK4 sub-step (unclamped contact law on the rock, none off it) and flipped at
   the event, so no stage straddles the switch.
 
-With the effects, J and the static limit are those of
-:func:`heavecomp.effects.terms.sliding_friction_fx` / ``static_limit_fx`` (friction
-memories, pressure friction, the dwell gain since the stick event).  Laws without a
+With effects, J and the static limit are the composition's ``sliding_friction_fx`` /
+``static_limit_fx`` (the seal-friction hooks: friction memories, pressure friction, the
+dwell gain since the stick event).  Laws without a
 jump (``none``; eq. 7 with C_p = 0; and no effect adding one) are integrated as one
 smooth system.  The end of the sine fade-in, where d2z_h/dt2 jumps, is a step
 boundary with the left-limit heave sample before it (``core.drive``).  The
@@ -51,14 +53,16 @@ samples they are interpolated with quintic Hermite polynomials.
 
 from __future__ import annotations
 
+import threading
 import types
 
 import numba as nb
 import numpy as np
 
-from heavecomp.effects import terms as _terms
+from heavecomp.effects import compose as _compose
 from heavecomp.friction import laws as _laws
 from heavecomp.plants import cmc as _cmc
+from heavecomp.plants.cmc import MC
 
 
 
@@ -105,57 +109,82 @@ _jit_inline = nb.njit(cache=True, fastmath=False, inline="always")
 _ENV: dict = {}
 
 
-def _compile(func, inline=False):
+def _compile(func, inline=False, env=None, *, cache=True, name=None, nogil=False):
     """njit ``func`` from its own source, with the names it calls bound to the
     already-compiled versions (so the plant modules need not import numba).
     ``inline=True`` inlines it into its callers in numba's IR (no call, no array
-    reference counting: LLVM leaves larger functions out of line)."""
+    reference counting: LLVM leaves larger functions out of line).  ``env`` (default the
+    module's ``_ENV``) receives it under ``name`` (default its own); ``cache=False`` for
+    generated source, which has no file for numba's cache."""
+    env = _ENV if env is None else env
     g = dict(func.__globals__)
-    g.update(_ENV)
+    g.update(env)
     clone = types.FunctionType(func.__code__, g, func.__name__, func.__defaults__, func.__closure__)
-    clone.__qualname__ = func.__qualname__
+    clone.__qualname__ = func.__qualname__ if name is None else name
     clone.__module__ = func.__module__
-    jitted = (_jit_inline if inline else _jit)(clone)
-    _ENV[func.__name__] = jitted
+    opts = {"cache": cache, "fastmath": False}
+    if inline:
+        opts["inline"] = "always"
+    if nogil:
+        opts["nogil"] = True
+    jitted = nb.njit(**opts)(clone)
+    env[func.__name__] = jitted
     return jitted
 
 
-stribeck_curve = _compile(_laws.stribeck_curve)
-friction_jump = _compile(_laws.friction_jump)
-friction_cont = _compile(_laws.friction_cont)
-gas_pressure = _compile(_cmc.gas_pressure)
-tension = _compile(_cmc.tension)
-contact_force = _compile(_cmc.contact_force)
+# the small pieces the hook functions add to the hot path are inlined (as the restated plant was):
+# out-of-line they cost the ahead-of-time build ~25 % (numba.pycc does not inline across functions);
+# so are the plant's and the laws' functions the hooks call
+stribeck_excess = _compile(_laws.stribeck_excess, inline=True)
+stribeck_curve = _compile(_laws.stribeck_curve, inline=True)
+friction_jump = _compile(_laws.friction_jump, inline=True)
+friction_cont = _compile(_laws.friction_cont, inline=True)
+gas_pressure = _compile(_cmc.gas_pressure, inline=True)
+tension = _compile(_cmc.tension, inline=True)
+contact_force = _compile(_cmc.contact_force, inline=True)
 wob = _compile(_cmc.wob)
+net_force = _compile(_cmc.net_force, inline=True)
 holding_force = _compile(_cmc.holding_force)
+lower_accel_wob = _compile(_cmc.lower_accel_wob)
 lower_accel = _compile(_cmc.lower_accel)
+lower_accel_tension = _compile(_cmc.lower_accel_tension, inline=True)
 lower_accel_contact = _compile(_cmc.lower_accel_contact)
 stroke_accel = _compile(_cmc.stroke_accel)
 sliding_friction = _compile(_cmc.sliding_friction)
 static_limit = _compile(_cmc.static_limit)
 contact_switch = _compile(_cmc.contact_switch)
-# the stepper integrates the CMC through plant_fx below; the composite CMC functions above
-# that it no longer calls directly (holding_force, ..., static_limit) stay compiled for
-# callers and for the pins (tests/test_kernel_pins.py): numba compiles them on first use only.
-# The effect terms (heavecomp.effects.terms), inlined; with EP = 0 they are the CMC above:
-gas_pressure_fx = _compile(_terms.gas_pressure_fx, inline=True)
-line_drop = _compile(_terms.line_drop, inline=True)
-cylinder_pressure_fx = _compile(_terms.cylinder_pressure_fx, inline=True)
-string_damping_fx = _compile(_terms.string_damping_fx, inline=True)
-plant_fx = _compile(_terms.plant_fx, inline=True)
-pressure_friction_fx = _compile(_terms.pressure_friction_fx, inline=True)
-friction_magnitude_fx = _compile(_terms.friction_magnitude_fx, inline=True)
-friction_jump_fx = _compile(_terms.friction_jump_fx, inline=True)
-sliding_friction_fx = _compile(_terms.sliding_friction_fx, inline=True)
-dwell_gain = _compile(_terms.dwell_gain, inline=True)
-static_limit_fx = _compile(_terms.static_limit_fx, inline=True)
-truth_thermal_rate = _compile(_terms.truth_thermal_rate, inline=True)
-lag_rates = _compile(_terms.lag_rates, inline=True)
+# the stepper integrates the CMC through the hook functions of an effect composition
+# (heavecomp.effects.compose): with no effect they are the functions above, composed; the composite
+# CMC functions it does not call directly (holding_force, ..., static_limit) stay compiled for callers
+# and for the pins (tests/test_kernel_pins.py): numba compiles them on first use only.
+
+
+def _compile_composition(comp, env):
+    """Compile the effects' hook methods and the generated hook functions of ``comp`` into ``env``."""
+    for i, c in enumerate(comp.classes):
+        for m in c.methods():
+            f = getattr(c, m)
+            _compile(f, inline=True, env=env)
+            env[f"E{i}_{m}"] = env.pop(f.__name__)
+    for fname in _compose.GENERATED:
+        _compile(comp.functions[fname], inline=True, env=env, cache=False)
+
+
+_NONE = _compose.composition(())
+_compile_composition(_NONE, _ENV)
+gas_fx = _ENV["gas_fx"]
+cylinder_pressure_fx = _ENV["cylinder_pressure_fx"]
+tension_fx = _ENV["tension_fx"]
+plant_fx = _ENV["plant_fx"]
+jump_fx = _ENV["jump_fx"]
+sliding_friction_fx = _ENV["sliding_friction_fx"]
+static_limit_fx = _ENV["static_limit_fx"]
+effect_rates = _ENV["effect_rates"]
 
 from heavecomp.simulate.layout import CHANNELS, FX_CHANNELS, NCH, NSTATS, SLIDING, STATS, STUCK  # noqa: E402,F401
 
-#: the effect parameters of the plain CMC (every effect off; a constant of the compiled code)
-NO_EFFECTS = np.zeros(_terms.N_EP)
+#: the effect parameters of the plain CMC (no effect composed; a constant of the compiled code)
+NO_EFFECTS = np.zeros(0)
 NO_EFFECTS.setflags(write=False)
 
 
@@ -209,26 +238,25 @@ def heave_at(t, sp, Z, DZ, DDZ):
 
 @_jit_inline
 def rhs(t, X, mode, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ):
-    """Time derivatives of ``X = (s, v, yb, vb, theta, w, E)`` in the given mode.
+    """Time derivatives of ``X = (s, v, yb, vb, x4, x5, x6)`` in the given mode.
 
-    The plant is :func:`heavecomp.effects.terms.plant_fx` (the CMC of
-    :mod:`heavecomp.plants.cmc`, bit for bit when ``EP = 0``); the contact state
-    ``cm`` is held, the stroke frozen while stuck.
+    The plant is the composition's ``plant_fx`` (:mod:`heavecomp.effects.compose`: the CMC of
+    :mod:`heavecomp.plants.cmc` with the effects' hook terms; x4-x6 are the effects' states);
+    the contact state ``cm`` is held, the stroke frozen while stuck.
     """
-    s, v, yb, vb, th, w, el = X
+    s, v, yb, vb, x4, x5, x6 = X
     if mode == STUCK:
         v = 0.0
     zh, dzh, ddzh = heave_at(t, sp, Z, DZ, DDZ)
-    p, T, hold, dvb = plant_fx(s, v, yb, vb, th, zh, dzh, ddzh, u, cm, PP, EP)
-    dth = truth_thermal_rate(s, v, th, PP, EP)
-    dw, de = lag_rates(v, w, el, FP, EP)
+    p, T, hold, dvb = plant_fx(s, v, yb, vb, x4, x5, x6, zh, dzh, ddzh, u, cm, PP, EP)
+    d4, d5, d6 = effect_rates(s, v, p, x4, x5, x6, PP, FP, EP)
     if mode == STUCK:
-        return (0.0, 0.0, vb, dvb, dth, dw, de)
+        return (0.0, 0.0, vb, dvb, d4, d5, d6)
     if smooth:
         Ff = friction_cont(code, v, p, FP)
     else:
-        Ff = sliding_friction_fx(code, d, v, p, w, el, FP, EP)
-    return (v, (hold - Ff) / PP[1], vb, dvb, dth, dw, de)
+        Ff = sliding_friction_fx(code, d, v, p, x4, x5, x6, FP, EP)
+    return (v, (hold - Ff) / PP[MC], vb, dvb, d4, d5, d6)
 
 
 @_jit
@@ -264,7 +292,7 @@ def rk4(t, h, X, mode, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ):
 def hold(t, X, u, PP, EP, sp, Z, DZ, DDZ):
     """(holding force, cylinder pressure) at v = 0: while stuck the friction is the holding force."""
     zh, dzh, ddzh = heave_at(t, sp, Z, DZ, DDZ)
-    p, T, F, dvb = plant_fx(X[0], 0.0, X[2], X[3], X[4], zh, dzh, ddzh, u, 1.0, PP, EP)
+    p, T, F, dvb = plant_fx(X[0], 0.0, X[2], X[3], X[4], X[5], X[6], zh, dzh, ddzh, u, 1.0, PP, EP)
     return F, p
 
 
@@ -332,9 +360,9 @@ def advance(state, mode_dir, t0, n_steps, h, code, FP, PP, smooth, u, sp, Z, DZ,
     in place.  Every ``out_every`` steps a row of CHANNELS is written to
     ``out[out_pos]`` (``out_pos`` is returned, advanced); the first row written
     is the state at ``t0`` when ``out_pos == 0``.  ``stats`` accumulates STATS.
-    This is :func:`advance_fx` with every effect off.
+    This is :func:`advance_fx` with no effect.
     """
-    X = (state[0], state[1], state[2], state[3], 1.0, 0.0, 0.0)
+    X = (state[0], state[1], state[2], state[3], 0.0, 0.0, 0.0)
     X, tau, mode, d, pos = _advance(X, 0.0, int(mode_dir[0]), mode_dir[1], t0, n_steps, h, code, FP, PP,
                                     NO_EFFECTS, smooth, u, sp, Z, DZ, DDZ, out, out_every, out_pos, stats)
     state[0], state[1], state[2], state[3] = X[0], X[1], X[2], X[3]
@@ -346,11 +374,12 @@ def advance(state, mode_dir, t0, n_steps, h, code, FP, PP, smooth, u, sp, Z, DZ,
 @nb.njit(cache=True, nogil=True)
 def advance_fx(state, mode_dir, t0, n_steps, h, code, FP, PP, EP, smooth, u, sp, Z, DZ, DDZ,
                out, out_every, out_pos, stats):
-    """:func:`advance` with the effect terms of :mod:`heavecomp.effects.terms` (parameters ``EP``).
+    """:func:`advance` with effects: the stepper of an effect composition (:func:`kernel_for`;
+    this module-level one has none) with effect parameters ``EP`` (:meth:`Composition.ep`).
 
-    ``state`` has 8 entries, ``[s, v, yb, vb, theta, w, E, tau]`` (gas temperature ratio,
-    friction memories, dwell time at rest); when ``out`` has more than NCH columns the
-    next ones get FX_CHANNELS.  Releases the GIL (the diagnosis fits in threads).
+    ``state`` has 8 entries, ``[s, v, yb, vb, x4, x5, x6, tau]`` (the effects' states, the
+    dwell time at rest); when ``out`` has more than NCH columns the next ones get FX_CHANNELS.
+    Releases the GIL (the diagnosis fits in threads).
     """
     X = (state[0], state[1], state[2], state[3], state[4], state[5], state[6])
     X, tau, mode, d, pos = _advance(X, state[7], int(mode_dir[0]), mode_dir[1], t0, n_steps, h, code, FP, PP,
@@ -421,7 +450,7 @@ def _advance(X, tau, mode, d, t0, n_steps, h, code, FP, PP, EP, smooth, u, sp, Z
                 tc += tz
                 left -= tz
                 F, p = hold(tc, X, u, PP, EP, sp, Z, DZ, DDZ)
-                if abs(F) <= static_limit_fx(code, p, X[5], X[6], 0.0, FP, EP):
+                if abs(F) <= static_limit_fx(code, p, X[4], X[5], X[6], 0.0, FP, EP):
                     mode = STUCK
                     tau = 0.0
                     stats[1] += 1.0
@@ -432,7 +461,7 @@ def _advance(X, tau, mode, d, t0, n_steps, h, code, FP, PP, EP, smooth, u, sp, Z
                     break
             else:  # STUCK
                 F1, p1 = hold(tc + cut, X1, u, PP, EP, sp, Z, DZ, DDZ)
-                lim1 = static_limit_fx(code, p1, X1[5], X1[6], tau + cut, FP, EP)
+                lim1 = static_limit_fx(code, p1, X1[4], X1[5], X1[6], tau + cut, FP, EP)
                 if abs(F1) <= lim1:
                     stats[0] += cut
                     tau += cut
@@ -448,7 +477,7 @@ def _advance(X, tau, mode, d, t0, n_steps, h, code, FP, PP, EP, smooth, u, sp, Z
                 # breakaway before the cut: bracket [lo, hi] with margin(lo) >= 0 > margin(hi)
                 sg = 1.0 if F1 > 0 else -1.0
                 F0, p0 = hold(tc, X, u, PP, EP, sp, Z, DZ, DDZ)
-                m_lo = static_limit_fx(code, p0, X[5], X[6], tau, FP, EP) - sg * F0
+                m_lo = static_limit_fx(code, p0, X[4], X[5], X[6], tau, FP, EP) - sg * F0
                 m_hi = lim1 - sg * F1
                 lo, hi = 0.0, cut
                 Xhi = X1
@@ -461,7 +490,7 @@ def _advance(X, tau, mode, d, t0, n_steps, h, code, FP, PP, EP, smooth, u, sp, Z
                         tt = 0.5 * (lo + hi)
                     X2 = rk4(tc, tt, X, STUCK, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ)
                     F2, p2 = hold(tc + tt, X2, u, PP, EP, sp, Z, DZ, DDZ)
-                    m = static_limit_fx(code, p2, X2[5], X2[6], tau + tt, FP, EP) - sg * F2
+                    m = static_limit_fx(code, p2, X2[4], X2[5], X2[6], tau + tt, FP, EP) - sg * F2
                     if m >= 0.0:
                         lo, m_lo = tt, m
                         if side == -1:
@@ -538,17 +567,17 @@ def _contact_time(tc, left, X, mode, d, cm, smooth, code, FP, PP, EP, u, sp, Z, 
 
 @_jit
 def _record(out, pos, t, X, mode, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ):
-    s, v, yb, vb, th, w, el = X
+    s, v, yb, vb, x4, x5, x6 = X
     if mode == STUCK:
         v = 0.0
     zh, dzh, ddzh = heave_at(t, sp, Z, DZ, DDZ)
-    p, T, F, dvb = plant_fx(s, v, yb, vb, th, zh, dzh, ddzh, u, cm, PP, EP)
+    p, T, F, dvb = plant_fx(s, v, yb, vb, x4, x5, x6, zh, dzh, ddzh, u, cm, PP, EP)
     if mode == STUCK:
         Ff = F
     elif smooth:
         Ff = friction_cont(code, v, p, FP)
     else:
-        Ff = sliding_friction_fx(code, d, v, p, w, el, FP, EP)
+        Ff = sliding_friction_fx(code, d, v, p, x4, x5, x6, FP, EP)
     out[pos, 0] = t
     out[pos, 1] = zh
     out[pos, 2] = s
@@ -561,6 +590,54 @@ def _record(out, pos, t, X, mode, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ,
     out[pos, 9] = vb
     out[pos, 10] = 1.0 if mode == STUCK else 0.0
     out[pos, 11] = u
-    if out.shape[1] >= NCH + 2:  # FX_CHANNELS
-        out[pos, NCH] = gas_pressure_fx(s, th, PP, EP)
-        out[pos, NCH + 1] = th
+    if out.shape[1] >= NCH + 4:  # FX_CHANNELS
+        out[pos, NCH] = gas_fx(s, v, x4, x5, x6, PP, EP)
+        out[pos, NCH + 1] = x4
+        out[pos, NCH + 2] = x5
+        out[pos, NCH + 3] = x6
+
+
+#: kernel functions that call the hook functions, callees first (cloned per composition)
+_PER_COMPOSITION = ("rhs", "rk4", "hold", "_contact_time", "_record", "_advance", "advance_fx")
+_KERNELS: dict = {}
+
+
+_HOOK_ENVS: dict = {}
+_LOCK = threading.Lock()
+
+
+def _hook_env(comp) -> dict:
+    """Names -> compiled functions with the hook functions of ``comp`` (compiled on first call)."""
+    if comp.key not in _HOOK_ENVS:
+        env = dict(_ENV)
+        _compile_composition(comp, env)
+        _HOOK_ENVS[comp.key] = env
+    return _HOOK_ENVS[comp.key]
+
+
+def kernel_for(comp):
+    """The compiled ``advance_fx`` of an effect composition (:class:`heavecomp.effects.compose.Composition`).
+
+    The stepper's functions that call the plant's hooks are compiled again from their own source,
+    with the composition's hook functions (the effects' methods, inlined) bound in their place;
+    numba's disk cache keeps each under a name keyed to the composition's source (about 30 s of
+    CPU to compile once per composition, then loaded in a fraction of a second).  The
+    composition of no effect is this module's :func:`advance_fx`.
+    """
+    if not comp.classes:
+        return advance_fx
+    with _LOCK:  # the diagnosis fits in threads: one dispatcher per composition, so one compile
+        if comp.key not in _KERNELS:
+            env = dict(_hook_env(comp))
+            for fname in _PER_COMPOSITION:
+                f = globals()[fname]
+                _compile(f.py_func, inline=fname == "rhs", env=env, name=f"{fname}__fx_{comp.key}",
+                         nogil=fname == "advance_fx")
+            _KERNELS[comp.key] = env["advance_fx"]  # numba compiles it once on the first call (its own lock)
+    return _KERNELS[comp.key]
+
+
+def compiled_hooks(comp) -> dict:
+    """The compiled hook functions of a composition (name -> numba dispatcher; for the pins)."""
+    env = _ENV if not comp.classes else _hook_env(comp)
+    return {f: env[f] for f in _compose.GENERATED}

@@ -11,8 +11,11 @@ from typing import Callable
 
 import numpy as np
 
+from heavecomp.effects.compose import composition_for
+from heavecomp.effects.registry import resolve
 from heavecomp.errors import InputError
 from heavecomp.params.budget import check_run_size
+from heavecomp.plants.cmc import eigen_rate, plant_vectors
 
 
 class SimulationError(InputError):
@@ -32,37 +35,17 @@ CHANNEL_UNITS = {"t": "s", "heave": "m", "stroke": "m", "pressure": "Pa", "wob":
                  "u_active": "N"}
 
 
-def plant_eigen_rate(params) -> float:
-    """Largest |eigenvalue| [1/s] of the linearised plant (stroke stuck or free),
-    including the steepest friction slope near v = 0 — sets the default step."""
-    c, ds, fo = params.compensator, params.drill_string, params.formation
-    Mc, mb = c.moving_mass, ds.lower_mass
-    law = FrictionLaw.from_params(params.friction)
-    FS, FC, vS, Cv, Cp, vt = law.FP
-    slope = Cv
-    if law.code in (1, 2) and law.model != "none":  # negative Stribeck slope at 0+
-        slope = max(slope, (FS - FC) / vS)
-    if law.code == 3:
-        slope = max(slope, (FC + (FS - FC) * math.exp(-vt / vS)) / vt + Cv)
-    K = np.array([[c.gas_stiffness + ds.stiffness, -ds.stiffness], [-ds.stiffness, ds.stiffness + fo.stiffness]])
-    C = np.array([[ds.damping + slope, -ds.damping], [-ds.damping, ds.damping + fo.damping]])
-    Minv = np.diag([1 / Mc, 1 / mb])
-    Asys = np.block([[np.zeros((2, 2)), np.eye(2)], [-Minv @ K, -Minv @ C]])
-    lam = np.abs(np.linalg.eigvals(Asys)).max()
-    return float(max(lam, math.sqrt((ds.stiffness + fo.stiffness) / mb), (ds.damping + fo.damping) / mb))
-
-
 def default_dt(params, rate: float | None = None) -> float:
     """Default RK4 step [s]: ``h * lambda_max <= 0.6`` and at most 50 ms (and a
     divisor of the output interval 1/rate when ``rate`` is given).
 
-    ``lambda_max`` is :func:`plant_eigen_rate` (fastest linear mode, including
-    the steepest friction slope).  RK4 is stable to h lambda ~ 2.8; at 0.6 the
+    ``lambda_max`` is :func:`heavecomp.plants.cmc.eigen_rate` (fastest mode of the plant's
+    linear model, including the steepest friction slope).  RK4 is stable to h lambda ~ 2.8; at 0.6 the
     paper-A case with full static friction is within 15 N rms of WOB (1 h, vs
     dt = 1 ms), ~0.03 % of its WOB std (``docs/numerics.md``).  Pass ``dt``
     explicitly for more accuracy: the scheme converges with order 4.
     """
-    h = min(0.05, 0.6 / plant_eigen_rate(params))
+    h = min(0.05, 0.6 / eigen_rate(params))
     if rate:
         interval = 1.0 / rate
         h = interval / math.ceil(interval / h - 1e-9)
@@ -201,14 +184,9 @@ class SimulationResult:
         return df
 
 
-def _friction_vectors(params):
-    law = FrictionLaw.from_params(params.friction)
-    return law, plant_vector(params)
-
-
 def simulate(params, duration: float, *, dt: float | None = None, rate: float = 20.0, heave=None,
              progress: Callable[[float], None] | None = None, stats_start: float | None = None,
-             u_active: float = 0.0) -> SimulationResult:
+             u_active: float = 0.0, effects=()) -> SimulationResult:
     """Simulate the CMC from rest at the operating point with exact stick-slip.
 
     Parameters
@@ -229,6 +207,10 @@ def simulate(params, duration: float, *, dt: float | None = None, rate: float = 
         heave fade-in (``heave.ramp``) or 0.
     u_active : float [N]
         Constant active-cylinder force (closed loops use :mod:`heavecomp.controllers`).
+    effects : sequence, optional
+        Effects at the plant's hooks (:mod:`heavecomp.effects`): instances
+        (``FlowLoss(resistance=2e5)``), registered names (default parameters) or
+        ``(name, {parameter: value})`` pairs.  None: the nominal CMC (the ahead-of-time stepper).
     """
     if not (duration > 0 and math.isfinite(duration)):
         raise InputError(f"--duration must be a positive number of seconds, got {duration}")
@@ -242,7 +224,7 @@ def simulate(params, duration: float, *, dt: float | None = None, rate: float = 
         log.warning("output interval 1/rate = %g s is not a multiple of dt = %g s; output every %d steps",
                     1 / rate, h, out_every)
     n_steps = int(math.ceil(duration / h - 1e-9))
-    check_run_size(params, duration=duration, h=h, n_steps=n_steps, n_rows=n_steps // out_every + 1, n_cols=NCH, dt=dt, rate=rate, rate_fn=plant_eigen_rate)
+    check_run_size(params, duration=duration, h=h, n_steps=n_steps, n_rows=n_steps // out_every + 1, n_cols=NCH, dt=dt, rate=rate, rate_fn=eigen_rate)
     sp = 0.5 * h
     if heave is None:
         hs = excitation.make_heave(params.heave, n_steps * h, sp, params.base_dir,
@@ -254,8 +236,9 @@ def simulate(params, duration: float, *, dt: float | None = None, rate: float = 
     else:
         t_in, z_in = heave
         hs = excitation.from_series(t_in, z_in, n_steps * h, sp, src="heave")
-    law, PP = _friction_vectors(params)
-    result = run_kernel(law, PP, hs, h, n_steps, out_every, u_active=u_active, progress=progress)
+    effects = resolve(effects)
+    result = run_kernel(plant_vectors(params), hs, h, n_steps, out_every, u_active=u_active, progress=progress,
+                        effects=effects)
     data, stats, wall = result
     if stats_start is None:
         stats_start = (params.heave.ramp or 0.0) if (heave is None and params.heave is not None) else 0.0
@@ -264,18 +247,45 @@ def simulate(params, duration: float, *, dt: float | None = None, rate: float = 
                             wall_time=wall, stats_start=stats_start)
 
 
-def run_kernel(law, PP, hs, h, n_steps, out_every, *, u_active=0.0, progress=None, chunk_steps=200_000):
-    """Run the compiled stepper from rest (stuck) at the operating point."""
-    advance = stepper()
+def plant_stepper(plant, effects=()):
+    """``(advance, state, smooth)`` for the plant ``plant`` (:func:`heavecomp.plants.cmc.plant_vectors`)
+    with ``effects`` (instances) at its hooks: ``advance`` has the signature of
+    :func:`heavecomp.simulate._kernel.advance` and updates ``state`` in place.
+
+    Without effects it is the nominal stepper (:func:`stepper`: ahead of time when built);
+    with effects the stepper of their composition (:func:`heavecomp.simulate._kernel.kernel_for`),
+    its effect parameters bound.
+    """
+    if not effects:
+        return stepper(), np.zeros(4), bool(not plant.has_stiction)
+    from heavecomp.simulate import _kernel
+
+    comp = composition_for(effects)
+    EP = comp.ep(effects)
+    advance_fx = _kernel.kernel_for(comp)
+
+    def advance(state, mode_dir, t0, n_steps, h, code, FP, PP, smooth, u, sp, Z, DZ, DDZ, out, out_every, out_pos,
+                stats):
+        return advance_fx(state, mode_dir, t0, n_steps, h, code, FP, PP, EP, smooth, u, sp, Z, DZ, DDZ, out,
+                          out_every, out_pos, stats)
+
+    return advance, comp.initial_state(plant.FP, plant.PP, EP), bool(not (plant.has_stiction or comp.adds_stiction(EP)))
+
+
+def run_kernel(plant, hs, h, n_steps, out_every, *, u_active=0.0, progress=None, chunk_steps=200_000, effects=()):
+    """Run the compiled stepper from rest (stuck) at the operating point.
+
+    ``plant`` is :func:`heavecomp.plants.cmc.plant_vectors`; ``effects`` (instances) act at its
+    hooks (:func:`plant_stepper`).
+    """
     n_out = n_steps // out_every + 1
     out = np.empty((n_out, NCH))
-    state = np.zeros(4)
     mode_dir = np.array([float(STUCK), 1.0])
     stats = np.zeros(len(STATS))
-    smooth = not law.has_stiction
+    advance, state, smooth = plant_stepper(plant, effects)
 
     def step(t0, n, Z, DZ, DDZ, pos):
-        return advance(state, mode_dir, t0, n, h, int(law.code), law.FP, PP, bool(smooth), float(u_active),
+        return advance(state, mode_dir, t0, n, h, plant.code, plant.FP, plant.PP, smooth, float(u_active),
                        0.5 * h, Z, DZ, DDZ, out, int(out_every), int(pos), stats)
 
     t0 = time.perf_counter()

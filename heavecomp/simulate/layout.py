@@ -7,8 +7,9 @@ SLIDING = 1
 CHANNELS = ("t", "heave", "stroke", "pressure", "wob", "stroke_velocity", "friction", "tension",
             "lower_displacement", "lower_velocity", "stuck", "u_active")
 NCH = len(CHANNELS)
-#: extra channels written by ``_kernel.advance_fx`` when ``out`` has room (after CHANNELS)
-FX_CHANNELS = ("gas_pressure", "theta")
+#: extra channels written by ``_kernel.advance_fx`` when ``out`` has room (after CHANNELS): the gas
+#: pressure before the line and the effects' states x4, x5, x6 (slots of ``effects.compose``)
+FX_CHANNELS = ("gas_pressure", "effect_state_4", "effect_state_5", "effect_state_6")
 #: slots of the ``stats`` array: time stuck [s]; counts of stick, breakaway, reversal events;
 #: steps that hit the event cap (more than 8 events in one step, finished without event
 #: checks) and the time [s] of the first such step (0 while there is none); bit contact switches
@@ -17,7 +18,7 @@ STATS = ("stuck_time", "n_stick", "n_breakaway", "n_reversal", "event_cap_hits",
 NSTATS = len(STATS)
 
 #: files whose source the compiled stepper is built from (the AOT build is keyed to them)
-KERNEL_SOURCES = ("friction/laws.py", "plants/cmc.py", "effects/terms.py", "simulate/_kernel.py",
+KERNEL_SOURCES = ("friction/laws.py", "plants/cmc.py", "effects/compose.py", "simulate/_kernel.py",
                   "simulate/layout.py")
 
 

@@ -1,0 +1,145 @@
+"""Effects as submodels at the CMC's hooks.
+
+The CMC (:mod:`heavecomp.plants.cmc`) has named hook points, each with a "none"
+default (the nominal equation).  An effect is one class in one file of
+:mod:`heavecomp.effects`: its parameters (a frozen dataclass of :func:`heavecomp.params.core.q`
+fields: unit, bounds, symbol; the default is the fit's initial guess), its extra states and
+its ``np.*`` terms, one static method per hook it acts at.  numba compiles those methods
+into the stepper (:func:`heavecomp.simulate._kernel.kernel_for`) and casadi traces the very
+same source (:func:`heavecomp.effects.model.casadi_model`), so ``simulate``, ``linearise``, the
+MPCs and the diagnosis accept any effect.
+
+Hooks (:data:`HOOKS`).  Every method gets the value so far at its hook and returns the
+new one (effects at one hook are chained in registry order); ``x`` is the tuple of the
+effect's own states, ``*prm`` its parameters in the order of the ``Params`` fields:
+
+=============  =================================================  ======================================
+hook (slot)    method                                             nominal ("none")
+=============  =================================================  ======================================
+gas spring     ``gas(s, v, p, x, PP, *prm) -> p_gas [Pa]``        polytropic, fixed charge
+line           ``line(v, p, x, PP, *prm) -> p_cyl [Pa]``          lossless, p_cyl = p_gas
+string         ``string(dv, T, x, PP, *prm) -> T_ds [N]``         spring + dashpot (dv = dz_h + v - v_b)
+seal friction  ``jump(code, a, p, J, x, FP, *prm) -> J [N]``      the friction law's J (paper A eq. 4/6/7)
+               ``static(code, p, lim, tau, x, FP, *prm) -> [N]``  static limit J(0, p); tau = dwell time
+states         ``rates(s, v, p, x, PP, FP, *prm) -> dx/dt``       (no extra states)
+               ``initial(FP, PP, *prm) -> x`` at rest,
+               ``steady(v, FP, PP, *prm) -> x`` sliding at v
+measured       ``channel``: applied to the recorded channel       ideal sensor
+heave input    ``heave``: (no effect yet)                         measured = seen
+=============  =================================================  ======================================
+
+A method must use ``np.*`` only and branch on parameters or the law ``code``, never on a
+state (casadi traces it).  ``PP`` / ``FP`` are indexed by the named constants of
+:mod:`heavecomp.plants.cmc` / :mod:`heavecomp.friction.laws`.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from heavecomp.errors import ParameterError, did_you_mean
+
+#: hook slot -> the methods an effect defines there (kernel hooks first; ``channel`` and
+#: ``heave`` act outside the kernel)
+HOOKS = {"seal_friction": ("jump", "static"), "gas_spring": ("gas",), "line": ("line",),
+         "string": ("string",), "channel": (), "heave": ()}
+#: the methods the stepper and the casadi model call, in the order they are composed
+METHODS = ("gas", "line", "string", "jump", "static", "rates")
+
+
+class Effect:
+    """Base class of an effect (a submodel at one of the plant's hooks).
+
+    Class attributes: ``name`` (the contract name), ``hook`` (a key of :data:`HOOKS`),
+    ``Params`` (frozen dataclass), ``states`` (names of extra states), ``adds_stiction``
+    (adds friction that jumps with sign(v): the stepper must treat even a smooth law as
+    stick-slip), ``kind`` (``"plant"``: terms at kernel hooks; ``"output"``: acts on a
+    measured channel; ``"nominal"``: refits nominal parameters), ``log`` (parameters fitted on
+    a log scale), ``candidate`` (the gap diagnosis fits it by default: the contract's effects,
+    ``diagnosis-contract.md``).  An instance carries parameter values: ``FlowLoss(resistance=2e5)``.
+    """
+
+    name: str = ""
+    hook: str = ""
+    Params: type = None
+    states: tuple = ()
+    adds_stiction: bool = False
+    kind: str = "plant"
+    log: tuple = ()
+    candidate: bool = False
+    # hook methods (staticmethods in subclasses); None: the effect does not act there
+    gas = line = string = jump = static = rates = initial = steady = None
+
+    def __init__(self, **values):
+        names = [f.name for f in self.fields()]
+        for k in values:
+            if k not in names:
+                raise ParameterError(f"effect {self.name}: unknown parameter {k!r}{did_you_mean(k, names)}; "
+                                     f"parameters: {', '.join(names)}")
+        self.params = self.Params(**values)
+
+    def __repr__(self):
+        return f"{type(self).__name__}({', '.join(f'{k}={v!r}' for k, v in self.values.items())})"
+
+    @property
+    def values(self) -> dict:
+        """Parameter values by name [SI]."""
+        return {f.name: getattr(self.params, f.name) for f in self.fields()}
+
+    @property
+    def prm(self) -> tuple:
+        """Parameter values in field order (the ``*prm`` of the hook methods)."""
+        return tuple(float(getattr(self.params, f.name)) for f in self.fields())
+
+    @classmethod
+    def methods(cls) -> tuple:
+        """The hook methods this effect defines (subset of :data:`METHODS`)."""
+        return tuple(m for m in METHODS if getattr(cls, m) is not None)
+
+    @classmethod
+    def null(cls, plant) -> dict | None:
+        """Parameter values at which the effect reproduces the nominal plant bit for bit
+        (``plant``: :class:`heavecomp.plants.cmc.PlantVectors`), or None when it has none
+        (e.g. a memory whose zero time constant is singular)."""
+        return None
+
+    # --- metadata and the fit vector ----------------------------------------
+    @classmethod
+    def fields(cls):
+        return dataclasses.fields(cls.Params)
+
+    @classmethod
+    def n_params(cls) -> int:
+        return len(cls.fields())
+
+    @classmethod
+    def describe(cls) -> list[dict]:
+        """Name, unit, bounds, symbol and initial guess of every parameter."""
+        return [{"name": f.name, "unit": f.metadata["unit"], "bounds": list(f.metadata["bounds"]),
+                 "symbol": f.metadata.get("symbol"), "initial": f.default, "doc": f.metadata.get("doc", "")}
+                for f in cls.fields()]
+
+    @classmethod
+    def x0(cls) -> np.ndarray:
+        return cls.to_x({f.name: f.default for f in cls.fields()})
+
+    @classmethod
+    def bounds_x(cls):
+        lo, hi = [], []
+        for f in cls.fields():
+            a, b = f.metadata["bounds"]
+            if f.name in cls.log:
+                a, b = np.log(a), np.log(b)
+            lo.append(a)
+            hi.append(b)
+        return np.array(lo), np.array(hi)
+
+    @classmethod
+    def to_x(cls, values: dict) -> np.ndarray:
+        return np.array([np.log(values[f.name]) if f.name in cls.log else values[f.name] for f in cls.fields()])
+
+    @classmethod
+    def from_x(cls, x) -> dict:
+        return {f.name: float(np.exp(xi) if f.name in cls.log else xi) for f, xi in zip(cls.fields(), x)}

@@ -1,0 +1,36 @@
+"""``flow_loss``: pressure drop in the line between cylinder and gas bank (line hook)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from heavecomp.effects.base import Effect
+from heavecomp.params.core import q
+
+
+class FlowLoss(Effect):
+    """Laminar line: p_cyl = p_gas - R v.
+
+    Flow out of the cylinder (v < 0, plunger pushed in) raises the cylinder pressure.
+    """
+
+    name = "flow_loss"
+    candidate = True
+    hook = "line"
+    log = ("resistance",)
+
+    @dataclass(frozen=True)
+    class Params:
+        resistance: float = q(3e4, "Pa s/m", bounds=(10.0, 1e7), symbol="R",
+                              doc="line pressure drop per unit stroke velocity")
+
+    @staticmethod
+    def line(v, p, x, PP, resistance):
+        return p - resistance * v
+
+    @classmethod
+    def null(cls, plant):
+        return {"resistance": 0.0}
+
+
+EFFECT = FlowLoss

@@ -1,0 +1,63 @@
+"""``friction_lag``: frictional memory of the Stribeck excess force (seal friction hook)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from heavecomp.effects.base import Effect
+from heavecomp.friction.laws import FC, FS, STRIBECK, VS, stribeck_excess
+from heavecomp.params.core import q
+
+
+class FrictionLag(Effect):
+    """The Stribeck excess (F_S - F_C) e^{-|v|/v_S} of paper A eq. 4 is replaced by a state E
+    that follows it with an asymmetric first-order memory.
+
+    Notes
+    -----
+    dE/dt = ((F_S - F_C) e^{-|v|/v_S} - E) / T, T = T_E while E rises and T_drop while it
+    falls.  Accelerating, E stays high (Stribeck-like); decelerating, it stays low
+    (viscous-like): the hysteresis of paper A Fig. 7.  The static limit at rest is
+    F_C + E + C_p |p|.  Acts on eq. 4 only (``code == STRIBECK``).
+    """
+
+    name = "friction_lag"
+    candidate = True
+    hook = "seal_friction"
+    states = ("E",)
+    log = ("lag_time", "drop_time")
+
+    @dataclass(frozen=True)
+    class Params:
+        lag_time: float = q(1.0, "s", bounds=(0.01, 100.0), symbol="T_E",
+                            doc="recovery time of the Stribeck excess force (rising towards its steady value)")
+        drop_time: float = q(0.05, "s", bounds=(0.001, 10.0), symbol="T_drop",
+                             doc="relaxation time of the Stribeck excess force while it falls")
+
+    @staticmethod
+    def jump(code, a, p, J, x, FP, lag_time, drop_time):
+        if code == STRIBECK:
+            return J - stribeck_excess(np.maximum(a, 0.0), FP[FS], FP[FC], FP[VS]) + x[0]
+        return J
+
+    @staticmethod
+    def rates(s, v, p, x, PP, FP, lag_time, drop_time):
+        td = drop_time + (drop_time <= 0.0) * lag_time
+        target = 0.0 * v  # a law without a Stribeck curve (v_S = 0: "none") has no excess
+        if FP[VS] > 0.0:
+            target = stribeck_excess(np.abs(v), FP[FS], FP[FC], FP[VS])
+        up = target > x[0]
+        return ((target - x[0]) / (lag_time * up + td * (1.0 - up)),)
+
+    @staticmethod
+    def initial(FP, PP, lag_time, drop_time):
+        return (FP[FS] - FP[FC],)
+
+    @staticmethod
+    def steady(v, FP, PP, lag_time, drop_time):
+        return (stribeck_excess(np.abs(v), FP[FS], FP[FC], FP[VS]) if FP[VS] > 0 else 0.0,)
+
+
+EFFECT = FrictionLag

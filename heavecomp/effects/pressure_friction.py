@@ -1,0 +1,36 @@
+"""``pressure_friction``: seal friction grows with pressure (seal friction hook)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from heavecomp.effects.base import Effect
+from heavecomp.params.core import q
+
+
+class PressureFriction(Effect):
+    """J += dC_p |p|: more of paper A eq. 4's C_p term (the seal is energised by the pressure)."""
+
+    name = "pressure_friction"
+    candidate = True
+    hook = "seal_friction"
+    adds_stiction = True
+    log = ("extra_pressure_coefficient",)
+
+    @dataclass(frozen=True)
+    class Params:
+        extra_pressure_coefficient: float = q(1e-3, "N/Pa", bounds=(1e-6, 0.05), symbol="dC_p",
+                                              doc="seal friction added per pascal of cylinder pressure")
+
+    @staticmethod
+    def jump(code, a, p, J, x, FP, extra_pressure_coefficient):
+        return J + extra_pressure_coefficient * np.abs(p)
+
+    @classmethod
+    def null(cls, plant):
+        return {"extra_pressure_coefficient": 0.0}
+
+
+EFFECT = PressureFriction

@@ -1,0 +1,32 @@
+"""``string_damping``: extra drill-string damping (string hook)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from heavecomp.effects.base import Effect
+from heavecomp.params.core import q
+
+
+class StringDamping(Effect):
+    """A linear dashpot c (dz_h + v - v_b) added to the drill-string tension."""
+
+    name = "string_damping"
+    candidate = True
+    hook = "string"
+    log = ("damping",)
+
+    @dataclass(frozen=True)
+    class Params:
+        damping: float = q(3e4, "N s/m", bounds=(10.0, 2e6), symbol="c", doc="extra drill-string damping")
+
+    @staticmethod
+    def string(dv, T, x, PP, damping):
+        return T + damping * dv
+
+    @classmethod
+    def null(cls, plant):
+        return {"damping": 0.0}
+
+
+EFFECT = StringDamping
