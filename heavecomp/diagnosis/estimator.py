@@ -7,7 +7,8 @@
 Method
 ------
 1. Replay: the nominal CMC (exact stick-slip, :mod:`heavecomp.diagnosis.stepper`)
-   driven by the measured heave (zero-phase FIR low-pass, spline derivatives).
+   driven by the measured heave (zero-phase FIR low-pass, spline derivatives), from the
+   state estimated from the first seconds of the run (:mod:`heavecomp.diagnosis.start`).
 2. Residual per channel r_c = y_model - y_meas on samples after the settling
    window, excluding dropouts; noise floor sigma_c from second differences.
 3. Each candidate is fitted (``scipy.optimize.least_squares``, bounded, few
@@ -101,7 +102,9 @@ class GapDiagnoser:
     segment : float [s] or None
         Multiple-shooting segment length: the replay restarts from the measured state every
         ``segment`` seconds, so one early stick-slip event does not decide the rest of the run
-        (exact stiction makes long open-loop replays drift).  None: one open-loop replay.
+        (exact stiction makes long open-loop replays drift).  None: one open-loop replay from the
+        estimated initial state (the default: measured to follow a cut run's whole replay more
+        closely than 20 s segments do, docs/diagnosis.md).
     reinit : float [s]
         Start of each restarted segment left out of the residuals.
     stuck_speed : float [m/s]
@@ -162,13 +165,32 @@ class GapDiagnoser:
 
         h = replay_dt(self.nominal)
         n_steps = int(math.ceil(run.t[-1] / h - 1e-9))
-        hs = heave_samples(run, h, n_steps)
+        self._start(run)
+        hs = heave_samples(run, h, n_steps, reference=self.initial_.heave_reference)
         code, FP, PP = _vectors(self.nominal)
         rp = Replay(run.t, h, n_steps, hs, code, FP, PP)
-        rp.bounds, rp.starts, rp.reinit = [(0, n_steps)], [None], np.zeros(run.t.size, bool)
+        rp.bounds, rp.starts, rp.reinit = [(0, n_steps)], [self.initial_.start()], np.zeros(run.t.size, bool)
         if self.segment:
             rp.bounds, rp.starts, rp.reinit = self._segments(run, h, n_steps, PP)
+            rp.starts[0] = self.initial_.start()
         return rp
+
+    def _start(self, run):
+        """Start anywhere (issue 12): the replay's initial state and heave reference estimated from
+        the first seconds of the run (:func:`heavecomp.diagnosis.start.estimate`); a warning when the
+        log does not start at rest at the operating point."""
+        from heavecomp.diagnosis import start as S
+        from heavecomp.diagnosis.data import heave_filtered
+
+        st = S.estimate(run, self.nominal, heave_filtered(run), stuck_speed=self.stuck_speed)
+        self.initial_ = st
+        self.start_warnings_ = []
+        if not st.at_rest:
+            self.start_warnings_.append(
+                f"the log does not start at rest at the operating point (stroke {st.stroke:+.4f} m, stroke velocity "
+                f"{st.stroke_velocity:+.4f} m/s, WOB {st.wob / 1e3:.1f} kN vs W_0 "
+                f"{self.nominal.operating_point.wob_setpoint / 1e3:.1f} kN, {'stuck' if st.stuck else 'sliding'}): "
+                f"the replay starts from the state estimated from its first {st.window:g} s (initial_state)")
 
     def _segments(self, run, h, n_steps, PP):
         """Multiple shooting: segments of ``segment`` s, each started from the measured state
@@ -208,7 +230,7 @@ class GapDiagnoser:
         """Model channels at the run's times (up to ``t_end``) for a configuration
         ``[(effect name, values), ...]`` (empty: the nominal model), driven by the replay's heave
         or by ``hs`` (heave samples on the same grid)."""
-        from heavecomp.diagnosis.stepper import CHANNELS as SC, run_fx, run_segments
+        from heavecomp.diagnosis.stepper import CHANNELS as SC, run_segments
 
         rp = self._rp
         hs = rp.hs if hs is None else hs
@@ -224,10 +246,7 @@ class GapDiagnoser:
             else:
                 shift = (values["channel"], values["delay"])
         n = rp.n_steps if t_end is None else min(rp.n_steps, int(math.ceil(t_end / rp.h)) + 2)
-        if self.segment:
-            out = run_segments(code, FP, PP, EP, hs, rp.h, rp.bounds, rp.starts, n + 1)
-        else:
-            out = run_fx(code, FP, PP, EP, hs, rp.h, n, 1)
+        out = run_segments(code, FP, PP, EP, hs, rp.h, rp.bounds, rp.starts, n + 1)
         tg = out[:, 0]
         t = rp.t if t_end is None else rp.t[rp.t <= tg[-1]]
         res = {}
@@ -402,7 +421,7 @@ class GapDiagnoser:
         t_split = self.split * T_end
         self.split_ = {"fit": [0.0, t_split], "validate": [t_split, T_end], "settle": settle}
         self._rp = self._setup(run)
-        self.warnings_ = list(run.warnings)
+        self.warnings_ = list(run.warnings) + self.start_warnings_
         self._y = {c: run[c] for c in CH}
         t = run.t
         keep = ~self._rp.reinit
@@ -621,7 +640,7 @@ class GapDiagnoser:
 
         def perturbed():
             pert = MeasuredRun(run.t, {"heave": run["heave"] + rng.normal(0.0, sz, run.t.size)}, run.source)
-            return heave_samples(pert, self._rp.h, self._rp.n_steps)
+            return heave_samples(pert, self._rp.h, self._rp.n_steps, reference=self._rp.hs.info["reference_m"])
 
         def ms(a, m):
             return {c: float(np.mean((a[c][m] - nom[c][m]) ** 2)) for c in CH}
@@ -634,7 +653,8 @@ class GapDiagnoser:
             other = ms(self.simulate([], hs=perturbed()), val)
             env = {c: max(env[c], other[c]) for c in CH}
         # sensitivity to the heave pre-processing: cut-off 1.5 x higher
-        alt2 = self.simulate([], hs=heave_samples(run, self._rp.h, self._rp.n_steps, cutoff=1.5 * HEAVE_CUTOFF))
+        alt2 = self.simulate([], hs=heave_samples(run, self._rp.h, self._rp.n_steps, cutoff=1.5 * HEAVE_CUTOFF,
+                                                  reference=self._rp.hs.info["reference_m"]))
         self.heave_noise_ = sz
         pre = ms(alt2, val)
         self._env_ms = {c: env[c] + pre[c] for c in CH}
@@ -659,4 +679,5 @@ class GapDiagnoser:
                 "noise": {"output": self.output_noise_, "replay_from_heave_noise": self.replay_floor_,
                           "heave": self.heave_noise_, "input_envelope": self.input_envelope_},
                 "warnings": list(getattr(self, "warnings_", [])),
+                "initial_state": self.initial_.to_json(),
                 "wall_time_s": self.wall_time_}
