@@ -70,6 +70,31 @@ def _vectors(params):
     return law.code, law.FP.copy(), plant_vector(params)
 
 
+BOUND_TOL = 0.01  #: a fitted parameter within this share of its search range from a bound is "at the bound"
+
+
+def at_bounds(name, values, tol=BOUND_TOL) -> list:
+    """Fitted parameters of candidate ``name`` that sit at a bound of their search range
+    (within ``tol`` of the range, on the fit's own scale: log where the candidate fits in log).
+
+    Returns a list of {parameter, value, side ("lower" | "upper"), bound}.
+    """
+    cls = get(name)
+    lo, hi = cls.bounds_x()
+    out = []
+    for f, a, b in zip(cls.fields(), lo, hi):
+        v = values.get(f.name)
+        if not isinstance(v, (int, float)) or not math.isfinite(v):
+            continue
+        x = math.log(v) if f.name in cls.log and v > 0 else v
+        span = tol * (b - a)
+        side = "upper" if x >= b - span else "lower" if x <= a + span else None
+        if side:
+            out.append({"parameter": f.name, "value": float(v), "side": side,
+                        "bound": float(f.metadata["bounds"][1 if side == "upper" else 0])})
+    return out
+
+
 class GapDiagnoser:
     """Sim-to-real gap diagnosis of a measured CMC run (an estimator: configure, ``fit``, results).
 
@@ -504,6 +529,7 @@ class GapDiagnoser:
         self._report(0.9, "verdict")
         self.second_tried_ = []
         self._verdict(rows, J_b, J_n)
+        self._bound_check(rows)
         self.candidates_ = [{k: v for k, v in r.items() if not k.startswith("_")} for r in rows]
         best_pred = rows[0]["_pred"] if self.verdict_["effect"] not in ("none",) else nom
         self.traces_ = {"t": run.t, "measured": {c: run[c] for c in CH}, "nominal": {c: nom[c] for c in CH},
@@ -572,6 +598,28 @@ class GapDiagnoser:
             v["second_effect"] = self._second(rows)
             v["second_candidates"] = self._second_candidates()
         self.verdict_ = v
+
+    def _bound_check(self, rows):
+        """A fitted parameter at its search bound (issue 14.3): the fit wanted to go further than the
+        candidate allows, so the candidate is probably standing in for something else (e.g. a heave
+        channel with the wrong sign fitted as a 3 s sensor delay).  Every candidate row gets
+        ``at_bound``; a named verdict with a parameter there drops to confidence ``low``, says so in
+        ``warnings`` and lists them in ``verdict.at_bound``."""
+        for r in rows:
+            r["at_bound"] = at_bounds(r["effect"], r["_values"])
+        v = self.verdict_
+        if v["effect"] in ("none", "inconclusive") or v["effect"] != rows[0]["effect"]:
+            return
+        hits = rows[0]["at_bound"]
+        if not hits:
+            return
+        v["at_bound"] = hits
+        was = v["confidence"]
+        v["confidence"] = "low"
+        where = ", ".join(f"{h['parameter']} = {h['value']:.4g} at its {h['side']} search bound {h['bound']:.4g}"
+                          for h in hits)
+        self.warnings_.append(f"verdict {v['effect']}: fitted {where}; the effect may stand in for another "
+                              f"(e.g. a channel with the wrong sign or unit) -- confidence lowered from {was} to low")
 
     def _second_candidates(self, n: int = 3) -> list:
         """The ``n`` joint partners that added most, best first (a user sees the likeliest second
