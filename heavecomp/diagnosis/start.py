@@ -35,6 +35,7 @@ import numpy as np
 WINDOW = 2.0  #: s of the measurement the initial state is estimated from
 STUCK_SPEED = 2e-3  #: m/s; below this measured stroke speed the compensator starts stuck
 LOWER_WINDOW = 0.15  #: s of WOB the lower-mass state is read from
+ZREF_WINDOW = (5.0, 30.0)  #: s of the run the heave reference is read from (after the pre-filter's edge)
 REST_SIGMAS = 4.0  #: an estimate within this many standard errors of the operating point counts as "at rest"
 
 
@@ -102,6 +103,13 @@ def _stroke_at_start(tw, s, sigma, stuck_speed):
     return best
 
 
+def _wob_slope(tw, W, at):
+    """dW/dt [N/s] at time ``at`` from a straight line over the LOWER_WINDOW (at least 8 samples) nearest it."""
+    d = np.abs(tw - at)
+    m = d <= max(LOWER_WINDOW, np.sort(d)[min(7, d.size - 1)])
+    return _poly_at_zero(tw[m] - at, W[m], 1)[1]
+
+
 def estimate(run, params, heave_filtered, *, window=WINDOW, stuck_speed=STUCK_SPEED, noise=None) -> InitialState:
     """Estimate the initial state of a measured run (see the module docstring).
 
@@ -135,11 +143,23 @@ def estimate(run, params, heave_filtered, *, window=WINDOW, stuck_speed=STUCK_SP
     ds, fo, op = params.drill_string, params.formation, params.operating_point
     kds, kF, W0 = ds.stiffness, fo.stiffness, op.wob_setpoint
     delta0 = W0 / kF
-    z = heave_filtered(t[w])
-    ok = np.isfinite(W) & np.isfinite(s)
-    yb = delta0 - W / kF
-    zref = float(np.mean((z + s - yb - (W0 - W) / kds)[ok]))
-    se_z = noise["wob"] * (1.0 / kds + 1.0 / kF) / math.sqrt(max(ok.sum(), 1))
+    # heave reference: a constant, so read from the string balance away from the filter's edge
+    # (the first ZREF_WINDOW[0] s of the filtered heave carry its edge error) over ZREF_WINDOW
+    rel = t - t[0]
+    wz = (rel >= ZREF_WINDOW[0]) & (rel <= ZREF_WINDOW[1])
+    if wz.sum() < 8:
+        wz = w
+    tz = rel[wz]
+    Wz, sz = run["wob"][wz], run["stroke"][wz]
+    z = heave_filtered(t[wz])
+    ok = np.isfinite(Wz) & np.isfinite(sz)
+    yb = delta0 - Wz / kF
+    # the lower mass' inertia over the window, mean(m_b a_b) = m_b (v_b(end) - v_b(start)) / T, with
+    # v_b = -dW/dt / k_F from straight lines at both ends (it oscillates at its own mode after stick events)
+    inertia = (ds.lower_mass * (_wob_slope(tz, Wz, tz[-1]) - _wob_slope(tz, Wz, tz[0])) / (-kF)
+               / max(tz[-1] - tz[0], 1e-9))
+    zref = float(np.mean((z + sz - yb - (W0 - Wz) / kds)[ok]) - inertia / kds)
+    se_z = math.hypot(noise["wob"] * (1.0 / kds + 1.0 / kF), noise["stroke"]) / math.sqrt(max(int(ok.sum()), 1))
     # lower mass from the measured WOB at t = 0 (a straight line over LOWER_WINDOW: shorter than half a
     # period of the lower-mass mode, which stick events excite), W = k_F (delta_0 - y_b) - c_F v_b
     m = tw <= max(LOWER_WINDOW, tw[min(7, tw.size - 1)])
@@ -148,7 +168,7 @@ def estimate(run, params, heave_filtered, *, window=WINDOW, stuck_speed=STUCK_SP
     yb0 = delta0 - (W_0t + fo.damping * vb0) / kF
     # measured WOB at t = 0 (straight line over the window) decides "at rest" with the stroke
     W_meas = _poly_at_zero(tw, W, 1)[0]
-    se_W = 2.0 * noise["wob"] / math.sqrt(max(ok.sum(), 1))
+    se_W = 2.0 * noise["wob"] / math.sqrt(max(int(np.isfinite(W).sum()), 1))
     at_rest = (stuck and abs(s0) <= REST_SIGMAS * max(se_s, 1e-6) + 1e-3
                and abs(W_meas - W0) <= REST_SIGMAS * se_W + 0.01 * W0)
     return InitialState(stroke=s0, stroke_velocity=v0, lower_displacement=float(yb0), lower_velocity=float(vb0),
