@@ -71,13 +71,14 @@ def test_initial_state_of_a_run_cut_mid_operation(t0):
     assert not st.at_rest
 
 
-def test_cut_run_is_replayed_like_the_whole_run_and_warned():
-    """The replay of a run cut at 60 s follows the whole run's replay: after the settling window their
+@pytest.mark.parametrize("t0", [23.7, 60.0, 97.1])
+def test_cut_run_is_replayed_like_the_whole_run_and_warned(t0):
+    """The replay of a run cut at t0 follows the whole run's replay: after the settling window their
     difference is a small fraction of each channel's noise (open-loop from the estimated state; the old
     replay from rest was 91-132x the stroke noise off)."""
     p, t, truth, meas = _truth_run()
     full = _crop(p, t, meas, 0.0)
-    cut = _crop(p, t, meas, 60.0)
+    cut = _crop(p, t, meas, t0)
     reps = {}
     for name, run in (("full", full), ("cut", cut)):
         d = GapDiagnoser(p, ["flow_loss"], second=0, n_jobs=1)
@@ -87,7 +88,7 @@ def test_cut_run_is_replayed_like_the_whole_run_and_warned():
     _, nom_f, _ = reps["full"]
     m = run_c.t >= 30.0
     for c, sigma in (("stroke", NOISE["stroke"]), ("wob", NOISE["wob"]), ("pressure", NOISE["pressure"])):
-        other = np.interp(run_c.t[m] + 60.0, full.t, nom_f[c])
+        other = np.interp(run_c.t[m] + t0, full.t, nom_f[c])
         assert np.sqrt(np.mean((nom_c[c][m] - other) ** 2)) < 0.5 * sigma, c
     assert any("does not start at rest" in w for w in d_c.start_warnings_)
 
