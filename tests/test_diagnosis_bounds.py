@@ -11,11 +11,18 @@ from heavecomp.diagnosis.generator import generate
 
 def test_at_bounds_reads_the_candidates_own_search_range():
     assert at_bounds("sensor_delay", {"channel": "wob", "delay": 3.0}) == [
-        {"parameter": "delay", "value": 3.0, "side": "upper", "bound": 3.0}]
+        {"parameter": "delay", "value": 3.0, "side": "upper", "bound": 3.0, "unit": "s"}]
     assert at_bounds("sensor_delay", {"channel": "wob", "delay": 0.4}) == []
     # log-scaled parameters are judged on the log scale: 1e7 is the upper bound, 1e6 is inside
     assert at_bounds("flow_loss", {"resistance": 1e7})[0]["side"] == "upper"
     assert at_bounds("flow_loss", {"resistance": 1e6}) == []
+    # parameter_mismatch: named as in the verdict's parameters, the value as a multiplier of the nominal
+    from heavecomp.effects import get
+
+    vals = {f.name: 1.0 for f in get("parameter_mismatch").fields()}
+    vals["gas_stiffness"] = 0.2
+    hit = at_bounds("parameter_mismatch", vals)
+    assert [(h["parameter"], h["side"], h["unit"]) for h in hit] == [("compensator.gas_stiffness", "lower", "x nominal")]
 
 
 @pytest.mark.slow

@@ -43,6 +43,7 @@ import numpy as np
 
 from heavecomp.effects import terms as T
 from heavecomp.effects.candidates import CANDIDATES, ParameterMismatch, get
+from heavecomp.effects.candidates import MISMATCH_KEYS
 from heavecomp.errors import InputError
 
 log = logging.getLogger(__name__)
@@ -91,7 +92,11 @@ def at_bounds(name, values, tol=BOUND_TOL) -> list:
         side = "upper" if x >= b - span else "lower" if x <= a + span else None
         if side:
             out.append({"parameter": f.name, "value": float(v), "side": side,
-                        "bound": float(f.metadata["bounds"][1 if side == "upper" else 0])})
+                        "bound": float(f.metadata["bounds"][1 if side == "upper" else 0]), "unit": f.metadata["unit"]})
+    if cls is ParameterMismatch:  # the names the verdict's parameters use ("table.key"), values as multipliers
+        names = {f.name: key for f, (key, _, _) in zip(cls.fields(), MISMATCH_KEYS)}
+        for o in out:
+            o["parameter"] = names.get(o["parameter"], o["parameter"])
     return out
 
 
