@@ -11,7 +11,14 @@ Hamming window) applied with ``scipy.signal.filtfilt`` (forward and backward:
 zero phase, squared magnitude response), central differences for the
 derivatives, and the filter applied again after each differentiation.
 
-Other modules may import it (e.g. diagnosis of measured runs).
+It is the package's one home for zero-phase filtering (issue 11.5): the diagnosis'
+heave and channel pre-filter (:func:`design_flat_lowpass`, a Kaiser-window FIR whose
+pass band is flat to 0.1 % after the forward-backward pass) and the identification's
+forward-backward Butterworth (:func:`butterworth_zero_phase`) live here too; the
+callers (``heavecomp.diagnosis.data``, ``heavecomp.identification.filtering``) only
+choose their filter.  No function here skips filtering silently: a cut-off at or above
+the Nyquist frequency, or a signal too short for the filter, raises
+:class:`~heavecomp.errors.InputError`.
 """
 
 from __future__ import annotations
@@ -19,6 +26,7 @@ from __future__ import annotations
 import numpy as np
 
 from heavecomp.errors import DataError, InputError
+from heavecomp.errors import ParameterError
 
 
 def sample_rate(t, *, name: str = "t", rtol: float = 1e-3) -> float:
@@ -62,20 +70,106 @@ def design_lowpass(fs: float, cutoff: float, numtaps: int | None = None) -> np.n
     return firwin(numtaps, cutoff, fs=fs, window="hamming")
 
 
+def design_flat_lowpass(fs: float, cutoff: float, width: float, ripple: float = 2e-4,
+                        max_taps: int | None = None) -> np.ndarray:
+    """FIR low-pass taps with a flat pass band (Kaiser window, linear phase).
+
+    Parameters
+    ----------
+    fs : float [Hz]
+    cutoff : float [Hz]
+        Centre of the transition band (-6 dB of one pass).
+    width : float [Hz]
+        Transition band: flat below ``cutoff - width/2``, attenuated above ``cutoff + width/2``.
+    ripple : float [-]
+        Largest deviation of one pass from 1 in the pass band (and of the gain from 0 in the stop
+        band); the forward-backward pass squares the response, so its pass band is flat to
+        about ``2 ripple``.
+    max_taps : int, optional
+        Longest filter allowed (a short signal); the transition band then widens and the
+        ripple is what that length gives (``scipy.signal.kaiserord`` inverted), never a silent skip.
+
+    Raises
+    ------
+    InputError
+        When the stop edge ``cutoff + width/2`` is not below ``fs/2``.
+    """
+    from scipy.signal import firwin, kaiser_beta, kaiserord
+
+    if not (0 < width and 0 < cutoff - 0.5 * width and cutoff + 0.5 * width < 0.5 * fs):
+        raise InputError(f"cutoff = {cutoff:g} Hz with a {width:g} Hz transition band must lie in "
+                         f"(0, fs/2 = {0.5 * fs:g} Hz)")
+    atten = -20.0 * np.log10(ripple)
+    numtaps, beta = kaiserord(atten, width / (0.5 * fs))
+    if max_taps is not None and numtaps > max_taps:
+        numtaps = int(max_taps)
+        # the attenuation this length reaches over the same transition band (kaiserord's formula)
+        atten = max(21.0, 7.95 + 2.285 * (numtaps - 1) * np.pi * width / (0.5 * fs))
+        beta = kaiser_beta(atten)
+    numtaps = int(numtaps) | 1
+    return firwin(numtaps, cutoff, fs=fs, window=("kaiser", beta))
+
+
+def filtfilt_fir(x, b) -> np.ndarray:
+    """Forward-backward FIR filtering of ``x`` with taps ``b`` (odd extension of 3 filter lengths):
+    zero phase, squared magnitude response.
+
+    The signal must be longer than 3 filter lengths; otherwise InputError.
+    """
+    from scipy.signal import filtfilt
+
+    x = np.asarray(x, dtype=float)
+    b = np.asarray(b, dtype=float)
+    if x.shape[-1] <= 3 * b.size:
+        raise InputError(f"signal of {x.shape[-1]} samples is too short for a {b.size}-tap filter: "
+                         "raise the cutoff or record longer")
+    return filtfilt(b, [1.0], x, padtype="odd", padlen=3 * b.size)
+
+
 def zero_phase_lowpass(x, fs: float, cutoff: float, numtaps: int | None = None) -> np.ndarray:
     """Filter ``x`` forward and backward with the FIR low-pass: no phase shift (paper B).
 
     The signal must be longer than 3 filter lengths (``filtfilt`` padding);
     otherwise InputError.
     """
-    from scipy.signal import filtfilt
-
     x = np.asarray(x, dtype=float)
     b = design_lowpass(fs, cutoff, numtaps)
     if x.shape[-1] <= 3 * b.size:
         raise InputError(f"signal of {x.shape[-1]} samples is too short for a {b.size}-tap filter "
                          f"(cutoff {cutoff:g} Hz at {fs:g} Hz): raise the cutoff or record longer")
-    return filtfilt(b, [1.0], x, padtype="odd", padlen=3 * b.size)
+    return filtfilt_fir(x, b)
+
+
+def butterworth_zero_phase(x, fs: float, cutoff: float, order: int = 4) -> np.ndarray:
+    """Forward-backward Butterworth low-pass (zero phase, squared magnitude); the identification's
+    filter (Gautier's IDIM-LS, :mod:`heavecomp.identification.filtering`).
+
+    Parameters
+    ----------
+    x : array
+        Signal sampled at ``fs``.
+    fs : float, Hz
+        Sampling rate.
+    cutoff : float, Hz
+        -3 dB frequency of the single-pass Butterworth filter (the forward-backward
+        pass is -6 dB there).
+    order : int
+        Butterworth order (the forward-backward pass doubles it).
+
+    Raises
+    ------
+    ParameterError
+        Cut-off outside (0, fs/2) or order < 1.
+    """
+    import scipy.signal as ss
+
+
+    if not 0.0 < cutoff < 0.5 * fs:
+        raise ParameterError(f"cutoff must be in (0, fs/2) = (0, {0.5 * fs:g}) Hz, got {cutoff:g}")
+    if int(order) < 1:
+        raise ParameterError(f"order must be a positive integer, got {order}")
+    sos = ss.butter(int(order), cutoff, fs=fs, output="sos")
+    return ss.sosfiltfilt(sos, np.asarray(x, dtype=float))
 
 
 def differentiate(t, x, cutoff: float, *, order: int = 2, numtaps: int | None = None, name: str = "x"):

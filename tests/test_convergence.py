@@ -92,7 +92,7 @@ def test_default_step_follows_the_fastest_mode_and_is_accurate(change):
 
     from heavecomp.friction.laws import steepest_slope
     from heavecomp.effects.model import casadi_model
-from heavecomp.plants.cmc import plant_vectors
+    from heavecomp.plants.cmc import plant_vectors
     from heavecomp.simulate import default_dt
 
     p = paper_a("stribeck").replace(**change)

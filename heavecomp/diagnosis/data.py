@@ -21,6 +21,7 @@ Treatments (documented in ``docs/diagnosis.md``):
 from __future__ import annotations
 
 import dataclasses
+import logging
 import math
 from pathlib import Path
 
@@ -30,8 +31,11 @@ from heavecomp.errors import DataError
 from heavecomp.simulate.excitation import HeaveSamples
 from heavecomp.io.series import MAX_DT_S, gaps
 from heavecomp.io.series import read_series
+from heavecomp.signals import design_flat_lowpass, filtfilt_fir
 
 P_ATM = 101325.0  #: atmospheric pressure [Pa] (cmc-reference.md)
+
+log = logging.getLogger(__name__)
 
 REQUIRED = ("t", "heave", "stroke", "pressure", "wob")
 CHANNELS = ("wob", "stroke", "pressure")
@@ -40,7 +44,8 @@ MAX_MISSING = 0.2  #: largest tolerated fraction of missing samples per column
 MAX_GAP = 2.0      #: longest heave dropout (or hole in the time column) bridged by interpolation [s]
 MIN_SAMPLES = 50   #: fewest samples of a run
 HEAVE_CUTOFF = 0.8  #: zero-phase FIR low-pass cut-off for the heave [Hz] (paper B's method; waves < 0.7 Hz)
-TAPS_PER_CUTOFF = 4.0  #: FIR length in periods of the cut-off (Hamming window)
+TRANSITION = 0.75  #: transition band of the pre-filter as a fraction of its cut-off [-] (0.5-1.1 Hz for the heave)
+RIPPLE = 2e-4  #: pass-band ripple of one pass of the pre-filter [-] (forward-backward: 0.04 %)
 
 
 @dataclasses.dataclass
@@ -241,35 +246,56 @@ def uniform(t, y, dt=None):
 
 
 def zero_phase_lowpass(y, dt, cutoff=HEAVE_CUTOFF):
-    """FIR low-pass run forward and backward (scipy ``filtfilt``): no phase shift (paper B).
+    """Zero-phase FIR low-pass of a uniformly sampled channel (spacing ``dt`` [s], ``cutoff`` [Hz]):
+    :func:`heavecomp.signals.design_flat_lowpass` (Kaiser window, transition band
+    ``TRANSITION`` x cut-off centred on it, pass-band ripple ``RIPPLE`` per pass) run forward and
+    backward (:func:`heavecomp.signals.filtfilt_fir`; paper B's zero-phase filtering).
 
-    Hamming-window FIR with TAPS_PER_CUTOFF periods of the cut-off in its length.
+    Below the transition band the response is flat to 2 ``RIPPLE`` (0.04 %): the heave's wave band
+    passes unchanged (the Hamming FIR used until 2026-11 amplified 0.1-0.4 Hz by 0.5-1 %).
+
+    When the stop edge lies at or above the Nyquist frequency ``1/(2 dt)`` the sampling itself
+    band-limits the channel below the filter: the channel is returned unchanged and this is
+    logged (documented in ``docs/diagnosis.md``; until 2026-11 the skip was silent).  A run too
+    short for the full filter gets the longest filter it can carry (a wider transition band).
     """
-    from scipy.signal import filtfilt, firwin
 
     fs = 1.0 / dt
-    if cutoff >= 0.45 * fs:
-        return y
-    ntaps = int(TAPS_PER_CUTOFF * fs / cutoff) | 1
-    ntaps = min(ntaps, (y.size - 1) // 3 - 1) | 1
-    b = firwin(ntaps, cutoff, fs=fs)
-    return filtfilt(b, [1.0], y)
+    width = TRANSITION * cutoff
+    if cutoff + 0.5 * width >= 0.5 * fs:
+        log.info("zero-phase low-pass at %g Hz skipped: sampling at %g Hz already band-limits below %g Hz",
+                 cutoff, fs, 0.5 * fs)
+        return np.asarray(y, dtype=float)
+    y = np.asarray(y, dtype=float)
+    b = design_flat_lowpass(fs, cutoff, width, RIPPLE, max_taps=max(3, (y.size - 1) // 3 - 1))
+    return filtfilt_fir(y, b)
 
 
-def heave_samples(run: MeasuredRun, h: float, n_steps: int, cutoff=HEAVE_CUTOFF):
-    """Heave input for the replay: gap-filled, uniformly resampled, zero-phase FIR low-passed
-    (``cutoff`` [Hz]), then a cubic spline gives z_h, dz_h, ddz_h on the stepper grid (h/2).
-
-    The first sample is the operating point's heave reference (cmc-reference.md).
-    """
+def heave_filtered(run: MeasuredRun, cutoff=HEAVE_CUTOFF):
+    """The replay's heave before its reference is removed: gap-filled, uniformly resampled,
+    zero-phase FIR low-passed (``cutoff`` [Hz]); a cubic spline of it (callable t -> z [m],
+    ``.derivative()`` for dz_h, ddz_h)."""
     from scipy.interpolate import CubicSpline
 
     tu, zu = uniform(run.t, run["heave"])
-    zf = zero_phase_lowpass(zu, tu[1] - tu[0], cutoff)
-    cs = CubicSpline(tu, zf - zf[0])
+    return CubicSpline(tu, zero_phase_lowpass(zu, tu[1] - tu[0], cutoff))
+
+
+def heave_samples(run: MeasuredRun, h: float, n_steps: int, cutoff=HEAVE_CUTOFF, reference=None):
+    """Heave input for the replay: :func:`heave_filtered` minus the operating point's heave
+    reference, z_h, dz_h, ddz_h on the stepper grid (h/2).
+
+    ``reference`` [m]: the heave the operating point belongs to (estimated by
+    :func:`heavecomp.diagnosis.start.estimate` for a log that starts anywhere); default the first
+    filtered sample (cmc-reference.md: a run that starts at rest at the operating point).
+    """
+
+    cs = heave_filtered(run, cutoff)
+    ref = float(cs(run.t[0])) if reference is None else float(reference)
     sp = 0.5 * h
-    tg = np.minimum(np.arange(2 * n_steps + 2) * sp, tu[-1])
-    return HeaveSamples(sp, cs(tg), cs(tg, 1), cs(tg, 2), {"kind": "measured", "cutoff_hz": cutoff})
+    tg = np.minimum(np.arange(2 * n_steps + 2) * sp, run.t[-1])
+    return HeaveSamples(sp, cs(tg) - ref, cs(tg, 1), cs(tg, 2), {"kind": "measured", "cutoff_hz": cutoff,
+                                                                 "reference_m": ref})
 
 
 def derivative_zero_phase(t, y, cutoff):
@@ -283,12 +309,30 @@ def derivative_zero_phase(t, y, cutoff):
     return cs(t, 1), cs(t, 2)
 
 
+NOISE_ORDERS = (2, 3, 4, 5, 6)  #: difference orders of the noise estimate
+
+
 def noise_floor(y, t=None) -> float:
-    """Measurement-noise standard deviation from second differences (robust: median absolute
-    deviation), sigma ~ 1.4826 MAD(d2 y) / sqrt(6) for white noise on a smooth signal."""
+    """Measurement-noise standard deviation of a channel [its unit], robust to the signal itself.
+
+    For white noise of standard deviation sigma the k-th difference has standard deviation
+    sigma sqrt(C(2k, k)); a smooth signal's k-th difference shrinks as (2 sin(pi f dt))^k, which is
+    below 1 for f < fs/6.  The estimate is the smallest over ``NOISE_ORDERS`` of
+    1.4826 MAD(d^k y) / sqrt(C(2k, k)) (median absolute deviation: robust to stick-slip events).
+    Second differences alone (until 2026-11) hold at 50-100 Hz but read the waves as noise at 10 Hz
+    (1.8x too high for 2 mm on a 2.5 m sea, 6x for 0.5 mm); from 10 to 100 Hz this estimate is within
+    a few % (``tests/test_diagnosis_preprocessing.py``).  A non-uniform ``t`` is resampled first.
+    """
+    from scipy.special import comb
+
     y = np.asarray(y, dtype=float)
     if t is not None:
         _, y = uniform(t, y)
     y = y[np.isfinite(y)]
-    d2 = np.diff(y, 2)
-    return float(1.4826 * np.median(np.abs(d2 - np.median(d2))) / math.sqrt(6.0))
+    best = math.inf
+    for k in NOISE_ORDERS:
+        if y.size <= k + 2:
+            break
+        d = np.diff(y, k)
+        best = min(best, float(1.4826 * np.median(np.abs(d - np.median(d))) / math.sqrt(comb(2 * k, k))))
+    return best if math.isfinite(best) else 0.0

@@ -7,7 +7,8 @@
 Method
 ------
 1. Replay: the nominal CMC (exact stick-slip, :mod:`heavecomp.diagnosis.stepper`)
-   driven by the measured heave (zero-phase FIR low-pass, spline derivatives).
+   driven by the measured heave (zero-phase FIR low-pass, spline derivatives), from the
+   state estimated from the first seconds of the run (:mod:`heavecomp.diagnosis.start`).
 2. Residual per channel r_c = y_model - y_meas on samples after the settling
    window, excluding dropouts; noise floor sigma_c from second differences.
 3. Each candidate is fitted (``scipy.optimize.least_squares``, bounded, few
@@ -40,16 +41,16 @@ import time
 
 import numpy as np
 
-from heavecomp.effects.candidates import CANDIDATES, ParameterMismatch, get
+from heavecomp.effects.candidates import CANDIDATES, MISMATCH_KEYS, ParameterMismatch, get
 from heavecomp.effects.compose import library_composition
-from heavecomp.plants.cmc import plant_vectors
 from heavecomp.errors import InputError
 from heavecomp.estimator import GapEstimator
 from heavecomp.diagnosis import where as W
 from heavecomp.diagnosis.data import (derivative_zero_phase, HEAVE_CUTOFF, heave_samples, MeasuredRun,
                                       noise_floor, uniform, zero_phase_lowpass)
-from heavecomp.friction.laws import FrictionLaw
-from heavecomp.plants.cmc import D0, KF, plant_vector
+from heavecomp.plants.cmc import D0, KF, plant_vectors
+from heavecomp.diagnosis.data import heave_filtered
+from heavecomp.diagnosis import start as S
 
 log = logging.getLogger(__name__)
 CH = ("wob", "stroke", "pressure")
@@ -64,6 +65,35 @@ class Replay:
     n_steps: int
     hs: object
     plant: object  # PlantVectors of the nominal parameters
+
+
+BOUND_TOL = 0.01  #: a fitted parameter within this share of its search range from a bound is "at the bound"
+
+
+def at_bounds(name, values, tol=BOUND_TOL) -> list:
+    """Fitted parameters of candidate ``name`` that sit at a bound of their search range
+    (within ``tol`` of the range, on the fit's own scale: log where the candidate fits in log).
+
+    Returns a list of {parameter, value, side ("lower" | "upper"), bound}.
+    """
+    cls = get(name)
+    lo, hi = cls.bounds_x()
+    out = []
+    for f, a, b in zip(cls.fields(), lo, hi):
+        v = values.get(f.name)
+        if not isinstance(v, (int, float)) or not math.isfinite(v):
+            continue
+        x = math.log(v) if f.name in cls.log and v > 0 else v
+        span = tol * (b - a)
+        side = "upper" if x >= b - span else "lower" if x <= a + span else None
+        if side:
+            out.append({"parameter": f.name, "value": float(v), "side": side,
+                        "bound": float(f.metadata["bounds"][1 if side == "upper" else 0]), "unit": f.metadata["unit"]})
+    if cls is ParameterMismatch:  # the names the verdict's parameters use ("table.key"), values as multipliers
+        names = {f.name: key for f, (key, _, _) in zip(cls.fields(), MISMATCH_KEYS)}
+        for o in out:
+            o["parameter"] = names.get(o["parameter"], o["parameter"])
+    return out
 
 
 class GapDiagnoser(GapEstimator):
@@ -98,7 +128,9 @@ class GapDiagnoser(GapEstimator):
     segment : float [s] or None
         Multiple-shooting segment length: the replay restarts from the measured state every
         ``segment`` seconds, so one early stick-slip event does not decide the rest of the run
-        (exact stiction makes long open-loop replays drift).  None: one open-loop replay.
+        (exact stiction makes long open-loop replays drift).  None: one open-loop replay from the
+        estimated initial state (the default: measured to follow a cut run's whole replay more
+        closely than 20 s segments do, docs/diagnosis.md).
     reinit : float [s]
         Start of each restarted segment left out of the residuals.
     stuck_speed : float [m/s]
@@ -160,13 +192,30 @@ class GapDiagnoser(GapEstimator):
 
         h = replay_dt(self.nominal)
         n_steps = int(math.ceil(run.t[-1] / h - 1e-9))
-        hs = heave_samples(run, h, n_steps)
+        self._start(run)
+        hs = heave_samples(run, h, n_steps, reference=self.initial_.heave_reference)
         rp = Replay(run.t, h, n_steps, hs, plant_vectors(self.nominal))
         PP = rp.plant.PP
-        rp.bounds, rp.starts, rp.reinit = [(0, n_steps)], [None], np.zeros(run.t.size, bool)
+        rp.bounds, rp.starts, rp.reinit = [(0, n_steps)], [self.initial_.start()], np.zeros(run.t.size, bool)
         if self.segment:
             rp.bounds, rp.starts, rp.reinit = self._segments(run, h, n_steps, PP)
+            rp.starts[0] = self.initial_.start()
         return rp
+
+    def _start(self, run):
+        """Start anywhere (issue 12): the replay's initial state and heave reference estimated from
+        the first seconds of the run (:func:`heavecomp.diagnosis.start.estimate`); a warning when the
+        log does not start at rest at the operating point."""
+
+        st = S.estimate(run, self.nominal, heave_filtered(run), stuck_speed=self.stuck_speed)
+        self.initial_ = st
+        self.start_warnings_ = []
+        if not st.at_rest:
+            self.start_warnings_.append(
+                f"the log does not start at rest at the operating point (stroke {st.stroke:+.4f} m, stroke velocity "
+                f"{st.stroke_velocity:+.4f} m/s, WOB {st.wob / 1e3:.1f} kN vs W_0 "
+                f"{self.nominal.operating_point.wob_setpoint / 1e3:.1f} kN, {'stuck' if st.stuck else 'sliding'}): "
+                f"the replay starts from the state estimated from its first {st.window:g} s (initial_state)")
 
     def _segments(self, run, h, n_steps, PP):
         """Multiple shooting: segments of ``segment`` s, each started from the measured state
@@ -203,7 +252,7 @@ class GapDiagnoser(GapEstimator):
         """Model channels at the run's times (up to ``t_end``) for a configuration
         ``[(effect name, values), ...]`` (empty: the nominal model), driven by the replay's heave
         or by ``hs`` (heave samples on the same grid)."""
-        from heavecomp.diagnosis.stepper import CHANNELS as SC, run_fx, run_segments
+        from heavecomp.diagnosis.stepper import CHANNELS as SC, run_segments
 
         rp = self._rp
         hs = rp.hs if hs is None else hs
@@ -221,10 +270,7 @@ class GapDiagnoser(GapEstimator):
                 shift = (values["channel"], values["delay"])
         EP = comp.ep(effects)
         n = rp.n_steps if t_end is None else min(rp.n_steps, int(math.ceil(t_end / rp.h)) + 2)
-        if self.segment:
-            out = run_segments(plant, comp, EP, hs, rp.h, rp.bounds, rp.starts, n + 1)
-        else:
-            out = run_fx(plant, comp, EP, hs, rp.h, n, 1)
+        out = run_segments(plant, comp, EP, hs, rp.h, rp.bounds, rp.starts, n + 1)
         tg = out[:, 0]
         t = rp.t if t_end is None else rp.t[rp.t <= tg[-1]]
         res = {}
@@ -396,7 +442,7 @@ class GapDiagnoser(GapEstimator):
         t_split = self.split * T_end
         self.split_ = {"fit": [0.0, t_split], "validate": [t_split, T_end], "settle": settle}
         self._rp = self._setup(run)
-        self.warnings_ = list(run.warnings)
+        self.warnings_ = list(run.warnings) + self.start_warnings_
         self._y = {c: run[c] for c in CH}
         t = run.t
         keep = ~self._rp.reinit
@@ -479,6 +525,7 @@ class GapDiagnoser(GapEstimator):
         self._report(0.9, "verdict")
         self.second_tried_ = []
         self._verdict(rows, J_b, J_n)
+        self._bound_check(rows)
         self.candidates_ = [{k: v for k, v in r.items() if not k.startswith("_")} for r in rows]
         best_pred = rows[0]["_pred"] if self.verdict_["effect"] not in ("none",) else nom
         self.traces_ = {"t": run.t, "measured": {c: run[c] for c in CH}, "nominal": {c: nom[c] for c in CH},
@@ -548,6 +595,28 @@ class GapDiagnoser(GapEstimator):
             v["second_candidates"] = self._second_candidates()
         self.verdict_ = v
 
+    def _bound_check(self, rows):
+        """A fitted parameter at its search bound (issue 14.3): the fit wanted to go further than the
+        candidate allows, so the candidate is probably standing in for something else (e.g. a heave
+        channel with the wrong sign fitted as a 3 s sensor delay).  Every candidate row gets
+        ``at_bound``; a named verdict with a parameter there drops to confidence ``low``, says so in
+        ``warnings`` and lists them in ``verdict.at_bound``."""
+        for r in rows:
+            r["at_bound"] = at_bounds(r["effect"], r["_values"])
+        v = self.verdict_
+        if v["effect"] in ("none", "inconclusive") or v["effect"] != rows[0]["effect"]:
+            return
+        hits = rows[0]["at_bound"]
+        if not hits:
+            return
+        v["at_bound"] = hits
+        was = v["confidence"]
+        v["confidence"] = "low"
+        where = ", ".join(f"{h['parameter']} = {h['value']:.4g} at its {h['side']} search bound {h['bound']:.4g}"
+                          for h in hits)
+        self.warnings_.append(f"verdict {v['effect']}: fitted {where}; the effect may stand in for another "
+                              f"(e.g. a channel with the wrong sign or unit) -- confidence lowered from {was} to low")
+
     def _second_candidates(self, n: int = 3) -> list:
         """The ``n`` joint partners that added most, best first (a user sees the likeliest second
         effect even when it falls short of the bar for naming it)."""
@@ -613,7 +682,7 @@ class GapDiagnoser(GapEstimator):
 
         def perturbed():
             pert = MeasuredRun(run.t, {"heave": run["heave"] + rng.normal(0.0, sz, run.t.size)}, run.source)
-            return heave_samples(pert, self._rp.h, self._rp.n_steps)
+            return heave_samples(pert, self._rp.h, self._rp.n_steps, reference=self._rp.hs.info["reference_m"])
 
         def ms(a, m):
             return {c: float(np.mean((a[c][m] - nom[c][m]) ** 2)) for c in CH}
@@ -626,7 +695,8 @@ class GapDiagnoser(GapEstimator):
             other = ms(self.simulate([], hs=perturbed()), val)
             env = {c: max(env[c], other[c]) for c in CH}
         # sensitivity to the heave pre-processing: cut-off 1.5 x higher
-        alt2 = self.simulate([], hs=heave_samples(run, self._rp.h, self._rp.n_steps, cutoff=1.5 * HEAVE_CUTOFF))
+        alt2 = self.simulate([], hs=heave_samples(run, self._rp.h, self._rp.n_steps, cutoff=1.5 * HEAVE_CUTOFF,
+                                                  reference=self._rp.hs.info["reference_m"]))
         self.heave_noise_ = sz
         pre = ms(alt2, val)
         self._env_ms = {c: env[c] + pre[c] for c in CH}
@@ -651,4 +721,5 @@ class GapDiagnoser(GapEstimator):
                 "noise": {"output": self.output_noise_, "replay_from_heave_noise": self.replay_floor_,
                           "heave": self.heave_noise_, "input_envelope": self.input_envelope_},
                 "warnings": list(getattr(self, "warnings_", [])),
+                "initial_state": self.initial_.to_json(),
                 "wall_time_s": self.wall_time_}

@@ -29,12 +29,9 @@ from heavecomp.simulate import _kernel as K
 from heavecomp.simulate.core import drive
 from heavecomp.simulate.layout import CHANNELS as _SIM_CHANNELS
 from heavecomp.simulate.layout import FX_CHANNELS, NSTATS, SLIDING, STUCK
-from heavecomp.friction.laws import FrictionLaw
-from heavecomp.plants.cmc import plant_vector
 from heavecomp.simulate import excitation
-from heavecomp.plants.cmc import plant_vectors
 from heavecomp.effects.registry import resolve
-from heavecomp.plants.cmc import eigen_rate
+from heavecomp.plants.cmc import eigen_rate, plant_vectors
 
 #: recorded channels (columns of the output array): simulate()'s channels, then the gas
 #: pressure before the line and the effects' states

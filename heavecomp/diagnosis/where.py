@@ -49,8 +49,37 @@ def residual_spectrum(t, r):
     return welch(ru - ru.mean(), fs=1 / dt, nperseg=min(ru.size, int(128 / dt)))
 
 
+TREND_DEGREE = 2  #: degree of the polynomial in time that counts as a slow trend in "where"
+
+
+def level_shares(t, r) -> dict:
+    """Split a residual's mean square into its offset, slow trend and fluctuation [-, shares summing to 1].
+
+    ``offset`` = mean(r)^2 / mean(r^2); ``trend`` = the part a polynomial of degree
+    ``TREND_DEGREE`` in time adds beyond the mean (a drift over the whole run: a gas charge that
+    leaks, a gas that warms under cycling, a sensor zero that drifts); ``fluctuation`` = the rest,
+    which the band spectrum splits.  Also returns the detrended residual.
+    """
+    ms = float(np.mean(r * r))
+    if ms <= 0 or r.size < TREND_DEGREE + 2:
+        return {"offset": 0.0, "trend": 0.0, "fluctuation": 1.0}, r - r.mean() if r.size else r
+    x = (t - t[0]) / max(t[-1] - t[0], 1e-12) * 2.0 - 1.0
+    fit = np.polynomial.legendre.Legendre.fit(x, r, TREND_DEGREE, domain=[-1, 1])
+    slow = fit(x)
+    mean = float(r.mean())
+    offset = mean * mean / ms
+    trend = float(np.mean((slow - mean) ** 2)) / ms
+    rest = r - slow
+    return {"offset": offset, "trend": trend, "fluctuation": float(np.mean(rest * rest)) / ms}, rest
+
+
 def locate(run, nom, params, mask, channel="wob") -> dict:
     """Shares of the squared residual by regime and band, and the worst segments.
+
+    ``bands`` are shares of the mean-removed spectrum (schema 1); ``levels`` splits the whole squared
+    residual into ``offset``, ``trend`` and the bands of the detrended rest (schema-2 addition: until
+    2026-11 an offset or a slow drift vanished from "where" -- a gas leak whose residual was 72 %
+    trend read as 90 % "resonance"); ``offset`` and ``trend`` are repeated at the top level.
 
     Regimes come from the replayed nominal model (noise-free): stuck; breakaway
     (the first ``BREAKAWAY_WINDOW`` s after a stuck -> sliding transition); sliding
@@ -81,6 +110,13 @@ def locate(run, nom, params, mask, channel="wob") -> dict:
     for k in BANDS:
         lo, hi = edges[k]
         bands[k] = float(S[(f >= lo) & (f < hi)].sum() / Stot)
+    lv, rest = level_shares(t[ok], r[ok])
+    f2, S2 = residual_spectrum(t[ok], rest)
+    S2tot = S2.sum() or 1.0
+    levels = {"offset": lv["offset"], "trend": lv["trend"]}
+    for k in BANDS:
+        lo, hi = edges[k]
+        levels[k] = float(lv["fluctuation"] * S2[(f2 >= lo) & (f2 < hi)].sum() / S2tot)
     # worst segments: rolling mean square over SEGMENT_LENGTH, top 3 disjoint windows
     dt = float(np.median(np.diff(t)))
     n = max(1, int(SEGMENT_LENGTH / dt))
@@ -94,6 +130,7 @@ def locate(run, nom, params, mask, channel="wob") -> dict:
         segs.append([float(max(c - 0.5 * SEGMENT_LENGTH, 0.0)), float(min(c + 0.5 * SEGMENT_LENGTH, t[-1]))])
         if len(segs) == 3:
             break
-    return {"regimes": regimes, "bands": bands, "segments": segs, "regime_time_share": regimes_time,
+    return {"regimes": regimes, "bands": bands, "segments": segs, "offset": levels["offset"],
+            "trend": levels["trend"], "levels": levels, "regime_time_share": regimes_time,
             "band_edges_hz": {k: [float(x) if math.isfinite(x) else None for x in e] for k, e in edges.items()},
             "eigenfrequencies_hz": eigenfrequencies(params), "channel": channel}

@@ -151,6 +151,26 @@ def fig_overlay(diag, span=40.0):
     return fig
 
 
+def _initial_state_lines(diag) -> list:
+    """The replay's estimated initial state (issue 12, start anywhere), one line."""
+    st = getattr(diag, "initial_", None)
+    if st is None:
+        return []
+    return [f"\nReplay started from the state estimated from the first {st.window:g} s: stroke {st.stroke:+.4f} m, "
+            f"stroke velocity {st.stroke_velocity:+.4f} m/s ({'stuck' if st.stuck else 'sliding'}), lower mass "
+            f"{1e3 * st.lower_displacement:+.2f} mm, WOB {st.wob / 1e3:.1f} kN, heave reference "
+            f"{st.heave_reference:+.4f} m ({'at rest at the operating point' if st.at_rest else 'not at rest'})."]
+
+
+def _levels_line(where) -> str:
+    """Offset and slow trend of the residual, and the bands of the rest, as shares of the whole."""
+    lv = where.get("levels")
+    if not lv:
+        return ""
+    return ("Of the whole squared residual: " + ", ".join(f"{k.replace('_', ' ')} {100 * x:.0f} %" for k, x in lv.items())
+            + " (offset and slow trend counted before the bands).")
+
+
 def write_report(diag, out_dir, *, title="Sim-to-real gap diagnosis") -> dict:
     """Write diagnosis.json, report.md and where.png / spectra.png / overlay.png into ``out_dir``."""
     out = Path(out_dir)
@@ -181,6 +201,7 @@ def write_report(diag, out_dir, *, title="Sim-to-real gap diagnosis") -> dict:
                          "held-out gap when fitted jointly with the first — below the 10 % needed to name it.")
     for w in getattr(diag, "warnings_", []):
         lines.append(f"\n> data: {w}")
+    lines += _initial_state_lines(diag)
     lines += ["", "## Gap (nominal replay vs measurement, after the settling window)", "",
               md_table(["channel", "unit", "rms", "nrmse [-]", "rms held-out", "noise floor"],
                        [[c, CH_UNITS[c][0], f"{g['channels'][c]['rms'] * CH_UNITS[c][1]:.4g}",
@@ -193,6 +214,7 @@ def write_report(diag, out_dir, *, title="Sim-to-real gap diagnosis") -> dict:
                   f"{k.replace('_', ' ')} {100 * x:.0f} %" for k, x in diag.where_["regimes"].items()) + ".",
               "By band: " + ", ".join(f"{k.replace('_', ' ')} {100 * x:.0f} %" for k, x in diag.where_["bands"].items())
               + f". Eigenfrequencies: {named_modes(diag.where_['eigenfrequencies_hz'])}.",
+              _levels_line(diag.where_),
               "Largest in: " + ", ".join(f"{a:.1f}-{b:.1f} s" for a, b in diag.where_["segments"]) + ".",
               "", "![where](where.png)", "", "![spectra](spectra.png)", "",
               "## Which: every candidate, fitted on the fit part, scored on the held-out part", "",
