@@ -13,10 +13,11 @@ import pytest
 
 from heavecomp.diagnosis import start as S
 from heavecomp.diagnosis.data import check_run, heave_filtered
-from heavecomp.diagnosis.estimator import GapDiagnoser, _vectors
+from heavecomp.diagnosis.estimator import GapDiagnoser
 from heavecomp.diagnosis.stepper import CHANNELS as SC, replay_dt, run_fx
-from heavecomp.effects import terms as T
+from heavecomp.effects.compose import composition
 from heavecomp.params import paper_a
+from heavecomp.plants.cmc import plant_vectors
 from heavecomp.simulate import excitation
 
 NOISE = {"heave": 2e-3, "stroke": 2e-3, "pressure": 2e3, "wob": 400.0}
@@ -28,8 +29,8 @@ def _truth_run(duration=200.0, hs=2.0, seed=3):
     h = replay_dt(p, 50.0)
     n = int(math.ceil(duration / h))
     sea = excitation.jonswap(hs, 10.0, 3.3, seed, 20.0, n * h, 0.5 * h)
-    code, FP, PP = _vectors(p)
-    out = run_fx(code, FP, PP, T.zero_ep(), sea, h, n, int(round(0.02 / h)))
+    comp = composition()  # the nominal plant: no effect
+    out = run_fx(plant_vectors(p), comp, comp.ep(), sea, h, n, int(round(0.02 / h)))
     t = out[:, 0]
     truth = {c: out[:, SC.index(c)] for c in SC}
     rng = np.random.default_rng(seed)
