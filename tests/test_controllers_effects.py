@@ -31,7 +31,7 @@ def test_mpc_that_knows_the_line_loss_holds_the_wob_better():
     sensor noise: the model is the only difference).  Measured over 120 s: 5.9 vs 7.0 kN."""
     from heavecomp.controllers.base import ControllerConfig
     from heavecomp.controllers.linear_mpc import LinearMPC
-    from heavecomp.simulate.closed_loop import simulate_closed_loop
+    from heavecomp.closed_loop.loop import simulate_closed_loop
 
     p = paper_a("stribeck")
     plant_effects = [effect_class("flow_loss")(resistance=R)]

@@ -2,7 +2,7 @@
 
 A rig log starts wherever the rig was, not at rest at the operating point.  Measured are the
 stroke s, the pressure p and the WOB W; the rest follows from the operating point
-(``shared/spec/cmc-reference.md``):
+(``docs/contracts/parameter-file.md``):
 
 - stroke and stroke velocity (s_0, v_0): a least-squares polynomial over the first
   ``window`` seconds of the stroke, evaluated at t = 0 (a straight line when the

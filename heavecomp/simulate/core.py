@@ -23,7 +23,8 @@ class SimulationError(InputError):
 
 log = logging.getLogger(__name__)
 
-from heavecomp.simulate.layout import CHANNELS, NCH, STATS, STUCK, source_hash
+from heavecomp.simulate import layout
+from heavecomp.simulate.layout import CHANNELS, NCH, STATS, STUCK
 from heavecomp.friction.laws import FrictionLaw
 from heavecomp.plants.cmc import plant_vector
 from heavecomp.simulate import excitation
@@ -394,7 +395,7 @@ def stepper():
             try:
                 from heavecomp.simulate import _cmc_aot
 
-                if _cmc_aot.source_hash() == source_hash():
+                if _cmc_aot.source_hash() == layout.source_hash():
                     fn = _cmc_aot.advance
                 else:
                     log.info("ahead-of-time stepper is stale (source changed since install); using the JIT")
