@@ -16,18 +16,16 @@ from heavecomp.effects.registry import resolve
 from heavecomp.errors import InputError
 from heavecomp.params.budget import check_run_size
 from heavecomp.plants.cmc import eigen_rate, plant_vectors
+from heavecomp.simulate import excitation, layout
+from heavecomp.simulate.layout import CHANNELS, NCH, STATS, STUCK
+
+log = logging.getLogger(__name__)
 
 
 class SimulationError(InputError):
     """The integration failed (e.g. diverged for a step too large for the parameters)."""
 
-log = logging.getLogger(__name__)
 
-from heavecomp.simulate import layout
-from heavecomp.simulate.layout import CHANNELS, NCH, STATS, STUCK
-from heavecomp.friction.laws import FrictionLaw
-from heavecomp.plants.cmc import plant_vector
-from heavecomp.simulate import excitation
 #: columns written to timeseries.csv (contract columns first)
 CSV_COLUMNS = ("t", "heave", "stroke", "pressure", "wob", "stroke_velocity", "friction", "tension", "stuck")
 #: unit of every channel (SI; ``stuck`` is 1 while the main cylinder sticks, else 0)
