@@ -94,3 +94,7 @@ def test_diagnosis_example_scenario_quick(tmp_path):
     assert m["verdict"]["effect"] == "string_damping"
     d = json.loads((tmp_path / "diagnosis.json").read_text())
     assert d["schema"] == 1 and (tmp_path / "overlay.png").is_file()
+    # a re-run leaves git clean: the fit wall times are in the untracked timings.json only
+    assert "wall" not in json.dumps({k: v for k, v in d.items() if k != "units"})
+    t = json.loads((tmp_path / "timings.json").read_text())["diagnosis.json"]
+    assert all(c["fit_wall_time"] > 0 for c in t["candidates"])

@@ -52,3 +52,12 @@ def test_friction_laws(tmp_path):
     lim = m["static_limit_N"]
     assert lim["rotating_eq7"] < lim["rotating_eq6"] < lim["stribeck"]
     assert lim["stribeck"] == pytest.approx(23e3 + 2e-3 * m["p0_Pa"])
+
+
+def test_out_help_names_the_report_folder(capsys):
+    """--help names the folder a scenario writes (reports/<name>), not the script path."""
+    from heavecomp.report.scenario import parse_args
+    with pytest.raises(SystemExit):
+        parse_args(["--help"], "paper_a_wob")
+    text = " ".join(capsys.readouterr().out.split())
+    assert "(default reports/paper_a_wob)" in text

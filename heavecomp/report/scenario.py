@@ -17,7 +17,7 @@ def parse_args(argv, name: str, doc: str | None = None, extra=None) -> argparse.
     """``--quick`` and ``--out DIR`` (default ``reports/<name>``) for every scenario."""
     p = argparse.ArgumentParser(prog=f"scenarios/{name}.py", description=(doc or "").strip().splitlines()[0] if doc else None)
     p.add_argument("--quick", action="store_true", help="short runs (for tests and a first look)")
-    p.add_argument("--out", default=str(ROOT / "reports" / name), help="output folder (default reports/%(prog)s)")
+    p.add_argument("--out", default=str(ROOT / "reports" / name), help=f"output folder (default reports/{name})")
     if extra:
         extra(p)
     args = p.parse_args(argv)
