@@ -45,7 +45,7 @@ UNITS: dict[str, str] = {
     # simulate / closed loop metrics
     "wob_mean": "N", "wob_std": "N", "wob_min": "N", "wob_max": "N", "wob_p2p": "N", "wob_setpoint": "N",
     "stick_fraction": "-", "stick_fraction_total": "-", "n_stick": "count", "n_breakaway": "count",
-    "n_reversal": "count", "event_cap_hits": "count", "event_cap_first_t": "s", "stroke_max": "m", "pressure_min": "Pa",
+    "n_reversal": "count", "event_cap_hits": "count", "event_cap_first_t": "s", "friction_power_min": "W", "n_negative_friction_power": "count", "stroke_max": "m", "pressure_min": "Pa",
     "pressure_max": "Pa", "heave_std": "m", "k_eff_eq14": "N/m", "stats_window": "s", "duration": "s", "dt": "s",
     "amplitude": "m", "period": "s", "ramp": "s", "hs": "m", "tp": "s", "gamma": "-", "seed": "-",
     "u_active_max": "N", "u_active_rms": "N", "fallbacks": "count", "violations_u_max": "count",
