@@ -94,7 +94,7 @@ UNITS: dict[str, str] = {
     "theta": "-", "n_parameters": "count", "coulomb_negative": "N", "coulomb_positive": "N",
     "viscous_negative": "N s/m", "viscous_positive": "N s/m", "viscous_asymmetry": "N s/m", "lag_force": "N",
     "presliding_length": "m", "stribeck_excess": "N", "stribeck_velocity": "m/s",
-    "v_min": "m/s", "area": "m^2", "change_in_uncertainties": "-",  # seal study settings, method sensitivity
+    "v_min": "m/s", "area": "m^2", "change_in_uncertainties": "-", "heave_reference": "m",  # seal study settings, method sensitivity
     # closed loop (heavecomp.controllers.ControllerConfig documents these units)
     "u_max": "N", "rate_max": "N/s", "horizon": "count", "q_wob": "1/N^2", "r_u": "1/N^2", "r_du": "1/N^2",
     "friction_eps": "m/s", "friction_scale": "-", "gas_stiffness_scale": "-", "kp": "-", "ki": "1/s", "kd": "s",
@@ -122,7 +122,7 @@ SUFFIX_UNITS = [("_N_per_bar", "N/bar"), ("_N_per_Pa", "N/Pa"), ("_mm_s", "mm/s"
 _CHANNEL_BLOCKS = ("noise", "operating_point", "channels")
 
 #: blocks whose entries are dimensionless shares (diagnosis "where", Fourier weights)
-_SHARE_BLOCKS = ("bands", "regimes", "frac_outside")
+_SHARE_BLOCKS = ("bands", "regimes", "frac_outside", "levels", "components")
 
 
 def _param_units() -> dict[str, str]:
@@ -173,6 +173,8 @@ def unit_of(path: tuple[str, ...]) -> str | None:
     for block in _SHARE_BLOCKS:
         if parents and parents[-1] == block:
             return "-"
+    if parents and parents[-1] == "where" and key in ("offset", "trend"):  # shares of the squared residual
+        return "-"
     if len(parents) >= 1:
         dotted = f"{parents[-1]}.{key}"
         if dotted in _PARAM_UNITS:
@@ -203,17 +205,19 @@ def units_of(obj, path: tuple = ()) -> tuple[dict[str, str], list[str]]:
     units: dict[str, str] = {}
     missing: list[str] = []
 
-    def walk(x, p):
+    def walk(x, p, own=None):
         if isinstance(x, dict):
+            # an entry that names its own unit (e.g. a fitted parameter at its bound: value, bound, unit)
+            own_unit = x.get("unit") if isinstance(x.get("unit"), str) else None
             for k, v in x.items():
                 if k in ("units", "provenance"):
                     continue
-                walk(v, p + (str(k),))
+                walk(v, p + (str(k),), own_unit if k in ("value", "bound") else None)
         elif isinstance(x, (list, tuple)):
             for v in x:
                 walk(v, p)
         elif isinstance(x, (int, float)) and not isinstance(x, bool) and p:
-            u = unit_of(p)
+            u = own or unit_of(p)
             name = p[-1] if not p[-1].isdigit() else ".".join(p[-2:])
             if u is None:
                 missing.append(".".join(p))
