@@ -32,11 +32,10 @@ import numpy as np
 
 from heavecomp.controllers import ControllerConfig, Measurement, make
 from heavecomp.errors import InputError
-from heavecomp.friction.laws import FrictionLaw
 from heavecomp.params.budget import check_run_size
 from heavecomp.params.cmc import active
 from heavecomp.effects.registry import resolve
-from heavecomp.plants.cmc import eigen_rate, plant_vector, plant_vectors
+from heavecomp.plants.cmc import eigen_rate, plant_vectors
 from heavecomp.simulate import excitation
 from heavecomp.simulate.core import CSV_COLUMNS, SimulationResult, default_dt, plant_stepper
 
@@ -176,9 +175,8 @@ def simulate_closed_loop(params, controller="passive", duration: float = 120.0, 
     else:
         t_in, z_in = heave
         hs = excitation.from_series(t_in, z_in, n_ctrl * Tc + horizon_t, sp, src="heave")
-    law = FrictionLaw.from_params(params.friction)
-    PP = plant_vector(params)
-    advance, state, smooth = plant_stepper(plant_vectors(params), resolve(effects))
+    plant = plant_vectors(params)  # the one params -> vectors conversion
+    advance, state, smooth = plant_stepper(plant, resolve(effects))
     rng = np.random.default_rng(noise.seed if noise else 0)
     sig = np.array([noise.stroke, noise.pressure, noise.wob, noise.heave]) if noise else np.zeros(4)
 
@@ -200,7 +198,7 @@ def simulate_closed_loop(params, controller="passive", duration: float = 120.0, 
     t_wall = time.perf_counter()
     for k in range(n_ctrl + 1):
         t = k * Tc
-        advance(state, mode_dir, t, 0, h, law.code, law.FP, PP, smooth, u, sp, hs.z, hs.dz, hs.ddz,
+        advance(state, mode_dir, t, 0, h, plant.code, plant.FP, plant.PP, smooth, u, sp, hs.z, hs.dz, hs.ddz,
                   rec, 1, 0, stats)
         rows[k] = rec[0]
         if k == n_ctrl:
@@ -233,7 +231,7 @@ def simulate_closed_loop(params, controller="passive", duration: float = 120.0, 
             previews.append(lp)
         for j in range(n_sub):
             u = u + min(max(u_cmd - u, -du_step), du_step)
-            advance(state, mode_dir, t + j * h, 1, h, law.code, law.FP, PP, smooth, u, sp, hs.z, hs.dz,
+            advance(state, mode_dir, t + j * h, 1, h, plant.code, plant.FP, plant.PP, smooth, u, sp, hs.z, hs.dz,
                       hs.ddz, none_out, 1, 0, stats)
         if progress is not None and k % 200 == 0:
             progress(k / n_ctrl)

@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 
-from heavecomp.identification.inverse import AxisRegression, InverseModelLS, cutoff_sensitivity
+from heavecomp.identification.inverse import InverseModelLS, cutoff_sensitivity
 from heavecomp.identification.residual import ResidualDiagnoser
 from heavecomp.identification.seal import BAR, BORE_DIAMETER, METHOD_VARIANTS, SealFrictionFit, scale_by_circumference
 from heavecomp.plants.axis import BASE_NAMES, EMPS_PUBLISHED
