@@ -45,6 +45,11 @@ from heavecomp.errors import ParameterError, did_you_mean
 #: ``heave`` act outside the kernel)
 HOOKS = {"seal_friction": ("jump", "static"), "gas_spring": ("gas",), "line": ("line",),
          "string": ("string",), "channel": (), "heave": ()}
+#: model components of the gap diagnosis (contract schema 2, ``where.components``), in report order
+COMPONENTS = ("friction", "gas_spring", "flow_line", "string_formation", "sensors", "heave_input")
+#: the component each hook belongs to
+HOOK_COMPONENT = {"seal_friction": "friction", "gas_spring": "gas_spring", "line": "flow_line",
+                  "string": "string_formation", "channel": "sensors", "heave": "heave_input"}
 #: the methods the stepper and the casadi model call, in the order they are composed
 METHODS = ("gas", "line", "string", "jump", "static", "rates")
 
@@ -69,8 +74,29 @@ class Effect:
     kind: str = "plant"
     log: tuple = ()
     candidate: bool = False
+    #: values of one nonlinear shape parameter searched by the equation-error fit (empty: none)
+    feature_grid: tuple = ()
     # hook methods (staticmethods in subclasses); None: the effect does not act there
     gas = line = string = jump = static = rates = initial = steady = None
+
+    @classmethod
+    def component(cls) -> str:
+        """The model component the effect lives in (:data:`COMPONENTS`; from its hook)."""
+        return HOOK_COMPONENT.get(cls.hook, "")
+
+    @classmethod
+    def features(cls, sig, shape=None):
+        """Equation-error regressors (issue 12 item 3): columns, linear in their coefficients, that
+        this effect adds to its component's equation residual, built from measured signals only.
+
+        ``sig`` maps signal names to arrays at the same samples (which names a plant provides:
+        ``heavecomp.diagnosis.components``; at least ``t`` [s], ``x`` position of the sliding
+        element [m], ``v`` [m/s], ``a`` [m/s^2], ``dwell`` time at rest so far [s], and ``p`` [Pa]
+        where the plant has a pressure); ``shape`` is one value of :attr:`feature_grid` (None when
+        the grid is empty).  Returns ``{column name: array}``, or None when the effect has no
+        equation-error form or a signal it needs is missing.
+        """
+        return None
 
     def __init__(self, **values):
         names = [f.name for f in self.fields()]
