@@ -19,7 +19,7 @@ from heavecomp import __version__
 from heavecomp.errors import InputError, did_you_mean
 from heavecomp.report import invocation
 from heavecomp.commands import _progress
-from heavecomp.commands import _output
+from heavecomp.report import paths as _output
 
 #: name -> (module, one-line help).  Order is the order shown by --help.
 COMMANDS: dict[str, tuple[str, str]] = {

@@ -12,7 +12,7 @@ import sys
 
 from heavecomp.campaign import spec
 from heavecomp.report.campaign import run_and_report
-from heavecomp.report.scenario import ROOT, parse_args, write_metrics
+from heavecomp.report.scenario import ROOT, parse_args, run, write_metrics
 
 
 def build(quick: bool = False):
@@ -58,4 +58,4 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(run(main))

@@ -13,7 +13,7 @@ from heavecomp.report import rigs as PLT
 from heavecomp.analysis import stick_map as SS
 from heavecomp.params import paper_a
 from heavecomp.report.figures import save
-from heavecomp.report.scenario import md_table, parse_args, write_metrics, write_report
+from heavecomp.report.scenario import md_table, parse_args, run, write_metrics, write_report
 
 MODELS = ("stribeck", "rotating_eq6", "rotating_eq7")
 
@@ -63,4 +63,4 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(run(main))

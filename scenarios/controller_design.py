@@ -15,7 +15,7 @@ import sys
 from heavecomp.closed_loop import design as D
 from heavecomp.report import controllers as RC
 from heavecomp.report.figures import save
-from heavecomp.report.scenario import md_table, parse_args, write_metrics, write_report
+from heavecomp.report.scenario import md_table, parse_args, run, write_metrics, write_report
 
 
 def build(quick: bool = False) -> dict:
@@ -99,4 +99,4 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(run(main))

@@ -14,7 +14,7 @@ from heavecomp.diagnosis.generator import generate
 from heavecomp.report.diagnosis import write_report
 from heavecomp.params import dumps
 from heavecomp.report.provenance import annotate_json, stamp
-from heavecomp.report.scenario import parse_args, write_metrics
+from heavecomp.report.scenario import parse_args, run, write_metrics
 
 
 def build(quick: bool = False, out=None):
@@ -40,4 +40,4 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    raise SystemExit(run(main))

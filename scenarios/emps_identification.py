@@ -16,7 +16,7 @@ from heavecomp.report import identification as plots
 from heavecomp.identification.study import emps_study
 from heavecomp.plants.axis import load_emps
 from heavecomp.report.figures import save
-from heavecomp.report.scenario import md_table, parse_args, write_metrics, write_report
+from heavecomp.report.scenario import md_table, parse_args, run, write_metrics, write_report
 
 DATA = EMPS
 
@@ -85,4 +85,4 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(run(main))

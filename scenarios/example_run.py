@@ -25,6 +25,7 @@ from heavecomp.data import EXAMPLE_PARAMS, EXAMPLE_RUN, WAVERIDER
 from heavecomp.diagnosis.generator import NOISE
 from heavecomp.params import dumps, paper_a
 from heavecomp.simulate import simulate
+from heavecomp.report.scenario import run
 from heavecomp.simulate.excitation import load_waverider, vessel_heave
 
 DURATION = 600.0  #: s
@@ -77,4 +78,4 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    raise SystemExit(run(main))

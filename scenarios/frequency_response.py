@@ -22,7 +22,7 @@ from heavecomp.analysis.linear import linearise
 from heavecomp.analysis.sweeps import DrillPipe, eigenfrequency_map
 from heavecomp.params import paper_a
 from heavecomp.report.figures import save
-from heavecomp.report.scenario import md_table, parse_args, write_metrics, write_report
+from heavecomp.report.scenario import md_table, parse_args, run, write_metrics, write_report
 
 DF_TOL = 0.10  # relative error asserted by tests/test_analysis_describing.py while the piston slides
 
@@ -142,4 +142,4 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(run(main))

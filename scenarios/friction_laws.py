@@ -16,7 +16,7 @@ import numpy as np
 from heavecomp.friction.laws import FrictionLaw, hydromechanical_friction
 from heavecomp.params import paper_a
 from heavecomp.report import figures as fig
-from heavecomp.report.scenario import md_table, parse_args, write_metrics, write_report
+from heavecomp.report.scenario import md_table, parse_args, run, write_metrics, write_report
 
 EPS = 1e-3  # m/s, regularisation width shown
 
@@ -68,4 +68,4 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(run(main))

@@ -17,7 +17,7 @@ import numpy as np
 from heavecomp.data import WAVERIDER
 from heavecomp.params import paper_a
 from heavecomp.report import figures as fig
-from heavecomp.report.scenario import md_table, parse_args, write_metrics, write_report
+from heavecomp.report.scenario import md_table, parse_args, run, write_metrics, write_report
 from heavecomp.simulate import simulate
 from heavecomp.simulate.excitation import load_waverider, spectral_hs_tp, vessel_heave
 
@@ -71,4 +71,4 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(run(main))

@@ -11,7 +11,7 @@ import sys
 
 from heavecomp.params import paper_a
 from heavecomp.report import figures as fig
-from heavecomp.report.scenario import md_table, parse_args, write_metrics, write_report
+from heavecomp.report.scenario import md_table, parse_args, run, write_metrics, write_report
 from heavecomp.simulate import simulate
 
 REGIMES = ("none", "rotating_eq7", "stribeck")
@@ -67,4 +67,4 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(run(main))

@@ -13,7 +13,7 @@ from heavecomp.report import rigs as PLT
 from heavecomp.pneumatic import stepper as PS
 from heavecomp.pneumatic import plant as pn
 from heavecomp.report.figures import save
-from heavecomp.report.scenario import md_table, parse_args, write_metrics, write_report
+from heavecomp.report.scenario import md_table, parse_args, run, write_metrics, write_report
 
 
 def build(duration: float = 3.0) -> dict:
@@ -54,4 +54,4 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(run(main))

@@ -16,7 +16,7 @@ from heavecomp.report import rigs as PLT
 from heavecomp.pneumatic import stickslip as SS
 from heavecomp.pneumatic import plant as pn
 from heavecomp.report.figures import save
-from heavecomp.report.scenario import md_table, parse_args, write_metrics, write_report
+from heavecomp.report.scenario import md_table, parse_args, run, write_metrics, write_report
 
 
 def build(n: int = 40, nonlinear_min_velocity: bool = True) -> dict:
@@ -89,4 +89,4 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(run(main))

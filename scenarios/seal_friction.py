@@ -20,7 +20,7 @@ from heavecomp.identification.seal import load_seal_csv, velocity_fir
 from heavecomp.identification.study import seal_study
 from heavecomp.report.figures import save
 from heavecomp.report.rigs import plot_seal
-from heavecomp.report.scenario import md_table, parse_args, write_metrics, write_report
+from heavecomp.report.scenario import md_table, parse_args, run, write_metrics, write_report
 
 DATA = SEAL_FRICTION
 FILES = ("O-ring_1bar.csv", "O-ring_3bar.csv", "O-ring_5bar.csv", "O-ring_7bar.csv")
@@ -95,4 +95,4 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(run(main))

@@ -10,7 +10,7 @@ import sys
 
 from heavecomp.params import paper_a
 from heavecomp.report import figures as fig
-from heavecomp.report.scenario import md_table, parse_args, write_metrics, write_report
+from heavecomp.report.scenario import md_table, parse_args, run, write_metrics, write_report
 from heavecomp.simulate import simulate
 
 REGIMES = ("none", "rotating_eq7", "stribeck")
@@ -62,4 +62,4 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(run(main))

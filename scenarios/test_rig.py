@@ -12,7 +12,7 @@ import numpy as np
 from heavecomp.report import rigs as PLT
 from heavecomp.test_rig import plant as TR
 from heavecomp.report.figures import save
-from heavecomp.report.scenario import md_table, parse_args, write_metrics, write_report
+from heavecomp.report.scenario import md_table, parse_args, run, write_metrics, write_report
 
 
 def build(fs: float = 200.0, noise: float = 2e3) -> dict:
@@ -54,4 +54,4 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(run(main))

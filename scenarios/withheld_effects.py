@@ -15,7 +15,7 @@ import time
 from heavecomp.diagnosis.generator import GAP_MIN, SECOND_SHARE, STICK_MIN, run_benchmark
 from heavecomp.report.diagnosis import fig_confusion, fig_shrink
 from heavecomp.report.figures import save
-from heavecomp.report.scenario import md_table, parse_args, write_metrics, write_report
+from heavecomp.report.scenario import md_table, parse_args, run, write_metrics, write_report
 
 log = logging.getLogger("withheld_effects")
 
@@ -64,4 +64,4 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    raise SystemExit(run(main))

@@ -51,7 +51,7 @@ def test_params_output_checked(tmp_path):
 
 
 def test_out_that_does_not_exist_yet_is_fine_and_not_created_by_the_check(tmp_path):
-    from heavecomp.commands._output import out_dir
+    from heavecomp.report.paths import out_dir
 
     target = tmp_path / "a" / "b"
     assert out_dir(target) == target

@@ -1,4 +1,6 @@
-"""Output paths checked before any work starts (issue 13.3): one line naming the flag, exit 2."""
+"""Output paths checked before any work starts (issue 13.3): one line naming the flag, exit 2.
+
+Used by the commands (`heavecomp.cli`) and the scenario scripts (:mod:`heavecomp.report.scenario`)."""
 
 from __future__ import annotations
 

@@ -7,7 +7,10 @@ import json
 import logging
 import sys
 from pathlib import Path
+
+from heavecomp.errors import InputError
 from heavecomp.report import invocation
+from heavecomp.report.paths import out_dir
 from heavecomp.report.provenance import _clean, annotate_json, stamp, stamp_report
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -21,6 +24,10 @@ def parse_args(argv, name: str, doc: str | None = None, extra=None) -> argparse.
     if extra:
         extra(p)
     args = p.parse_args(argv)
+    try:
+        out_dir(args.out, "--out")
+    except InputError as exc:
+        p.exit(2, f"{p.prog}: error: {exc}\n")
 
     given = list(sys.argv[1:] if argv is None else argv)
     invocation.COMMAND = ["python", f"scenarios/{name}.py", *given]
@@ -29,6 +36,20 @@ def parse_args(argv, name: str, doc: str | None = None, extra=None) -> argparse.
     logging.basicConfig(level=logging.INFO, format="%(message)s")
     return args
 
+
+def run(main, argv=None) -> int:
+    """Run a scenario's ``main``: bad input (any :class:`InputError`) is one line on stderr and exit
+    code 2, never a traceback; Ctrl-C is exit 130."""
+
+    try:
+        return int(main(argv) or 0)
+    except InputError as exc:
+        name = Path(sys.argv[0]).name if argv is None else "scenario"
+        print(f"{name}: error: {str(exc).strip().replace(chr(10), ' ')}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("interrupted", file=sys.stderr)
+        return 130
 
 
 def write_metrics(out: Path, metrics: dict) -> Path:
