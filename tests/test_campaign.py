@@ -365,3 +365,18 @@ def test_cli_killed_mid_campaign_resumes(tmp_path):
     resumed = int(first.split(" resumed")[0].split()[-1])
     assert resumed >= done and first.startswith(f"{n - resumed} runs simulated")
     assert sorted(_rows_by_id(table)) == sorted(x.run_id for x in spec.load(camp).runs())
+
+
+def test_campaign_over_the_run_size_budget_is_refused_before_any_chunk(tmp_path):
+    """A chunk of 64 runs of 28 h holds ~12 GB of heave samples at once: one line naming
+    settings.chunk_size, exit 2, and no table written (checked before any chunk runs)."""
+    camp = tmp_path / "big.toml"
+    camp.write_text(TINY.replace("duration = 90.0", "duration = 1.0e5").replace("chunk_size = 4", "chunk_size = 64")
+                    .replace("seeds = 2", "seeds = 20"))
+    out = tmp_path / "o"
+    r = subprocess.run([sys.executable, "-m", "heavecomp.cli", "campaign", str(camp), "--out", str(out)],
+                       capture_output=True, text=True, timeout=120)
+    assert r.returncode == 2, r.stderr
+    err = r.stderr.strip().splitlines()
+    assert len(err) == 1 and "settings.chunk_size = 64" in err[0] and "GiB budget" in err[0], err
+    assert not (out / "runs.csv").exists()

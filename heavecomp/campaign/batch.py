@@ -33,8 +33,9 @@ import numba as nb
 import numpy as np
 
 from heavecomp.simulate import _kernel as K, excitation
-from heavecomp.friction.laws import FrictionLaw
-from heavecomp.plants.cmc import plant_vector
+from heavecomp.errors import ParameterError
+from heavecomp.params.budget import HEAVE_BYTES_PER_STEP, MAX_BYTES, check_run_size
+from heavecomp.plants.cmc import eigen_rate, plant_vectors
 from heavecomp.simulate.core import default_dt
 
 log = logging.getLogger(__name__)
@@ -150,6 +151,34 @@ def _batch(codes, FPs, PPs, smooth, hsteps, nsteps, out_every, t_stat, W0, half,
             stats[r, k] = st[k]
 
 
+def check_budget(campaign, runs, base=None) -> None:
+    """Refuse, before any chunk runs, a campaign whose runs or chunks cannot fit the run-size budget
+    (:mod:`heavecomp.params.budget`): per run its RK4 steps, per chunk the heave samples of its
+    ``chunk_size`` runs, which a chunk holds at once (twice: as generated and padded into one array).
+    Raises a one-line :class:`ParameterError`."""
+    s = campaign.settings
+    base = base if base is not None else campaign.base_params()
+    longest = 0
+    seen = set()
+    for run in runs:
+        key = (run.regime, run.variant)
+        if key in seen:
+            continue
+        seen.add(key)
+        p = campaign.params_for(run, base=base)
+        h = default_dt(p, s.rate)
+        k = int(math.ceil(s.duration / h - 1e-9))
+        check_run_size(p, duration=s.duration, h=h, n_steps=k, n_rows=0, n_cols=0, rate=s.rate, rate_fn=eigen_rate)
+        longest = max(longest, k)
+    per_chunk = min(s.chunk_size, len(runs))
+    need = 2.0 * HEAVE_BYTES_PER_STEP * (longest + 1) * per_chunk
+    if need > MAX_BYTES:
+        raise ParameterError(
+            f"settings.chunk_size = {s.chunk_size}: a chunk of {per_chunk} runs of settings.duration = {s.duration:g} s "
+            f"holds {need / 1e9:.3g} GB of heave samples, over the {MAX_BYTES / 2 ** 30:g} GiB budget; lower "
+            "settings.chunk_size or settings.duration")
+
+
 def prepare(campaign, runs, base=None):
     """Per-run arrays for the compiled driver (parameters, steps, heave samples)."""
     s = campaign.settings
@@ -172,19 +201,20 @@ def prepare(campaign, runs, base=None):
         p = campaign.params_for(run, base=base)
         key = (run.regime, run.variant)
         if key not in cache:
-            law = FrictionLaw.from_params(p.friction)
-            h = default_dt(p, s.rate)
-            cache[key] = (law, plant_vector(p), h)
-        law, PP, h = cache[key]
+            cache[key] = (plant_vectors(p), default_dt(p, s.rate))
+        pv, h = cache[key]
         if PPs is None:
-            PPs = np.zeros((n, PP.size))
-        codes[i], smooth[i], FPs[i], PPs[i] = law.code, not law.has_stiction, law.FP, PP
+            PPs = np.zeros((n, pv.PP.size))
+        codes[i], smooth[i], FPs[i], PPs[i] = pv.code, not pv.has_stiction, pv.FP, pv.PP
         hsteps[i] = h
         out_every[i] = max(1, int(round(1.0 / (s.rate * h))))
         nsteps[i] = int(math.ceil(s.duration / h - 1e-9))
         t_stat[i] = min(p.heave.ramp, 0.5 * s.duration)
         W0[i] = p.operating_point.wob_setpoint
         half[i] = campaign.band.half_width(W0[i])
+    for i, run in enumerate(runs):
+        p = campaign.params_for(run, base=base)
+        h = hsteps[i]
         heaves.append(jonswap_samples(run.hs, run.tp, s.gamma, run.seed, p.heave.ramp, nsteps[i] * h, 0.5 * h,
                                       spectra))
     kink_step = np.full(n, -1, dtype=np.int64)

@@ -189,11 +189,12 @@ def run_campaign(campaign, out_dir, *, workers: int | None = None, scheduler: st
     -------
     CampaignRun
     """
-    from heavecomp.campaign.batch import run_chunk
+    from heavecomp.campaign.batch import check_budget, run_chunk
 
     out = Path(out_dir)
     _check_manifest(campaign, out)
     runs = campaign.runs()
+    check_budget(campaign, runs)  # before any chunk runs (one line, exit 2 from the CLI)
     done, header = finished_ids(out / TABLE)
     pending = [r.run_id for r in runs if r.run_id not in done]
     n_skip = len(runs) - len(pending)
