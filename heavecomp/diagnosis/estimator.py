@@ -67,6 +67,9 @@ class Replay:
     plant: object  # PlantVectors of the nominal parameters
 
 
+#: longest replay the diagnosis takes (about 28 h at 10 ms; each replay ~3 s there, the diagnosis makes
+#: several hundred, and the replay grid of 1e7 steps x 8 channels is 0.6 GB per thread)
+MAX_REPLAY_STEPS = 10_000_000
 BOUND_TOL = 0.01  #: a fitted parameter within this share of its search range from a bound is "at the bound"
 
 
@@ -192,6 +195,10 @@ class GapDiagnoser(GapEstimator):
 
         h = replay_dt(self.nominal)
         n_steps = int(math.ceil(run.t[-1] / h - 1e-9))
+        if n_steps > MAX_REPLAY_STEPS:  # before any work: the diagnosis replays the log hundreds of times
+            raise InputError(f"{run.source}: the log is {run.t[-1] / 3600:.3g} h long, {n_steps:.3g} replay steps of "
+                             f"{1e3 * h:.3g} ms, over the diagnosis budget of {MAX_REPLAY_STEPS:.3g} "
+                             f"({MAX_REPLAY_STEPS * h / 3600:.3g} h); diagnose a part of it (e.g. the hour of interest)")
         self._start(run)
         hs = heave_samples(run, h, n_steps, reference=self.initial_.heave_reference)
         rp = Replay(run.t, h, n_steps, hs, plant_vectors(self.nominal))
