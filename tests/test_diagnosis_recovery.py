@@ -74,3 +74,31 @@ def test_parameter_mismatch_names_what_moved():
     assert got["compensator.gas_stiffness"] == pytest.approx(60e3, rel=0.1)
     assert got["drill_string.stiffness"] == pytest.approx(1.2e6, rel=0.15)
     assert got["friction.static_force"] == pytest.approx(23e3, rel=0.1)
+
+
+@pytest.mark.slow
+def test_parameter_mismatch_rescan_leaves_the_stick_slip_side_minimum():
+    """The side minimum a local fit reached on another kernel (F_S 12.5 kN against 23 kN, F_C's
+    multiplier clipped): started there, the plain fit stays; the rescan of the rugged static
+    force finds the truth's basin, on the fit part's cost alone."""
+    from heavecomp.effects.candidates import ParameterMismatch as PM
+
+    truth = paper_a().replace(compensator={"gas_stiffness": 60e3}, drill_string={"stiffness": 1.2e6})
+    nominal, run = _planted("parameter_mismatch", {}, params=truth)
+    d = GapDiagnoser(nominal, ["parameter_mismatch"], n_jobs=1, second=0, settle=10.0).fit(run)
+    t_end = d.split_["fit"][1]
+    lo, hi = PM.bounds_x()
+
+    def fun(x):
+        return d._resid_vec(d.simulate([("parameter_mismatch", PM.from_x(x))], t_end))
+
+    x0 = PM.x0()
+    x0[1] = math.log(0.54)
+    trapped = d._least_squares(fun, x0, lo, hi)
+    assert PM.named_values(nominal, PM.from_x(trapped.x))["friction.static_force"] < 0.8 * 23e3  # the trap is real
+    r = d._rescan(PM, fun, trapped, lo, hi)
+    got = PM.named_values(nominal, PM.from_x(r.x))
+    assert r.cost < trapped.cost
+    assert got["friction.static_force"] == pytest.approx(23e3, rel=0.1)
+    assert got["compensator.gas_stiffness"] == pytest.approx(60e3, rel=0.1)
+    assert got["drill_string.stiffness"] == pytest.approx(1.2e6, rel=0.15)

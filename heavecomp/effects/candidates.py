@@ -48,6 +48,9 @@ class ParameterMismatch(Effect):
     Params = MismatchParams
     kind = "nominal"
     log = tuple(f.name for f in dataclasses.fields(MismatchParams))
+    #: multipliers whose fit cost is rugged (stick-slip timing jumps with the breakaway force): the
+    #: diagnosis scans them over their search box for a second start (GapDiagnoser._rescan)
+    rugged = ("static_force",)
 
     @classmethod
     def apply(cls, params, values):
@@ -65,6 +68,17 @@ class ParameterMismatch(Effect):
         if params.friction.model == "none":
             ch.pop("friction", None)
         return params.replace(**ch)
+
+    @classmethod
+    def effective(cls, params, values) -> dict:
+        """The same model with the clip written into the multipliers: F_C's multiplier lowered to
+        what :meth:`apply` uses (min(F_C, F_S)).  A scan of F_S then keeps the fitted Coulomb force
+        instead of releasing a clipped, meaningless one."""
+        out = dict(values)
+        fs, fc = params.friction.static_force, params.friction.coulomb_force
+        if fs and fc:
+            out["coulomb_force"] = min(values["coulomb_force"], values["static_force"] * fs / fc)
+        return out
 
     @classmethod
     def named_values(cls, params, values) -> dict:
