@@ -7,13 +7,17 @@ checks; here each effect's own behaviour is measured on a simulated run."""
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 import pytest
 
+from heavecomp.effects.base import Effect
 from heavecomp.effects.registry import effect_class
 from heavecomp.errors import ParameterError
 from heavecomp.friction import laws
 from heavecomp.params import paper_a
+from heavecomp.params.core import q
 from heavecomp.plants import cmc
 from heavecomp.simulate import simulate
 
@@ -187,3 +191,63 @@ def test_linearise_with_a_wob_gain_scales_the_wob_row():
 def test_channel_effect_names_its_channel():
     with pytest.raises(ParameterError, match="unknown channel 'wobb'.*did you mean 'wob'"):
         effect_class("sensor_gain")(channel="wobb", gain=1.1)
+
+
+class _Drifts(Effect):
+    """Test effect with two states drifting at constant rates (a gas spring term 0 x[0])."""
+
+    name = "_drifts"
+    hook = "gas_spring"
+    states = ("a", "b")
+
+    @dataclass(frozen=True)
+    class Params:
+        rate: float = q(1.0, "1/s", bounds=(0.0, 10.0), symbol="r", doc="rate of the first state")
+
+    @staticmethod
+    def gas(s, v, p, x, PP, rate):
+        return p + 0.0 * x[0] * x[1]
+
+    @staticmethod
+    def rates(s, v, p, x, PP, FP, rate):
+        return (rate + 0.0 * v, 2.0 * rate + 0.0 * v)
+
+    @staticmethod
+    def initial(FP, PP, rate):
+        return (0.0, 1.0)
+
+
+def test_a_composition_has_as_many_state_slots_as_its_effects():
+    """The library's three state effects plus one with two states: five effect states (the
+    stepper's state was once limited to three), laid out after the plant's four."""
+    from heavecomp.effects.compose import composition
+    from heavecomp.effects.model import casadi_model
+    from heavecomp.effects.registry import library
+
+    classes = tuple(c for c in library().values() if c.kind == "plant" and c.states) + (_Drifts,)
+    comp = composition(classes)
+    assert comp.n_states == 5 and comp.slots["_drifts"] == (7, 8)
+    plant = cmc.plant_vectors(paper_a())
+    EP = comp.ep([_Drifts(rate=0.5)])
+    X0 = comp.initial_state(plant.FP, plant.PP, EP)
+    assert X0.shape == (10,) and X0[8] == 1.0
+    fn = comp.functions
+    X = tuple(X0[:9])
+    k = fn["state_dot"](0.1, 0.2, 0.3, 0.4, 0.0, 0.1, 2e6, X, plant.PP, plant.FP, EP)
+    assert k == (0.1, 0.2, 0.3, 0.4, 0.0, 0.0, 0.0, 0.5, 1.0)
+    f = casadi_model(paper_a("none"), effects=[_Drifts(rate=0.5)])
+    xd = np.asarray(f(np.r_[0.0, 0.1, 0.0, 0.0, 0.0, 1.0], np.zeros(4))[0]).ravel()
+    assert xd.size == 6 and xd[4] == 0.5 and xd[5] == 1.0
+
+
+@pytest.mark.slow
+def test_a_five_state_composition_compiles_and_integrates():
+    """The stepper compiled for five effect states integrates them (constant rates: exact)."""
+    from heavecomp.effects.compose import composition
+    from heavecomp.effects.registry import library
+    from heavecomp.diagnosis.stepper import simulate_fx
+
+    classes = tuple(c for c in library().values() if c.kind == "plant" and c.states) + (_Drifts,)
+    res = simulate_fx(paper_a(), 20.0, [_Drifts(rate=0.5), ("gas_leak", {"leak_rate": -1e-4})], rate=10.0,
+                      comp=composition(classes))
+    np.testing.assert_allclose(res["effect_state_6"], -1e-4 * res["t"], rtol=1e-9, atol=1e-15)
