@@ -106,7 +106,7 @@ def test_gas_heat_transfer_warming_makes_a_slow_mean_offset(nominal):
 
 
 def test_sensor_gain_minus_one_flips_the_sign(nominal):
-    res = _run(paper_a("stribeck"), [effect_class("sensor_gain")(channel="wob", gain=-1.0)])
+    res = _run(paper_a("stribeck"), [effect_class("sensor_gain")(channel="wob", factor=-1.0)])
     np.testing.assert_array_equal(res["wob"], -nominal["wob"])
     for c in ("stroke", "pressure", "heave", "friction"):
         np.testing.assert_array_equal(res[c], nominal[c])
@@ -124,7 +124,7 @@ def test_heave_reference_scales_and_delays_what_the_plant_sees():
     recorded heave stays the measured one."""
     p = paper_a("none")
     ref = _run(p, duration=120.0)
-    res = _run(p, [effect_class("heave_reference")(gain=0.88, delay=0.5)], duration=120.0)
+    res = _run(p, [effect_class("heave_reference")(scale=0.88, delay=0.5)], duration=120.0)
     np.testing.assert_allclose(res["heave"], ref["heave"], rtol=0, atol=1e-12)  # (the output times' last bits)
     t, late = ref.t, ref.t > 60.0
     s_ref = ref["stroke"] - np.mean(ref["stroke"][late])
@@ -138,10 +138,10 @@ def test_heave_reference_scales_and_delays_what_the_plant_sees():
     assert np.std(t) > 0
 
 
-@pytest.mark.parametrize("name, values", [("sensor_gain", {"channel": "stroke", "gain": 1.0}),
+@pytest.mark.parametrize("name, values", [("sensor_gain", {"channel": "stroke", "factor": 1.0}),
                                           ("sensor_offset", {"channel": "wob", "offset": 0.0, "drift": 0.0}),
                                           ("sensor_delay", {"channel": "pressure", "delay": 0.0}),
-                                          ("heave_reference", {"gain": 1.0, "delay": 0.0})])
+                                          ("heave_reference", {"scale": 1.0, "delay": 0.0})])
 def test_channel_and_heave_effects_at_null_reproduce_the_nominal_run_bit_for_bit(nominal, name, values):
     cls = effect_class(name)
     assert values == {**values, **cls.null(None)}
@@ -156,9 +156,9 @@ def test_casadi_model_takes_gains_and_refuses_delays_and_drifts():
 
     p = paper_a("none")
     f0 = casadi_model(p)
-    fg = casadi_model(p, effects=[effect_class("sensor_gain")(channel="wob", gain=1.08),
+    fg = casadi_model(p, effects=[effect_class("sensor_gain")(channel="wob", factor=1.08),
                                   effect_class("sensor_offset")(channel="pressure", offset=1e5, drift=0.0)])
-    fh = casadi_model(p, effects=[effect_class("heave_reference")(gain=0.9, delay=0.0)])
+    fh = casadi_model(p, effects=[effect_class("heave_reference")(scale=0.9, delay=0.0)])
     rng = np.random.default_rng(3)
     for _ in range(10):
         x = np.r_[rng.uniform(-0.5, 0.5), rng.uniform(-0.3, 0.3), rng.uniform(-0.01, 0.01), rng.uniform(-0.1, 0.1)]
@@ -170,7 +170,7 @@ def test_casadi_model_takes_gains_and_refuses_delays_and_drifts():
         xdh, _ = (np.asarray(a).ravel() for a in fh(x, u))
         xd_ref = np.asarray(f0(x, np.r_[0.9 * u[:3], u[3]])[0]).ravel()
         np.testing.assert_allclose(xdh, xd_ref, rtol=1e-12, atol=1e-12)
-    for bad in ([effect_class("heave_reference")(gain=0.9, delay=0.3)],
+    for bad in ([effect_class("heave_reference")(scale=0.9, delay=0.3)],
                 [effect_class("sensor_offset")(channel="wob", offset=0.0, drift=5.0)],
                 [effect_class("sensor_delay")(channel="wob", delay=0.2)]):
         with pytest.raises(ParameterError, match=bad[0].name):
@@ -182,7 +182,7 @@ def test_linearise_with_a_wob_gain_scales_the_wob_row():
 
     p = paper_a("none")
     a = linearise(p, friction="none")
-    b = linearise(p, friction="none", effects=[("sensor_gain", {"channel": "wob", "gain": -1.0})])
+    b = linearise(p, friction="none", effects=[("sensor_gain", {"channel": "wob", "factor": -1.0})])
     i = list(a.output_labels).index("wob")
     np.testing.assert_allclose(b.C[i], -a.C[i], rtol=1e-12, atol=1e-12)
     np.testing.assert_allclose(b.D[i], -a.D[i], rtol=1e-12, atol=1e-12)
@@ -190,7 +190,7 @@ def test_linearise_with_a_wob_gain_scales_the_wob_row():
 
 def test_channel_effect_names_its_channel():
     with pytest.raises(ParameterError, match="unknown channel 'wobb'.*did you mean 'wob'"):
-        effect_class("sensor_gain")(channel="wobb", gain=1.1)
+        effect_class("sensor_gain")(channel="wobb", factor=1.1)
 
 
 class _Drifts(Effect):
