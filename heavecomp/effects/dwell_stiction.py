@@ -31,7 +31,7 @@ class DwellStiction(Effect):
         exponent: float = q(0.5, "-", bounds=(0.05, 1.0), symbol="beta", doc="power of the dwell time")
 
     @staticmethod
-    def static(code, p, lim, tau, x, FP, gain, exponent):
+    def static(code, p, lim, tau, s, d, x, FP, gain, exponent):
         return lim + gain * np.maximum(tau, 1e-12) ** exponent
 
     @classmethod

@@ -25,7 +25,7 @@ class PressureFriction(Effect):
                                               doc="seal friction added per pascal of cylinder pressure")
 
     @staticmethod
-    def jump(code, a, p, J, x, FP, extra_pressure_coefficient):
+    def jump(code, a, p, J, s, d, x, FP, extra_pressure_coefficient):
         return J + extra_pressure_coefficient * np.abs(p)
 
     @classmethod
