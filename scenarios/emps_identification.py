@@ -68,18 +68,32 @@ def main(argv=None) -> int:
         + ", ".join(f"{k} {v['share']:.2f} (mean {v['mean'] if v['mean'] is None else round(v['mean'], 2)} N)"
                     for k, v in {**w["direction"], **w["motion"]}.items()),
         "![map](residual_map.png)",
-        md_table(["candidate", "k", "held-out rms [N]", "shrink", "score (BIC-like)"],
-                 [(c["effect"], c["n_parameters"], c["rms_after"], c["shrink"], c["score"])
+        "Candidates: the effect library's classes (the same the CMC diagnosis fits), through their "
+        "equation-error features; an effect without a form on this plant (no pressure, no gas, ...) "
+        "is left out.",
+        md_table(["candidate", "component", "k", "held-out rms [N]", "shrink", "score (BIC-like)"],
+                 [(c["effect"], c["component"], c["n_parameters"], c["rms_after"], c["shrink"], c["score"])
                   for c in m["candidates"]], fmt="{:.3f}"),
-        "Candidate parameters (fitted on the fit part; SI: N, N s/m, m/s, m, s):\n\n" + md_table(
+        "Candidate parameters (fitted on the fit part; SI: N, N s/m, m/s, m, s, N/s^beta):\n\n" + md_table(
             ["candidate", "parameters"],
             [(c["effect"], ", ".join(f"{k} = {v:.4g}" for k, v in c["parameters"].items() if not k.startswith("base_")))
              for c in m["candidates"]]),
         "Forward selection (each step chosen by the BIC of the fit part, its shrink measured on the "
         "held-out part): "
         + "; ".join(f"{' + '.join(s['effects'])}: shrink {s['shrink']:.3f}" for s in sel),
+        "Open search (sparse regression over physical features of the friction residual, "
+        "`discovered`, a suggestion, never a name): " + (f"{m['discovered']['term']} (N), held-out shrink "
+                                                         f"{m['discovered']['shrink']:.3f}" if m["discovered"] else "none"),
         _findings(m),
         "![overlay](overlay.png)",
+        "**Withheld published terms** (issue 12 item 7): the same diagnosis against a nominal model that "
+        "lacks one published term (its value 0, its column not refitted): the Coulomb force F_c, or the "
+        "direction asymmetry F_off (with the axis moving, F_off + F_c sign(v) is an asymmetric Coulomb "
+        "force F_c+- = F_c +- F_off). The first row is the control (full published model; shown, not scored: the remainder the "
+        "published model leaves). Reachable "
+        "shrink = 1 - held-out rms of the full nominal / rms before: what restoring the term could give. "
+        "Fit and held-out parts as above.",
+        plots.withheld_terms_table(m["withheld_terms"]),
     ])
     return 0
 

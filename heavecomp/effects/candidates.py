@@ -56,6 +56,9 @@ class ParameterMismatch(Effect):
     feature_grid = tuple(np.geomspace(1e-3, 0.1, 13))
     #: name and unit of the equation-error shape parameter
     feature_shape = ("friction.stribeck_velocity", "m/s")
+    #: units of the feature coefficients [SI]
+    feature_units = {"friction.coulomb_force": "N", "friction.viscous_coefficient": "N s/m",
+                     "friction.static_force": "N", "friction.stribeck_velocity": "m/s"}
 
     @classmethod
     def features(cls, sig, shape=None):

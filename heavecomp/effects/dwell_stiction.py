@@ -29,6 +29,8 @@ class DwellStiction(Effect):
     feature_grid = (0.25, 0.5, 0.75, 1.0)
     #: name and unit of the equation-error shape parameter
     feature_shape = ("exponent", "-")
+    #: units of the feature coefficients [SI]
+    feature_units = {"breakaway_excess": "N/s^beta", "exponent": "-"}
     #: how long after a breakaway the excess static friction is counted [s] (equation error only)
     breakaway_window = 0.05
 

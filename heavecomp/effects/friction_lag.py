@@ -33,6 +33,8 @@ class FrictionLag(Effect):
     feature_grid = tuple(np.geomspace(1e-3, 0.2, 12))
     #: name and unit of the equation-error shape parameter
     feature_shape = ("lag_time", "s")
+    #: units of the feature coefficients [SI]
+    feature_units = {"lag_force": "N", "lag_time": "s"}
 
     @dataclass(frozen=True)
     class Params:

@@ -19,6 +19,8 @@ class PressureFriction(Effect):
     hook = "seal_friction"
     adds_stiction = True
     log = ("extra_pressure_coefficient",)
+    #: units of the feature coefficients [SI]
+    feature_units = {"pressure_friction": "N/Pa"}
 
     @dataclass(frozen=True)
     class Params:
