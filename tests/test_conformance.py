@@ -11,6 +11,7 @@
 from __future__ import annotations
 
 import dataclasses
+import itertools
 
 import numpy as np
 import pytest
@@ -72,8 +73,8 @@ def test_finite_outputs_at_sampled_states(model, name):
     for s, v, yb, vb, zh, dzh, ddzh, u in _states(50, 1):
         vals = list(fn["plant_fx"](s, v, yb, vb, *x, zh, dzh, ddzh, u, 1.0, plant.PP, EP))
         p = vals[0]
-        vals.append(fn["sliding_friction_fx"](plant.code, np.sign(v), v, p, *x, plant.FP, EP))
-        vals.append(fn["static_limit_fx"](plant.code, p, *x, 2.0, plant.FP, EP))
+        vals.append(fn["sliding_friction_fx"](plant.code, np.sign(v), v, p, s, *x, plant.FP, EP))
+        vals.append(fn["static_limit_fx"](plant.code, p, s, np.sign(v), *x, 2.0, plant.FP, EP))
         vals += list(fn["effect_rates"](s, v, p, *x, plant.PP, plant.FP, EP))
         assert np.all(np.isfinite(vals)), vals
 
@@ -103,10 +104,10 @@ def test_seal_effects_dissipate(model, name):
     for mem in np.linspace(0.0, FS - FC, 5):
         x = (mem, 0.0, 0.0)
         for v in np.r_[-np.logspace(-5, 0, 30), np.logspace(-5, 0, 30)]:
-            for p in (0.0, 2.4e6, 4e6):
-                F = fn["sliding_friction_fx"](plant.code, np.sign(v), v, p, *x, plant.FP, EP)
-                assert F * v >= 0.0, (v, p, F)
-                assert fn["static_limit_fx"](plant.code, p, *x, 3.0, plant.FP, EP) >= 0.0
+            for p, s in itertools.product((0.0, 2.4e6, 4e6), np.linspace(-1.5, 1.5, 7)):
+                F = fn["sliding_friction_fx"](plant.code, np.sign(v), v, p, s, *x, plant.FP, EP)
+                assert F * v >= 0.0, (v, p, s, F)
+                assert fn["static_limit_fx"](plant.code, p, s, np.sign(v), *x, 3.0, plant.FP, EP) >= 0.0
 
 
 # ------------------------------------------------------------ zero size = nominal
@@ -140,7 +141,7 @@ def test_zero_size_reproduces_the_nominal_plant_bit_for_bit(name):
         assert pr == cmc.gas_pressure(s, plant.PP)
         assert T == cmc.tension(s, v, yb, vb, zh, dzh, plant.PP)
         assert hold == cmc.holding_force(s, v, yb, vb, zh, dzh, ddzh, u, plant.PP)
-        assert (fn["sliding_friction_fx"](plant.code, np.sign(v), v, pr, 0.0, 0.0, 0.0, plant.FP, EP)
+        assert (fn["sliding_friction_fx"](plant.code, np.sign(v), v, pr, s, 0.0, 0.0, 0.0, plant.FP, EP)
                 == cmc.sliding_friction(plant.code, np.sign(v), s, v, plant.FP, plant.PP))
     ref = simulate(p, 30.0, rate=20.0)
     got = simulate(p, 30.0, rate=20.0, effects=[e])  # the library's compiled stepper
@@ -154,7 +155,7 @@ def _kernel_xdot(hooks, n_eff, plant, EP, X, w, u):
     zh, dzh, ddzh = w
     cm = 1.0 if K.contact_switch(yb, vb, plant.PP) > 0 else 0.0
     p, T, hold, dvb = hooks["plant_fx"](s, v, yb, vb, *xe, zh, dzh, ddzh, u, cm, plant.PP, EP)
-    Ff = hooks["sliding_friction_fx"](plant.code, float(np.sign(v)), v, p, *xe, plant.FP, EP)
+    Ff = hooks["sliding_friction_fx"](plant.code, float(np.sign(v)), v, p, s, *xe, plant.FP, EP)
     rates = hooks["effect_rates"](s, v, p, *xe, plant.PP, plant.FP, EP)[:n_eff]
     return np.r_[v, (hold - Ff) / plant.PP[cmc.MC], vb, dvb, rates]
 
@@ -213,3 +214,36 @@ def test_steepest_slope_is_the_laws_derivative_at_rest(model):
     bound = laws.steepest_slope(law.code, law.FP)
     assert slope <= bound * (1 + 1e-3)
     assert bound <= (slope + law.FP[laws.CV]) * (1 + 1e-3)
+
+
+# -------------------------------------------------- channel and heave effects
+OUTSIDE_EFFECTS = [n for n, c in library().items() if c.kind in ("output", "heave")]
+
+
+@pytest.mark.parametrize("name", OUTSIDE_EFFECTS)
+def test_channel_and_heave_effects_finite_and_null(name):
+    """Finite readings at sampled series; at its null values the effect leaves the series bit for bit
+    (the whole run: tests/test_effects_schema2.py)."""
+    cls = library()[name]
+    t = np.linspace(0.0, 30.0, 601)
+    y = 2e5 + 3e4 * np.sin(0.5 * t) + np.random.default_rng(1).normal(0.0, 50.0, t.size)
+    null = cls.null(None)
+    assert null is not None, name
+    if cls.kind == "output":
+        e, e0 = cls(channel="wob", **_effect(name).values), cls(channel="wob", **null)
+        assert np.all(np.isfinite(e.measure(t, t, y)))
+        np.testing.assert_array_equal(e0.measure(t, t, y), y)
+    else:
+        hs = _heave_samples(t, y)
+        e, e0 = _effect(name), cls(**null)
+        out = e.transform(hs)
+        assert all(np.all(np.isfinite(a)) for a in (out.z, out.dz, out.ddz))
+        same = e0.transform(hs)
+        for a, b in ((same.z, hs.z), (same.dz, hs.dz), (same.ddz, hs.ddz)):
+            np.testing.assert_array_equal(a, b)
+
+
+def _heave_samples(t, z):
+    from heavecomp.simulate.excitation import HeaveSamples
+
+    return HeaveSamples(float(t[1] - t[0]), z, np.gradient(z, t), np.gradient(np.gradient(z, t), t))

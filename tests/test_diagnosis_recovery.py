@@ -24,16 +24,19 @@ def _planted(name, values, *, amplitude_hs=2.5, seed=4, params=None):
     truth = nominal if params is None else params
     cls = get(name)
     comp = library_composition()
-    EP = comp.ep([cls(**values)] if cls.kind == "plant" else [])
+    e = cls(**values)
+    EP = comp.ep([e] if cls.kind == "plant" else [])
     h = replay_dt(truth, 50.0)
     n = int(math.ceil(DUR / h))
     hs = excitation.jonswap(amplitude_hs, 10.0, 3.3, seed, 20.0, n * h, 0.5 * h)
-    out = run_fx(plant_vectors(truth), comp, EP, hs, h, n, int(round(0.02 / h)))
+    out = run_fx(plant_vectors(truth), comp, EP, e.transform(hs) if cls.kind == "heave" else hs, h, n,
+                 int(round(0.02 / h)))
     t = out[:, 0]
     cols = {c: out[:, SC.index(c)].copy() for c in ("heave", "stroke", "pressure", "wob")}
+    if cls.kind == "heave":  # the log has the measured heave, the plant saw another
+        cols["heave"] = np.interp(t, hs.t, hs.z)
     if cls.kind == "output":
-        c = values["channel"]
-        cols[c] = np.interp(t - values["delay"], t, cols[c])
+        cols[e.channel] = e.measure(t, t, cols[e.channel])
     rng = np.random.default_rng(1)
     for c, s in {"stroke": 2e-4, "pressure": 200.0, "wob": 50.0}.items():
         cols[c] += rng.normal(0, s, t.size)
@@ -48,6 +51,11 @@ CASES = [
     ("flow_loss", {"resistance": 1e5}, 0.15),
     ("string_damping", {"damping": 2e5}, 0.2),
     ("sensor_delay", {"channel": "wob", "delay": 0.4}, 0.05),
+    ("asymmetric_friction", {"asymmetry": 0.3}, 0.1),
+    ("gas_leak", {"leak_rate": -2e-4}, 0.1),
+    ("sensor_gain", {"channel": "pressure", "gain": 1.05}, 0.01),
+    ("sensor_offset", {"channel": "pressure", "offset": 1e5, "drift": 100.0}, 0.05),
+    ("heave_reference", {"gain": 0.88, "delay": 0.3}, 0.05),
 ]
 
 

@@ -12,7 +12,9 @@ from heavecomp.effects.compose import composition
 from heavecomp.errors import ParameterError
 
 CONTRACT = ("friction_lag", "dwell_stiction", "pressure_friction", "gas_heat_transfer", "flow_loss",
-            "string_damping", "sensor_delay", "parameter_mismatch")
+            "string_damping", "sensor_delay", "parameter_mismatch",
+            # schema 2 (diagnosis-contract.md)
+            "asymmetric_friction", "position_friction", "gas_leak", "sensor_gain", "sensor_offset", "heave_reference")
 
 
 def test_contract_names_exactly():
@@ -47,11 +49,11 @@ def test_dwell_truth_is_not_the_candidate_law():
     from scipy.optimize import least_squares
 
     tau = np.linspace(0.05, 10, 200)
-    truth = TR.TruthDwell.static(1, 0.0, 0.0, tau, (), None, 10e3, 1.0)
+    truth = TR.TruthDwell.static(1, 0.0, 0.0, tau, 0.0, 1.0, (), None, 10e3, 1.0)
     cand = get("dwell_stiction")
 
     def r(x):
-        return cand.static(1, 0.0, 0.0, tau, (), None, np.exp(x[0]), x[1]) - truth
+        return cand.static(1, 0.0, 0.0, tau, 0.0, 1.0, (), None, np.exp(x[0]), x[1]) - truth
 
     res = least_squares(r, [np.log(5e3), 0.5], bounds=([0, 0.05], [15, 1.0]))
     assert np.sqrt(np.mean(res.fun ** 2)) > 0.05 * 10e3

@@ -121,10 +121,10 @@ def _check_nominal_hooks(fn, code, FP, PP, EP):
         pr = cmc.gas_pressure(s, PP)
         for d in (1.0, -1.0):
             for a in (d * v, -1e-3):  # also a trial step past a reversal (a < 0)
-                assert fn["jump_fx"](code, a, pr, 0.7, 0.3, 0.1, FP, EP) == laws.friction_jump(code, a, pr, FP)
-            assert (fn["sliding_friction_fx"](code, d, v, pr, 0.7, 0.3, 0.1, FP, EP)
+                assert fn["jump_fx"](code, a, pr, s, d, 0.7, 0.3, 0.1, FP, EP) == laws.friction_jump(code, a, pr, FP)
+            assert (fn["sliding_friction_fx"](code, d, v, pr, s, 0.7, 0.3, 0.1, FP, EP)
                     == cmc.sliding_friction(code, d, s, v, FP, PP))
-        assert fn["static_limit_fx"](code, pr, 0.7, 0.3, 0.1, 3.0, FP, EP) == cmc.static_limit(code, s, FP, PP)
+        assert fn["static_limit_fx"](code, pr, s, 1.0, 0.7, 0.3, 0.1, 3.0, FP, EP) == cmc.static_limit(code, s, FP, PP)
 
 
 @pytest.mark.parametrize("model", MODELS)
@@ -170,10 +170,10 @@ def test_compiled_effect_hooks_equal_python_originals():
             for code in (laws.NONE, laws.STRIBECK, laws.EQ7):
                 FP = plant.FP.copy()
                 FP[laws.VT] = 0.05 if code == laws.EQ7 else 0.0
-                assert _close(fc["sliding_friction_fx"](code, np.sign(v), v, pr, *x, FP, EP),
-                              fp["sliding_friction_fx"](code, np.sign(v), v, pr, *x, FP, EP), 1e5)
-                assert _close(fc["static_limit_fx"](code, pr, *x, tau, FP, EP),
-                              fp["static_limit_fx"](code, pr, *x, tau, FP, EP), 1e5)
+                assert _close(fc["sliding_friction_fx"](code, np.sign(v), v, pr, s, *x, FP, EP),
+                              fp["sliding_friction_fx"](code, np.sign(v), v, pr, s, *x, FP, EP), 1e5)
+                assert _close(fc["static_limit_fx"](code, pr, s, np.sign(v), *x, tau, FP, EP),
+                              fp["static_limit_fx"](code, pr, s, np.sign(v), *x, tau, FP, EP), 1e5)
             for a, b in zip(fc["effect_rates"](s, v, pr, *x, PP, plant.FP, EP),
                             fp["effect_rates"](s, v, pr, *x, PP, plant.FP, EP)):
                 assert _close(a, b, 1e4)

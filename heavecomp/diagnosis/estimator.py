@@ -258,16 +258,17 @@ class GapDiagnoser(GapEstimator):
         hs = rp.hs if hs is None else hs
         plant = rp.plant
         comp = library_composition()
-        effects = []
-        shift = None
+        effects, sensors = [], []
         for name, values in config:
             cls = get(name)
             if cls.kind == "plant":
                 effects.append(cls(**values))
             elif cls.kind == "nominal":
                 plant = plant_vectors(ParameterMismatch.apply(self.nominal, values))
-            else:
-                shift = (values["channel"], values["delay"])
+            elif cls.kind == "heave":  # the heave the plant sees (heave_reference)
+                hs = cls(**values).transform(hs)
+            else:  # a channel that misreads (sensor_delay, sensor_gain, sensor_offset)
+                sensors.append(cls(**values))
         EP = comp.ep(effects)
         n = rp.n_steps if t_end is None else min(rp.n_steps, int(math.ceil(t_end / rp.h)) + 2)
         out = run_segments(plant, comp, EP, hs, rp.h, rp.bounds, rp.starts, n + 1)
@@ -276,9 +277,12 @@ class GapDiagnoser(GapEstimator):
         res = {}
         for c in CH + ("stroke_velocity", "stuck"):
             res[c] = np.interp(t, tg, out[:, SC.index(c)])
-        if shift is not None:
-            c, dly = shift
-            res[c] = get("sensor_delay").apply(t, tg, out[:, SC.index(c)], dly)
+        done = set()
+        for e in sensors:  # the first on a channel reads the model's grid, the next ones its reading
+            c = e.channel
+            if c in CH:
+                res[c] = e.measure(t, t, res[c]) if c in done else e.measure(t, tg, out[:, SC.index(c)])
+                done.add(c)
         res["t"] = t
         res["_grid"] = out
         return res
@@ -330,7 +334,9 @@ class GapDiagnoser(GapEstimator):
         cls = get(name)
         t0 = time.perf_counter()
         t_end = self.split_["fit"][1]
-        if cls.kind == "output":
+        if cls.kind == "output" and getattr(cls, "linear", False):
+            out = self._fit_linear_output(cls, fixed, t_end)
+        elif cls.kind == "output":
             best = None
             base = self.simulate(list(fixed), t_end)
             grid = base["_grid"]
@@ -381,6 +387,43 @@ class GapDiagnoser(GapEstimator):
             out = {"values": values, "sigma": sigma, "nfev": int(r.nfev), "cost": float(2 * r.cost)}
         out["wall_time"] = time.perf_counter() - t0
         return out
+
+    def _fit_linear_output(self, cls, fixed, t_end):
+        """A channel effect whose reading is affine in its parameters (``linear``: sensor_gain,
+        sensor_offset): per channel, linear least squares of the measured channel on the columns
+        the effect's own ``apply`` makes of the replay (no re-simulation); the channel whose fit
+        leaves the smallest weighted residual wins.  Parameters are clipped to their bounds."""
+        base = self.simulate(list(fixed), t_end)
+        t = base["t"]
+        m = self._fitmask[: t.size]
+        names = [f.name for f in cls.fields()]
+        lo, hi = (np.array([f.metadata["bounds"][i] for f in cls.fields()]) for i in (0, 1))
+        best = None
+        for c in CH:
+            y = self._y[c][: t.size]
+            ok = m & np.isfinite(y)
+            zero = np.zeros(len(names))
+            a0 = cls.apply(t, t, base[c], *zero)
+            X = np.column_stack([cls.apply(t, t, base[c], *np.eye(len(names))[i]) - a0 for i in range(len(names))])
+            Xo, yo = X[ok], (y - a0)[ok]
+            coef, *_ = np.linalg.lstsq(Xo, yo, rcond=None)
+            coef = np.clip(coef, lo, hi)
+            r = yo - Xo @ coef
+            pred = dict(base)
+            pred[c] = a0 + X @ coef
+            rv = self._resid_vec(pred)
+            cost = float(rv @ rv)
+            if best is None or cost < best[0]:
+                dof = max(int(ok.sum()) - len(names), 1)
+                try:
+                    cov = np.linalg.pinv(Xo.T @ Xo) * float(r @ r) / dof
+                    sig = np.sqrt(np.maximum(np.diag(cov), 0.0))
+                except np.linalg.LinAlgError:
+                    sig = np.full(len(names), math.nan)
+                best = (cost, c, coef, sig)
+        cost, c, coef, sig = best
+        values = {"channel": c, **{n: float(v) for n, v in zip(names, coef)}}
+        return {"values": values, "sigma": {n: float(s) for n, s in zip(names, sig)}, "nfev": 1, "cost": cost}
 
     def _nelder_mead(self, fun, x0, lo, hi):
         """Derivative-free refinement (Nelder-Mead on the clipped parameters; stick-slip costs are

@@ -126,7 +126,8 @@ def run_segments(plant, comp, EP, hs, h, bounds, starts, n_out):
     """Multiple-shooting replay: segment k covers grid steps ``bounds[k]`` = (i0, i1) and starts
     from the state ``starts[k]`` = (s, v, y_b, v_b, stuck) estimated from the measurement
     (``None``: rest at the operating point).  Effect states restart from their steady values
-    at that velocity (:meth:`Composition.steady_states`), the dwell time from 0.
+    at that velocity (:meth:`Composition.steady_states`; slow states, e.g. a gas leak's, carry on
+    from the end of the previous segment), the dwell time from 0.
 
     Returns the output rows on the stepper grid (row i at t = i h), shape (n_out, NCH).
     """
@@ -135,6 +136,7 @@ def run_segments(plant, comp, EP, hs, h, bounds, starts, n_out):
     smooth = smooth_fx(plant, comp, EP)
     stats = np.zeros(NSTATS)
     out = np.empty((n_out, NCH))
+    prev = None  # where the previous segment ended (slow effect states carry on from there)
     for (i0, i1), st in zip(bounds, starts):
         if i0 >= n_out - 1:
             break
@@ -147,7 +149,8 @@ def run_segments(plant, comp, EP, hs, h, bounds, starts, n_out):
             if not stuck:
                 X0[1] = v
                 mode_dir[:] = (float(SLIDING), 1.0 if v > 0 else -1.0)
-            comp.steady_states(X0[1], FP, PP, EP, X0)
+            comp.steady_states(X0[1], FP, PP, EP, X0, prev)
         advance_fx(X0, mode_dir, i0 * h, i1 - i0, h, plant.code, FP, PP, EP, smooth, 0.0, 0.5 * h, hs.z, hs.dz,
                    hs.ddz, out[i0:], 1, 0, stats)
+        prev = X0
     return out

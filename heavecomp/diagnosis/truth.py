@@ -46,7 +46,7 @@ class TruthSpeedLag(Effect):
                                   doc="lag of the speed the Stribeck curve sees")
 
     @staticmethod
-    def jump(code, a, p, J, x, FP, lag_time_speed):
+    def jump(code, a, p, J, s, d, x, FP, lag_time_speed):
         if code == STRIBECK:
             return J - stribeck_excess(np.maximum(a, 0.0), FP[FS], FP[FC], FP[VS]) + stribeck_excess(
                 x[0], FP[FS], FP[FC], FP[VS])
@@ -78,7 +78,7 @@ class TruthDwell(Effect):
         tau_d: float = q(1.0, "s", bounds=(0.0, 100.0), open_low=True, symbol="tau_d", doc="dwell time constant")
 
     @staticmethod
-    def static(code, p, lim, tau, x, FP, dF, tau_d):
+    def static(code, p, lim, tau, s, d, x, FP, dF, tau_d):
         return lim + dF * (1.0 - np.exp(-tau / tau_d))
 
 
@@ -95,7 +95,7 @@ class TruthEnergisedSeal(Effect):
         p_th: float = q(2e6, "Pa", bounds=(0.0, 1e8), symbol="p_th", doc="threshold pressure")
 
     @staticmethod
-    def jump(code, a, p, J, x, FP, k, p_th):
+    def jump(code, a, p, J, s, d, x, FP, k, p_th):
         return J + k * np.maximum(p - p_th, 0.0)
 
 

@@ -19,14 +19,20 @@ hook (slot)    method                                             nominal ("none
 gas spring     ``gas(s, v, p, x, PP, *prm) -> p_gas [Pa]``        polytropic, fixed charge
 line           ``line(v, p, x, PP, *prm) -> p_cyl [Pa]``          lossless, p_cyl = p_gas
 string         ``string(dv, T, x, PP, *prm) -> T_ds [N]``         spring + dashpot (dv = dz_h + v - v_b)
-seal friction  ``jump(code, a, p, J, x, FP, *prm) -> J [N]``      the friction law's J (paper A eq. 4/6/7)
-               ``static(code, p, lim, tau, x, FP, *prm) -> [N]``  static limit J(0, p); tau = dwell time
+seal friction  ``jump(code, a, p, J, s, d, x, FP, *prm) -> J``    the friction law's J [N] (paper A eq. 4/6/7)
+               ``static(code, p, lim, tau, s, d, x, FP, *prm)``   static limit J(0, p) [N]; tau = dwell time
 states         ``rates(s, v, p, x, PP, FP, *prm) -> dx/dt``       (no extra states)
                ``initial(FP, PP, *prm) -> x`` at rest,
                ``steady(v, FP, PP, *prm) -> x`` sliding at v
-measured       ``channel``: applied to the recorded channel       ideal sensor
-heave input    ``heave``: (no effect yet)                         measured = seen
+               (None: a slow state, carried over a restart)
+measured       ``apply(t, tg, y, *prm) -> y_meas``                ideal sensor
+               (:class:`ChannelEffect`, on the recorded channel)
+heave input    ``seen(t, z, *prm) -> z`` (:class:`HeaveEffect`)    measured = seen
 =============  =================================================  ======================================
+
+At the seal-friction hook ``s`` is the stroke [m] and ``d`` the direction of the (impending) motion:
++1 while the stroke grows (v > 0, extending), -1 while it shrinks (retracting); at rest the sign of
+the holding force that would start the motion; in the smooth casadi model tanh(v / eps).
 
 A method must use ``np.*`` only and branch on parameters or the law ``code``, never on a
 state (casadi traces it).  ``PP`` / ``FP`` are indexed by the named constants of
@@ -52,6 +58,8 @@ HOOK_COMPONENT = {"seal_friction": "friction", "gas_spring": "gas_spring", "line
                   "string": "string_formation", "channel": "sensors", "heave": "heave_input"}
 #: the methods the stepper and the casadi model call, in the order they are composed
 METHODS = ("gas", "line", "string", "jump", "static", "rates")
+#: measured channels a channel effect (:class:`ChannelEffect`) may act on
+SENSOR_CHANNELS = ("wob", "stroke", "pressure", "heave")
 
 
 class Effect:
@@ -95,6 +103,14 @@ class Effect:
         where the plant has a pressure); ``shape`` is one value of :attr:`feature_grid` (None when
         the grid is empty).  Returns ``{column name: array}``, or None when the effect has no
         equation-error form or a signal it needs is missing.
+
+        The CMC adds: ``heave`` measured heave z_h [m], ``heave_velocity`` [m/s], ``wob`` [N],
+        ``dz`` the drill string's extension from the measured signals [m] (tension
+        T_ds = T_0 + k_ds dz: more tension, less WOB), ``p_gas_abs`` the nominal gas spring's
+        absolute pressure at the measured stroke [Pa] and ``p_charge_abs`` its absolute pre-charge
+        at stroke 0 [Pa] (a number), and, for the ``sensors`` component, ``y`` the measured
+        channel whose residual is fitted (its SI unit).  Residuals are measured minus nominal, so a
+        column is the effect's contribution to the measured quantity per unit coefficient.
         """
         return None
 
@@ -169,3 +185,57 @@ class Effect:
     @classmethod
     def from_x(cls, x) -> dict:
         return {f.name: float(np.exp(xi) if f.name in cls.log else xi) for f, xi in zip(cls.fields(), x)}
+
+
+class ChannelEffect(Effect):
+    """Base of an effect on one measured channel (hook ``channel``, ``kind = "output"``): the plant is
+    nominal, the recorded channel misreads.  ``apply(t, tg, y, *prm)`` gives the recorded channel at
+    times ``t`` [s] from the true one ``y`` on the grid ``tg`` [s]; an instance names its channel
+    (:data:`SENSOR_CHANNELS`): ``SensorGain(channel="wob", gain=1.08)``."""
+
+    hook = "channel"
+    kind = "output"
+    apply = None
+    #: the reading is affine in the parameters (the diagnosis fits them by linear least squares)
+    linear = False
+
+    def __init__(self, channel: str = "wob", **values):
+        if channel not in SENSOR_CHANNELS:
+            raise ParameterError(f"effect {self.name}: unknown channel {channel!r}{did_you_mean(channel, SENSOR_CHANNELS)}; "
+                                 f"channels: {', '.join(SENSOR_CHANNELS)}")
+        self.channel = channel
+        super().__init__(**values)
+
+    def __repr__(self):
+        vals = "".join(f", {k}={v!r}" for k, v in self.values.items())
+        return f"{type(self).__name__}(channel={self.channel!r}{vals})"
+
+    def measure(self, t, tg, y):
+        """The recorded channel at times ``t`` from the true ``y`` on the grid ``tg``."""
+        return self.apply(np.asarray(t, dtype=float), np.asarray(tg, dtype=float), np.asarray(y, dtype=float),
+                          *self.prm)
+
+
+class HeaveEffect(Effect):
+    """Base of an effect on the heave input (hook ``heave``, ``kind = "heave"``): the heave the
+    compensator sees is not the measured one.  ``seen(t, z, *prm)`` maps a measured heave series
+    (or its derivatives: the map is linear and time-invariant) on the uniform grid ``t`` [s] to the
+    one the plant sees."""
+
+    hook = "heave"
+    kind = "heave"
+    seen = None
+
+    def transform(self, hs):
+        """The heave samples the plant sees (:class:`heavecomp.simulate.excitation.HeaveSamples`)
+        from the measured ones ``hs``."""
+        t = hs.t
+        return dataclasses.replace(hs, z=self.seen(t, hs.z, *self.prm), dz=self.seen(t, hs.dz, *self.prm),
+                                   ddz=self.seen(t, hs.ddz, *self.prm),
+                                   info={**hs.info, "heave_effect": repr(self)},
+                                   kink=hs.kink if self.null_like() else None)
+
+    def null_like(self) -> bool:
+        """True when the effect leaves the heave as it is (its :meth:`null` values)."""
+        n = self.null(None)
+        return n is not None and all(self.values[k] == v for k, v in n.items())

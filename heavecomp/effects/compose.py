@@ -72,7 +72,9 @@ class Composition:
             self.offsets[c.name] = k
             k += 1 + c.n_params()
             if len(c.states) > len(free):
-                raise ParameterError(f"effects {', '.join(names)}: more than {len(STATE_SLOTS)} extra states")
+                n = sum(len(e.states) for e in self.classes)
+                raise ParameterError(f"effects {', '.join(names)}: {n} extra states, the stepper's state has "
+                                     f"{len(STATE_SLOTS)} slots for them (heavecomp.effects.compose.STATE_SLOTS)")
             self.slots[c.name] = tuple(free[:len(c.states)])
             del free[:len(c.states)]
         self.n_ep = k
@@ -116,13 +118,14 @@ class Composition:
               f"    p = cylinder_pressure_fx(s, v, {_X}, PP, EP)",
               f"    T = tension_fx(s, v, yb, vb, zh, dzh, {_X}, PP, EP)",
               "    return p, T, net_force(p, T, ddzh, u, PP), lower_accel_tension(T, yb, vb, contact, PP)", ""]
-        L += [f"def jump_fx(code, a, p, {_X}, FP, EP):", "    J = friction_jump(code, a, p, FP)"]
-        L += self._calls("jump", "J", "code, a, p, J, {x}, FP") + ["    return J", ""]
-        L += [f"def sliding_friction_fx(code, direction, v, p, {_X}, FP, EP):",
-              f"    return jump_fx(code, direction * v, p, {_X}, FP, EP) * direction + friction_cont(code, v, p, FP)",
-              ""]
-        L += [f"def static_limit_fx(code, p, {_X}, tau, FP, EP):", f"    lim = jump_fx(code, 0.0 * p, p, {_X}, FP, EP)"]
-        L += self._calls("static", "lim", "code, p, lim, tau, {x}, FP") + ["    return lim", ""]
+        L += [f"def jump_fx(code, a, p, s, d, {_X}, FP, EP):", "    J = friction_jump(code, a, p, FP)"]
+        L += self._calls("jump", "J", "code, a, p, J, s, d, {x}, FP") + ["    return J", ""]
+        L += [f"def sliding_friction_fx(code, direction, v, p, s, {_X}, FP, EP):",
+              f"    return (jump_fx(code, direction * v, p, s, direction, {_X}, FP, EP) * direction"
+              " + friction_cont(code, v, p, FP))", ""]
+        L += [f"def static_limit_fx(code, p, s, d, {_X}, tau, FP, EP):",
+              f"    lim = jump_fx(code, 0.0 * p, p, s, d, {_X}, FP, EP)"]
+        L += self._calls("static", "lim", "code, p, lim, tau, s, d, {x}, FP") + ["    return lim", ""]
         L += [f"def effect_rates(s, v, p, {_X}, PP, FP, EP):", "    d4 = 0.0 * v", "    d5 = 0.0 * v", "    d6 = 0.0 * v"]
         for i, c in enumerate(self.classes):
             if c.rates is None:
@@ -167,11 +170,19 @@ class Composition:
                 X0[list(self.slots[c.name])] = c.initial(FP, PP, *prm)
         return X0
 
-    def steady_states(self, v, FP, PP, EP, X0) -> None:
-        """Set the effect states of ``X0`` to their steady values sliding at ``v`` (segment restarts)."""
+    def steady_states(self, v, FP, PP, EP, X0, prev=None) -> None:
+        """Set the effect states of ``X0`` to their steady values sliding at ``v`` (segment restarts).
+
+        A slow state (an effect without ``steady``: a drift, a warming) carries on from ``prev``
+        (the state where the previous segment ended), or stays as it is in ``X0`` without one."""
         for c, prm in self._active(EP):
-            if c.states:
-                X0[list(self.slots[c.name])] = c.steady(v, FP, PP, *prm)
+            if not c.states:
+                continue
+            sl = list(self.slots[c.name])
+            if c.steady is not None:
+                X0[sl] = c.steady(v, FP, PP, *prm)
+            elif prev is not None:
+                X0[sl] = np.asarray(prev)[sl]
 
 
 _CACHE: dict = {}

@@ -56,7 +56,7 @@ class DwellStiction(Effect):
         return {"breakaway_excess": np.sign(sig["v"]) * tau ** float(shape)}
 
     @staticmethod
-    def static(code, p, lim, tau, x, FP, gain, exponent):
+    def static(code, p, lim, tau, s, d, x, FP, gain, exponent):
         return lim + gain * np.maximum(tau, 1e-12) ** exponent
 
     @classmethod

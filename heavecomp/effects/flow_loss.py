@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numpy as np
+
 from heavecomp.effects.base import Effect
 from heavecomp.params.core import q
 
@@ -23,6 +25,14 @@ class FlowLoss(Effect):
     class Params:
         resistance: float = q(3e4, "Pa s/m", bounds=(10.0, 1e7), symbol="R",
                               doc="line pressure drop per unit stroke velocity")
+
+    @classmethod
+    def features(cls, sig, shape=None):
+        """``flow_line`` residual (measured minus nominal cylinder pressure) [Pa]: ``flow_loss``
+        -v [m/s] (coefficient R [Pa s/m]): the drop with the flow A v out of the cylinder."""
+        if "v" not in sig:
+            return None
+        return {"flow_loss": -np.asarray(sig["v"], dtype=float)}
 
     @staticmethod
     def line(v, p, x, PP, resistance):

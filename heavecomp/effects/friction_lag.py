@@ -61,7 +61,7 @@ class FrictionLag(Effect):
         return {"lag_force": first_order_lag(sig["t"], s, float(shape)) - s}
 
     @staticmethod
-    def jump(code, a, p, J, x, FP, lag_time, drop_time):
+    def jump(code, a, p, J, s, d, x, FP, lag_time, drop_time):
         if code == STRIBECK:
             return J - stribeck_excess(np.maximum(a, 0.0), FP[FS], FP[FC], FP[VS]) + x[0]
         return J

@@ -11,7 +11,8 @@ from __future__ import annotations
 import numpy as np
 
 from heavecomp.effects.compose import composition
-from heavecomp.effects.registry import resolve
+from heavecomp.effects.registry import resolve, split_effects
+from heavecomp.errors import ParameterError
 from heavecomp.friction.laws import friction_cont
 from heavecomp.plants.cmc import MC, lower_accel_wob, plant_vectors, wob
 from heavecomp.plants.symbolic import casadi
@@ -33,7 +34,9 @@ def casadi_model(params, *, eps: float | None = None, sym: str = "SX", effects=(
         ``(name, values)``).  Their hook methods are traced by casadi from the same source the
         stepper compiles (:mod:`heavecomp.effects.compose`); their states follow the four
         plant states.  The seal-friction ``static`` hook (e.g. a dwell gain) has no part in a
-        regularised model, which never sticks.
+        regularised model, which never sticks.  A heave effect scales the heave input (its gain;
+        a delay is refused: ParameterError), a channel effect scales and shifts its output
+        (``g y + o``; a heave sensor's inverse on the input; a delay or a drift is refused).
 
     Returns
     -------
@@ -43,7 +46,7 @@ def casadi_model(params, *, eps: float | None = None, sym: str = "SX", effects=(
     """
     ca = casadi()
     plant = plant_vectors(params)
-    effects = resolve(effects)
+    effects, heave_fx, sensor_fx = split_effects(resolve(effects))
     comp = composition(tuple(dict.fromkeys(type(e) for e in effects)))
     EP = comp.ep(effects)
     if (plant.has_stiction or comp.adds_stiction(EP)) and not (eps and eps > 0):
@@ -56,21 +59,66 @@ def casadi_model(params, *, eps: float | None = None, sym: str = "SX", effects=(
     s, v, yb, vb = x[0], x[1], x[2], x[3]
     xe = [x[4 + i] for i in range(n_eff)] + [0.0] * (3 - n_eff)  # the effects' state slots x4..x6
     zh, dzh, ddzh, ua = u[0], u[1], u[2], u[3]
+    for e in heave_fx:  # the heave the plant sees: a gain on the measured one
+        g = _static_gain(e, e.seen)
+        zh, dzh, ddzh = g * zh, g * dzh, g * ddzh
+    for e in sensor_fx:  # a heave sensor that reads g z + o: the plant sees (u - o) / g
+        if e.channel == "heave":
+            g, o = _static_affine(e)
+            zh, dzh, ddzh = (zh - o) / g, dzh / g, ddzh / g
     fn = comp.functions
     p, T, hold, dvb = fn["plant_fx"](s, v, yb, vb, *xe, zh, dzh, ddzh, ua, 1.0, PP, EP)
     dvb = lower_accel_wob(T, yb, vb, PP)  # the clamped contact law (smooth model)
-    Ff = fn["jump_fx"](code, np.abs(v), p, *xe, FP, EP) * np.tanh(v / (eps or 1.0)) + friction_cont(code, v, p, FP)
+    sv = np.tanh(v / (eps or 1.0))  # the direction of motion, smoothed
+    Ff = fn["jump_fx"](code, np.abs(v), p, s, sv, *xe, FP, EP) * sv + friction_cont(code, v, p, FP)
     dv = (hold - Ff) / PP[MC]
     rates = fn["effect_rates"](s, v, p, *xe, PP, FP, EP)[:n_eff]
     xdot = ca.vertcat(v, dv, vb, dvb, *rates)
-    y = ca.vertcat(wob(yb, vb, PP), s, p, T, Ff)
+    y = {"wob": wob(yb, vb, PP), "stroke": s, "pressure": p}
+    for e in sensor_fx:  # a recorded channel that reads g y + o
+        if e.channel in y:
+            g, o = _static_affine(e)
+            y[e.channel] = g * y[e.channel] + o
+    y = ca.vertcat(y["wob"], y["stroke"], y["pressure"], T, Ff)
     return ca.Function("cmc", [x, u], [xdot, y], ["x", "u"], ["xdot", "y"])
+
+
+#: probe times [s] and values for the static maps of heave and channel effects
+_PROBE_T = np.linspace(0.0, 10.0, 41)
+
+
+def _static_gain(e, seen):
+    """g of a heave effect whose map is z -> g z (memoryless, time-invariant), else ParameterError."""
+    g = float(seen(_PROBE_T, np.ones_like(_PROBE_T), *e.prm)[20])
+    ramp = seen(_PROBE_T, _PROBE_T, *e.prm)
+    if not np.allclose(ramp[4:-4], g * _PROBE_T[4:-4], rtol=1e-12, atol=1e-12):
+        raise ParameterError(f"effect {e.name} ({', '.join(f'{k}={v:g}' for k, v in e.values.items())}): the "
+                             "casadi model (linearise, MPC) takes the heave effect's gain only; its delay has no "
+                             "finite-state model: set it to 0")
+    return g
+
+
+def _static_affine(e):
+    """(g, o) of a channel effect that reads g y + o (memoryless, time-invariant), else ParameterError."""
+    t = _PROBE_T
+    o = e.measure(t, t, np.zeros_like(t))
+    g = e.measure(t, t, np.ones_like(t)) - o
+    ramp = e.measure(t, t, t)
+    if not (np.allclose(o, o[20], rtol=0, atol=1e-12 * (1 + abs(o[20])))
+            and np.allclose(g, g[20], rtol=1e-12, atol=1e-12)
+            and np.allclose(ramp[4:-4], g[20] * t[4:-4] + o[20], rtol=1e-12, atol=1e-12 * (1 + abs(o[20])))):
+        raise ParameterError(f"effect {e.name} on {e.channel} ({', '.join(f'{k}={v:g}' for k, v in e.values.items())}): "
+                             "the casadi model (linearise, MPC) takes a reading g y + o only; a delay or a drift "
+                             "in time has no finite-state, time-invariant model: set it to 0")
+    if e.channel == "heave" and g[20] == 0.0:
+        raise ParameterError(f"effect {e.name} on heave: a gain of 0 leaves no heave to compensate")
+    return float(g[20]), float(o[20])
 
 
 def initial_effect_states(params, effects=()) -> np.ndarray:
     """The effect states of :func:`casadi_model` at rest at the operating point (its x[4:])."""
     plant = plant_vectors(params)
-    effects = resolve(effects)
+    effects = split_effects(resolve(effects))[0]
     comp = composition(tuple(dict.fromkeys(type(e) for e in effects)))
     n_eff = sum(len(c.states) for c in comp.classes)
     return comp.initial_state(plant.FP, plant.PP, comp.ep(effects))[4:4 + n_eff]

@@ -36,7 +36,7 @@ class PressureFriction(Effect):
         return {"pressure_friction": np.sign(sig["v"]) * np.abs(sig["p"])}
 
     @staticmethod
-    def jump(code, a, p, J, x, FP, extra_pressure_coefficient):
+    def jump(code, a, p, J, s, d, x, FP, extra_pressure_coefficient):
         return J + extra_pressure_coefficient * np.abs(p)
 
     @classmethod

@@ -20,6 +20,12 @@ MODULES = (
     "string_damping",
     "sensor_delay",
     "charge_drift",
+    "asymmetric_friction",
+    "position_friction",
+    "gas_leak",
+    "sensor_gain",
+    "sensor_offset",
+    "heave_reference",
 )
 
 _LIBRARY: dict = {}
@@ -60,3 +66,16 @@ def resolve(effects) -> list:
             cls = name if isinstance(name, type) else effect_class(name)
             out.append(cls(**values))
     return out
+
+
+def split_effects(effects):
+    """``(plant, heave, sensor)`` effects of the instances ``effects``: terms at the plant's hooks
+    (the stepper), the heave the plant sees (``kind = "heave"``), the recorded channels
+    (``kind = "output"``).  A nominal refit (``parameter_mismatch``) is no submodel: ParameterError."""
+    out = {"plant": [], "heave": [], "output": []}
+    for e in effects:
+        if e.kind not in out:
+            raise ParameterError(f"effect {e.name} is no submodel (kind {e.kind!r}): apply its parameters to the "
+                                 "parameter set instead")
+        out[e.kind].append(e)
+    return out["plant"], out["heave"], out["output"]

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numpy as np
+
 from heavecomp.effects.base import Effect
 from heavecomp.params.core import q
 
@@ -19,6 +21,15 @@ class StringDamping(Effect):
     @dataclass(frozen=True)
     class Params:
         damping: float = q(3e4, "N s/m", bounds=(10.0, 2e6), symbol="c", doc="extra drill-string damping")
+
+    @classmethod
+    def features(cls, sig, shape=None):
+        """``string_formation`` residual (measured minus nominal WOB) [N]: ``string_damping``
+        -d(dz)/dt [m/s] (coefficient c [N s/m]): the dashpot's tension c d(dz)/dt on the string's
+        extension rate (``dz``) takes that much off the bit."""
+        if not all(k in sig for k in ("t", "dz")):
+            return None
+        return {"string_damping": -np.gradient(np.asarray(sig["dz"], dtype=float), np.asarray(sig["t"], dtype=float))}
 
     @staticmethod
     def string(dv, T, x, PP, damping):

@@ -255,7 +255,7 @@ def rhs(t, X, mode, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ):
     if smooth:
         Ff = friction_cont(code, v, p, FP)
     else:
-        Ff = sliding_friction_fx(code, d, v, p, x4, x5, x6, FP, EP)
+        Ff = sliding_friction_fx(code, d, v, p, s, x4, x5, x6, FP, EP)
     return (v, (hold - Ff) / PP[MC], vb, dvb, d4, d5, d6)
 
 
@@ -450,7 +450,7 @@ def _advance(X, tau, mode, d, t0, n_steps, h, code, FP, PP, EP, smooth, u, sp, Z
                 tc += tz
                 left -= tz
                 F, p = hold(tc, X, u, PP, EP, sp, Z, DZ, DDZ)
-                if abs(F) <= static_limit_fx(code, p, X[4], X[5], X[6], 0.0, FP, EP):
+                if abs(F) <= static_limit_fx(code, p, X[0], 1.0 if F > 0 else -1.0, X[4], X[5], X[6], 0.0, FP, EP):
                     mode = STUCK
                     tau = 0.0
                     stats[1] += 1.0
@@ -461,7 +461,7 @@ def _advance(X, tau, mode, d, t0, n_steps, h, code, FP, PP, EP, smooth, u, sp, Z
                     break
             else:  # STUCK
                 F1, p1 = hold(tc + cut, X1, u, PP, EP, sp, Z, DZ, DDZ)
-                lim1 = static_limit_fx(code, p1, X1[4], X1[5], X1[6], tau + cut, FP, EP)
+                lim1 = static_limit_fx(code, p1, X1[0], 1.0 if F1 > 0 else -1.0, X1[4], X1[5], X1[6], tau + cut, FP, EP)
                 if abs(F1) <= lim1:
                     stats[0] += cut
                     tau += cut
@@ -477,7 +477,7 @@ def _advance(X, tau, mode, d, t0, n_steps, h, code, FP, PP, EP, smooth, u, sp, Z
                 # breakaway before the cut: bracket [lo, hi] with margin(lo) >= 0 > margin(hi)
                 sg = 1.0 if F1 > 0 else -1.0
                 F0, p0 = hold(tc, X, u, PP, EP, sp, Z, DZ, DDZ)
-                m_lo = static_limit_fx(code, p0, X[4], X[5], X[6], tau, FP, EP) - sg * F0
+                m_lo = static_limit_fx(code, p0, X[0], sg, X[4], X[5], X[6], tau, FP, EP) - sg * F0
                 m_hi = lim1 - sg * F1
                 lo, hi = 0.0, cut
                 Xhi = X1
@@ -490,7 +490,7 @@ def _advance(X, tau, mode, d, t0, n_steps, h, code, FP, PP, EP, smooth, u, sp, Z
                         tt = 0.5 * (lo + hi)
                     X2 = rk4(tc, tt, X, STUCK, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ)
                     F2, p2 = hold(tc + tt, X2, u, PP, EP, sp, Z, DZ, DDZ)
-                    m = static_limit_fx(code, p2, X2[4], X2[5], X2[6], tau + tt, FP, EP) - sg * F2
+                    m = static_limit_fx(code, p2, X2[0], sg, X2[4], X2[5], X2[6], tau + tt, FP, EP) - sg * F2
                     if m >= 0.0:
                         lo, m_lo = tt, m
                         if side == -1:
@@ -577,7 +577,7 @@ def _record(out, pos, t, X, mode, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ,
     elif smooth:
         Ff = friction_cont(code, v, p, FP)
     else:
-        Ff = sliding_friction_fx(code, d, v, p, x4, x5, x6, FP, EP)
+        Ff = sliding_friction_fx(code, d, v, p, s, x4, x5, x6, FP, EP)
     out[pos, 0] = t
     out[pos, 1] = zh
     out[pos, 2] = s

@@ -12,7 +12,7 @@ from typing import Callable
 import numpy as np
 
 from heavecomp.effects.compose import composition_for
-from heavecomp.effects.registry import resolve
+from heavecomp.effects.registry import resolve, split_effects
 from heavecomp.errors import InputError
 from heavecomp.params.budget import check_run_size
 from heavecomp.plants.cmc import eigen_rate, plant_vectors
@@ -210,6 +210,9 @@ def simulate(params, duration: float, *, dt: float | None = None, rate: float = 
         Effects at the plant's hooks (:mod:`heavecomp.effects`): instances
         (``FlowLoss(resistance=2e5)``), registered names (default parameters) or
         ``(name, {parameter: value})`` pairs.  None: the nominal CMC (the ahead-of-time stepper).
+        A heave effect (``heave_reference``) changes the heave the plant sees (the recorded
+        ``heave`` stays the measured one); a channel effect (``sensor_gain``, ``sensor_offset``,
+        ``sensor_delay``, each with its ``channel``) changes the recorded channel.
     """
     if not (duration > 0 and math.isfinite(duration)):
         raise InputError(f"--duration must be a positive number of seconds, got {duration}")
@@ -235,10 +238,21 @@ def simulate(params, duration: float, *, dt: float | None = None, rate: float = 
     else:
         t_in, z_in = heave
         hs = excitation.from_series(t_in, z_in, n_steps * h, sp, src="heave")
-    effects = resolve(effects)
+    plant_fx, heave_fx, sensor_fx = split_effects(resolve(effects))
+    measured = hs
+    for e in heave_fx:  # the heave the plant sees is not the measured one
+        hs = e.transform(hs)
     result = run_kernel(plant_vectors(params), hs, h, n_steps, out_every, u_active=u_active, progress=progress,
-                        effects=effects)
+                        effects=plant_fx)
     data, stats, wall = result
+    if heave_fx:  # the recorded heave is the measured one (interpolated as the stepper does)
+        from heavecomp.simulate._kernel import heave_at
+
+        data[:, CHANNELS.index("heave")] = [heave_at(ti, measured.spacing, measured.z, measured.dz, measured.ddz)[0]
+                                            for ti in data[:, 0]]
+    for e in sensor_fx:  # a recorded channel that misreads
+        k = CHANNELS.index(e.channel)
+        data[:, k] = e.measure(data[:, 0], data[:, 0], data[:, k])
     if stats_start is None:
         stats_start = (params.heave.ramp or 0.0) if (heave is None and params.heave is not None) else 0.0
         stats_start = min(stats_start, 0.5 * duration)
