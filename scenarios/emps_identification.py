@@ -33,10 +33,10 @@ def _findings(m: dict) -> str:
              f"the axis moving the two cannot be told apart, so asymmetric Coulomb is not a separate candidate)."]
     if "asymmetric_viscous_split" in m:
         a = m["asymmetric_viscous_split"]
-        lines.append(f"Best single effect: asymmetric viscous friction, F_v+ = {a['viscous_positive']:.1f} N s/m, "
+        lines.append(f"Best single effect: asymmetric_friction, through its viscous column, F_v+ = {a['viscous_positive']:.1f} N s/m, "
                      f"F_v- = {a['viscous_negative']:.1f} N s/m; with it the offset falls to {a['offset']:.2f} N "
                      f"(F_c = {a['coulomb']:.2f} N): the published offset mostly stands in for a direction-dependent "
-                     f"viscous term.")
+                     f"viscous term (its Coulomb column is the offset itself, already in the model).")
     else:
         lines.append(f"Best single effect: {m['best_single']}.")
     return " ".join(lines)
@@ -74,10 +74,9 @@ def main(argv=None) -> int:
         md_table(["candidate", "component", "k", "held-out rms [N]", "shrink", "score (BIC-like)"],
                  [(c["effect"], c["component"], c["n_parameters"], c["rms_after"], c["shrink"], c["score"])
                   for c in m["candidates"]], fmt="{:.3f}"),
-        "Candidate parameters (fitted on the fit part; SI: N, N s/m, m/s, m, s, N/s^beta):\n\n" + md_table(
+        "Candidate parameters (fitted on the fit part, SI):\n\n" + md_table(
             ["candidate", "parameters"],
-            [(c["effect"], ", ".join(f"{k} = {v:.4g}" for k, v in c["parameters"].items() if not k.startswith("base_")))
-             for c in m["candidates"]]),
+            [(c["effect"], plots.parameters_text(c["parameters"], c["units"])) for c in m["candidates"]]),
         "Forward selection (each step chosen by the BIC of the fit part, its shrink measured on the "
         "held-out part): "
         + "; ".join(f"{' + '.join(s['effects'])}: shrink {s['shrink']:.3f}" for s in sel),

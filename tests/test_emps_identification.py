@@ -91,11 +91,17 @@ def test_diagnoser_says_none_without_an_effect():
     assert max(r["shrink"] for r in d.results_) < 0.02
 
 
-def test_emps_residual_lives_in_the_negative_direction(emps_fit):
+def test_emps_residual_lives_in_the_negative_direction_and_viscous_asymmetry_shrinks_it(emps_fit):
     d = ResidualDiagnoser(fit_window=(0.1, 15.0), validate_window=(15.0, 24.7)).fit(emps_fit.regression_)
     w = d.where_["direction"]
     assert sum(v["share"] for v in w.values()) == pytest.approx(1.0)
     assert w["negative"]["share"] > 0.5
+    # the library's asymmetric_friction, through its viscous column (its Coulomb column is the
+    # published offset, already in the nominal: dropped)
+    assert d.best_["effect"] == "asymmetric_friction" and d.best_["shrink"] > 0.15
+    assert "asymmetric_friction" not in d.best_["parameters"]
+    # more viscous friction moving in the negative direction than in the positive one
+    assert d.best_["parameters"]["asymmetric_viscous"] < 0
     assert d.selection_[-1]["shrink"] >= d.best_["shrink"]
 
 

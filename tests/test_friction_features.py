@@ -84,3 +84,32 @@ def test_parameter_mismatch_columns_are_the_friction_law_regressors():
     # Stribeck excess exp(-|v|/v_S) sign(v): e^-5 at |v| = 5 v_S
     assert cols["friction.static_force"][0] == pytest.approx(math.exp(-5.0))
     assert ParameterMismatch.features({"t": sig["t"]}, 0.01) is None
+
+
+def test_asymmetric_friction_columns_are_the_kernel_term_while_sliding():
+    """J (1 + a d) sign(v) from the effect's own jump() = J sign(v) + (a J) x its Coulomb column."""
+    from heavecomp.effects.asymmetric_friction import AsymmetricFriction
+
+    sig = _signals()
+    cols = AsymmetricFriction.features(sig)
+    assert set(cols) == {"asymmetric_friction", "asymmetric_pressure_friction", "asymmetric_viscous"}
+    v = sig["v"]
+    sliding = v != 0
+    J, a = 12.0, -0.2
+    kernel = np.array([AsymmetricFriction.jump(0, abs(vi), 0.0, J, 0.0, np.sign(vi), (), None, a) * np.sign(vi)
+                       for vi in v[sliding]])
+    assert np.allclose(kernel, J * np.sign(v[sliding]) + a * J * cols["asymmetric_friction"][sliding], rtol=1e-12)
+    assert np.array_equal(cols["asymmetric_viscous"], np.abs(v))
+    assert "asymmetric_pressure_friction" not in AsymmetricFriction.features(_signals(with_pressure=False))
+
+
+def test_position_friction_column_is_the_band_of_the_kernel_on_the_travelled_span():
+    from heavecomp.effects.position_friction import PositionFriction
+
+    x = np.linspace(0.2, 0.6, 401)
+    sig = {"t": np.arange(x.size) * 1e-3, "x": x, "v": np.full(x.size, -0.01)}
+    c = PositionFriction.features(sig, (0.5, 0.2))["position_friction"]
+    assert c[200] == pytest.approx(-math.tanh(5.0), rel=1e-9)   # the span's centre (edges 0.1 w), moving backwards
+    assert abs(c[0]) < 1e-6 and abs(c[-1]) < 1e-6                # far outside the band
+    assert np.count_nonzero(np.abs(c) > 0.5) == pytest.approx(0.2 * 400, abs=2)   # width 20 % of 0.4 m
+    assert all(len(s) == 2 for s in PositionFriction.feature_grid)

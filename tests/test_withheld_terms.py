@@ -25,7 +25,7 @@ pytestmark = pytest.mark.slow
 def emps(data_dir):
     reg = AxisRegression(load_emps(data_dir / "emps" / "DATA_EMPS.mat"))
     return {w: ResidualDiagnoser(**EMPS_WINDOWS).fit(AxisFriction(reg, withheld=w))
-            for w in ((), ("coulomb",))}
+            for w in ((), ("coulomb",), ("offset",))}
 
 
 @pytest.fixture(scope="module")
@@ -53,6 +53,21 @@ def test_emps_without_coulomb_names_the_coulomb_force(emps):
     # restoring the term is (nearly) all the verdict does: at least 95 % of what the full model reaches
     assert v["shrink"] >= 0.95 * _reachable(emps[()], d) > 0.5
     # runner-up far behind: no other friction effect stands in for the Coulomb force
+    assert d.results_[1]["shrink"] < 0.3 * v["shrink"]
+
+
+def test_emps_without_the_direction_asymmetry_names_asymmetric_friction(emps):
+    """F_off + F_c sign(v) is an asymmetric Coulomb force while the axis moves: without F_off the
+    diagnosis names asymmetric_friction, whose Coulomb column takes F_off's place (and whose viscous
+    column the remainder the published model leaves)."""
+    d = emps[("offset",)]
+    v = d.verdict_
+    assert v["effect"] == "asymmetric_friction" and v["component"] == "friction"
+    # the full published model leaves a direction-dependent viscous remainder, which this verdict
+    # also takes: its shrink reaches at least what restoring F_off alone does
+    assert v["shrink"] >= _reachable(emps[()], d) > 0.3
+    # more friction retracting: a negative Coulomb asymmetry, as the published offset
+    assert v["parameters"]["asymmetric_friction"] < 0 and EMPS_PUBLISHED["offset"] < 0
     assert d.results_[1]["shrink"] < 0.3 * v["shrink"]
 
 

@@ -94,7 +94,8 @@ class AxisFriction(_Plant):
         self.reg, self.withheld = reg, tuple(withheld)
         theta = np.array([0.0 if k in withheld else float(nominal[k]) for k in BASE_NAMES])
         X = reg.base_matrix().copy()
-        X[:, BASE_NAMES.index("offset")] = 1.0  # the decimated ones column is 1 to rounding: exactly 1
+        i = BASE_NAMES.index("offset")
+        X[:, i] = _exact_constant(X[:, i])
         keep = [i for i, k in enumerate(BASE_NAMES) if k not in withheld]
         self.t = reg.t_d
         self.y = reg.force_d - X @ theta
@@ -108,7 +109,19 @@ class AxisFriction(_Plant):
 
     def features(self, effect, shape=None):
         cols = effect.features(self.sig, shape)
-        return None if cols is None else {k: self.reg.decimate(c) for k, c in cols.items()}
+        return None if cols is None else {k: _exact_constant(self.reg.decimate(c)) for k, c in cols.items()}
+
+
+def _exact_constant(c: np.ndarray) -> np.ndarray:
+    """A column the decimation filter left constant to rounding (the offset's ones, |sign v| while
+    always moving) made exactly constant: a spread of 1e-16 must not count as signal (the engine
+    scales each column by its spread).  Its value (the filter's DC gain, 0.9886 for the EMPS
+    decimation, applied alike to the force) is rounded to 2^-20 so that its mean, and so its
+    spread, is exact (a change of < 1e-6 relative)."""
+    m = float(np.max(np.abs(c))) if c.size else 0.0
+    if m > 0 and float(np.std(c)) < 1e-12 * m:
+        return np.full(c.size, round(float(np.mean(c)) * 2 ** 20) / 2 ** 20)
+    return c
 
 
 class SealFriction(_Plant):

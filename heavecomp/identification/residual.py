@@ -245,20 +245,22 @@ class ResidualDiagnoser(GapEstimator):
         results = []
         self._chosen = {}
         for eff in self.candidates:
+            if eff.component() not in ("friction", ""):     # "": parameter_mismatch (the nominal law)
+                continue
             got = self._fit_candidate(eff)
             if got is None:
                 log.debug("candidate %s: no equation-error form on %s", eff.name, pl.name)
                 continue
             shape, cols, res = got
-            k = len(cols) + (1 if eff.feature_grid else 0)
+            k = len(cols) + (len(shape) if isinstance(shape, tuple) else 1 if eff.feature_grid else 0)
             score, rms = self._score(res, k)
             coef = res["coefficients"]
             params = dict(coef)
             if eff.feature_grid:
                 sname, sunit = _shape_label(eff)
-                params[sname] = float(shape)
+                params[sname] = [float(s) for s in shape] if isinstance(shape, tuple) else float(shape)
                 if shape in (eff.feature_grid[0], eff.feature_grid[-1]):
-                    log.info("candidate %s: shape %s at the edge of its grid (%g %s)", eff.name, sname, shape, sunit)
+                    log.info("candidate %s: shape %s at the edge of its grid (%s %s)", eff.name, sname, shape, sunit)
             params.update({f"base_{n}": pl.nominal[n] + v for n, v in res["base"].items()})
             # a nominal parameter moved (a term the nominal lacks has nominal value 0)
             changes = ({n: [pl.nominal.get(n, 0.0), pl.nominal.get(n, 0.0) + c] for n, c in coef.items()}

@@ -122,7 +122,15 @@ def seal_friction_vs_pressure(strokes: list, fits: dict):
 
 
 def _fmt(x) -> str:
+    if isinstance(x, (list, tuple)):
+        return "(" + ", ".join(_fmt(v) for v in x) + ")"
     return "-" if x is None else f"{x:.4g}"
+
+
+def parameters_text(params: dict, units: dict) -> str:
+    """``name = value unit, ...`` of a candidate's fitted parameters (the refitted base left out)."""
+    return ", ".join(f"{k} = {_fmt(v)} {units.get(k, '')}".rstrip() for k, v in params.items()
+                     if not k.startswith("base_"))
 
 
 def _cell(text: str) -> str:
@@ -138,7 +146,7 @@ def withheld_terms_table(w: dict) -> str:
         unit = r["unit"]
         u = r["units"]
         fitted = "; ".join(f"{k}: {_fmt(a)} -> {_fmt(b)} {u.get(k, '')}" for k, (a, b) in r["changes"].items()) or (
-            ", ".join(f"{k} = {_fmt(v)} {u.get(k, '')}" for k, v in r["parameters"].items()))
+            parameters_text(r["parameters"], u))
         rows.append((r["withheld"], f"{_fmt(r['nominal_value'])} {unit}" if r["nominal_value"] is not None else "-",
                      r["expected"], f"**{r['verdict']}**", fitted or "-", f"{r['shrink']:.3f}",
                      _fmt(r["reachable_shrink"]), f"{r['rms_before']:.3f} -> {r['rms_after']:.3f}",
