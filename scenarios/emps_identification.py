@@ -30,7 +30,8 @@ def _findings(m: dict) -> str:
     b, eq = m["baseline_fit_part"]["parameters"], m["asymmetric_coulomb_equivalent"]
     lines = [f"Base model on the fit part: offset {b['offset']:.2f} N + F_c sign(v) is the same as an asymmetric "
              f"Coulomb force F_c+ = {eq['coulomb_positive']:.2f} N, F_c- = {eq['coulomb_negative']:.2f} N (with "
-             f"the axis moving the two cannot be told apart, so asymmetric Coulomb is not a separate candidate)."]
+             f"the axis moving the two cannot be told apart: asymmetric_friction's Coulomb column is the offset's, so "
+             f"it keeps only its viscous column here)."]
     if "asymmetric_viscous_split" in m:
         a = m["asymmetric_viscous_split"]
         lines.append(f"Best single effect: asymmetric_friction, through its viscous column, F_v+ = {a['viscous_positive']:.1f} N s/m, "

@@ -128,7 +128,7 @@ def withheld_terms(plant_for, cases, expected: dict, labels: dict, units: dict, 
                      "runner_up": second["effect"] if second else None,
                      "runner_up_shrink": second["shrink"] if second else None,
                      "rms_before": rms0, "rms_after": d.best_["rms_after"] if d.best_ else rms0,
-                     "reachable_shrink": None if full_rms is None else 1.0 - full_rms / rms0,
+                     "reachable_shrink": 1.0 - full_rms / rms0 if case else None,
                      "discovered": v["discovered"]["term"] if v["discovered"] else None,
                      "discovered_shrink": v["discovered"]["shrink"] if v["discovered"] else None,
                      # the control is reported, not scored: a real record keeps a remainder

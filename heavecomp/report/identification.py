@@ -153,6 +153,6 @@ def withheld_terms_table(w: dict) -> str:
                      f"{r['runner_up']} ({r['runner_up_shrink']:.3f})" if r["runner_up"] else "-",
                      f"{_cell(r['discovered'])} ({r['discovered_shrink']:.3f})" if r["discovered"] else "-",
                      "control" if r["right"] is None else "yes" if r["right"] else "**no**"))
-    return md_table(["withheld term", "published value", "expected", "verdict", "fitted", "held-out shrink",
-                     "reachable shrink", "held-out rms [N]", "runner-up (shrink)", "discovered (shrink)", "right"],
-                    rows)
+    return md_table(["withheld term", "published value [unit given]", "expected [name]", "verdict",
+                     "fitted [units given]", "held-out shrink [-]", "reachable shrink [-]", "held-out rms [N]",
+                     "runner-up (shrink [-])", "discovered [N] (shrink [-])", "right [yes/no]"], rows)
