@@ -50,8 +50,9 @@ log = logging.getLogger(__name__)
 def get_candidates(names=None) -> list[type]:
     """Candidate effects (:class:`heavecomp.effects.base.Effect` classes) by contract name or as
     classes; None = every candidate of the library (:data:`heavecomp.effects.candidates.CANDIDATES`).
-    An unknown name raises with the list of known ones.  A candidate without an equation-error form
-    on a plant (``features`` returns None) is skipped there."""
+    An unknown name raises with the list of known ones.  :class:`ResidualDiagnoser` fits those of the
+    friction component (and ``parameter_mismatch``, the nominal law's own terms); a candidate without
+    an equation-error form on a plant (``features`` returns None) is skipped there."""
     if names is None:
         return list(CANDIDATES.values())
     return [n if isinstance(n, type) and issubclass(n, Effect) else get(n) for n in names]
@@ -105,6 +106,15 @@ def localise(r, v, q, a, dead_band: float = 0.005, n_velocity: int = 10, n_posit
     idx = np.clip(np.searchsorted(qe, q, side="right") - 1, 0, n_position - 1)
     out["position"] = [{"lo": float(qe[i]), "hi": float(qe[i + 1]), **_bin_stats(r, idx == i, total)}
                        for i in range(n_position)]
+    return out
+
+
+def _by_effect(coefficients: dict) -> dict:
+    """``{"effect:column": value}`` -> ``{effect: {column: value}}``."""
+    out: dict = {}
+    for key, value in coefficients.items():
+        effect, column = key.split(":", 1)
+        out.setdefault(effect, {})[column] = value
     return out
 
 
@@ -297,7 +307,7 @@ class ResidualDiagnoser(GapEstimator):
             score, rms = self._score(res, k_tot)
             self.selection_.append({"effects": list(chosen), "bic_fit": current, "rms_after": rms,
                                     "shrink": 1.0 - rms / rms0, "score": score,
-                                    "coefficients": res["coefficients"]})
+                                    "coefficients": _by_effect(res["coefficients"])})
         rv_sel = self._solve(list(cols.values()))[1] if cols else rv0
         sig_s = {**pl.sig_s, "still": np.abs(pl.v_s) <= self.dead_band}
         self.discovered_ = open_search(pl.y, sig_s, self.mf_, self.mv_, base=self.base_, component="friction")

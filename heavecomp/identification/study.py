@@ -65,7 +65,7 @@ def emps_study(record, cutoff: float = 50.0, order: int = 4, decimate: int = 10,
         "best_single_parameters": diag.best_["parameters"] if diag.best_ else {},
         "selection": diag.selection_,
         "where_after_selection": diag.where_after_,
-        "discovered": diag.discovered_,
+        "discovered": _discovered(diag.discovered_),
     }
     p = diag.best_["parameters"] if diag.best_ else {}
     if "asymmetric_viscous" in p:
@@ -80,6 +80,12 @@ def emps_study(record, cutoff: float = 50.0, order: int = 4, decimate: int = 10,
         {(): "none", ("coulomb",): AXIS_TERMS["coulomb"], ("offset",): AXIS_TERMS["offset"]},
         AXIS_UNITS, fit_window=(t0, t_split), validate_window=(t_split, t1))
     return {"metrics": metrics, "estimator": est, "diagnoser": diag, "sensitivity": sens}
+
+
+def _discovered(d):
+    """The open search's result for a report: the readable term (coefficients in SI) and its shrink."""
+    return None if d is None else {k: d[k] for k in ("term", "features", "shrink", "component", "rms_before",
+                                                     "rms_after")}
 
 
 def withheld_terms(plant_for, cases, expected: dict, labels: dict, units: dict, **settings) -> dict:
@@ -105,7 +111,7 @@ def withheld_terms(plant_for, cases, expected: dict, labels: dict, units: dict, 
     Returns
     -------
     dict
-        ``rows``: per case ``withheld``, ``nominal_value`` of the withheld term and its ``unit``,
+        ``rows``: per case ``withheld``, ``published`` ({term: its value in the full nominal}) and its ``unit``,
         ``expected``, the ``verdict`` (effect, component, held-out shrink, parameters, changes),
         ``runner_up`` and its shrink, ``rms_before`` / ``rms_after`` [N] on the held-out part,
         ``reachable_shrink`` (1 - rms of the full nominal / rms before: what restoring the term
@@ -121,7 +127,7 @@ def withheld_terms(plant_for, cases, expected: dict, labels: dict, units: dict, 
             full_rms, full_nominal = rms0, dict(plant.nominal)
         term = labels[case]
         second = d.results_[1] if len(d.results_) > 1 else None
-        rows.append({"withheld": term, "nominal_value": full_nominal.get(term) if case else None,
+        rows.append({"withheld": term, "published": {term: full_nominal[term]} if case else {},
                      "unit": units.get(term, "-"), "expected": expected[case],
                      "verdict": v["effect"], "component": v["component"], "shrink": v["shrink"],
                      "parameters": v["parameters"], "changes": v["changes"], "units": v["units"],

@@ -147,7 +147,8 @@ def withheld_terms_table(w: dict) -> str:
         u = r["units"]
         fitted = "; ".join(f"{k}: {_fmt(a)} -> {_fmt(b)} {u.get(k, '')}" for k, (a, b) in r["changes"].items()) or (
             parameters_text(r["parameters"], u))
-        rows.append((r["withheld"], f"{_fmt(r['nominal_value'])} {unit}" if r["nominal_value"] is not None else "-",
+        pub = r["published"].get(r["withheld"])
+        rows.append((r["withheld"], f"{_fmt(pub)} {unit}" if pub is not None else "-",
                      r["expected"], f"**{r['verdict']}**", fitted or "-", f"{r['shrink']:.3f}",
                      _fmt(r["reachable_shrink"]), f"{r['rms_before']:.3f} -> {r['rms_after']:.3f}",
                      f"{r['runner_up']} ({r['runner_up_shrink']:.3f})" if r["runner_up"] else "-",
