@@ -2,7 +2,9 @@
 
 The CMC's :class:`heavecomp.diagnosis.GapDiagnoser` and the 1-DOF axis'
 :class:`heavecomp.identification.residual.ResidualDiagnoser` answer the same
-question for two plants: where does the held-out residual of the nominal model
+question for several plants (the CMC; the EMPS axis and the O-ring seal rig, whose diagnoser
+takes the same candidates: the effect library's classes, through their equation-error
+features): where does the held-out residual of the nominal model
 live, and which candidate effect shrinks it.  Both follow the scikit-learn /
 pysindy convention (settings in ``__init__``, ``fit(data)`` returns ``self``,
 learned results end in ``_``) and share this base, which gives them the same

@@ -30,13 +30,14 @@ def _findings(m: dict) -> str:
     b, eq = m["baseline_fit_part"]["parameters"], m["asymmetric_coulomb_equivalent"]
     lines = [f"Base model on the fit part: offset {b['offset']:.2f} N + F_c sign(v) is the same as an asymmetric "
              f"Coulomb force F_c+ = {eq['coulomb_positive']:.2f} N, F_c- = {eq['coulomb_negative']:.2f} N (with "
-             f"the axis moving the two cannot be told apart, so asymmetric Coulomb is not a separate candidate)."]
+             f"the axis moving the two cannot be told apart: asymmetric_friction's Coulomb column is the offset's, so "
+             f"it keeps only its viscous column here)."]
     if "asymmetric_viscous_split" in m:
         a = m["asymmetric_viscous_split"]
-        lines.append(f"Best single effect: asymmetric viscous friction, F_v+ = {a['viscous_positive']:.1f} N s/m, "
+        lines.append(f"Best single effect: asymmetric_friction, through its viscous column, F_v+ = {a['viscous_positive']:.1f} N s/m, "
                      f"F_v- = {a['viscous_negative']:.1f} N s/m; with it the offset falls to {a['offset']:.2f} N "
                      f"(F_c = {a['coulomb']:.2f} N): the published offset mostly stands in for a direction-dependent "
-                     f"viscous term.")
+                     f"viscous term (its Coulomb column is the offset itself, already in the model).")
     else:
         lines.append(f"Best single effect: {m['best_single']}.")
     return " ".join(lines)
@@ -68,18 +69,31 @@ def main(argv=None) -> int:
         + ", ".join(f"{k} {v['share']:.2f} (mean {v['mean'] if v['mean'] is None else round(v['mean'], 2)} N)"
                     for k, v in {**w["direction"], **w["motion"]}.items()),
         "![map](residual_map.png)",
-        md_table(["candidate", "k", "held-out rms [N]", "shrink", "score (BIC-like)"],
-                 [(c["effect"], c["n_parameters"], c["rms_after"], c["shrink"], c["score"])
+        "Candidates: the effect library's classes (the same the CMC diagnosis fits), through their "
+        "equation-error features; an effect without a form on this plant (no pressure, no gas, ...) "
+        "is left out.",
+        md_table(["candidate", "component", "k", "held-out rms [N]", "shrink", "score (BIC-like)"],
+                 [(c["effect"], c["component"], c["n_parameters"], c["rms_after"], c["shrink"], c["score"])
                   for c in m["candidates"]], fmt="{:.3f}"),
-        "Candidate parameters (fitted on the fit part; SI: N, N s/m, m/s, m, s):\n\n" + md_table(
+        "Candidate parameters (fitted on the fit part, SI):\n\n" + md_table(
             ["candidate", "parameters"],
-            [(c["effect"], ", ".join(f"{k} = {v:.4g}" for k, v in c["parameters"].items() if not k.startswith("base_")))
-             for c in m["candidates"]]),
+            [(c["effect"], plots.parameters_text(c["parameters"], c["units"])) for c in m["candidates"]]),
         "Forward selection (each step chosen by the BIC of the fit part, its shrink measured on the "
         "held-out part): "
         + "; ".join(f"{' + '.join(s['effects'])}: shrink {s['shrink']:.3f}" for s in sel),
+        "Open search (sparse regression over physical features of the friction residual, "
+        "`discovered`, a suggestion, never a name): " + (f"{m['discovered']['term']} (N), held-out shrink "
+                                                         f"{m['discovered']['shrink']:.3f}" if m["discovered"] else "none"),
         _findings(m),
         "![overlay](overlay.png)",
+        "**Withheld published terms** (issue 12 item 7): the same diagnosis against a nominal model that "
+        "lacks one published term (its value 0, its column not refitted): the Coulomb force F_c, or the "
+        "direction asymmetry F_off (with the axis moving, F_off + F_c sign(v) is an asymmetric Coulomb "
+        "force F_c+- = F_c +- F_off). The first row is the control (full published model; shown, not scored: the remainder the "
+        "published model leaves). Reachable "
+        "shrink = 1 - held-out rms of the full nominal / rms before: what restoring the term could give. "
+        "Fit and held-out parts as above.",
+        plots.withheld_terms_table(m["withheld_terms"]),
     ])
     return 0
 

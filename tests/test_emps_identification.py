@@ -72,12 +72,16 @@ def test_planted_parameters_recovered_on_synthetic_axis():
 
 def test_diagnoser_names_a_planted_stribeck_effect():
     """Generated with a Gaussian Stribeck peak (exp(-(v/v_s)^2), v_s = 15 mm/s), fitted with the
-    exponential candidate: a different law, so the check is not circular."""
+    friction law's exponential Stribeck column: a different law, so the check is not circular.  The
+    nominal (EMPS) law has no Stribeck term, so the diagnosis names the law's static force: a
+    parameter_mismatch of friction.static_force (F_S - F_C > 0: a friction peak at low speed)."""
     rec, _ = _synthetic(lambda v, q: 8.0 * np.exp(-(v / 0.015) ** 2) * np.tanh(v / 2e-4))
     d = ResidualDiagnoser(fit_window=(0.1, 12.0), validate_window=(12.0, 19.9)).fit(AxisRegression(rec))
-    assert d.best_["effect"] == "stribeck"
+    assert d.best_["effect"] == "parameter_mismatch"
     assert d.best_["shrink"] > 0.3
-    assert d.best_["parameters"]["stribeck_excess"] > 0          # friction peak at low speed
+    assert list(d.best_["changes"]) == ["friction.static_force"]
+    assert d.best_["parameters"]["friction.static_force"] > 0          # friction peak at low speed
+    assert 0.005 < d.best_["parameters"]["friction.stribeck_velocity"] < 0.05
 
 
 def test_diagnoser_says_none_without_an_effect():
@@ -92,9 +96,12 @@ def test_emps_residual_lives_in_the_negative_direction_and_viscous_asymmetry_shr
     w = d.where_["direction"]
     assert sum(v["share"] for v in w.values()) == pytest.approx(1.0)
     assert w["negative"]["share"] > 0.5
-    assert d.best_["effect"] == "asymmetric_viscous" and d.best_["shrink"] > 0.15
+    # the library's asymmetric_friction, through its viscous column (its Coulomb column is the
+    # published offset, already in the nominal: dropped)
+    assert d.best_["effect"] == "asymmetric_friction" and d.best_["shrink"] > 0.15
+    assert "asymmetric_friction" not in d.best_["parameters"]
     # more viscous friction moving in the negative direction than in the positive one
-    assert d.best_["parameters"]["viscous_asymmetry"] < 0
+    assert d.best_["parameters"]["asymmetric_viscous"] < 0
     assert d.selection_[-1]["shrink"] >= d.best_["shrink"]
 
 

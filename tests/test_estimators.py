@@ -18,7 +18,7 @@ def test_both_diagnosers_are_gap_estimators_with_the_same_door():
 
 
 @pytest.mark.parametrize("make", [lambda: GapDiagnoser(paper_a(), ["flow_loss"], split=0.5),
-                                  lambda: ResidualDiagnoser(["stribeck"], fit_window=(0.0, 5.0))])
+                                  lambda: ResidualDiagnoser(["friction_lag"], fit_window=(0.0, 5.0))])
 def test_results_before_fit_are_a_one_line_error(make):
     d = make()
     assert not d.fitted
@@ -39,13 +39,15 @@ def test_get_params_rebuilds_the_same_settings():
 
 
 def test_axis_diagnoser_names_a_planted_effect_and_none_without_one():
-    """The base's effect_ is what the diagnoser decided: the planted Stribeck peak, or None."""
+    """The base's effect_ is what the diagnoser decided: the planted Stribeck peak (a term of the
+    friction law the nominal lacks: parameter_mismatch of friction.static_force), or None."""
     import numpy as np
     from test_emps_identification import _synthetic
 
     rec, _ = _synthetic(lambda v, q: 8.0 * np.exp(-(v / 0.015) ** 2) * np.tanh(v / 2e-4))
     d = ResidualDiagnoser(fit_window=(0.1, 12.0), validate_window=(12.0, 19.9)).fit(AxisRegression(rec))
-    assert d.effect_ == "stribeck" and d.ranking_[0]["effect"] == "stribeck"
+    assert d.effect_ == "parameter_mismatch" and d.ranking_[0]["effect"] == "parameter_mismatch"
+    assert list(d.ranking_[0]["changes"]) == ["friction.static_force"]
     assert [r["score"] for r in d.ranking_] == sorted(r["score"] for r in d.ranking_)
     rec, _ = _synthetic(seed=3)
     d = ResidualDiagnoser(fit_window=(0.1, 12.0), validate_window=(12.0, 19.9)).fit(AxisRegression(rec))

@@ -1,5 +1,5 @@
-"""Identification helpers: candidate friction terms against their analytic limits,
-the zero-phase filters, least-squares standard errors, residual localisation, errors."""
+"""Identification helpers: the zero-phase filters, least-squares standard errors, residual
+localisation, errors.  (The candidate terms are the effects' features: tests/test_friction_features.py.)"""
 
 from __future__ import annotations
 
@@ -7,34 +7,10 @@ import math
 
 import numpy as np
 import pytest
-from scipy.integrate import solve_ivp
-
 from heavecomp.errors import ParameterError
-from heavecomp.identification import terms as T
 from heavecomp.identification.filtering import derivatives, parallel_decimate, zero_phase_lowpass
 from heavecomp.identification.inverse import least_squares
 from heavecomp.identification.residual import get_candidates, localise
-
-
-def test_dahl_step_is_the_exact_solution_and_relaxes_over_the_presliding_length():
-    delta, v, h = 1e-3, -0.02, 0.01
-    sol = solve_ivp(lambda t, z: (v - abs(v) * z) / delta, (0, h), [0.3], rtol=1e-11, atol=1e-12)
-    assert T.dahl_step(0.3, v, h, delta) == pytest.approx(sol.y[0, -1], abs=1e-9)
-    # from z = -1 (sliding backwards) forward: after sliding 5 delta, z = 1 - 2 e^-5
-    z = T.run_state(T.dahl_step, np.full(501, 0.01), 1e-3, 1e-3 / 1.0, y0=-1.0)
-    assert z[-1] == pytest.approx(1 - 2 * math.exp(-5.0), rel=1e-9)
-    assert T.dahl_step(0.4, 0.0, 1.0, delta) == 0.4         # at rest the state holds (memory)
-
-
-def test_lag_step_unit_step_and_stribeck_shape():
-    y = T.run_state(T.lag_step, np.ones(1001), 1e-3, 0.1)
-    assert y[100] == pytest.approx(1 - math.exp(-1.0), rel=1e-9)   # one time constant
-    v = np.array([1e-9, 0.01, -0.01, 1.0])
-    s = T.stribeck_excess(v, 0.01)
-    assert s[0] == pytest.approx(1.0) and s[1] == pytest.approx(math.exp(-1)) and s[2] == -s[1]
-    assert s[3] < 1e-40
-    assert T.positive_direction(-0.2) == 0.0 and T.positive_direction(0.2) == 1.0
-    assert T.fourier_position(0.2, 0.1, 0.4, 1, -0.5 * np.pi) == pytest.approx(math.sin(math.pi / 2))
 
 
 def test_zero_phase_filters_keep_phase_and_differentiate():
@@ -80,5 +56,6 @@ def test_localise_shares_add_up():
 
 
 def test_unknown_candidate_names_the_known_ones():
-    with pytest.raises(ParameterError, match=r"unknown candidate 'stribek' \(did you mean 'stribeck'\?\); known: "):
-        get_candidates(["stribek"])
+    """The axis' candidates are the effect library's: one registry, one error."""
+    with pytest.raises(ParameterError, match=r"unknown effect 'frictoin_lag' \(did you mean 'friction_lag'\?\); known: "):
+        get_candidates(["frictoin_lag"])

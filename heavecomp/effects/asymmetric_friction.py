@@ -4,7 +4,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numpy as np
+
 from heavecomp.effects.base import Effect
+from heavecomp.effects.features import need
 from heavecomp.params.core import q
 
 
@@ -28,6 +31,34 @@ class AsymmetricFriction(Effect):
     class Params:
         asymmetry: float = q(0.1, "-", bounds=(-0.9, 0.9), symbol="a",
                              doc="relative friction excess extending (+) over retracting (-): J (1 + a sign(v))")
+
+    #: units of the feature coefficients [SI]
+    feature_units = {"asymmetric_friction": "N", "asymmetric_pressure_friction": "N/Pa", "asymmetric_viscous": "N s/m"}
+
+    @classmethod
+    def features(cls, sig, shape=None):
+        """``asymmetric_friction`` |sign v| [-] (coefficient a F_C [N]), with a pressure also
+        ``asymmetric_pressure_friction`` |sign v| |p| [Pa] (coefficient a C_p [N/Pa]), and
+        ``asymmetric_viscous`` |v| [m/s] (coefficient (F_v+ - F_v-)/2 [N s/m]).
+
+        Notes
+        -----
+        J (1 + a d) sign(v) = J sign(v) + a J |sign v| while sliding (d = sign v): the direction
+        asymmetry is a force of one sign in both directions, a J.  J = F_C + C_p |p| gives the first
+        two columns.  The third is the same asymmetry of the viscous part, F_v (1 + a_v d) v =
+        F_v v + a_v F_v |v|: the kernel term scales J only, the equation error also looks for the
+        viscous asymmetry (on the EMPS axis it is the larger one).  A plant whose nominal has a
+        constant force (an offset) already spans the first column: the diagnoser drops it there.
+        """
+        if not need(sig, "v"):
+            return None
+        v = np.asarray(sig["v"], dtype=float)
+        moving = np.abs(np.sign(v))
+        cols = {"asymmetric_friction": moving}
+        if need(sig, "p"):
+            cols["asymmetric_pressure_friction"] = moving * np.abs(sig["p"])
+        cols["asymmetric_viscous"] = np.abs(v)
+        return cols
 
     @staticmethod
     def jump(code, a, p, J, s, d, x, FP, asymmetry):

@@ -11,7 +11,11 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass
 
+import numpy as np
+
 from heavecomp.effects.base import Effect
+from heavecomp.effects.features import need
+from heavecomp.friction.laws import stribeck_excess
 from heavecomp.errors import ParameterError, did_you_mean
 from heavecomp.params.core import q
 from heavecomp.effects.registry import library
@@ -51,6 +55,32 @@ class ParameterMismatch(Effect):
     #: multipliers whose fit cost is rugged (stick-slip timing jumps with the breakaway force): the
     #: diagnosis scans them over their search box for a second start (GapDiagnoser._rescan)
     rugged = ("static_force",)
+    #: Stribeck velocities v_S [m/s] searched by the equation-error fit
+    feature_grid = tuple(np.geomspace(1e-3, 0.1, 13))
+    #: name and unit of the equation-error shape parameter
+    feature_shape = ("friction.stribeck_velocity", "m/s")
+    #: units of the feature coefficients [SI]
+    feature_units = {"friction.coulomb_force": "N", "friction.viscous_coefficient": "N s/m",
+                     "friction.static_force": "N", "friction.stribeck_velocity": "m/s"}
+
+    @classmethod
+    def features(cls, sig, shape=None):
+        """The nominal friction law's own regressors (paper A eq. 4 without C_p), named by their
+        parameter-file keys: ``friction.coulomb_force`` sign(v) [-], ``friction.viscous_coefficient``
+        v [m/s] and ``friction.static_force`` exp(-|v|/v_S) sign(v) [-] (coefficient F_S - F_C [N];
+        ``shape`` is v_S [m/s]).
+
+        Notes
+        -----
+        On a component residual (measured minus nominal friction) a coefficient is how far the
+        nominal value is off: a term the nominal lacks comes back as its value.  A plant whose base
+        columns already hold one of these parameters drops that column (same name).
+        """
+        if not need(sig, "v"):
+            return None
+        v = np.asarray(sig["v"], dtype=float)
+        return {"friction.coulomb_force": np.sign(v), "friction.viscous_coefficient": v,
+                "friction.static_force": stribeck_excess(np.abs(v), 1.0, 0.0, float(shape)) * np.sign(v)}
 
     @classmethod
     def apply(cls, params, values):

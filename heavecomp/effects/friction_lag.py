@@ -7,6 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from heavecomp.effects.base import Effect
+from heavecomp.effects.features import first_order_lag, need
 from heavecomp.friction.laws import FC, FS, STRIBECK, VS, stribeck_excess
 from heavecomp.params.core import q
 
@@ -28,6 +29,12 @@ class FrictionLag(Effect):
     hook = "seal_friction"
     states = ("E",)
     log = ("lag_time", "drop_time")
+    #: lag times T [s] searched by the equation-error fit
+    feature_grid = tuple(np.geomspace(1e-3, 0.2, 12))
+    #: name and unit of the equation-error shape parameter
+    feature_shape = ("lag_time", "s")
+    #: units of the feature coefficients [SI]
+    feature_units = {"lag_force": "N", "lag_time": "s"}
 
     @dataclass(frozen=True)
     class Params:
@@ -35,6 +42,23 @@ class FrictionLag(Effect):
                             doc="recovery time of the Stribeck excess force (rising towards its steady value)")
         drop_time: float = q(0.05, "s", bounds=(0.001, 10.0), symbol="T_drop",
                              doc="relaxation time of the Stribeck excess force while it falls")
+
+    @classmethod
+    def features(cls, sig, shape=None):
+        """``lag_force``: T-lagged sign(v) minus sign(v) [-] (coefficient: the lagging force [N]).
+
+        Notes
+        -----
+        The equation-error form of frictional memory on any plant: the sliding friction follows its
+        direction through a first-order lag of time T (``shape`` [s]), so after a reversal or a
+        start it stays behind sign(v) for a few T.  It needs only ``t`` and ``v``; the kernel term
+        lags the Stribeck excess, whose shape depends on the nominal law, which the features do not
+        know.
+        """
+        if not need(sig, "t", "v"):
+            return None
+        s = np.sign(sig["v"])
+        return {"lag_force": first_order_lag(sig["t"], s, float(shape)) - s}
 
     @staticmethod
     def jump(code, a, p, J, s, d, x, FP, lag_time, drop_time):

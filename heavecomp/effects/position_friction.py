@@ -7,6 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from heavecomp.effects.base import Effect
+from heavecomp.effects.features import need
 from heavecomp.params.core import q
 
 #: width of the band's edges as a share of its width (tanh ramps: smooth, so the stepper's event
@@ -37,6 +38,27 @@ class PositionFriction(Effect):
         extra_force: float = q(3e3, "N", bounds=(10.0, 1e5), symbol="dF", doc="friction added inside the band")
         centre: float = q(0.0, "m", bounds=(-2.0, 2.0), symbol="s_c", doc="stroke at the centre of the band")
         width: float = q(0.3, "m", bounds=(0.02, 3.0), symbol="w", doc="width of the band along the stroke")
+
+    #: bands searched by the equation-error fit: (centre, width) as shares of the travelled span
+    feature_grid = tuple((c, w) for w in (0.1, 0.2, 0.4) for c in np.arange(0.1, 0.95, 0.1).round(2))
+    #: name and unit of the equation-error shape parameter
+    feature_shape = ("band_centre_width", "share of the travelled span")
+    #: units of the feature coefficients [SI]
+    feature_units = {"position_friction": "N", "band_centre_width": "share of the travelled span"}
+
+    @classmethod
+    def features(cls, sig, shape=None):
+        """``position_friction`` sign(v) b(x) [-] (coefficient dF [N]) for the band ``shape`` =
+        (centre, width) given as shares of the travelled span min(x) .. max(x) (plant-independent),
+        b from :meth:`band` (the kernel term's own equation)."""
+        if not need(sig, "v", "x") or shape is None:
+            return None
+        x = np.asarray(sig["x"], dtype=float)
+        x0, span = float(x.min()), float(x.max() - x.min())
+        if span <= 0:
+            return None
+        c, w = shape
+        return {"position_friction": np.sign(sig["v"]) * cls.band(x, x0 + c * span, w * span)}
 
     @staticmethod
     def jump(code, a, p, J, s, d, x, FP, extra_force, centre, width):

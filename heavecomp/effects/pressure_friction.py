@@ -7,6 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from heavecomp.effects.base import Effect
+from heavecomp.effects.features import need
 from heavecomp.params.core import q
 
 
@@ -18,11 +19,21 @@ class PressureFriction(Effect):
     hook = "seal_friction"
     adds_stiction = True
     log = ("extra_pressure_coefficient",)
+    #: units of the feature coefficients [SI]
+    feature_units = {"pressure_friction": "N/Pa"}
 
     @dataclass(frozen=True)
     class Params:
         extra_pressure_coefficient: float = q(1e-3, "N/Pa", bounds=(1e-6, 0.05), symbol="dC_p",
                                               doc="seal friction added per pascal of cylinder pressure")
+
+    @classmethod
+    def features(cls, sig, shape=None):
+        """``pressure_friction``: sign(v) |p| [Pa] (coefficient: ``extra_pressure_coefficient`` [N/Pa]);
+        None on a plant without a pressure."""
+        if not need(sig, "v", "p"):
+            return None
+        return {"pressure_friction": np.sign(sig["v"]) * np.abs(sig["p"])}
 
     @staticmethod
     def jump(code, a, p, J, s, d, x, FP, extra_pressure_coefficient):

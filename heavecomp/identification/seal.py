@@ -23,6 +23,11 @@ The velocity is either the slope over +-0.1 s (default) or paper B's measurement
 FIR, :func:`heavecomp.signals.differentiate`); the stroke summary is the mean or the
 median.  :data:`METHOD_VARIANTS` are the analysis choices whose effect on C_p the
 study reports (the single seal study: this module + :func:`heavecomp.identification.study.seal_study`).
+
+The same files are also a plant of the gap diagnoser (the door every diagnoser shares,
+:class:`heavecomp.estimator.GapEstimator`): :class:`heavecomp.identification.plants.SealFriction`
+gives the friction residual against this module's ``split`` law, and
+:class:`heavecomp.identification.residual.ResidualDiagnoser` fits the effect library's candidates to it.
 """
 
 from __future__ import annotations

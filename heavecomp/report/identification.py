@@ -7,6 +7,7 @@ import numpy as np
 
 from heavecomp.plants.axis import BASE_NAMES, EMPS_PUBLISHED, EMPS_UNITS
 from heavecomp.report.figures import _plt as plt
+from heavecomp.report.scenario import md_table
 
 
 def _plt():
@@ -118,3 +119,41 @@ def seal_friction_vs_pressure(strokes: list, fits: dict):
                  "much more in the positive direction", fontsize=10)
     fig.tight_layout()
     return fig
+
+
+def _fmt(x) -> str:
+    if isinstance(x, (list, tuple)):
+        return "(" + ", ".join(_fmt(v) for v in x) + ")"
+    return "-" if x is None else f"{x:.4g}"
+
+
+def parameters_text(params: dict, units: dict) -> str:
+    """``name = value unit, ...`` of a candidate's fitted parameters (the refitted base left out)."""
+    return ", ".join(f"{k} = {_fmt(v)} {units.get(k, '')}".rstrip() for k, v in params.items()
+                     if not k.startswith("base_"))
+
+
+def _cell(text: str) -> str:
+    """Text for a Markdown table cell (``|`` of |v| escaped)."""
+    return text.replace("|", "\\|")
+
+
+def withheld_terms_table(w: dict) -> str:
+    """Markdown table of :func:`heavecomp.identification.study.withheld_terms` (one row per nominal
+    model that lacks a published term; the first row is the control with nothing withheld)."""
+    rows = []
+    for r in w["rows"]:
+        unit = r["unit"]
+        u = r["units"]
+        fitted = "; ".join(f"{k}: {_fmt(a)} -> {_fmt(b)} {u.get(k, '')}" for k, (a, b) in r["changes"].items()) or (
+            parameters_text(r["parameters"], u))
+        pub = r["published"].get(r["withheld"])
+        rows.append((r["withheld"], f"{_fmt(pub)} {unit}" if pub is not None else "-",
+                     r["expected"], f"**{r['verdict']}**", fitted or "-", f"{r['shrink']:.3f}",
+                     _fmt(r["reachable_shrink"]), f"{r['rms_before']:.3f} -> {r['rms_after']:.3f}",
+                     f"{r['runner_up']} ({r['runner_up_shrink']:.3f})" if r["runner_up"] else "-",
+                     f"{_cell(r['discovered'])} ({r['discovered_shrink']:.3f})" if r["discovered"] else "-",
+                     "control" if r["right"] is None else "yes" if r["right"] else "**no**"))
+    return md_table(["withheld term", "published value [unit given]", "expected [name]", "verdict",
+                     "fitted [units given]", "held-out shrink [-]", "reachable shrink [-]", "held-out rms [N]",
+                     "runner-up (shrink [-])", "discovered [N] (shrink [-])", "right [yes/no]"], rows)

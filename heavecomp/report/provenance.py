@@ -95,6 +95,13 @@ UNITS: dict[str, str] = {
     "viscous_negative": "N s/m", "viscous_positive": "N s/m", "viscous_asymmetry": "N s/m", "lag_force": "N",
     "presliding_length": "m", "stribeck_excess": "N", "stribeck_velocity": "m/s",
     "v_min": "m/s", "area": "m^2", "change_in_uncertainties": "-", "heave_reference": "m",  # seal study settings, method sensitivity
+    # equation-error diagnosis of the axis / seal (identification.plants terms; withheld-term rows)
+    "direction_offset": "N", "direction_offset_pressure": "N/Pa", "friction.coulomb_force": "N",
+    "friction.viscous_coefficient": "N s/m", "friction.pressure_coefficient": "N/Pa",
+    "base_direction_offset": "N", "base_direction_offset_pressure": "N/Pa", "base_friction.coulomb_force": "N",
+    "base_friction.viscous_coefficient": "N s/m", "base_friction.pressure_coefficient": "N/Pa",
+    "fit_window": "s", "validate_window": "s", "reachable_shrink": "-", "runner_up_shrink": "-",
+    "discovered_shrink": "-",
     # closed loop (heavecomp.controllers.ControllerConfig documents these units)
     "u_max": "N", "rate_max": "N/s", "horizon": "count", "q_wob": "1/N^2", "r_u": "1/N^2", "r_du": "1/N^2",
     "friction_eps": "m/s", "friction_scale": "-", "gas_stiffness_scale": "-", "kp": "-", "ki": "1/s", "kd": "s",
@@ -149,6 +156,8 @@ def _param_units() -> dict[str, str]:
         for cand in (CANDIDATES.values() if isinstance(CANDIDATES, dict) else CANDIDATES):
             for spec in cand.describe() if hasattr(cand, "describe") else ():
                 out.setdefault(spec["name"], spec["unit"])
+            for k, u in getattr(cand, "feature_units", {}).items():   # equation-error coefficients
+                out.setdefault(k, u)
     except Exception as exc:  # noqa: BLE001
         log.debug("effect parameter units unavailable: %s", exc)
     return out

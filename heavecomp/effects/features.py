@@ -1,0 +1,97 @@
+"""Building blocks of the seal-friction effects' equation-error features (issue 12 item 3).
+
+An effect's :meth:`~heavecomp.effects.base.Effect.features` returns regressor columns built from
+measured signals only (``sig``: ``t`` [s], ``x`` [m], ``v`` [m/s], ``a`` [m/s^2], ``dwell`` [s],
+``p`` [Pa] where the plant has one).  Friction features are plant-independent: the CMC, the 1-DOF
+axis (EMPS) and the O-ring seal rig use the same columns.  The few signal operations they share
+(a first-order lag, the rest that preceded a breakaway, the time at rest) are written here once.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def first_order_lag(t, x, tau: float, y0: float = 0.0) -> np.ndarray:
+    """y with dy/dt = (x - y) / tau, x held over each sample interval (exact step).
+
+    Parameters
+    ----------
+    t : array, s
+        Sample times (strictly increasing, uniform or not).
+    x : array
+        Input at the same samples.
+    tau : float, s
+        Time constant.
+    y0 : float
+        State before the first sample.
+
+    Returns
+    -------
+    ndarray
+        ``y[i]`` is the state when ``x[i]`` is sampled (before ``x[i]`` acts), so ``y`` lags ``x``.
+    """
+    x = np.asarray(x, dtype=float)
+    decay = np.exp(-np.diff(np.asarray(t, dtype=float)) / tau)
+    y = np.empty(x.size)
+    yk = float(y0)
+    for i in range(x.size):
+        y[i] = yk
+        if i < decay.size:
+            yk = x[i] + (yk - x[i]) * decay[i]
+    return y
+
+
+def dwell_time(t, v, dead_band: float) -> np.ndarray:
+    """Time at rest so far [s]: grows while |v| <= ``dead_band`` [m/s], 0 while sliding."""
+    t = np.asarray(t, dtype=float)
+    rest = np.abs(np.asarray(v, dtype=float)) <= dead_band
+    out = np.zeros(t.size)
+    start = None
+    for i in range(t.size):
+        if rest[i]:
+            start = t[i] if start is None else start
+            out[i] = t[i] - start
+        else:
+            start = None
+    return out
+
+
+def breakaway_dwell(t, dwell, window: float) -> np.ndarray:
+    """The length [s] of the rest that preceded the current sliding phase, during the first
+    ``window`` [s] of that phase (0 elsewhere and while at rest).
+
+    ``dwell`` is the time at rest so far (:func:`dwell_time`): a sliding sample has dwell 0, and the
+    rest before it ended at the last sample with dwell > 0.
+    """
+    t = np.asarray(t, dtype=float)
+    dwell = np.asarray(dwell, dtype=float)
+    out = np.zeros(t.size)
+    last_rest, t_break = 0.0, None
+    for i in range(t.size):
+        if dwell[i] > 0.0:
+            last_rest, t_break = dwell[i], None
+            continue
+        if t_break is None:
+            t_break = t[i]
+        if last_rest > 0.0 and t[i] - t_break < window:
+            out[i] = last_rest
+    return out
+
+
+def position_harmonics(x, harmonics: int = 3) -> dict:
+    """cos and sin of 2 pi k (x - x_min) / L, k = 1..``harmonics``, over the travelled span
+    L = max(x) - min(x) [m]: a smooth function of position as a few Fourier terms."""
+    x = np.asarray(x, dtype=float)
+    x0, length = float(x.min()), float(x.max() - x.min())
+    out = {}
+    for k in range(1, harmonics + 1):
+        arg = 2.0 * np.pi * k * (x - x0) / length
+        out[f"cos{k}"] = np.cos(arg)
+        out[f"sin{k}"] = np.cos(arg - 0.5 * np.pi)
+    return out
+
+
+def need(sig: dict, *names) -> bool:
+    """True when every signal of ``names`` is in ``sig``."""
+    return all(n in sig for n in names)

@@ -1,0 +1,75 @@
+"""The equation-error engine (heavecomp.diagnosis.equation_error): candidate columns and the open
+search on a component residual; synthetic data with a planted term, and pure noise."""
+
+import numpy as np
+import pytest
+
+from heavecomp.diagnosis import equation_error as E
+from heavecomp.effects.base import Effect
+
+
+def _signals(seed=0, n=6001):
+    t = np.linspace(0.0, 300.0, n)
+    v = 0.2 * np.sin(0.31 * t) * np.cos(0.047 * t + 0.3)
+    x = np.cumsum(v) * (t[1] - t[0])
+    p = 4e6 + 2e5 * np.sin(0.23 * t + 1.0)
+    return {"t": t, "v": v, "x": x, "p": p}, t < 200.0, t >= 200.0, np.random.default_rng(seed)
+
+
+@pytest.mark.parametrize("planted, coef, feature", [
+    (lambda s: (s["v"] > 0).astype(float), 1.9e3, "sign_v_pos"),
+    (lambda s: s["p"] * np.sign(s["v"]), 2e-3, "p_sign_v"),
+    (lambda s: s["t"] - s["t"][0], 4.0, "t"),
+])
+def test_open_search_recovers_a_planted_term(planted, coef, feature):
+    sig, fit, val, rng = _signals()
+    r = coef * planted(sig) + rng.normal(0.0, 0.3 * coef * np.std(planted(sig)), sig["t"].size)
+    d = E.open_search(r, sig, fit, val, component="friction")
+    assert d is not None and d["features"] == [feature]
+    assert d["coefficients"][feature] == pytest.approx(coef, rel=0.05)
+    assert d["shrink"] > 0.6 and d["component"] == "friction"
+    assert d["term"].endswith(E.library(sig)[feature][1])
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_open_search_rejects_pure_noise(seed):
+    sig, fit, val, rng = _signals(seed)
+    white = rng.normal(0.0, 500.0, sig["t"].size)
+    coloured = np.convolve(white, np.ones(25) / 25, mode="same")  # a filtered residual: autocorrelated
+    assert E.open_search(white, sig, fit, val) is None
+    assert E.open_search(coloured, sig, fit, val) is None
+
+
+class _Band(Effect):
+    name = "test_band"
+    hook = "seal_friction"
+    feature_grid = (0.2, 0.5, 0.8)
+
+    @classmethod
+    def features(cls, sig, shape=None):
+        x = sig["x"]
+        return {"extra": np.sign(sig["v"]) * (x > np.quantile(x, shape))}
+
+
+def test_rank_effects_picks_the_shape_and_coefficient():
+    sig, fit, val, rng = _signals(3)
+    x = sig["x"]
+    r = 700.0 * np.sign(sig["v"]) * (x > np.quantile(x, 0.5)) + rng.normal(0.0, 200.0, x.size)
+    rows = E.rank_effects(r, sig, [_Band, Effect], fit, val)
+    assert len(rows) == 1  # the base Effect has no equation-error form
+    best = rows[0]
+    assert best["effect"] == "test_band" and best["component"] == "friction" and best["shape"] == 0.5
+    assert best["coefficients"]["extra"] == pytest.approx(700.0, rel=0.1)
+    assert best["shrink"] > 0.3 and best["delta_bic"] < 0
+
+
+def test_fit_columns_refits_the_base_columns_in_the_reference():
+    sig, fit, val, rng = _signals(4)
+    r = 3.0 * sig["v"] + 50.0 * np.sign(sig["v"]) + rng.normal(0.0, 1.0, sig["t"].size)
+    res = E.fit_columns(r, {"coulomb": np.sign(sig["v"])}, fit, val, base={"viscous": sig["v"]})
+    assert res["base"]["viscous"] == pytest.approx(3.0, rel=0.05)
+    assert res["coefficients"]["coulomb"] == pytest.approx(50.0, rel=0.02)
+    # the reference is the base-only refit, so the shrink is the candidate's own
+    only = E.fit_columns(r, {}, fit, val, base={"viscous": sig["v"]})
+    assert res["rms_before"] == pytest.approx(only["rms_after"])
+    assert res["shrink"] > 0.9
