@@ -63,9 +63,7 @@ def _diagnose(tr, kind, workdir: Path, n_jobs: int) -> dict:
     case = tr.truth["case"]
     stem = f"{case['seed']}_{case['label']}_{kind}"
     csv = tr.to_csv(workdir / f"{stem}.csv")
-    toml = workdir / f"{case['params']}.toml"
-    if not toml.exists():
-        write_params(workdir, tr.nominal, toml.name)
+    toml = write_params(workdir, tr.nominal, f"{stem}.toml")  # one file per run: workers write in parallel
     nominal = load(toml)
     d = GapDiagnoser(nominal, n_jobs=n_jobs).fit(load_run(csv, nominal))
     v = d.verdict_

@@ -630,9 +630,8 @@ def _validation_draw(label, variant, duration, nominal):
             return ({"alpha": float(rng.choice([-1, 1]) * rng.uniform(0.15, 0.35)), "t_flip": rng.uniform(0.05, 0.2),
                      "v_e": 2e-3}, "alpha", 0.8, plant(plant_truth(label)))
         if label == "position_friction":
-            s1 = rng.uniform(-0.4, 0.0)
-            return ({"beta": rng.uniform(0.3, 0.6), "s_1": s1, "s_2": s1 + rng.uniform(0.2, 0.4),
-                     "edge": rng.uniform(0.02, 0.06)}, "beta", 3.0, plant(plant_truth(label)))
+            return ({"beta": rng.uniform(0.3, 0.6), "s_c": rng.uniform(-0.3, 0.3), "w": rng.uniform(0.15, 0.3)},
+                    "beta", 3.0, plant(plant_truth(label)))
         if label == "gas_leak":  # 1-3 % of the charge over the run
             return {"leak_rate": rng.uniform(0.01, 0.03) / duration}, "leak_rate", 0.15 / duration, plant(plant_truth(label))
         if label == "line_inertance":
@@ -661,7 +660,7 @@ def _validation_draw(label, variant, duration, nominal):
             if variant == "mru":
                 return ({"gain_error": -rng.uniform(0.08, 0.14), "corner": rng.uniform(0.005, 0.015)}, "gain_error",
                         0.5, out(_mru, heave=True))
-            return ({"lever_arm": rng.uniform(15.0, 40.0), "pitch_rms": rng.uniform(0.01, 0.025),
+            return ({"lever_arm": rng.uniform(5.0, 15.0), "pitch_rms": rng.uniform(0.005, 0.01),
                      "pitch_period": rng.uniform(8.0, 12.0), "pitch_seed": int(rng.integers(2**31))}, "lever_arm",
                     120.0, out(_lever, heave=True))
         if label == "wob_saturation":

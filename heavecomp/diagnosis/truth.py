@@ -22,6 +22,7 @@ string_damping                quadratic drag c_q dv|dv| in the tension      line
 
 from __future__ import annotations
 
+import inspect
 from dataclasses import dataclass
 
 import numpy as np
@@ -186,8 +187,8 @@ def truth_composition():
 # ==========================  =================  =====================================================
 # asymmetric_friction         friction           J (1 + alpha d), d a lagged direction,
 #                                                dd/dt = (v/(|v| + v_e) - d)/T_d (seal lip flips over)
-# position_friction           friction           J (1 + beta band(s)), band = smooth plateau between
-#                                                s_1 and s_2 (tanh edges of width e); s a state ds/dt = v
+# position_friction           friction           J (1 + beta max(0, 1 - ((s - s_c)/w)^2)), a parabolic
+#                                                bump; s a state ds/dt = v
 # gas_leak                    gas_spring         gas mass fraction mu, laminar leak dmu/dt = -mu p/(p_0 T_l),
 #                                                p_gas + p_atm = (p + p_atm) mu^n
 # sensor_gain                 sensors            y_m = g LP(y) (5 Hz first-order sensor bandwidth), g = -1
@@ -206,6 +207,9 @@ def truth_composition():
 # ---------------------------------------------------------------------------------------------
 
 
+SEAL_SD = "d" in inspect.signature(TruthEnergisedSeal.jump).parameters  #: the hook passes (s, d)
+
+
 class TruthLaggedDirection(Effect):
     """Direction-asymmetric seal friction: J (1 + alpha d) with d a lagged direction of motion."""
 
@@ -219,9 +223,14 @@ class TruthLaggedDirection(Effect):
         t_flip: float = q(0.1, "s", bounds=(0.0, 10.0), open_low=True, symbol="T_d", doc="seal lip flip time")
         v_e: float = q(2e-3, "m/s", bounds=(0.0, 1.0), open_low=True, symbol="v_e", doc="direction smoothing speed")
 
-    @staticmethod
-    def jump(code, a, p, J, x, FP, alpha, t_flip, v_e):
-        return J * (1.0 + alpha * x[0])
+    if SEAL_SD:
+        @staticmethod
+        def jump(code, a, p, J, s, d, x, FP, alpha, t_flip, v_e):
+            return J * (1.0 + alpha * x[0])
+    else:
+        @staticmethod
+        def jump(code, a, p, J, x, FP, alpha, t_flip, v_e):
+            return J * (1.0 + alpha * x[0])
 
     @staticmethod
     def rates(s, v, p, x, PP, FP, alpha, t_flip, v_e):
@@ -237,7 +246,8 @@ class TruthLaggedDirection(Effect):
 
 
 class TruthWornBand(Effect):
-    """Friction raised by beta inside a band s_1 < s < s_2 of the stroke (a scored band), smooth edges."""
+    """Friction raised by up to beta inside a worn band of the stroke, a parabolic bump
+    J (1 + beta max(0, 1 - ((s - s_c)/w)^2)), with the stroke s tracked as a state (ds/dt = v)."""
 
     name = "position_friction"
     hook = "seal_friction"
@@ -245,25 +255,29 @@ class TruthWornBand(Effect):
 
     @dataclass(frozen=True)
     class Params:
-        beta: float = q(0.3, "-", bounds=(-0.9, 5.0), symbol="beta", doc="relative friction change in the band")
-        s_1: float = q(-0.2, "m", bounds=(-5.0, 5.0), symbol="s_1", doc="lower edge of the band")
-        s_2: float = q(0.2, "m", bounds=(-5.0, 5.0), symbol="s_2", doc="upper edge of the band")
-        edge: float = q(0.05, "m", bounds=(0.0, 1.0), open_low=True, symbol="e", doc="edge width")
+        beta: float = q(0.3, "-", bounds=(-0.9, 5.0), symbol="beta", doc="relative friction change at the centre")
+        s_c: float = q(0.0, "m", bounds=(-5.0, 5.0), symbol="s_c", doc="centre of the band")
+        w: float = q(0.2, "m", bounds=(0.0, 5.0), open_low=True, symbol="w", doc="half width of the band")
+
+    if SEAL_SD:
+        @staticmethod
+        def jump(code, a, p, J, s, d, x, FP, beta, s_c, w):
+            return J * (1.0 + beta * np.maximum(1.0 - ((x[0] - s_c) / w) ** 2, 0.0))
+    else:
+        @staticmethod
+        def jump(code, a, p, J, x, FP, beta, s_c, w):
+            return J * (1.0 + beta * np.maximum(1.0 - ((x[0] - s_c) / w) ** 2, 0.0))
 
     @staticmethod
-    def jump(code, a, p, J, x, FP, beta, s_1, s_2, edge):
-        return J * (1.0 + beta * 0.5 * (np.tanh((x[0] - s_1) / edge) - np.tanh((x[0] - s_2) / edge)))
-
-    @staticmethod
-    def rates(s, v, p, x, PP, FP, beta, s_1, s_2, edge):
+    def rates(s, v, p, x, PP, FP, beta, s_c, w):
         return (v,)
 
     @staticmethod
-    def initial(FP, PP, beta, s_1, s_2, edge):
+    def initial(FP, PP, beta, s_c, w):
         return (0.0,)  # the run starts at rest at the operating point, s = 0
 
     @staticmethod
-    def steady(v, FP, PP, beta, s_1, s_2, edge):
+    def steady(v, FP, PP, beta, s_c, w):
         return (0.0,)
 
 
@@ -339,9 +353,14 @@ class TruthSealWarming(Effect):
         v_ref: float = q(0.3, "m/s", bounds=(0.0, 10.0), open_low=True, symbol="v_ref", doc="reference mean speed")
         t_th: float = q(120.0, "s", bounds=(0.0, 1e5), open_low=True, symbol="T_th", doc="seal thermal time")
 
-    @staticmethod
-    def jump(code, a, p, J, x, FP, beta, v_ref, t_th):
-        return J * (1.0 - beta * np.minimum(x[0], 1.0))
+    if SEAL_SD:
+        @staticmethod
+        def jump(code, a, p, J, s, d, x, FP, beta, v_ref, t_th):
+            return J * (1.0 - beta * np.minimum(x[0], 1.0))
+    else:
+        @staticmethod
+        def jump(code, a, p, J, x, FP, beta, v_ref, t_th):
+            return J * (1.0 - beta * np.minimum(x[0], 1.0))
 
     @staticmethod
     def rates(s, v, p, x, PP, FP, beta, v_ref, t_th):
