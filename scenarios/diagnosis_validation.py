@@ -28,6 +28,7 @@ from pathlib import Path
 import numpy as np
 
 from heavecomp.diagnosis import GapDiagnoser, load_run
+from heavecomp.errors import InputError
 from heavecomp.diagnosis.generator import NEAR_NOISE, generate_case, validation_cases
 from heavecomp.params import load
 from heavecomp.report.provenance import write_params
@@ -65,7 +66,13 @@ def _diagnose(tr, kind, workdir: Path, n_jobs: int) -> dict:
     csv = tr.to_csv(workdir / f"{stem}.csv")
     toml = write_params(workdir, tr.nominal, f"{stem}.toml")  # one file per run: workers write in parallel
     nominal = load(toml)
-    d = GapDiagnoser(nominal, n_jobs=n_jobs).fit(load_run(csv, nominal))
+    try:
+        d = GapDiagnoser(nominal, n_jobs=n_jobs).fit(load_run(csv, nominal))
+    except InputError as exc:  # the command would exit 2: a refusal, counted as a wrong verdict
+        return {"kind": kind, "verdict": "refused", "confidence": "low", "component": None, "discovered": None,
+                "shrink": 0.0, "shrink_channel": "wob", "true_shrink": None, "explained": None,
+                "gap_to_noise_diagnosed": None, "second_effect": None, "refused": str(exc),
+                "duration": float(tr.t[-1] - tr.t[0])}
     v = d.verdict_
     ch = v.get("shrink_channel", "wob")
     true = tr.true_shrink(d.split)
