@@ -96,9 +96,14 @@ def run_case(case, workdir, n_jobs=1) -> dict:
     row["truth"] = {k: tr.truth[k] for k in ("component", "named", "out_of_library", "parameters", "gap_to_noise",
                                              "noise_floor", "sea", "draws")}
     row["generate_wall_time"] = time.perf_counter() - t0
-    row["full"] = _diagnose(tr, "full", Path(workdir), n_jobs)
-    if case["pair_cut"]:
-        row["cut"] = _diagnose(tr.cropped(case["pair_cut"]), "cut", Path(workdir), n_jobs)
+    try:
+        row["full"] = _diagnose(tr, "full", Path(workdir), n_jobs)
+        if case["pair_cut"]:
+            row["cut"] = _diagnose(tr.cropped(case["pair_cut"]), "cut", Path(workdir), n_jobs)
+    except Exception as exc:  # noqa: BLE001 - one crashing run is reported, the set goes on
+        log.exception("%s (seed %s): the diagnosis failed", case["label"], case["seed"])
+        row.pop("full", None)
+        row["error"] = f"diagnosis failed: {exc!r}"
     row["wall_time"] = time.perf_counter() - t0
     return row
 
@@ -253,7 +258,7 @@ def write(out: Path, which, rows, summary, settings, digest, frozen_note, quick)
         f"**Thresholds: {frozen_note}.** Settings (GapDiagnoser.get_params(), less {', '.join(NOT_FROZEN)}): "
         + ", ".join(f"`{k}={v}`" for k, v in settings.items()) + ".",
         f"{s['n_generated']} of {s['n_cases']} cases generated"
-        + (f" (not generated: {', '.join(s['not_generated'])})" if s["not_generated"] else "")
+        + (f" (not generated or failed: {', '.join(s['not_generated'])})" if s["not_generated"] else "")
         + (" — **quick mode: 3 short runs, not a validation**" if quick else "") + ". "
         f"A verdict counts as in the contract: the withheld effect named with a held-out shrink >= {SHRINK_REAL:g} "
         "(named runs); `none` (no-effect runs); the right `verdict.component` and no named effect with medium or "
