@@ -782,7 +782,7 @@ def validation_cases(which, quick=False):
             _case("friction_lag", next(s), "named", sea="buoy", duration=600.0, start=mid, pair_cut=60.0),
             _case("dwell_stiction", next(s), "named", sea="calm", duration=600.0, params="long_soft_string", start=mid),
             _case("pressure_friction", next(s), "named", sea="buoy", duration=1200.0, rate=10.0, start=mid),
-            _case("gas_heat_transfer", next(s), "named", sea="mixed", duration=300.0, rate=100.0, start=mid),
+            _case("gas_heat_transfer", next(s), "named", sea="buoy", duration=300.0, rate=100.0, start=mid),
             _case("flow_loss", next(s), "named", sea="mixed", noise=2.0, params="soft_rock", start=mid, pair_cut=60.0),
             _case("string_damping", next(s), "named", sea="buoy", params="soft_rock", start=mid),
             _case("sensor_delay", next(s), "named", sea="mixed", rate=10.0, duration=600.0, start=mid),
