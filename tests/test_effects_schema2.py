@@ -251,3 +251,24 @@ def test_a_five_state_composition_compiles_and_integrates():
     res = simulate_fx(paper_a(), 20.0, [_Drifts(rate=0.5), ("gas_leak", {"leak_rate": -1e-4})], rate=10.0,
                       comp=composition(classes))
     np.testing.assert_allclose(res["effect_state_6"], -1e-4 * res["t"], rtol=1e-9, atol=1e-15)
+
+
+def test_controllers_predict_with_the_heave_the_plant_sees():
+    """A heave reference the controller knows: its earth-frame model is built on the seen heave
+    (dX/dt = V exactly, no heave acceleration left in the dynamics), and both MPCs refuse a delay."""
+    from heavecomp.controllers.linear_mpc import LinearMPC
+    from heavecomp.controllers.model import controller_model
+    from heavecomp.controllers.nonlinear_mpc import NonlinearMPC
+
+    p = paper_a("stribeck")
+    f = controller_model(p, eps=1e-3, effects=[("heave_reference", {"scale": 0.9, "delay": 0.0})])
+    rng = np.random.default_rng(2)
+    for _ in range(5):
+        xe = np.r_[rng.uniform(-1, 1), rng.uniform(-0.5, 0.5), rng.uniform(-0.01, 0.01), rng.uniform(-0.1, 0.1)]
+        u = np.r_[rng.uniform(-1, 1), rng.uniform(-0.5, 0.5), rng.uniform(-0.3, 0.3), 0.0]
+        xd = np.asarray(f(xe, u)[0]).ravel()
+        assert xd[0] == pytest.approx(xe[1], abs=1e-12)
+    LinearMPC(p, None, effects=[("heave_reference", {"scale": 0.9, "delay": 0.0})])
+    for cls in (LinearMPC, NonlinearMPC):
+        with pytest.raises(ParameterError, match="heave_reference.*delay"):
+            cls(p, None, effects=[("heave_reference", {"scale": 0.9, "delay": 0.3})])

@@ -35,7 +35,8 @@ import dataclasses
 
 import numpy as np
 
-from heavecomp.effects.model import casadi_model, initial_effect_states
+from heavecomp.effects.model import casadi_model, heave_map, initial_effect_states
+from heavecomp.effects.registry import resolve
 from heavecomp.friction.laws import FORCE_KEYS
 from heavecomp.plants.symbolic import casadi
 
@@ -75,10 +76,12 @@ def controller_params(params, config):
 FRAMES = ("earth", "stroke")
 
 
-def earth_frame(f):
+def earth_frame(f, heave=(1.0, 0.0)):
     """The casadi model ``f(x, u) -> (xdot, y)`` (x = [s, v, y_b, v_b], u = [z_h, dz_h,
     ddz_h, u_active]) with the top mass in the earth frame: x_e = [X, V, y_b, v_b],
     X = z_h + s, V = dz_h + v.  Same inputs and outputs; exact change of variables.
+    ``heave = (a, b)``: the plant sees the heave a z_h + b (a heave effect the controller knows,
+    :func:`heavecomp.effects.model.heave_map`), so X = a z_h + b + s, V = a dz_h + v.
 
     Raises ValueError if the transformed dynamics still depend on ddz_h (they must
     not: the heave acceleration acts on the top mass only through the relative
@@ -88,9 +91,11 @@ def earth_frame(f):
     n = f.size1_in(0)  # 4 plant states, then the effects' states (unchanged by the frame)
     xe = ca.SX.sym("xe", n)
     u = ca.SX.sym("u", 4)
-    x = ca.vertcat(xe[0] - u[0], xe[1] - u[1], xe[2:])
+    ga, gb = heave
+    z, dz, ddz = (u[0], u[1], u[2]) if (ga, gb) == (1.0, 0.0) else (ga * u[0] + gb, ga * u[1], ga * u[2])
+    x = ca.vertcat(xe[0] - z, xe[1] - dz, xe[2:])
     xdot, y = f(x, u)
-    xedot = xdot + ca.vertcat(u[1], u[2], ca.SX.zeros(n - 2))
+    xedot = xdot + ca.vertcat(dz, ddz, ca.SX.zeros(n - 2))
     dep = ca.Function("d", [xe, u], [ca.jacobian(xedot, u[2])])(np.zeros(n), np.zeros(4))
     if np.max(np.abs(np.array(dep))) > 1e-9:
         raise ValueError("earth_frame: the model's dynamics depend on the heave acceleration in the earth frame")
@@ -102,8 +107,9 @@ def controller_model(params, *, eps=None, frame: str = "earth", effects=()):
     ``effects``: effects at the plant's hooks the controller knows, :mod:`heavecomp.effects`)."""
     if frame not in FRAMES:
         raise ValueError(f"model frame {frame!r}: not one of {', '.join(FRAMES)}")
+    effects = resolve(effects)
     f = casadi_model(params, eps=eps, effects=effects)
-    return earth_frame(f) if frame == "earth" else f
+    return earth_frame(f, heave_map(effects)) if frame == "earth" else f
 
 
 def discrete_model(params, Ts: float, frame: str = "earth", effects=()) -> DiscreteModel:

@@ -58,14 +58,9 @@ def casadi_model(params, *, eps: float | None = None, sym: str = "SX", effects=(
     u = S.sym("u", 4)
     s, v, yb, vb = x[0], x[1], x[2], x[3]
     X = [x[i] for i in range(4 + n_eff)]  # the stepper's state: the plant's four, then the effects'
-    zh, dzh, ddzh, ua = u[0], u[1], u[2], u[3]
-    for e in heave_fx:  # the heave the plant sees: a gain on the measured one
-        g = _static_gain(e, e.seen)
-        zh, dzh, ddzh = g * zh, g * dzh, g * ddzh
-    for e in sensor_fx:  # a heave sensor that reads g z + o: the plant sees (u - o) / g
-        if e.channel == "heave":
-            g, o = _static_affine(e)
-            zh, dzh, ddzh = (zh - o) / g, dzh / g, ddzh / g
+    ua = u[3]
+    a, b = heave_map(heave_fx + sensor_fx)  # the heave the plant sees from the measured one
+    zh, dzh, ddzh = (u[0], u[1], u[2]) if (a, b) == (1.0, 0.0) else (a * u[0] + b, a * u[1], a * u[2])
     fn = comp.functions
     p, T, hold, dvb = fn["plant_fx"](s, v, yb, vb, X, zh, dzh, ddzh, ua, 1.0, PP, EP)
     dvb = lower_accel_wob(T, yb, vb, PP)  # the clamped contact law (smooth model)
@@ -113,6 +108,22 @@ def _static_affine(e):
     if e.channel == "heave" and g[20] == 0.0:
         raise ParameterError(f"effect {e.name} on heave: a gain of 0 leaves no heave to compensate")
     return float(g[20]), float(o[20])
+
+
+def heave_map(effects) -> tuple:
+    """``(a, b)``: the heave the plant sees is ``a z_meas + b`` (its derivatives ``a`` times the
+    measured ones) for the heave and channel effects among ``effects`` (instances): a heave
+    effect's gain, the inverse of a heave sensor's reading g z + o.  ParameterError for a map with
+    memory or a drift (no finite-state, time-invariant model)."""
+    a, b = 1.0, 0.0
+    for e in effects:
+        if e.kind == "heave":
+            g = _static_gain(e, e.seen)
+            a, b = g * a, g * b
+        elif e.kind == "output" and e.channel == "heave":
+            g, o = _static_affine(e)
+            a, b = a / g, (b - o) / g
+    return a, b
 
 
 def initial_effect_states(params, effects=()) -> np.ndarray:
