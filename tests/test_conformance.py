@@ -69,13 +69,14 @@ def test_finite_outputs_at_sampled_states(model, name):
     comp = library_composition()
     EP = comp.ep(effects)
     fn = comp.functions
-    x = comp.initial_state(plant.FP, plant.PP, EP)[4:7]
+    x = tuple(comp.initial_state(plant.FP, plant.PP, EP)[4:4 + comp.n_states])
     for s, v, yb, vb, zh, dzh, ddzh, u in _states(50, 1):
-        vals = list(fn["plant_fx"](s, v, yb, vb, *x, zh, dzh, ddzh, u, 1.0, plant.PP, EP))
+        X = (s, v, yb, vb) + x
+        vals = list(fn["plant_fx"](s, v, yb, vb, X, zh, dzh, ddzh, u, 1.0, plant.PP, EP))
         p = vals[0]
-        vals.append(fn["sliding_friction_fx"](plant.code, np.sign(v), v, p, s, *x, plant.FP, EP))
-        vals.append(fn["static_limit_fx"](plant.code, p, s, np.sign(v), *x, 2.0, plant.FP, EP))
-        vals += list(fn["effect_rates"](s, v, p, *x, plant.PP, plant.FP, EP))
+        vals.append(fn["sliding_friction_fx"](plant.code, np.sign(v), v, p, s, X, plant.FP, EP))
+        vals.append(fn["static_limit_fx"](plant.code, p, s, np.sign(v), X, 2.0, plant.FP, EP))
+        vals += list(fn["effect_rates"](s, v, p, X, plant.PP, plant.FP, EP))
         assert np.all(np.isfinite(vals)), vals
 
 
@@ -102,12 +103,12 @@ def test_seal_effects_dissipate(model, name):
     fn = comp.functions
     FS, FC = plant.FP[laws.FS], plant.FP[laws.FC]
     for mem in np.linspace(0.0, FS - FC, 5):
-        x = (mem, 0.0, 0.0)
         for v in np.r_[-np.logspace(-5, 0, 30), np.logspace(-5, 0, 30)]:
             for p, s in itertools.product((0.0, 2.4e6, 4e6), np.linspace(-1.5, 1.5, 7)):
-                F = fn["sliding_friction_fx"](plant.code, np.sign(v), v, p, s, *x, plant.FP, EP)
+                X = (s, v, 0.0, 0.0) + (mem,) * comp.n_states  # the memory in every effect slot
+                F = fn["sliding_friction_fx"](plant.code, np.sign(v), v, p, s, X, plant.FP, EP)
                 assert F * v >= 0.0, (v, p, s, F)
-                assert fn["static_limit_fx"](plant.code, p, s, np.sign(v), *x, 3.0, plant.FP, EP) >= 0.0
+                assert fn["static_limit_fx"](plant.code, p, s, np.sign(v), X, 3.0, plant.FP, EP) >= 0.0
 
 
 # ------------------------------------------------------------ zero size = nominal
@@ -137,11 +138,12 @@ def test_zero_size_reproduces_the_nominal_plant_bit_for_bit(name):
     EP = comp.ep([e])
     fn = comp.functions
     for s, v, yb, vb, zh, dzh, ddzh, u in _states(50, 2):
-        pr, T, hold, dvb = fn["plant_fx"](s, v, yb, vb, 0.0, 0.0, 0.0, zh, dzh, ddzh, u, 1.0, plant.PP, EP)
+        X = (s, v, yb, vb) + (0.0,) * comp.n_states
+        pr, T, hold, dvb = fn["plant_fx"](s, v, yb, vb, X, zh, dzh, ddzh, u, 1.0, plant.PP, EP)
         assert pr == cmc.gas_pressure(s, plant.PP)
         assert T == cmc.tension(s, v, yb, vb, zh, dzh, plant.PP)
         assert hold == cmc.holding_force(s, v, yb, vb, zh, dzh, ddzh, u, plant.PP)
-        assert (fn["sliding_friction_fx"](plant.code, np.sign(v), v, pr, s, 0.0, 0.0, 0.0, plant.FP, EP)
+        assert (fn["sliding_friction_fx"](plant.code, np.sign(v), v, pr, s, X, plant.FP, EP)
                 == cmc.sliding_friction(plant.code, np.sign(v), s, v, plant.FP, plant.PP))
     ref = simulate(p, 30.0, rate=20.0)
     got = simulate(p, 30.0, rate=20.0, effects=[e])  # the library's compiled stepper
@@ -151,12 +153,12 @@ def test_zero_size_reproduces_the_nominal_plant_bit_for_bit(name):
 # ------------------------------------------------------------------ numba = casadi
 def _kernel_xdot(hooks, n_eff, plant, EP, X, w, u):
     s, v, yb, vb = X[:4]
-    xe = tuple(X[4:]) + (0.0,) * (3 - n_eff)
+    xe = tuple(float(a) for a in X)
     zh, dzh, ddzh = w
     cm = 1.0 if K.contact_switch(yb, vb, plant.PP) > 0 else 0.0
-    p, T, hold, dvb = hooks["plant_fx"](s, v, yb, vb, *xe, zh, dzh, ddzh, u, cm, plant.PP, EP)
-    Ff = hooks["sliding_friction_fx"](plant.code, float(np.sign(v)), v, p, s, *xe, plant.FP, EP)
-    rates = hooks["effect_rates"](s, v, p, *xe, plant.PP, plant.FP, EP)[:n_eff]
+    p, T, hold, dvb = hooks["plant_fx"](s, v, yb, vb, xe, zh, dzh, ddzh, u, cm, plant.PP, EP)
+    Ff = hooks["sliding_friction_fx"](plant.code, float(np.sign(v)), v, p, s, xe, plant.FP, EP)
+    rates = hooks["effect_rates"](s, v, p, xe, plant.PP, plant.FP, EP)
     return np.r_[v, (hold - Ff) / plant.PP[cmc.MC], vb, dvb, rates]
 
 

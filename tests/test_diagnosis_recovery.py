@@ -53,9 +53,9 @@ CASES = [
     ("sensor_delay", {"channel": "wob", "delay": 0.4}, 0.05),
     ("asymmetric_friction", {"asymmetry": 0.3}, 0.1),
     ("gas_leak", {"leak_rate": -2e-4}, 0.1),
-    ("sensor_gain", {"channel": "pressure", "gain": 1.05}, 0.01),
+    ("sensor_gain", {"channel": "pressure", "factor": 1.05}, 0.01),
     ("sensor_offset", {"channel": "pressure", "offset": 1e5, "drift": 100.0}, 0.05),
-    ("heave_reference", {"gain": 0.88, "delay": 0.3}, 0.05),
+    ("heave_reference", {"scale": 0.88, "delay": 0.3}, 0.05),
 ]
 
 

@@ -7,13 +7,17 @@ checks; here each effect's own behaviour is measured on a simulated run."""
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 import pytest
 
+from heavecomp.effects.base import Effect
 from heavecomp.effects.registry import effect_class
 from heavecomp.errors import ParameterError
 from heavecomp.friction import laws
 from heavecomp.params import paper_a
+from heavecomp.params.core import q
 from heavecomp.plants import cmc
 from heavecomp.simulate import simulate
 
@@ -102,7 +106,7 @@ def test_gas_heat_transfer_warming_makes_a_slow_mean_offset(nominal):
 
 
 def test_sensor_gain_minus_one_flips_the_sign(nominal):
-    res = _run(paper_a("stribeck"), [effect_class("sensor_gain")(channel="wob", gain=-1.0)])
+    res = _run(paper_a("stribeck"), [effect_class("sensor_gain")(channel="wob", factor=-1.0)])
     np.testing.assert_array_equal(res["wob"], -nominal["wob"])
     for c in ("stroke", "pressure", "heave", "friction"):
         np.testing.assert_array_equal(res[c], nominal[c])
@@ -120,7 +124,7 @@ def test_heave_reference_scales_and_delays_what_the_plant_sees():
     recorded heave stays the measured one."""
     p = paper_a("none")
     ref = _run(p, duration=120.0)
-    res = _run(p, [effect_class("heave_reference")(gain=0.88, delay=0.5)], duration=120.0)
+    res = _run(p, [effect_class("heave_reference")(scale=0.88, delay=0.5)], duration=120.0)
     np.testing.assert_allclose(res["heave"], ref["heave"], rtol=0, atol=1e-12)  # (the output times' last bits)
     t, late = ref.t, ref.t > 60.0
     s_ref = ref["stroke"] - np.mean(ref["stroke"][late])
@@ -134,10 +138,10 @@ def test_heave_reference_scales_and_delays_what_the_plant_sees():
     assert np.std(t) > 0
 
 
-@pytest.mark.parametrize("name, values", [("sensor_gain", {"channel": "stroke", "gain": 1.0}),
+@pytest.mark.parametrize("name, values", [("sensor_gain", {"channel": "stroke", "factor": 1.0}),
                                           ("sensor_offset", {"channel": "wob", "offset": 0.0, "drift": 0.0}),
                                           ("sensor_delay", {"channel": "pressure", "delay": 0.0}),
-                                          ("heave_reference", {"gain": 1.0, "delay": 0.0})])
+                                          ("heave_reference", {"scale": 1.0, "delay": 0.0})])
 def test_channel_and_heave_effects_at_null_reproduce_the_nominal_run_bit_for_bit(nominal, name, values):
     cls = effect_class(name)
     assert values == {**values, **cls.null(None)}
@@ -152,9 +156,9 @@ def test_casadi_model_takes_gains_and_refuses_delays_and_drifts():
 
     p = paper_a("none")
     f0 = casadi_model(p)
-    fg = casadi_model(p, effects=[effect_class("sensor_gain")(channel="wob", gain=1.08),
+    fg = casadi_model(p, effects=[effect_class("sensor_gain")(channel="wob", factor=1.08),
                                   effect_class("sensor_offset")(channel="pressure", offset=1e5, drift=0.0)])
-    fh = casadi_model(p, effects=[effect_class("heave_reference")(gain=0.9, delay=0.0)])
+    fh = casadi_model(p, effects=[effect_class("heave_reference")(scale=0.9, delay=0.0)])
     rng = np.random.default_rng(3)
     for _ in range(10):
         x = np.r_[rng.uniform(-0.5, 0.5), rng.uniform(-0.3, 0.3), rng.uniform(-0.01, 0.01), rng.uniform(-0.1, 0.1)]
@@ -166,7 +170,7 @@ def test_casadi_model_takes_gains_and_refuses_delays_and_drifts():
         xdh, _ = (np.asarray(a).ravel() for a in fh(x, u))
         xd_ref = np.asarray(f0(x, np.r_[0.9 * u[:3], u[3]])[0]).ravel()
         np.testing.assert_allclose(xdh, xd_ref, rtol=1e-12, atol=1e-12)
-    for bad in ([effect_class("heave_reference")(gain=0.9, delay=0.3)],
+    for bad in ([effect_class("heave_reference")(scale=0.9, delay=0.3)],
                 [effect_class("sensor_offset")(channel="wob", offset=0.0, drift=5.0)],
                 [effect_class("sensor_delay")(channel="wob", delay=0.2)]):
         with pytest.raises(ParameterError, match=bad[0].name):
@@ -178,7 +182,7 @@ def test_linearise_with_a_wob_gain_scales_the_wob_row():
 
     p = paper_a("none")
     a = linearise(p, friction="none")
-    b = linearise(p, friction="none", effects=[("sensor_gain", {"channel": "wob", "gain": -1.0})])
+    b = linearise(p, friction="none", effects=[("sensor_gain", {"channel": "wob", "factor": -1.0})])
     i = list(a.output_labels).index("wob")
     np.testing.assert_allclose(b.C[i], -a.C[i], rtol=1e-12, atol=1e-12)
     np.testing.assert_allclose(b.D[i], -a.D[i], rtol=1e-12, atol=1e-12)
@@ -186,4 +190,64 @@ def test_linearise_with_a_wob_gain_scales_the_wob_row():
 
 def test_channel_effect_names_its_channel():
     with pytest.raises(ParameterError, match="unknown channel 'wobb'.*did you mean 'wob'"):
-        effect_class("sensor_gain")(channel="wobb", gain=1.1)
+        effect_class("sensor_gain")(channel="wobb", factor=1.1)
+
+
+class _Drifts(Effect):
+    """Test effect with two states drifting at constant rates (a gas spring term 0 x[0])."""
+
+    name = "_drifts"
+    hook = "gas_spring"
+    states = ("a", "b")
+
+    @dataclass(frozen=True)
+    class Params:
+        rate: float = q(1.0, "1/s", bounds=(0.0, 10.0), symbol="r", doc="rate of the first state")
+
+    @staticmethod
+    def gas(s, v, p, x, PP, rate):
+        return p + 0.0 * x[0] * x[1]
+
+    @staticmethod
+    def rates(s, v, p, x, PP, FP, rate):
+        return (rate + 0.0 * v, 2.0 * rate + 0.0 * v)
+
+    @staticmethod
+    def initial(FP, PP, rate):
+        return (0.0, 1.0)
+
+
+def test_a_composition_has_as_many_state_slots_as_its_effects():
+    """The library's three state effects plus one with two states: five effect states (the
+    stepper's state was once limited to three), laid out after the plant's four."""
+    from heavecomp.effects.compose import composition
+    from heavecomp.effects.model import casadi_model
+    from heavecomp.effects.registry import library
+
+    classes = tuple(c for c in library().values() if c.kind == "plant" and c.states) + (_Drifts,)
+    comp = composition(classes)
+    assert comp.n_states == 5 and comp.slots["_drifts"] == (7, 8)
+    plant = cmc.plant_vectors(paper_a())
+    EP = comp.ep([_Drifts(rate=0.5)])
+    X0 = comp.initial_state(plant.FP, plant.PP, EP)
+    assert X0.shape == (10,) and X0[8] == 1.0
+    fn = comp.functions
+    X = tuple(X0[:9])
+    k = fn["state_dot"](0.1, 0.2, 0.3, 0.4, 0.0, 0.1, 2e6, X, plant.PP, plant.FP, EP)
+    assert k == (0.1, 0.2, 0.3, 0.4, 0.0, 0.0, 0.0, 0.5, 1.0)
+    f = casadi_model(paper_a("none"), effects=[_Drifts(rate=0.5)])
+    xd = np.asarray(f(np.r_[0.0, 0.1, 0.0, 0.0, 0.0, 1.0], np.zeros(4))[0]).ravel()
+    assert xd.size == 6 and xd[4] == 0.5 and xd[5] == 1.0
+
+
+@pytest.mark.slow
+def test_a_five_state_composition_compiles_and_integrates():
+    """The stepper compiled for five effect states integrates them (constant rates: exact)."""
+    from heavecomp.effects.compose import composition
+    from heavecomp.effects.registry import library
+    from heavecomp.diagnosis.stepper import simulate_fx
+
+    classes = tuple(c for c in library().values() if c.kind == "plant" and c.states) + (_Drifts,)
+    res = simulate_fx(paper_a(), 20.0, [_Drifts(rate=0.5), ("gas_leak", {"leak_rate": -1e-4})], rate=10.0,
+                      comp=composition(classes))
+    np.testing.assert_allclose(res["effect_state_6"], -1e-4 * res["t"], rtol=1e-9, atol=1e-15)

@@ -83,10 +83,10 @@ def test_kernel_rhs_equals_casadi_model_away_from_zero_velocity(model):
         cm = 1.0 if K.contact_switch(yb, vb, PP) > 0 else 0.0  # the stepper's contact state here
         # held contact state = the clamped law wherever they agree (physics once)
         assert _close(K.lower_accel_contact(s, v, yb, vb, zh, dzh, cm, PP), cmc.lower_accel(s, v, yb, vb, zh, dzh, PP), 1.0)
-        X = (s, v, yb, vb, 1.0, 0.0, 0.0)  # effect states at their rest values (EP = 0: unused)
+        X = (s, v, yb, vb)  # the plain CMC's stepper: no effect states
         EP = K.NO_EFFECTS
         k = K.rhs(0.0, X, K.SLIDING, float(np.sign(v)), cm, smooth, law.code, law.FP, PP, EP, u, 1.0, Z, DZ, DDZ)
-        assert k[0] == v and k[2] == vb and k[4:] == (0.0, 0.0, 0.0)
+        assert k[0] == v and k[2] == vb and len(k) == 4
         assert _close(k[1], xdot[1], 1.0)
         assert _close(k[3], xdot[3], 1.0)
         # outputs: wob, stroke, pressure, tension, friction
@@ -112,8 +112,9 @@ def test_kernel_rhs_equals_casadi_model_away_from_zero_velocity(model):
 def _check_nominal_hooks(fn, code, FP, PP, EP):
     """The composed hook functions ``fn`` with effect parameters EP are the CMC exactly."""
     for s, v, yb, vb, zh, dzh, ddzh, u in _states(200, 3):
+        X = (s, v, yb, vb, 0.7, 0.3, 0.1)  # effect states (of effects switched off) anywhere
         for cm in (0.0, 1.0):
-            pr, T, hold, dvb = fn["plant_fx"](s, v, yb, vb, 0.7, 0.3, 0.1, zh, dzh, ddzh, u, cm, PP, EP)
+            pr, T, hold, dvb = fn["plant_fx"](s, v, yb, vb, X, zh, dzh, ddzh, u, cm, PP, EP)
             assert pr == cmc.gas_pressure(s, PP)
             assert T == cmc.tension(s, v, yb, vb, zh, dzh, PP)
             assert hold == cmc.holding_force(s, v, yb, vb, zh, dzh, ddzh, u, PP)
@@ -121,10 +122,10 @@ def _check_nominal_hooks(fn, code, FP, PP, EP):
         pr = cmc.gas_pressure(s, PP)
         for d in (1.0, -1.0):
             for a in (d * v, -1e-3):  # also a trial step past a reversal (a < 0)
-                assert fn["jump_fx"](code, a, pr, s, d, 0.7, 0.3, 0.1, FP, EP) == laws.friction_jump(code, a, pr, FP)
-            assert (fn["sliding_friction_fx"](code, d, v, pr, s, 0.7, 0.3, 0.1, FP, EP)
+                assert fn["jump_fx"](code, a, pr, s, d, X, FP, EP) == laws.friction_jump(code, a, pr, FP)
+            assert (fn["sliding_friction_fx"](code, d, v, pr, s, X, FP, EP)
                     == cmc.sliding_friction(code, d, s, v, FP, PP))
-        assert fn["static_limit_fx"](code, pr, s, 1.0, 0.7, 0.3, 0.1, 3.0, FP, EP) == cmc.static_limit(code, s, FP, PP)
+        assert fn["static_limit_fx"](code, pr, s, 1.0, X, 3.0, FP, EP) == cmc.static_limit(code, s, FP, PP)
 
 
 @pytest.mark.parametrize("model", MODELS)
@@ -161,21 +162,21 @@ def test_compiled_effect_hooks_equal_python_originals():
         EP = comp.ep(effects)
         fc, fp = K.compiled_hooks(comp), comp.functions
         for s, v, yb, vb, zh, dzh, ddzh, u in _states(100, 5):
-            x = (rng.uniform(0.9, 1.1), abs(v) * rng.uniform(0.5, 1.5), rng.uniform(0, 2e4))
+            x = (s, v, yb, vb, rng.uniform(0.9, 1.1), abs(v) * rng.uniform(0.5, 1.5), rng.uniform(0, 2e4))
             tau = rng.uniform(0, 5)
-            for a, b in zip(fc["plant_fx"](s, v, yb, vb, *x, zh, dzh, ddzh, u, 1.0, PP, EP),
-                            fp["plant_fx"](s, v, yb, vb, *x, zh, dzh, ddzh, u, 1.0, PP, EP)):
+            for a, b in zip(fc["plant_fx"](s, v, yb, vb, x, zh, dzh, ddzh, u, 1.0, PP, EP),
+                            fp["plant_fx"](s, v, yb, vb, x, zh, dzh, ddzh, u, 1.0, PP, EP)):
                 assert _close(a, b, 1e5)
-            pr = fp["cylinder_pressure_fx"](s, v, *x, PP, EP)
+            pr = fp["cylinder_pressure_fx"](s, v, x, PP, EP)
             for code in (laws.NONE, laws.STRIBECK, laws.EQ7):
                 FP = plant.FP.copy()
                 FP[laws.VT] = 0.05 if code == laws.EQ7 else 0.0
-                assert _close(fc["sliding_friction_fx"](code, np.sign(v), v, pr, s, *x, FP, EP),
-                              fp["sliding_friction_fx"](code, np.sign(v), v, pr, s, *x, FP, EP), 1e5)
-                assert _close(fc["static_limit_fx"](code, pr, s, np.sign(v), *x, tau, FP, EP),
-                              fp["static_limit_fx"](code, pr, s, np.sign(v), *x, tau, FP, EP), 1e5)
-            for a, b in zip(fc["effect_rates"](s, v, pr, *x, PP, plant.FP, EP),
-                            fp["effect_rates"](s, v, pr, *x, PP, plant.FP, EP)):
+                assert _close(fc["sliding_friction_fx"](code, np.sign(v), v, pr, s, x, FP, EP),
+                              fp["sliding_friction_fx"](code, np.sign(v), v, pr, s, x, FP, EP), 1e5)
+                assert _close(fc["static_limit_fx"](code, pr, s, np.sign(v), x, tau, FP, EP),
+                              fp["static_limit_fx"](code, pr, s, np.sign(v), x, tau, FP, EP), 1e5)
+            for a, b in zip(fc["effect_rates"](s, v, pr, x, PP, plant.FP, EP),
+                            fp["effect_rates"](s, v, pr, x, PP, plant.FP, EP)):
                 assert _close(a, b, 1e4)
 
 

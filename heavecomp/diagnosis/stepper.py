@@ -4,8 +4,8 @@ The stepper is :func:`heavecomp.simulate._kernel.kernel_for` of an effect compos
 (:mod:`heavecomp.effects.compose`), the same compiled exact stick-slip RK4 with event location
 that :func:`heavecomp.simulate.simulate` runs (velocity reversal, stick, breakaway, bit lift-off
 and touchdown, the end of the fade-in as a step boundary), with the effects' terms at the
-plant's hooks switched on by the effect-parameter vector ``EP`` (extra states: slots x4-x6,
-dwell time at rest ``tau``).  With every effect off a run is :func:`heavecomp.simulate.simulate`
+plant's hooks switched on by the effect-parameter vector ``EP`` (extra states: the slots after the
+plant's four, dwell time at rest ``tau``).  With every effect off a run is :func:`heavecomp.simulate.simulate`
 bit for bit (``tests/test_diagnosis_stepper.py``).
 
 Equations: paper A section 4 / cmc-reference.md with the hook terms of the composed effects

@@ -191,7 +191,7 @@ class ChannelEffect(Effect):
     """Base of an effect on one measured channel (hook ``channel``, ``kind = "output"``): the plant is
     nominal, the recorded channel misreads.  ``apply(t, tg, y, *prm)`` gives the recorded channel at
     times ``t`` [s] from the true one ``y`` on the grid ``tg`` [s]; an instance names its channel
-    (:data:`SENSOR_CHANNELS`): ``SensorGain(channel="wob", gain=1.08)``."""
+    (:data:`SENSOR_CHANNELS`): ``SensorGain(channel="wob", factor=1.08)``."""
 
     hook = "channel"
     kind = "output"

@@ -33,7 +33,7 @@ class HeaveReference(HeaveEffect):
 
     @dataclass(frozen=True)
     class Params:
-        gain: float = q(1.0, "-", bounds=(0.5, 1.5), symbol="g", doc="factor from the measured to the seen heave")
+        scale: float = q(1.0, "-", bounds=(0.5, 1.5), symbol="g", doc="factor from the measured to the seen heave")
         delay: float = q(0.0, "s", bounds=(-2.0, 2.0), symbol="t_d",
                          doc="time by which the seen heave lags the measured one (negative: leads)")
 
@@ -52,14 +52,14 @@ class HeaveReference(HeaveEffect):
         return {"gain": z, "delay": cls.seen(t, z, 1.0, d) - z}
 
     @staticmethod
-    def seen(t, z, gain, delay):
+    def seen(t, z, scale, delay):
         """The seen heave (or its derivative) on the uniform grid ``t`` [s] from the measured ``z``
         (linear interpolation; held at the ends)."""
-        return gain * np.interp(t - delay, t, z)
+        return scale * np.interp(t - delay, t, z)
 
     @classmethod
     def null(cls, plant):
-        return {"gain": 1.0, "delay": 0.0}
+        return {"scale": 1.0, "delay": 0.0}
 
 
 EFFECT = HeaveReference

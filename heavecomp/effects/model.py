@@ -52,12 +52,12 @@ def casadi_model(params, *, eps: float | None = None, sym: str = "SX", effects=(
     if (plant.has_stiction or comp.adds_stiction(EP)) and not (eps and eps > 0):
         raise ValueError("casadi_model: friction with stiction needs an explicit eps > 0 [m/s]")
     code, FP, PP = plant.code, plant.FP, plant.PP
-    n_eff = sum(len(c.states) for c in comp.classes)
+    n_eff = comp.n_states
     S = getattr(ca, sym)
     x = S.sym("x", 4 + n_eff)
     u = S.sym("u", 4)
     s, v, yb, vb = x[0], x[1], x[2], x[3]
-    xe = [x[4 + i] for i in range(n_eff)] + [0.0] * (3 - n_eff)  # the effects' state slots x4..x6
+    X = [x[i] for i in range(4 + n_eff)]  # the stepper's state: the plant's four, then the effects'
     zh, dzh, ddzh, ua = u[0], u[1], u[2], u[3]
     for e in heave_fx:  # the heave the plant sees: a gain on the measured one
         g = _static_gain(e, e.seen)
@@ -67,12 +67,12 @@ def casadi_model(params, *, eps: float | None = None, sym: str = "SX", effects=(
             g, o = _static_affine(e)
             zh, dzh, ddzh = (zh - o) / g, dzh / g, ddzh / g
     fn = comp.functions
-    p, T, hold, dvb = fn["plant_fx"](s, v, yb, vb, *xe, zh, dzh, ddzh, ua, 1.0, PP, EP)
+    p, T, hold, dvb = fn["plant_fx"](s, v, yb, vb, X, zh, dzh, ddzh, ua, 1.0, PP, EP)
     dvb = lower_accel_wob(T, yb, vb, PP)  # the clamped contact law (smooth model)
     sv = np.tanh(v / (eps or 1.0))  # the direction of motion, smoothed
-    Ff = fn["jump_fx"](code, np.abs(v), p, s, sv, *xe, FP, EP) * sv + friction_cont(code, v, p, FP)
+    Ff = fn["jump_fx"](code, np.abs(v), p, s, sv, X, FP, EP) * sv + friction_cont(code, v, p, FP)
     dv = (hold - Ff) / PP[MC]
-    rates = fn["effect_rates"](s, v, p, *xe, PP, FP, EP)[:n_eff]
+    rates = fn["effect_rates"](s, v, p, X, PP, FP, EP)
     xdot = ca.vertcat(v, dv, vb, dvb, *rates)
     y = {"wob": wob(yb, vb, PP), "stroke": s, "pressure": p}
     for e in sensor_fx:  # a recorded channel that reads g y + o
@@ -120,5 +120,5 @@ def initial_effect_states(params, effects=()) -> np.ndarray:
     plant = plant_vectors(params)
     effects = split_effects(resolve(effects))[0]
     comp = composition(tuple(dict.fromkeys(type(e) for e in effects)))
-    n_eff = sum(len(c.states) for c in comp.classes)
+    n_eff = comp.n_states
     return comp.initial_state(plant.FP, plant.PP, comp.ep(effects))[4:4 + n_eff]

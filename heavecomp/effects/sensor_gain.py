@@ -13,7 +13,8 @@ from heavecomp.params.core import q
 class SensorGain(ChannelEffect):
     """y_meas = g y for one channel (``channel``: wob, stroke, pressure or heave): a calibration
     error, a wrong unit factor, or a sign flip (g = -1, a load cell or a transducer wired the
-    other way).  Acts on the recorded channel, outside the stepper; the diagnosis fits which channel.
+    other way).  The parameter is ``factor`` (not ``gain``: its unit differs from dwell_stiction's
+    ``gain``, and the report's units go by parameter name).  Acts on the recorded channel, outside the stepper; the diagnosis fits which channel.
     """
 
     name = "sensor_gain"
@@ -22,7 +23,7 @@ class SensorGain(ChannelEffect):
 
     @dataclass(frozen=True)
     class Params:
-        gain: float = q(1.0, "-", bounds=(-2.0, 2.0), symbol="g",
+        factor: float = q(1.0, "-", bounds=(-2.0, 2.0), symbol="g",
                         doc="factor the channel reads (1: right; -1: sign flipped)")
 
     @classmethod
@@ -34,13 +35,13 @@ class SensorGain(ChannelEffect):
         return {"sensor_gain": np.asarray(sig["y"], dtype=float)}
 
     @staticmethod
-    def apply(t, tg, y, gain):
+    def apply(t, tg, y, factor):
         """The recorded channel at times ``t`` from the true ``y`` on the grid ``tg``."""
-        return gain * np.interp(t, tg, y)
+        return factor * np.interp(t, tg, y)
 
     @classmethod
     def null(cls, plant):
-        return {"gain": 1.0}
+        return {"factor": 1.0}
 
 
 EFFECT = SensorGain

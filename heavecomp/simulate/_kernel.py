@@ -8,7 +8,8 @@ the plant's hooks (:mod:`heavecomp.effects`), compiled by numba from the same so
 One stepper serves the simulator and the gap diagnosis.  It integrates the hook functions
 of an effect composition (:mod:`heavecomp.effects.compose`: ``plant_fx``,
 ``sliding_friction_fx``, ``static_limit_fx``, ``effect_rates``; the effects' states in the
-slots x4-x6 of the state, the dwell time tau since the last stick event kept by the stepper),
+slots after the plant's four in the state, as many as the composition has, the dwell time tau
+since the last stick event kept by the stepper),
 each effect switched on by its slot of the effect-parameter vector ``EP``.  This module's
 functions are compiled for the composition of no effect, where the hooks are the plain CMC:
 :func:`advance` (used by :func:`heavecomp.simulate.simulate`, the closed loop, the campaigns,
@@ -180,6 +181,13 @@ jump_fx = _ENV["jump_fx"]
 sliding_friction_fx = _ENV["sliding_friction_fx"]
 static_limit_fx = _ENV["static_limit_fx"]
 effect_rates = _ENV["effect_rates"]
+state_axpy = _ENV["state_axpy"]
+state_rest = _ENV["state_rest"]
+state_rk4 = _ENV["state_rk4"]
+state_dot = _ENV["state_dot"]
+state_load = _ENV["state_load"]
+state_store = _ENV["state_store"]
+state_record = _ENV["state_record"]
 
 from heavecomp.simulate.layout import CHANNELS, FX_CHANNELS, NCH, NSTATS, SLIDING, STATS, STUCK  # noqa: E402,F401
 
@@ -238,61 +246,41 @@ def heave_at(t, sp, Z, DZ, DDZ):
 
 @_jit_inline
 def rhs(t, X, mode, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ):
-    """Time derivatives of ``X = (s, v, yb, vb, x4, x5, x6)`` in the given mode.
+    """Time derivatives of ``X = (s, v, yb, vb, effect states...)`` in the given mode.
 
     The plant is the composition's ``plant_fx`` (:mod:`heavecomp.effects.compose`: the CMC of
-    :mod:`heavecomp.plants.cmc` with the effects' hook terms; x4-x6 are the effects' states);
-    the contact state ``cm`` is held, the stroke frozen while stuck.
+    :mod:`heavecomp.plants.cmc` with the effects' hook terms; X[4:] are the effects' states, as
+    many as the composition has); the contact state ``cm`` is held, the stroke frozen while stuck.
     """
-    s, v, yb, vb, x4, x5, x6 = X
+    s, v, yb, vb = X[0], X[1], X[2], X[3]
     if mode == STUCK:
         v = 0.0
     zh, dzh, ddzh = heave_at(t, sp, Z, DZ, DDZ)
-    p, T, hold, dvb = plant_fx(s, v, yb, vb, x4, x5, x6, zh, dzh, ddzh, u, cm, PP, EP)
-    d4, d5, d6 = effect_rates(s, v, p, x4, x5, x6, PP, FP, EP)
+    p, T, hold, dvb = plant_fx(s, v, yb, vb, X, zh, dzh, ddzh, u, cm, PP, EP)
     if mode == STUCK:
-        return (0.0, 0.0, vb, dvb, d4, d5, d6)
+        return state_dot(0.0, 0.0, vb, dvb, s, v, p, X, PP, FP, EP)
     if smooth:
         Ff = friction_cont(code, v, p, FP)
     else:
-        Ff = sliding_friction_fx(code, d, v, p, s, x4, x5, x6, FP, EP)
-    return (v, (hold - Ff) / PP[MC], vb, dvb, d4, d5, d6)
-
-
-@_jit
-def _axpy(X, h, k):
-    return (X[0] + h * k[0], X[1] + h * k[1], X[2] + h * k[2], X[3] + h * k[3], X[4] + h * k[4],
-            X[5] + h * k[5], X[6] + h * k[6])
-
-
-@_jit
-def _at_rest(X):
-    """X with the stroke velocity exactly 0."""
-    return (X[0], 0.0, X[2], X[3], X[4], X[5], X[6])
+        Ff = sliding_friction_fx(code, d, v, p, s, X, FP, EP)
+    return state_dot(v, (hold - Ff) / PP[MC], vb, dvb, s, v, p, X, PP, FP, EP)
 
 
 @_jit
 def rk4(t, h, X, mode, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ):
     k1 = rhs(t, X, mode, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ)
     h2 = 0.5 * h
-    k2 = rhs(t + h2, _axpy(X, h2, k1), mode, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ)
-    k3 = rhs(t + h2, _axpy(X, h2, k2), mode, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ)
-    k4 = rhs(t + h, _axpy(X, h, k3), mode, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ)
-    h6 = h / 6.0
-    return (X[0] + h6 * (k1[0] + 2 * k2[0] + 2 * k3[0] + k4[0]),
-            X[1] + h6 * (k1[1] + 2 * k2[1] + 2 * k3[1] + k4[1]),
-            X[2] + h6 * (k1[2] + 2 * k2[2] + 2 * k3[2] + k4[2]),
-            X[3] + h6 * (k1[3] + 2 * k2[3] + 2 * k3[3] + k4[3]),
-            X[4] + h6 * (k1[4] + 2 * k2[4] + 2 * k3[4] + k4[4]),
-            X[5] + h6 * (k1[5] + 2 * k2[5] + 2 * k3[5] + k4[5]),
-            X[6] + h6 * (k1[6] + 2 * k2[6] + 2 * k3[6] + k4[6]))
+    k2 = rhs(t + h2, state_axpy(X, h2, k1), mode, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ)
+    k3 = rhs(t + h2, state_axpy(X, h2, k2), mode, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ)
+    k4 = rhs(t + h, state_axpy(X, h, k3), mode, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ)
+    return state_rk4(X, h / 6.0, k1, k2, k3, k4)
 
 
 @_jit
 def hold(t, X, u, PP, EP, sp, Z, DZ, DDZ):
     """(holding force, cylinder pressure) at v = 0: while stuck the friction is the holding force."""
     zh, dzh, ddzh = heave_at(t, sp, Z, DZ, DDZ)
-    p, T, F, dvb = plant_fx(X[0], 0.0, X[2], X[3], X[4], X[5], X[6], zh, dzh, ddzh, u, 1.0, PP, EP)
+    p, T, F, dvb = plant_fx(X[0], 0.0, X[2], X[3], X, zh, dzh, ddzh, u, 1.0, PP, EP)
     return F, p
 
 
@@ -362,7 +350,7 @@ def advance(state, mode_dir, t0, n_steps, h, code, FP, PP, smooth, u, sp, Z, DZ,
     is the state at ``t0`` when ``out_pos == 0``.  ``stats`` accumulates STATS.
     This is :func:`advance_fx` with no effect.
     """
-    X = (state[0], state[1], state[2], state[3], 0.0, 0.0, 0.0)
+    X = (state[0], state[1], state[2], state[3])
     X, tau, mode, d, pos = _advance(X, 0.0, int(mode_dir[0]), mode_dir[1], t0, n_steps, h, code, FP, PP,
                                     NO_EFFECTS, smooth, u, sp, Z, DZ, DDZ, out, out_every, out_pos, stats)
     state[0], state[1], state[2], state[3] = X[0], X[1], X[2], X[3]
@@ -377,16 +365,15 @@ def advance_fx(state, mode_dir, t0, n_steps, h, code, FP, PP, EP, smooth, u, sp,
     """:func:`advance` with effects: the stepper of an effect composition (:func:`kernel_for`;
     this module-level one has none) with effect parameters ``EP`` (:meth:`Composition.ep`).
 
-    ``state`` has 8 entries, ``[s, v, yb, vb, x4, x5, x6, tau]`` (the effects' states, the
-    dwell time at rest); when ``out`` has more than NCH columns the next ones get FX_CHANNELS.
+    ``state`` is ``[s, v, yb, vb, effect states..., tau]`` (the composition's effect states, the
+    dwell time at rest: :meth:`Composition.initial_state`); when ``out`` has more than NCH columns
+    the next ones get FX_CHANNELS (the gas pressure, then the effect states as far as there is room).
     Releases the GIL (the diagnosis fits in threads).
     """
-    X = (state[0], state[1], state[2], state[3], state[4], state[5], state[6])
-    X, tau, mode, d, pos = _advance(X, state[7], int(mode_dir[0]), mode_dir[1], t0, n_steps, h, code, FP, PP,
+    X, tau = state_load(state)
+    X, tau, mode, d, pos = _advance(X, tau, int(mode_dir[0]), mode_dir[1], t0, n_steps, h, code, FP, PP,
                                     EP, smooth, u, sp, Z, DZ, DDZ, out, out_every, out_pos, stats)
-    for k in range(7):
-        state[k] = X[k]
-    state[7] = tau
+    state_store(state, X, tau)
     mode_dir[0] = mode
     mode_dir[1] = d
     return pos
@@ -409,7 +396,7 @@ def _advance(X, tau, mode, d, t0, n_steps, h, code, FP, PP, EP, smooth, u, sp, Z
         for _ev in range(8):
             # tentative step to the grid, cut at the first contact switch (lift-off/touchdown)
             if mode == STUCK:
-                X = _at_rest(X)
+                X = state_rest(X)
             X1 = rk4(tc, left, X, mode, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ)
             cut = left
             switched = False
@@ -446,11 +433,11 @@ def _advance(X, tau, mode, d, t0, n_steps, h, code, FP, PP, EP, smooth, u, sp, Z
                     if nt >= cut:
                         nt = 0.5 * (tz + cut)
                     tz = nt
-                X = _at_rest(Xt)
+                X = state_rest(Xt)
                 tc += tz
                 left -= tz
                 F, p = hold(tc, X, u, PP, EP, sp, Z, DZ, DDZ)
-                if abs(F) <= static_limit_fx(code, p, X[0], 1.0 if F > 0 else -1.0, X[4], X[5], X[6], 0.0, FP, EP):
+                if abs(F) <= static_limit_fx(code, p, X[0], 1.0 if F > 0 else -1.0, X, 0.0, FP, EP):
                     mode = STUCK
                     tau = 0.0
                     stats[1] += 1.0
@@ -461,7 +448,7 @@ def _advance(X, tau, mode, d, t0, n_steps, h, code, FP, PP, EP, smooth, u, sp, Z
                     break
             else:  # STUCK
                 F1, p1 = hold(tc + cut, X1, u, PP, EP, sp, Z, DZ, DDZ)
-                lim1 = static_limit_fx(code, p1, X1[0], 1.0 if F1 > 0 else -1.0, X1[4], X1[5], X1[6], tau + cut, FP, EP)
+                lim1 = static_limit_fx(code, p1, X1[0], 1.0 if F1 > 0 else -1.0, X1, tau + cut, FP, EP)
                 if abs(F1) <= lim1:
                     stats[0] += cut
                     tau += cut
@@ -477,7 +464,7 @@ def _advance(X, tau, mode, d, t0, n_steps, h, code, FP, PP, EP, smooth, u, sp, Z
                 # breakaway before the cut: bracket [lo, hi] with margin(lo) >= 0 > margin(hi)
                 sg = 1.0 if F1 > 0 else -1.0
                 F0, p0 = hold(tc, X, u, PP, EP, sp, Z, DZ, DDZ)
-                m_lo = static_limit_fx(code, p0, X[0], sg, X[4], X[5], X[6], tau, FP, EP) - sg * F0
+                m_lo = static_limit_fx(code, p0, X[0], sg, X, tau, FP, EP) - sg * F0
                 m_hi = lim1 - sg * F1
                 lo, hi = 0.0, cut
                 Xhi = X1
@@ -490,7 +477,7 @@ def _advance(X, tau, mode, d, t0, n_steps, h, code, FP, PP, EP, smooth, u, sp, Z
                         tt = 0.5 * (lo + hi)
                     X2 = rk4(tc, tt, X, STUCK, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ)
                     F2, p2 = hold(tc + tt, X2, u, PP, EP, sp, Z, DZ, DDZ)
-                    m = static_limit_fx(code, p2, X2[0], sg, X2[4], X2[5], X2[6], tau + tt, FP, EP) - sg * F2
+                    m = static_limit_fx(code, p2, X2[0], sg, X2, tau + tt, FP, EP) - sg * F2
                     if m >= 0.0:
                         lo, m_lo = tt, m
                         if side == -1:
@@ -505,7 +492,7 @@ def _advance(X, tau, mode, d, t0, n_steps, h, code, FP, PP, EP, smooth, u, sp, Z
                     if abs(m) < 1e-9 * (1.0 + abs(lim1)):
                         if m < 0.0:
                             break
-                X = _at_rest(Xhi)
+                X = state_rest(Xhi)
                 stats[0] += hi
                 tc += hi
                 left -= hi
@@ -522,7 +509,7 @@ def _advance(X, tau, mode, d, t0, n_steps, h, code, FP, PP, EP, smooth, u, sp, Z
             if left > 0.0:
                 X = rk4(tc, left, X, mode, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ)
                 if mode == STUCK:
-                    X = _at_rest(X)
+                    X = state_rest(X)
                     stats[0] += left
                     tau += left
                 if stats[4] == 0.0:
@@ -567,17 +554,17 @@ def _contact_time(tc, left, X, mode, d, cm, smooth, code, FP, PP, EP, u, sp, Z, 
 
 @_jit
 def _record(out, pos, t, X, mode, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ):
-    s, v, yb, vb, x4, x5, x6 = X
+    s, v, yb, vb = X[0], X[1], X[2], X[3]
     if mode == STUCK:
         v = 0.0
     zh, dzh, ddzh = heave_at(t, sp, Z, DZ, DDZ)
-    p, T, F, dvb = plant_fx(s, v, yb, vb, x4, x5, x6, zh, dzh, ddzh, u, cm, PP, EP)
+    p, T, F, dvb = plant_fx(s, v, yb, vb, X, zh, dzh, ddzh, u, cm, PP, EP)
     if mode == STUCK:
         Ff = F
     elif smooth:
         Ff = friction_cont(code, v, p, FP)
     else:
-        Ff = sliding_friction_fx(code, d, v, p, s, x4, x5, x6, FP, EP)
+        Ff = sliding_friction_fx(code, d, v, p, s, X, FP, EP)
     out[pos, 0] = t
     out[pos, 1] = zh
     out[pos, 2] = s
@@ -590,11 +577,9 @@ def _record(out, pos, t, X, mode, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ,
     out[pos, 9] = vb
     out[pos, 10] = 1.0 if mode == STUCK else 0.0
     out[pos, 11] = u
-    if out.shape[1] >= NCH + 4:  # FX_CHANNELS
-        out[pos, NCH] = gas_fx(s, v, x4, x5, x6, PP, EP)
-        out[pos, NCH + 1] = x4
-        out[pos, NCH + 2] = x5
-        out[pos, NCH + 3] = x6
+    if out.shape[1] > NCH:  # FX_CHANNELS
+        out[pos, NCH] = gas_fx(s, v, X, PP, EP)
+        state_record(out, pos, NCH + 1, X)
 
 
 #: kernel functions that call the hook functions, callees first (cloned per composition)

@@ -8,7 +8,8 @@ CHANNELS = ("t", "heave", "stroke", "pressure", "wob", "stroke_velocity", "frict
             "lower_displacement", "lower_velocity", "stuck", "u_active")
 NCH = len(CHANNELS)
 #: extra channels written by ``_kernel.advance_fx`` when ``out`` has room (after CHANNELS): the gas
-#: pressure before the line and the effects' states x4, x5, x6 (slots of ``effects.compose``)
+#: pressure before the line and the first three effect states X[4], X[5], X[6] (slots of ``effects.compose``;
+#: a composition with more records these three)
 FX_CHANNELS = ("gas_pressure", "effect_state_4", "effect_state_5", "effect_state_6")
 #: slots of the ``stats`` array: time stuck [s]; counts of stick, breakaway, reversal events;
 #: steps that hit the event cap (more than 8 events in one step, finished without event
