@@ -29,7 +29,7 @@ import inspect
 from heavecomp.errors import InputError
 
 #: verdicts that name no effect
-NO_EFFECT = ("none", "inconclusive")
+NO_EFFECT = ("none", "inconclusive", "discovered")  # discovered: an open-search term, never a named effect
 
 
 class NotFittedError(InputError):

@@ -115,15 +115,26 @@ def filtfilt_fir(x, b) -> np.ndarray:
     zero phase, squared magnitude response.
 
     The signal must be longer than 3 filter lengths; otherwise InputError.
+
+    ``scipy.signal.filtfilt(b, [1.0], x, padtype="odd", padlen=3 * b.size)`` step by step, with the
+    FIR's steady-state initial condition in closed form (``zi[k] = sum(b[k+1:])``, what
+    ``lfilter_zi`` returns) instead of ``lfilter_zi``'s dense solve, cubic in the number of taps
+    (0.14 s per call for a 1 Hz filter at 50 Hz; ``tests/test_signals.py`` pins the two equal).
     """
-    from scipy.signal import filtfilt
+    from scipy.signal import lfilter
+    from scipy.signal._arraytools import odd_ext
 
     x = np.asarray(x, dtype=float)
     b = np.asarray(b, dtype=float)
     if x.shape[-1] <= 3 * b.size:
         raise InputError(f"signal of {x.shape[-1]} samples is too short for a {b.size}-tap filter: "
                          "raise the cutoff or record longer")
-    return filtfilt(b, [1.0], x, padtype="odd", padlen=3 * b.size)
+    n = 3 * b.size
+    zi = np.cumsum(b[::-1])[::-1][1:] if b.size > 1 else np.zeros(0)
+    ext = odd_ext(x, n, axis=-1)
+    y, _ = lfilter(b, [1.0], ext, zi=zi * ext[0])
+    y, _ = lfilter(b, [1.0], y[::-1], zi=zi * y[-1])
+    return y[::-1][n:-n]
 
 
 def zero_phase_lowpass(x, fs: float, cutoff: float, numtaps: int | None = None) -> np.ndarray:

@@ -55,8 +55,14 @@ def test_cli_diagnose_contract_json(tmp_path):
                        capture_output=True, text=True)
     assert r.returncode == 0, r.stderr[-2000:]
     d = json.loads((tmp_path / "out" / "diagnosis.json").read_text())
-    assert d["schema"] == 1
+    assert d["schema"] == 2
     v = d["verdict"]
+    # schema 2: where the gap lives by model component, the start state, warnings
+    comps = d["gap"]["where"]["components"]
+    assert set(comps) == {"friction", "gas_spring", "flow_line", "string_formation", "sensors", "heave_input"}
+    assert sum(comps.values()) == pytest.approx(1.0, abs=1e-6)
+    assert v["component"] == "sensors" and {"stroke", "stroke_velocity"} <= set(d["initial_state"])
+    assert isinstance(d["warnings"], list)
     assert {"effect", "confidence", "parameters", "shrink"} <= set(v)
     assert v["confidence"] in ("high", "medium", "low")
     # the lagged channel is found and the delay is of the order of the generated sensor lag
@@ -93,7 +99,8 @@ def test_diagnosis_example_scenario_quick(tmp_path):
     assert sd["channels"]["wob"]["rms_after"] < sd["channels"]["wob"]["rms_before"]
     assert m["verdict"]["effect"] == "string_damping"
     d = json.loads((tmp_path / "diagnosis.json").read_text())
-    assert d["schema"] == 1 and (tmp_path / "overlay.png").is_file()
+    assert d["schema"] == 2 and (tmp_path / "overlay.png").is_file()
+    assert d["verdict"]["component"] == "string_formation" and "components" in d["gap"]["where"]
     # a re-run leaves git clean: the fit wall times are in the untracked timings.json only
     assert "wall" not in json.dumps({k: v for k, v in d.items() if k != "units"})
     t = json.loads((tmp_path / "timings.json").read_text())["diagnosis.json"]

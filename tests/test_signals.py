@@ -53,3 +53,15 @@ def test_friction_recovered_from_synthetic_pneumatic_measurement():
     r = synthetic_validation(duration=2.5)
     assert r["rms_error_N"] < 0.02 * r["friction_span_N"]
     assert r["velocity_rms_error"] < 1e-3  # m/s, vs u_0 = 30 mm/s
+
+
+def test_filtfilt_fir_is_scipy_filtfilt():
+    """The closed-form FIR initial condition gives scipy's filtfilt (odd padding, 3 lengths)."""
+    from scipy.signal import filtfilt
+
+    from heavecomp.signals import design_flat_lowpass, filtfilt_fir
+
+    x = np.cumsum(np.random.default_rng(2).normal(size=3000)) + 5.0
+    for b in (design_flat_lowpass(50.0, 1.0, 0.75), np.array([0.25, 0.5, 0.25])):
+        ref = filtfilt(b, [1.0], x, padtype="odd", padlen=3 * b.size)
+        assert np.max(np.abs(filtfilt_fir(x, b) - ref)) <= 1e-9 * np.max(np.abs(ref))

@@ -51,6 +51,9 @@ from heavecomp.diagnosis.data import (derivative_zero_phase, HEAVE_CUTOFF, heave
 from heavecomp.plants.cmc import D0, KF, plant_vectors
 from heavecomp.diagnosis.data import heave_filtered
 from heavecomp.diagnosis import start as S
+from heavecomp.diagnosis import components as CR
+from heavecomp.diagnosis import equation_error as EE
+from heavecomp.effects.base import COMPONENTS
 
 log = logging.getLogger(__name__)
 CH = ("wob", "stroke", "pressure")
@@ -67,6 +70,11 @@ class Replay:
     plant: object  # PlantVectors of the nominal parameters
 
 
+PRESCREEN_GAP = 1.0  #: a component gap (noise variances above noise and floor) at or below which its candidates are not replayed
+DISCOVER_SHRINK = 0.5  #: an open-search term this good on its held-out component residual turns inconclusive into discovered
+#: component of each parameter table of parameter_mismatch
+TABLE_COMPONENT = {"compensator": "gas_spring", "friction": "friction", "drill_string": "string_formation",
+                   "formation": "string_formation"}
 BOUND_TOL = 0.01  #: a fitted parameter within this share of its search range from a bound is "at the bound"
 
 
@@ -140,6 +148,13 @@ class GapDiagnoser(GapEstimator):
     input_draws : int
         Replays with independent heave-noise draws for the input-noise envelope of the ``none``
         test (the largest held-out difference any of them makes).
+    prescreen_gap : float
+        Candidates at a kernel hook whose model component's equation-error gap
+        (:meth:`heavecomp.diagnosis.components.ComponentResiduals.gap`, noise variances above the noise
+        and the nominal replay's floor) is at most this are not replayed (issue 12 item 8).
+    discover_shrink : float
+        An ``inconclusive`` verdict becomes ``discovered`` when the open search's term shrinks its
+        held-out component residual by at least this share.
     none_tail, none_explained : float
         A held-out gap up to ``none_tail`` x the input-noise envelope that no candidate explains
         ``none_explained`` of is ``none`` (low confidence), not ``inconclusive``: runs without any
@@ -160,7 +175,8 @@ class GapDiagnoser(GapEstimator):
 
     def __init__(self, nominal, candidates=None, *, split=0.67, settle=None, penalty=0.03, min_explained=0.5,
                  none_ratio=1.2, max_nfev=40, decimate=2, n_jobs=2, progress=None, second=None, segment=None,
-                 reinit=1.5, stuck_speed=2e-3, grid=7, input_draws=8, none_tail=2.0, none_explained=0.25):
+                 reinit=1.5, stuck_speed=2e-3, grid=7, input_draws=8, none_tail=2.0, none_explained=0.25,
+                 prescreen_gap=PRESCREEN_GAP, discover_shrink=DISCOVER_SHRINK):
         self.nominal = nominal
         names = list(CANDIDATES) if candidates is None else list(candidates)
         for n in names:
@@ -185,6 +201,8 @@ class GapDiagnoser(GapEstimator):
         self.input_draws = max(1, int(input_draws))
         self.none_tail = none_tail
         self.none_explained = none_explained
+        self.prescreen_gap = prescreen_gap
+        self.discover_shrink = discover_shrink
 
     # ------------------------------------------------------------------ replay
     def _setup(self, run):
@@ -519,9 +537,18 @@ class GapDiagnoser(GapEstimator):
                                         "noise_floor": self.noise_floor_[c]}
         self.where_ = W.locate(run, nom, self.nominal, allmask)
         self.gap_["where"] = self.where_
+        # ---- where by component (equation error, from the measured signals; floor: the nominal replay)
+        self._report(0.04, "component residuals (equation error)")
+        self.components_ = CR.residuals(run, self.nominal, heave_reference=self.initial_.heave_reference,
+                                        noise=dict(self.output_noise_, heave=self.heave_noise_), mask=allmask,
+                                        floor_channels=nom)
+        self.where_["components"] = self.components_.shares()
+        self.where_["component_table"] = self.components_.table()
+        # ---- pre-screen: candidates whose component shows no gap are not replayed
+        self.prescreen_ = self._prescreen(self.candidates)
+        names = [n for n in self.candidates if self.prescreen_[n]["replay"]]
         # ---- which
         results = {}
-        names = list(self.candidates)
         done = 0
 
         def finish(name, fitted):
@@ -569,7 +596,10 @@ class GapDiagnoser(GapEstimator):
         self.second_tried_ = []
         self._verdict(rows, J_b, J_n)
         self._bound_check(rows)
+        self._component_verdict(rows)
         self.candidates_ = [{k: v for k, v in r.items() if not k.startswith("_")} for r in rows]
+        skipped = [self._skipped_row(n, mse_b) for n in self.candidates if n not in names]
+        self.candidates_ = sorted(self.candidates_ + skipped, key=lambda r: -r["score"])  # stable: fitted first at ties
         best_pred = rows[0]["_pred"] if self.verdict_["effect"] not in ("none",) else nom
         self.traces_ = {"t": run.t, "measured": {c: run[c] for c in CH}, "nominal": {c: nom[c] for c in CH},
                         "best": {c: best_pred[c] for c in CH}, "best_effect": rows[0]["effect"],
@@ -637,6 +667,99 @@ class GapDiagnoser(GapEstimator):
             v["second_effect"] = self._second(rows)
             v["second_candidates"] = self._second_candidates()
         self.verdict_ = v
+
+    # ----------------------------------------------------- components, pre-screen, discovered
+    def _prescreen(self, names) -> dict:
+        """Per candidate: its component, the component's gap over noise and floor
+        (:meth:`~heavecomp.diagnosis.components.ComponentResiduals.gap`), its equation-error fit on the
+        component residual where it has one (:func:`heavecomp.diagnosis.equation_error.rank_effects`),
+        and whether it is replayed: a plant candidate whose component shows no gap
+        (<= :attr:`prescreen_gap`; only components whose residual sees all their candidates,
+        :data:`heavecomp.diagnosis.components.SCREENED`) and whose equation-error columns shrink nothing held out
+        (< :data:`heavecomp.diagnosis.equation_error.MIN_SHRINK`) is not.  Output and nominal
+        candidates (a channel delay, the six-parameter refit) are always replayed, and so is every
+        candidate when none would be."""
+        cr = self.components_
+        gap = cr.gap()
+        fm, vm = self._fitmask & cr.mask, self._valmask & cr.mask
+        out = {}
+        for n in names:
+            cls = get(n)
+            comp = cls.component() if cls.kind == "plant" else ("sensors" if cls.kind == "output" else "")
+            ee = None
+            if comp in cr.residual:
+                ranked = EE.rank_effects(cr.residual[comp], cr.signals_for(comp), [cls], fm, vm, component=comp)
+                ee = ranked[0] if ranked else None
+            quiet = comp in CR.SCREENED and gap[comp] <= self.prescreen_gap and (ee is None or ee["shrink"] < EE.MIN_SHRINK)
+            replay = not (cls.kind == "plant" and quiet)
+            out[n] = {"component": comp, "component_gap": float(gap.get(comp, math.nan)), "replay": replay,
+                      "equation_error": ee}
+        if not any(o["replay"] for o in out.values()):
+            for o in out.values():
+                o["replay"] = True
+        return out
+
+    def _skipped_row(self, name, mse_b) -> dict:
+        """The candidates row of a candidate the pre-screen did not replay (contract fields; its
+        held-out prediction is the nominal's: shrink and explained 0, score the parsimony penalty)."""
+        pre = self.prescreen_[name]
+        rms = math.sqrt(mse_b["wob"])
+        return {"effect": name, "parameters": {}, "rms_before": rms, "rms_after": rms, "shrink": 0.0,
+                "score": -self.penalty * get(name).n_params(), "explained": 0.0, "n_params": get(name).n_params(),
+                "at_bound": [],
+                "skipped": f"pre-screen: its component {pre['component']} shows no gap over its noise "
+                           f"(gap {pre['component_gap']:.2f} <= {self.prescreen_gap:g})",
+                "equation_error": pre["equation_error"]}
+
+    def _moved_most(self, values) -> str:
+        """Component of the nominal parameter a parameter_mismatch moved most (|log multiplier|)."""
+        names = {f.name: table for f, (_, table, _) in zip(ParameterMismatch.fields(), MISMATCH_KEYS)}
+        k = max(values, key=lambda n: abs(math.log(max(values[n], 1e-12))))
+        return TABLE_COMPONENT.get(names.get(k, ""), "")
+
+    def _component_verdict(self, rows):
+        """``verdict.component`` (every verdict but ``none``) and the open search's ``discovered`` term
+        when no named effect explains half the gap (best explained < ``min_explained``): the verdict
+        becomes ``discovered`` (confidence low) only when an ``inconclusive`` verdict's discovered term
+        shrinks its held-out component residual by >= ``discover_shrink``; otherwise the term is
+        attached as a suggestion."""
+        v = self.verdict_
+        shares = self.where_["components"]
+        eff = v["effect"]
+        if eff == "none":
+            return
+        largest = max(COMPONENTS, key=lambda c: shares[c]) if any(shares.values()) else ""
+        if eff == "inconclusive":
+            v["component"] = largest or self.prescreen_.get(rows[0]["effect"], {}).get("component", "")
+        elif eff == "parameter_mismatch":
+            v["component"] = self._moved_most(rows[0]["_values"])
+        else:
+            v["component"] = self.prescreen_.get(eff, {}).get("component") or get(eff).component()
+        if rows[0]["explained"] >= self.min_explained:
+            return
+        found = self._discover()
+        if found is None:
+            return
+        v["discovered"] = found
+        if eff == "inconclusive" and found["shrink"] >= self.discover_shrink:
+            v.update(effect="discovered", component=found["component"], confidence="low",
+                     note=f"no named effect explains half the gap (best {rows[0]['effect']}: "
+                          f"{100 * rows[0]['explained']:.0f} %); the open search's term {found['term']} shrinks the "
+                          f"held-out {found['component']} residual by {100 * found['shrink']:.0f} %")
+
+    def _discover(self):
+        """The open search (:func:`heavecomp.diagnosis.equation_error.open_search`) on every component
+        with a gap, the best held-out shrink; None when nothing beats noise."""
+        cr = self.components_
+        gap = cr.gap()
+        fm, vm = self._fitmask & cr.mask, self._valmask & cr.mask
+        best = None
+        for c in sorted((c for c in COMPONENTS if gap[c] > 0), key=lambda c: -gap[c])[:3]:
+            d = EE.open_search(cr.residual[c], cr.signals_for(c), fm, vm, component=c)
+            if d is not None and (best is None or d["shrink"] > best["shrink"]):
+                best = dict(d, unit=CR.UNITS[c])
+        self.discovered_ = best
+        return best
 
     def _bound_check(self, rows):
         """A fitted parameter at its search bound (issue 14.3): the fit wanted to go further than the
@@ -753,9 +876,11 @@ class GapDiagnoser(GapEstimator):
 
     # ---------------------------------------------------------------- output
     def to_json(self) -> dict:
-        """The ``diagnosis.json`` content (contract schema 1, plus extras)."""
+        """The ``diagnosis.json`` content (contract schema 2: schema 1's keys, plus ``verdict.component``,
+        ``verdict.discovered``, ``gap.where.components``, ``initial_state``, ``warnings``; extras:
+        ``prescreen``)."""
         v = dict(self.verdict_)
-        return {"schema": 1,
+        return {"schema": 2,
                 "verdict": v,
                 "gap": self.gap_,
                 "candidates": self.candidates_,
@@ -765,4 +890,5 @@ class GapDiagnoser(GapEstimator):
                           "heave": self.heave_noise_, "input_envelope": self.input_envelope_},
                 "warnings": list(getattr(self, "warnings_", [])),
                 "initial_state": self.initial_.to_json(),
+                "prescreen": getattr(self, "prescreen_", {}),
                 "wall_time_s": self.wall_time_}

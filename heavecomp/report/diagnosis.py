@@ -171,6 +171,37 @@ def _levels_line(where) -> str:
             + " (offset and slow trend counted before the bands).")
 
 
+def _component_lines(diag) -> list:
+    """The components table (schema 2 ``where.components``) and the open search's discovered term."""
+    rows = diag.where_.get("component_table")
+    if not rows:
+        return []
+    v = diag.verdict_
+    out = ["Each model equation evaluated on the measured signals alone (measured minus nominal); the share of "
+           "the gap is each component's mean square above its noise and above what the same computation makes "
+           "of the nominal model's own replay.", "",
+           md_table(["component", "share [-]", "gap / noise [-]", "residual rms", "noise rms", "unit", "equation"],
+                    [[r["component"], f"{r['share']:.2f}", f"{r['gap_to_noise']:.2f}", f"{r['rms']:.4g}",
+                      f"{r['noise']:.4g}", r["unit"], ", ".join(r["equations"]).replace("_", " ")] for r in rows])]
+    if v.get("component"):
+        out += ["", f"The gap lives in: **{v['component'].replace('_', ' ')}**."]
+    d = v.get("discovered")
+    if d:
+        out += ["", f"Open search (sparse regression on the {d['component'].replace('_', ' ')} residual, "
+                    f"{d.get('unit', '')}): `{d['term']}` (features {', '.join(d['features'])}), held-out shrink of "
+                    f"that residual {d['shrink']:.2f}. A suggestion, not a named effect."]
+    return out
+
+
+def _skipped_lines(diag) -> list:
+    """Candidates the pre-screen did not replay (their component shows no gap)."""
+    sk = [c for c in diag.candidates_ if c.get("skipped")]
+    if not sk:
+        return []
+    return ["", "Not replayed (pre-screen, equation error): " + "; ".join(
+        f"`{c['effect']}` ({c['skipped'].split(': ', 1)[-1]})" for c in sk) + "."]
+
+
 def write_report(diag, out_dir, *, title="Sim-to-real gap diagnosis") -> dict:
     """Write diagnosis.json, report.md and where.png / spectra.png / overlay.png into ``out_dir``."""
     out = Path(out_dir)
@@ -225,7 +256,9 @@ def write_report(diag, out_dir, *, title="Sim-to-real gap diagnosis") -> dict:
                          f"{c['channels']['stroke']['shrink']:.2f}", f"{c['channels']['pressure']['shrink']:.2f}",
                          ", ".join(_with_unit(k, val, units=_effect_units(c["effect"]))
                                    for k, val in c["parameters"].items())]
-                        for c in diag.candidates_]),
+                        for c in diag.candidates_ if not c.get("skipped")]),
+              *_skipped_lines(diag),
+              "", "## Where, by model component (equation error)", "", *_component_lines(diag),
               "", f"Split: fit {diag.split_['fit'][0]:.0f}-{diag.split_['fit'][1]:.0f} s, held out "
                   f"{diag.split_['validate'][0]:.0f}-{diag.split_['validate'][1]:.0f} s; first "
                   f"{diag.split_['settle']:.0f} s excluded (start-up).",

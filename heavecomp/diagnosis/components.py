@@ -1,0 +1,328 @@
+"""The CMC's component residuals: each model equation evaluated on the measured signals alone.
+
+Paper B measures the seal friction from pressure and displacement (``F_f = F_drive - M a``); the same
+idea, applied to every equation of :mod:`heavecomp.plants.cmc` (called, never restated), gives one
+residual per model component (:data:`heavecomp.effects.base.COMPONENTS`), measured minus nominal:
+
+======================  =====  ==================================================================
+equation                unit   residual
+======================  =====  ==================================================================
+top-mass force balance  N      seal friction the balance needs, ``net_force(p, T, ddz_h) - M_c a``,
+                               minus the nominal law at the measured v and p (sliding samples, away
+                               from rest and reversals by the filter's reach)
+lower-mass balance      N      string tension the lower mass needs, ``m_b (a_b + g) - W``, minus
+                               ``tension()`` at the measured relative displacement (bit on the rock:
+                               ``y_b = delta_0 - (W + c_F v_b) / k_F``, ``v_b = -dW/dt / k_F``;
+                               left out where the bit lifts off)
+gas law                 Pa     measured pressure minus ``gas_pressure(s)`` at the measured stroke
+======================  =====  ==================================================================
+
+Derivatives and the values themselves come through the same zero-phase FIR low-pass
+(:data:`CUTOFF`; :func:`heavecomp.diagnosis.data.zero_phase_lowpass`), so linear terms see one
+frequency response.  Each equation residual is split by a joint least-squares regression (on the
+whole analysed span) into the parts other components explain:
+
+- gas law: ``flow_line`` (v, v|v|: a pressure drop growing with flow), ``sensors`` (dp/dt: a lagging
+  pressure channel); the rest (preload, stiffness, drift) is ``gas_spring``;
+- lower-mass balance: ``heave_input`` (z_h, dz_h: a heave that is not the one the compensator sees),
+  ``sensors`` (dW/dt: a lagging WOB channel); the rest is ``string_formation``;
+- top-mass balance: ``heave_input`` (ddz_h); the rest is ``friction``.
+
+The friction residual is blind near rest and reversals (the filtered sign(v) jump): effects acting at
+breakaway (dwell stiction, frictional memory) show little there; measured on generated runs, the
+largest holding force before a breakaway, read through the same filter, is dominated by the filter's
+smear (-21 kN +- 10 kN with and without the effect), so it is not used.
+
+Shares (:meth:`ComponentResiduals.shares`): each part's mean square over the noise variance of its
+equation (the rms change of the residual when the channels get their own noise-floor noise),
+minus the noise's own expected 1 for the rest parts, clipped at 0, normalised to sum 1 (all 0 when
+no component rises above its noise).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+
+from heavecomp.diagnosis.data import derivative_zero_phase, fill_gaps, noise_floor, uniform, zero_phase_lowpass
+from heavecomp.effects.base import COMPONENTS
+from heavecomp.friction.laws import friction_cont, friction_jump
+from heavecomp.plants.cmc import CF, D0, KF, MB, MC, G, gas_pressure, net_force, plant_vectors, tension
+
+CUTOFF = 1.0  #: zero-phase low-pass of every channel before the equations [Hz]
+STUCK_SPEED = 2e-3  #: below this filtered stroke speed the seal is at rest (friction set-valued) [m/s]
+LIFTOFF = 0.1  #: WOB below this share of its median: the bit is off the rock (lower-mass residual left out) [-]
+REACH = 0.5  #: friction samples within REACH / cutoff [s] of rest or a reversal are left out [-]
+EDGE = 3.0  #: s at each end of the run left out (the filter's edges)
+UNITS = {"friction": "N", "gas_spring": "Pa", "flow_line": "Pa", "string_formation": "N", "sensors": "-",
+         "heave_input": "N"}
+#: components whose residual sees every candidate there (the friction residual is blind at breakaway):
+#: the gap diagnosis' pre-screen skips replays only for candidates in these
+SCREENED = ("gas_spring", "flow_line", "string_formation")
+#: the equation each component's residual comes from
+EQUATION = {"friction": "top_mass", "gas_spring": "gas", "flow_line": "gas", "string_formation": "lower_mass",
+            "sensors": "gas+lower_mass", "heave_input": "top_mass+lower_mass"}
+
+
+def _smooth(t, y, cutoff):
+    """Zero-phase low-passed channel at the original times, and its first two derivatives."""
+    tu, yu = uniform(t, y)
+    yf = np.interp(t, tu, zero_phase_lowpass(yu, tu[1] - tu[0], cutoff))
+    d1, d2 = derivative_zero_phase(t, y, cutoff)
+    return yf, d1, d2
+
+
+def _dilate(t, flag, width):
+    """``flag`` widened by ``width`` [s] on each side."""
+    if not flag.any():
+        return flag
+    n = max(1, int(round(width / float(np.median(np.diff(t))))))
+    return np.convolve(flag.astype(float), np.ones(2 * n + 1), mode="same") > 0
+
+
+def _dwell(t, still):
+    """Time at rest so far (0 while moving) and the duration of the last rest, held while moving [s]."""
+    so_far = np.zeros(t.size)
+    held = np.zeros(t.size)
+    start, last = None, 0.0
+    for i in range(t.size):
+        if still[i]:
+            start = t[i] if start is None else start
+            so_far[i] = t[i] - start
+            held[i] = so_far[i]
+        else:
+            if start is not None:
+                last, start = t[i] - start, None
+            held[i] = last
+    return so_far, held
+
+
+def equations(t, heave, stroke, pressure, wob, params, heave_reference=0.0, cutoff=CUTOFF):
+    """The three equation residuals and the signals they are built from.
+
+    Parameters
+    ----------
+    t : array [s]; heave, stroke [m]; pressure [Pa] (gauge); wob [N]
+    params : CMCParams (nominal)
+    heave_reference : float [m]
+        The heave of the operating point (``InitialState.heave_reference``).
+
+    Returns
+    -------
+    (residuals {top_mass [N], lower_mass [N], gas [Pa]}, signals {name: array}, sliding mask)
+    """
+    code, FP, PP, _ = plant_vectors(params)
+    zh, dzh, ddzh = _smooth(t, heave, cutoff)
+    zh = zh - heave_reference
+    s, v, a = _smooth(t, stroke, cutoff)
+    p, dp, _ = _smooth(t, pressure, cutoff)
+    W, dW, ddW = _smooth(t, wob, cutoff)
+    vb, ab = -dW / PP[KF], -ddW / PP[KF]
+    yb = PP[D0] - (W + PP[CF] * vb) / PP[KF]
+    T_meas = PP[MB] * (ab + PP[G]) - W                      # lower-mass balance: the tension it needs
+    sliding = np.abs(v) > STUCK_SPEED
+    sv = np.sign(v)
+    F_meas = net_force(p, T_meas, ddzh, 0.0, PP) - PP[MC] * a  # top-mass balance: the friction it needs
+    F_nom = friction_jump(code, np.abs(v), p, FP) * sv + friction_cont(code, v, p, FP)
+    # the bit lifted off (W near 0, and the filter's reach around it): y_b is not read from W there
+    lifted = _dilate(t, W < LIFTOFF * max(float(np.median(W)), 0.0), 1.0 / cutoff)
+    # away from rest and reversals by the filter's reach: there the filtered sign(v) jump is smeared and
+    # the nominal law at the filtered v differs from the filtered friction (artefact, not gap)
+    clear = ~_dilate(t, ~sliding | (np.diff(sv, prepend=sv[0]) != 0), REACH / cutoff)
+    res = {"top_mass": np.where(clear, F_meas - F_nom, np.nan),
+           "lower_mass": np.where(lifted, np.nan, T_meas - tension(s, v, yb, vb, zh, dzh, PP)),
+           "gas": p - gas_pressure(s, PP)}
+    dwell, rest = _dwell(t, ~sliding)
+    sig = {"t": t, "x": s, "v": v, "a": a, "p": p, "dp": dp, "wob": W, "dwob": dW, "zh": zh, "dzh": dzh,
+           "ddzh": ddzh, "rel": zh + s - yb, "vrel": dzh + v - vb, "dwell": dwell, "rest": rest,
+           "still": ~sliding}
+    return res, sig, sliding
+
+
+#: per equation: {component: feature names} of the joint attribution regression (the equation's own
+#: component is the rest; its nominal structure (constant, drift, stiffness) is listed under it)
+SPLIT = {"gas": {"gas_spring": ("const", "t", "x"), "flow_line": ("v", "v_abs_v"), "sensors": ("dp",)},
+         "lower_mass": {"string_formation": ("const", "rel", "vrel"), "heave_input": ("zh", "dzh"),
+                        "sensors": ("dwob",)},
+         "top_mass": {"friction": (), "heave_input": ("ddzh",)}}
+OWN = {"gas": "gas_spring", "lower_mass": "string_formation", "top_mass": "friction"}
+
+
+def _column(sig, name):
+    if name == "const":
+        return np.ones(sig["t"].size)
+    if name == "t":
+        return sig["t"] - sig["t"][0]
+    if name == "v_abs_v":
+        return sig["v"] * np.abs(sig["v"])
+    return sig[name]
+
+
+@dataclasses.dataclass
+class ComponentResiduals:
+    """Component residuals of one run (:func:`residuals`).
+
+    Attributes
+    ----------
+    t : array [s]
+    equations : {top_mass, lower_mass, gas: array}  equation residuals [N, N, Pa]
+    noise : {equation: float}  rms of the residual's change under the channels' own noise [N, N, Pa]
+    parts : {component: {equation: array}}  each component's part of each equation residual
+    residual : {component: array}  the residual a component's candidates are fitted to (its
+        equation's residual minus the parts other components explain), unit :data:`UNITS`
+    signals : {name: array}  the filtered signals (feature inputs, :meth:`Effect.features`)
+    mask : boolean array  samples analysed (edges and the caller's mask)
+    floor : {component: {equation: z}}  the same computation on the nominal model's noise-free replay
+        (:func:`residuals` ``floor_channels``), subtracted in :meth:`gap`
+    """
+
+    t: np.ndarray
+    equations: dict
+    noise: dict
+    parts: dict
+    residual: dict
+    signals: dict
+    mask: np.ndarray
+    floor: dict = dataclasses.field(default_factory=dict)
+
+    def z(self, mask=None) -> dict:
+        """{component: {equation: mean square of its part / noise variance of the equation}} [-]."""
+        m = self.mask if mask is None else (mask & self.mask)
+        out = {}
+        for c in COMPONENTS:
+            out[c] = {}
+            for eq, part in self.parts.get(c, {}).items():
+                ok = m & np.isfinite(part)
+                if ok.any() and self.noise[eq] > 0:
+                    out[c][eq] = float(np.mean(part[ok] ** 2)) / self.noise[eq] ** 2
+        return out
+
+    def gap(self, mask=None) -> dict:
+        """Per component: mean square of its parts over the noise variance of their equations, minus
+        the noise's expected 1 for the equations' own rests and minus :attr:`floor` (what the same
+        computation makes of the nominal model's own replay: filter and stick-event artefacts),
+        clipped at 0 [-]."""
+        out = {}
+        for c, zs in self.z(mask).items():
+            out[c] = sum(max(z - (1.0 if OWN[eq] == c else 0.0) - self.floor.get(c, {}).get(eq, 0.0), 0.0)
+                         for eq, z in zs.items())
+        return out
+
+    def shares(self, mask=None) -> dict:
+        """``where.components``: shares of the gap by component, summing to 1 (all 0: no component
+        rises above its noise)."""
+        g = self.gap(mask)
+        tot = sum(g.values())
+        return {c: (g[c] / tot if tot > 0 else 0.0) for c in COMPONENTS}
+
+    def gap_to_noise(self, mask=None) -> dict:
+        """Per component: rms of its parts over the noise, sqrt(1 + gap) for its own equation [-]."""
+        return {c: math.sqrt(1.0 + g) for c, g in self.gap(mask).items()}
+
+    def signals_for(self, component) -> dict:
+        """The ``sig`` of :meth:`Effect.features` for a component (``x``/``v`` are the string's relative
+        displacement and velocity for ``string_formation``)."""
+        sig = dict(self.signals)
+        if component == "string_formation":
+            sig["x"], sig["v"] = sig["rel"], sig["vrel"]
+        return sig
+
+    def table(self, mask=None) -> list:
+        """Rows for the report: component, share, rms of its residual [unit], noise [unit], gap/noise."""
+        sh, gn = self.shares(mask), self.gap_to_noise(mask)
+        m = self.mask if mask is None else (mask & self.mask)
+        rows = []
+        for c in COMPONENTS:
+            r = self.residual[c]
+            ok = m & np.isfinite(r)
+            eqs = list(self.parts.get(c, {}))
+            rows.append({"component": c, "share": sh[c], "gap_to_noise": gn[c],
+                         "rms": float(np.sqrt(np.mean(r[ok] ** 2))) if ok.any() else 0.0,
+                         "noise": float(math.sqrt(sum(self.noise[e] ** 2 for e in eqs) / max(len(eqs), 1))),
+                         "unit": UNITS[c], "equations": eqs})
+        return rows
+
+
+def residuals(run, params, *, heave_reference=None, noise=None, mask=None, cutoff=CUTOFF, seed=7,
+              floor_channels=None) -> ComponentResiduals:
+    """Component residuals of a :class:`~heavecomp.diagnosis.data.MeasuredRun` against the nominal
+    ``params``.
+
+    Parameters
+    ----------
+    heave_reference : float [m], optional
+        Heave of the operating point (default: the first filtered heave sample).
+    noise : {channel: sigma}, optional
+        Measurement noise per channel [SI] (default :func:`heavecomp.diagnosis.data.noise_floor`).
+    mask : boolean array, optional
+        Samples to analyse (e.g. after the settling window); the filter edges are always left out.
+    floor_channels : {stroke, pressure, wob: array}, optional
+        The nominal model's replay at the run's times (driven by the measured heave): its component
+        z-values are the floor subtracted from the run's (:attr:`ComponentResiduals.floor`).
+    """
+
+    t = run.t
+    ch = {k: fill_gaps(t, run[k]) for k in ("heave", "stroke", "pressure", "wob")}
+    if heave_reference is None:
+        heave_reference = float(_smooth(t, ch["heave"], cutoff)[0][0])
+    m = (t >= t[0] + EDGE) & (t <= t[-1] - EDGE)
+    if mask is not None:
+        m &= mask
+    noise = dict(noise) if noise else {k: noise_floor(run[k], None if run.uniform else t) for k in ch}
+    out = _split(t, ch, params, heave_reference, cutoff, noise, m, seed)
+    if floor_channels is not None:
+        ref = dict(ch, **{k: fill_gaps(t, np.asarray(floor_channels[k], float)) for k in ("stroke", "pressure", "wob")})
+        nf = _split(t, ref, params, heave_reference, cutoff, None, m, seed, noise_of=out.noise)
+        out.floor = nf.z()
+    return out
+
+
+def _split(t, ch, params, heave_reference, cutoff, noise, m, seed, noise_of=None):
+    """Equation residuals of channels ``ch``, their noise (or ``noise_of``) and the attribution."""
+    eq, sig, _ = equations(t, ch["heave"], ch["stroke"], ch["pressure"], ch["wob"], params, heave_reference, cutoff)
+    if noise_of is not None:
+        return _attribute(t, eq, sig, noise_of, m)
+    # noise of each equation residual: the change when every channel gets its own noise again
+    rng = np.random.default_rng(seed)
+    eq2, _, _ = equations(t, *(ch[k] + rng.normal(0.0, noise[k], t.size) for k in ("heave", "stroke", "pressure", "wob")),
+                          params, heave_reference, cutoff)
+    sig_noise = {}
+    for k in eq:
+        d = eq2[k] - eq[k]
+        ok = m & np.isfinite(d)
+        sig_noise[k] = float(np.sqrt(np.mean(d[ok] ** 2))) if ok.any() else 0.0
+    return _attribute(t, eq, sig, sig_noise, m)
+
+
+def _attribute(t, eq, sig, sig_noise, m):
+    """Split each equation residual into the components' parts (:data:`SPLIT`, joint least squares on ``m``)."""
+    parts = {c: {} for c in COMPONENTS}
+    resid = {}
+    for e, split in SPLIT.items():
+        r = eq[e]
+        names = [(c, f) for c, fs in split.items() for f in fs]
+        ok = m & np.isfinite(r)
+        X = np.column_stack([_column(sig, f) for _, f in names]) if names else np.zeros((t.size, 0))
+        contrib = {c: np.zeros(t.size) for c in split}
+        if names and ok.sum() > len(names):
+            sc = X[ok].std(axis=0)
+            sc[sc == 0] = 1.0
+            coef, *_ = np.linalg.lstsq(X[ok] / sc, r[ok], rcond=None)
+            for j, ((c, _), k) in enumerate(zip(names, coef / sc)):
+                contrib[c] = contrib[c] + k * X[:, j]
+        own = OWN[e]
+        rest = r - sum(contrib[c] for c in split if c != own)
+        parts[own][e] = rest
+        for c in split:
+            if c != own:
+                parts[c][e] = np.where(np.isfinite(r), contrib[c], np.nan)
+        resid[own] = rest
+    # a component that only explains parts of other equations: its residual is the equation's (the one
+    # where it is largest) with the other components' parts removed (what its candidates see)
+    for c in COMPONENTS:
+        if c not in resid:
+            e = max(parts[c], key=lambda k: np.nanmean(parts[c][k][m] ** 2) / max(sig_noise[k], 1e-300) ** 2)
+            resid[c] = parts[OWN[e]][e] + parts[c][e]
+    return ComponentResiduals(t, eq, sig_noise, parts, resid, sig, m)

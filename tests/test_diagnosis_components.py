@@ -1,0 +1,81 @@
+"""Component residuals of the CMC (heavecomp.diagnosis.components): an effect planted in one model
+component shows up in that component's share, from the measured signals alone."""
+
+import numpy as np
+import pytest
+
+from heavecomp.diagnosis import components as CR
+from heavecomp.diagnosis import equation_error as EE
+from heavecomp.diagnosis.data import check_run
+from heavecomp.effects.charge_drift import ChargeDrift
+from heavecomp.effects.pressure_friction import PressureFriction
+from heavecomp.params.sets import paper_a
+from heavecomp.simulate import simulate
+
+pytestmark = pytest.mark.slow  # compiles two effect compositions (~2 min on 2 busy cores)
+
+NOISE = {"heave": 0.002, "stroke": 0.002, "pressure": 2e3, "wob": 400.0}
+T = 240.0
+
+
+@pytest.fixture(scope="module")
+def nominal():
+    p = paper_a("stribeck")
+    return p, simulate(p, T, rate=50.0)
+
+
+def _measured(p, sim, seed=0):
+    rng = np.random.default_rng(seed)
+    t = sim.t
+    cols = {c: sim[c] + rng.normal(0.0, NOISE[c], t.size) for c in NOISE}
+    return check_run(t, cols, params=p)
+
+
+def _components(p, nominal_sim, effects):
+    sim = simulate(p, T, rate=50.0, effects=effects)
+    run = _measured(p, sim)
+    floor = {c: nominal_sim[c] for c in ("stroke", "pressure", "wob")}
+    return CR.residuals(run, p, heave_reference=0.0, noise=NOISE, floor_channels=floor)
+
+
+def test_shares_are_the_contract_components_and_sum_to_one(nominal):
+    p, nom = nominal
+    cr = _components(p, nom, [ChargeDrift(charge_error=0.03)])
+    sh = cr.shares()
+    assert tuple(sh) == ("friction", "gas_spring", "flow_line", "string_formation", "sensors", "heave_input")
+    assert sum(sh.values()) == pytest.approx(1.0)
+    assert [r["unit"] for r in cr.table()] == ["N", "Pa", "Pa", "N", "-", "N"]
+
+
+def test_gas_charge_error_lands_in_gas_spring(nominal):
+    p, nom = nominal
+    cr = _components(p, nom, [ChargeDrift(charge_error=0.03)])
+    sh = cr.shares()
+    assert max(sh, key=sh.get) == "gas_spring" and sh["gas_spring"] > 0.5
+    # the gas residual is the charge error itself: (p + p_atm) x 0.03 at the measured stroke
+    r = cr.residual["gas_spring"][cr.mask]
+    expected = 0.03 * (p.p0 + 101325.0)
+    assert np.median(r) == pytest.approx(expected, rel=0.15)
+    # the open search on that residual names an offset (the preload), held out
+    t = cr.t
+    d = EE.open_search(cr.residual["gas_spring"], cr.signals_for("gas_spring"), cr.mask & (t < 160.0),
+                       cr.mask & (t >= 160.0), component="gas_spring")
+    assert d is not None and "const" in d["features"] and d["shrink"] > 0.5
+
+
+def test_pressure_friction_lands_in_friction(nominal):
+    p, nom = nominal
+    cr = _components(p, nom, [PressureFriction(extra_pressure_coefficient=3e-3)])
+    sh = cr.shares()
+    assert max(sh, key=sh.get) == "friction" and sh["friction"] > 0.5
+    # the friction residual recovers the planted force dC_p |p| sign(v) (sliding samples)
+    r, sig = cr.residual["friction"], cr.signals
+    ok = cr.mask & np.isfinite(r)
+    k = np.linalg.lstsq((np.abs(sig["p"]) * np.sign(sig["v"]))[ok, None], r[ok], rcond=None)[0][0]
+    assert k == pytest.approx(3e-3, rel=0.2)
+
+
+def test_no_effect_shows_no_component_gap(nominal):
+    p, nom = nominal
+    cr = _components(p, nom, [])
+    assert max(cr.gap().values()) < 1.0
