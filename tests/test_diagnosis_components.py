@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 
 from heavecomp.diagnosis import components as CR
+from heavecomp.diagnosis import equation_error as EE
 from heavecomp.diagnosis.data import check_run
 from heavecomp.effects.charge_drift import ChargeDrift
 from heavecomp.effects.pressure_friction import PressureFriction
@@ -55,6 +56,11 @@ def test_gas_charge_error_lands_in_gas_spring(nominal):
     r = cr.residual["gas_spring"][cr.mask]
     expected = 0.03 * (p.p0 + 101325.0)
     assert np.median(r) == pytest.approx(expected, rel=0.15)
+    # the open search on that residual names an offset (the preload), held out
+    t = cr.t
+    d = EE.open_search(cr.residual["gas_spring"], cr.signals_for("gas_spring"), cr.mask & (t < 160.0),
+                       cr.mask & (t >= 160.0), component="gas_spring")
+    assert d is not None and "const" in d["features"] and d["shrink"] > 0.5
 
 
 def test_pressure_friction_lands_in_friction(nominal):

@@ -35,6 +35,19 @@ def test_first_order_lag_is_the_exact_solution_on_an_uneven_grid():
     assert y[i] == pytest.approx(1 - math.exp(-t[i] / 0.1), rel=1e-9)
 
 
+def test_first_order_lag_uniform_filter_is_the_same_recursion():
+    """On a uniform grid the lag runs as a linear filter: the same numbers as the exact step loop."""
+    t = np.arange(0.0, 2.0, 1e-3)
+    x = np.sign(np.sin(7.0 * t))
+    y = first_order_lag(t, x, 0.05, y0=0.3)
+    ref = np.empty(t.size)
+    yk = 0.3
+    for i in range(t.size):
+        ref[i] = yk
+        yk = x[i] + (yk - x[i]) * math.exp(-1e-3 / 0.05)
+    assert np.max(np.abs(y - ref)) < 1e-12 and y[0] == 0.3
+
+
 def test_dwell_and_the_rest_before_a_breakaway():
     sig = _signals()
     t, dwell = sig["t"], sig["dwell"]

@@ -32,7 +32,14 @@ def first_order_lag(t, x, tau: float, y0: float = 0.0) -> np.ndarray:
         ``y[i]`` is the state when ``x[i]`` is sampled (before ``x[i]`` acts), so ``y`` lags ``x``.
     """
     x = np.asarray(x, dtype=float)
-    decay = np.exp(-np.diff(np.asarray(t, dtype=float)) / tau)
+    dt = np.diff(np.asarray(t, dtype=float))
+    if dt.size and np.ptp(dt) <= 1e-9 * abs(float(dt.mean())):
+        # uniform sampling: the same recursion, y[i+1] = d y[i] + (1 - d) x[i], as a linear filter
+        from scipy.signal import lfilter
+
+        d = float(np.exp(-dt.mean() / tau))
+        return lfilter([0.0, 1.0 - d], [1.0, -d], x, zi=[float(y0)])[0]
+    decay = np.exp(-dt / tau)
     y = np.empty(x.size)
     yk = float(y0)
     for i in range(x.size):
