@@ -641,6 +641,7 @@ class GapDiagnoser(GapEstimator):
         fm, vm = self._fitmask & cr.mask, self._valmask & cr.mask
         out = {}
         for n in names:
+            t0 = time.perf_counter()
             cls = get(n)
             comp = cls.component() if cls.kind == "plant" else ("sensors" if cls.kind == "output" else "")
             ee = None
@@ -650,7 +651,7 @@ class GapDiagnoser(GapEstimator):
             quiet = comp in CR.SCREENED and gap[comp] <= self.prescreen_gap and (ee is None or ee["shrink"] < EE.MIN_SHRINK)
             replay = not (cls.kind == "plant" and quiet)
             out[n] = {"component": comp, "component_gap": float(gap.get(comp, math.nan)), "replay": replay,
-                      "equation_error": ee}
+                      "equation_error": ee, "wall_time": time.perf_counter() - t0}
         if not any(o["replay"] for o in out.values()):
             for o in out.values():
                 o["replay"] = True
@@ -663,7 +664,7 @@ class GapDiagnoser(GapEstimator):
         rms = math.sqrt(mse_b["wob"])
         return {"effect": name, "parameters": {}, "rms_before": rms, "rms_after": rms, "shrink": 0.0,
                 "score": -self.penalty * get(name).n_params(), "explained": 0.0, "n_params": get(name).n_params(),
-                "at_bound": [],
+                "at_bound": [], "fit_wall_time": pre["wall_time"],
                 "skipped": f"pre-screen: its component {pre['component']} shows no gap over its noise "
                            f"(gap {pre['component_gap']:.2f} <= {self.prescreen_gap:g})",
                 "equation_error": pre["equation_error"]}
