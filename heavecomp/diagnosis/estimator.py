@@ -169,6 +169,10 @@ class GapDiagnoser(GapEstimator):
     noise_floor_ : dict  sigma per channel [SI]
     split_ : dict        fit / validate intervals [s]
     traces_ : dict       time series for the report (t, measured, nominal, best)
+    components_ : ComponentResiduals  the equation residuals by model component
+                         (:mod:`heavecomp.diagnosis.components`); shares in ``where_["components"]``
+    prescreen_ : dict    per candidate: component, component gap, equation-error fit, replayed or not
+    discovered_ : dict   the open search's best term (when it ran; None: nothing beat noise)
     """
 
     _ranking_attr, _choice_attr = "candidates_", "verdict_"  # GapEstimator's ranking_ and effect_
