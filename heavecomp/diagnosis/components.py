@@ -35,8 +35,9 @@ smear (-21 kN +- 10 kN with and without the effect), so it is not used.
 
 Shares (:meth:`ComponentResiduals.shares`): each part's mean square over the noise variance of its
 equation (the rms change of the residual when the channels get their own noise-floor noise),
-minus the noise's own expected 1 for the rest parts, clipped at 0, normalised to sum 1 (all 0 when
-no component rises above its noise).
+minus the noise's own expected 1 for the rest parts and minus the nominal replay's floor, clipped at 0;
+components below :data:`SHARE_MIN` get none; normalised to sum 1 (all 0 when no component rises
+above its noise).
 """
 
 from __future__ import annotations
@@ -53,6 +54,7 @@ from heavecomp.plants.cmc import CF, D0, KF, MB, MC, G, gas_pressure, net_force,
 
 CUTOFF = 1.0  #: zero-phase low-pass of every channel before the equations [Hz]
 STUCK_SPEED = 2e-3  #: below this filtered stroke speed the seal is at rest (friction set-valued) [m/s]
+SHARE_MIN = 1.0  #: a component gap below this (noise variances above noise and floor) gets no share [-]
 LIFTOFF = 0.1  #: WOB below this share of its median: the bit is off the rock (lower-mass residual left out) [-]
 REACH = 0.5  #: friction samples within REACH / cutoff [s] of rest or a reversal are left out [-]
 EDGE = 3.0  #: s at each end of the run left out (the filter's edges)
@@ -211,9 +213,10 @@ class ComponentResiduals:
         return out
 
     def shares(self, mask=None) -> dict:
-        """``where.components``: shares of the gap by component, summing to 1 (all 0: no component
-        rises above its noise)."""
-        g = self.gap(mask)
+        """``where.components``: shares of the gap by component, summing to 1, over the components whose
+        gap reaches :data:`SHARE_MIN` (all 0: no component rises above its noise; shares of gaps below it
+        were noise: a dwell-stiction run read 0.43 "sensors" from gaps of 0.04-0.06)."""
+        g = {c: (x if x >= SHARE_MIN else 0.0) for c, x in self.gap(mask).items()}
         tot = sum(g.values())
         return {c: (g[c] / tot if tot > 0 else 0.0) for c in COMPONENTS}
 

@@ -175,6 +175,10 @@ class GapDiagnoser(GapEstimator):
     noise_floor_ : dict  sigma per channel [SI]
     split_ : dict        fit / validate intervals [s]
     traces_ : dict       time series for the report (t, measured, nominal, best)
+    components_ : ComponentResiduals  the equation residuals by model component
+                         (:mod:`heavecomp.diagnosis.components`); shares in ``where_["components"]``
+    prescreen_ : dict    per candidate: component, component gap, equation-error fit, replayed or not
+    discovered_ : dict   the open search's best term (when it ran; None: nothing beat noise)
     """
 
     _ranking_attr, _choice_attr = "candidates_", "verdict_"  # GapEstimator's ranking_ and effect_
@@ -732,6 +736,7 @@ class GapDiagnoser(GapEstimator):
         fm, vm = self._fitmask & cr.mask, self._valmask & cr.mask
         out = {}
         for n in names:
+            t0 = time.perf_counter()
             cls = get(n)
             comp = cls.component() if cls.kind == "plant" else ("sensors" if cls.kind == "output" else "")
             ee = None
@@ -741,7 +746,7 @@ class GapDiagnoser(GapEstimator):
             quiet = comp in CR.SCREENED and gap[comp] <= self.prescreen_gap and (ee is None or ee["shrink"] < EE.MIN_SHRINK)
             replay = not (cls.kind == "plant" and quiet)
             out[n] = {"component": comp, "component_gap": float(gap.get(comp, math.nan)), "replay": replay,
-                      "equation_error": ee}
+                      "equation_error": ee, "wall_time": time.perf_counter() - t0}
         if not any(o["replay"] for o in out.values()):
             for o in out.values():
                 o["replay"] = True
@@ -754,7 +759,7 @@ class GapDiagnoser(GapEstimator):
         rms = math.sqrt(mse_b["wob"])
         return {"effect": name, "parameters": {}, "rms_before": rms, "rms_after": rms, "shrink": 0.0,
                 "score": -self.penalty * get(name).n_params(), "explained": 0.0, "n_params": get(name).n_params(),
-                "at_bound": [],
+                "at_bound": [], "fit_wall_time": pre["wall_time"],
                 "skipped": f"pre-screen: its component {pre['component']} shows no gap over its noise "
                            f"(gap {pre['component_gap']:.2f} <= {self.prescreen_gap:g})",
                 "equation_error": pre["equation_error"]}
