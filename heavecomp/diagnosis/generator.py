@@ -774,7 +774,7 @@ def validation_cases(which, quick=False):
                   _case("gas_leak", next(s), "near_noise", near=True, duration=600.0)]
         cases += [_case("seal_warming", next(s), "out_of_library", duration=600.0, params="light_friction"),
                   _case("wob_saturation", next(s), "out_of_library")]
-        cases += [_case("flow_loss", next(s), "two_effects", second="string_damping", params="soft_formation")]
+        cases += [_case("string_damping", next(s), "two_effects", second="pressure_friction")]
     elif which == "scoring":
         s = iter(range(50000, 51000))
         mid = 90.0  # every scoring log starts mid-operation
