@@ -73,3 +73,41 @@ def test_fit_columns_refits_the_base_columns_in_the_reference():
     only = E.fit_columns(r, {}, fit, val, base={"viscous": sig["v"]})
     assert res["rms_before"] == pytest.approx(only["rms_after"])
     assert res["shrink"] > 0.9
+
+
+def test_a_near_constant_column_does_not_swamp_the_others():
+    """A column of ones with a rounding-level spread (e.g. decimated) is an intercept, not a column
+    to divide by its ~1e-16 spread: the other coefficient comes back."""
+    from heavecomp.diagnosis.equation_error import fit_columns
+
+    rng = np.random.default_rng(0)
+    n = 2000
+    x = rng.normal(size=n)
+    ones = np.ones(n) + rng.normal(0.0, 1e-16, n)
+    r = 3.0 * x + 5.0 + rng.normal(0.0, 0.01, n)
+    fit = np.arange(n) < 1400
+    res = fit_columns(r, {"x": x, "one": ones}, fit, ~fit)
+    assert res["coefficients"]["x"] == pytest.approx(3.0, rel=1e-2)
+    assert res["coefficients"]["one"] == pytest.approx(5.0, rel=1e-2)
+
+
+def test_shape_is_chosen_on_the_fit_part_only():
+    """The held-out part scores, never chooses: with the fit part made by shape 2 and the held-out
+    part by shape 5, the chosen shape is 2 (choosing by held-out shrink would pick 5)."""
+    from heavecomp.diagnosis.equation_error import rank_effects
+    from heavecomp.effects.base import Effect
+
+    class Shaped(Effect):
+        name = "shaped"
+        hook = "seal_friction"
+        feature_grid = (1.0, 2.0, 5.0)
+
+        @classmethod
+        def features(cls, sig, shape=None):
+            return {"c": np.sin(shape * sig["t"])}
+
+    t = np.linspace(0.0, 100.0, 5000)
+    fit = t < 60.0
+    r = np.where(fit, np.sin(2.0 * t), np.sin(5.0 * t))
+    ranked = rank_effects(r, {"t": t}, [Shaped], fit, ~fit)
+    assert ranked[0]["shape"] == 2.0

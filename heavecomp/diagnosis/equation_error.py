@@ -73,7 +73,11 @@ def _lstsq(X, y):
     if X.shape[1] == 0:
         return np.zeros(0)
     s = X.std(axis=0)
-    s[s == 0] = 1.0
+    size = np.max(np.abs(X), axis=0) if X.shape[0] else np.ones(X.shape[1])
+    # a constant column (an intercept, or a decimated column of ones whose spread is rounding) is
+    # scaled by its size, not by its spread: dividing by ~1e-16 would swamp every other coefficient
+    flat = s <= 1e-9 * np.maximum(size, 1e-300)
+    s[flat] = np.where(size[flat] > 0, size[flat], 1.0)
     c, *_ = np.linalg.lstsq(X / s, y, rcond=None)
     return c / s
 
@@ -127,7 +131,9 @@ def fit_columns(r, cols: dict, fit, validate, base=None) -> dict:
 
 def rank_effects(r, sig, effects, fit, validate, base=None, component="") -> list:
     """Fit every effect class's equation-error columns (:meth:`Effect.features` over its
-    ``feature_grid``) to the component residual ``r``; the best shape per effect (held-out shrink).
+    ``feature_grid``) to the component residual ``r``; the best shape per effect by the *fit* part's
+    BIC (the held-out part only scores, never chooses).  Columns named like a ``base`` column are
+    dropped (the base already refits that parameter; two copies would split its coefficient).
 
     Returns a list, best first, of {``effect``, ``component``, ``shape``, ``coefficients``,
     ``shrink``, ``bic``, ``delta_bic``, ``rms_before``, ``rms_after``}; effects without an
@@ -138,10 +144,12 @@ def rank_effects(r, sig, effects, fit, validate, base=None, component="") -> lis
         best = None
         for shape in (cls.feature_grid or (None,)):
             cols = cls.features(sig, shape)
+            if cols and base:
+                cols = {n: c for n, c in cols.items() if n not in base}
             if not cols:
                 continue
             res = fit_columns(r, cols, fit, validate, base)
-            if best is None or res["shrink"] > best["shrink"]:
+            if best is None or res["bic"] < best["bic"]:
                 best = dict(res, shape=shape)
         if best is not None:
             out.append(dict(best, effect=cls.name, component=component or cls.component()))
