@@ -32,7 +32,7 @@ from heavecomp.errors import InputError
 from heavecomp.diagnosis.generator import NEAR_NOISE, generate_case, validation_cases
 from heavecomp.params import load
 from heavecomp.report.provenance import write_params
-from heavecomp.report.scenario import ROOT, md_table, parse_args, write_metrics, write_report
+from heavecomp.report.scenario import ROOT, md_table, parse_args, run, write_metrics, write_report
 
 log = logging.getLogger("diagnosis_validation")
 
@@ -346,4 +346,4 @@ def _log_row(row, i, n, t0):
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    raise SystemExit(run(main))

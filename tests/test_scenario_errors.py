@@ -10,6 +10,8 @@ import pytest
 from heavecomp.errors import InputError
 from heavecomp.report.scenario import run
 
+#: arguments a scenario requires besides --out
+REQUIRED = {"diagnosis_validation": ["--set", "tuning"]}
 SCENARIOS = sorted(p for p in (Path(__file__).resolve().parents[1] / "scenarios").glob("*.py"))
 
 
@@ -28,7 +30,7 @@ def test_bad_out_is_one_line_exit_2(path, tmp_path, capsys):
     blocker = tmp_path / "a_file"
     blocker.write_text("x")
     with pytest.raises(SystemExit) as exc:
-        run(mod.main, ["--out", str(blocker / "sub")])
+        run(mod.main, [*REQUIRED.get(path.stem, []), "--out", str(blocker / "sub")])
     assert exc.value.code == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "--out" in err[0] and "Traceback" not in err[0], err

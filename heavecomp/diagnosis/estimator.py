@@ -670,6 +670,10 @@ class GapDiagnoser(GapEstimator):
         gap_ratio = max(self.gap_["channels"][c]["rms_validate"] / max(self.noise_floor_[c], 1e-30) for c in CH)
         runner = rows[1] if len(rows) > 1 else None
         margin = best["score"] - runner["score"] if runner else 1.0
+        # the margin must survive the replay's own input-noise spread (issue 12 item 6): how far a
+        # candidate's explained share moves when the heave is redrawn within its noise, best and runner-up
+        spread = math.hypot(*(abs(r["explained_replay"] - r["explained_perturbed_heave"]) for r in (best, runner or best)))
+        survives = margin > spread
         # the verdict's shrink is on wob (the primary channel) unless the gap lies elsewhere (e.g. a
         # lagging stroke sensor): wob's held-out gap over its floor is under half the largest channel's
         # (wob can sit at 1.2-1.7x its floor from stick-event noise alone); then on that channel
@@ -680,7 +684,8 @@ class GapDiagnoser(GapEstimator):
         input_ratio = max(self.gap_["channels"][c]["rms_validate"] / max(self.input_envelope_[c], 1e-30) for c in CH)
         v = {"effect": best["effect"], "confidence": "low", "parameters": best["parameters"],
              "shrink": best["channels"][ch]["shrink"], "shrink_channel": ch, "uncertainty": best["uncertainty"], "explained": best["explained"],
-             "gap_to_noise": gap_ratio, "gap_to_input_envelope": input_ratio, "margin": margin}
+             "gap_to_noise": gap_ratio, "gap_to_input_envelope": input_ratio, "margin": margin,
+             "margin_input_noise": spread}
         if input_ratio <= self.none_ratio or (input_ratio <= self.none_tail and best["explained"] < self.none_explained):
             # between none_ratio and none_tail x the envelope: a gap that no candidate (not even the
             # six-parameter refit) explains a quarter of is read as the tail of the stick-event noise
@@ -701,7 +706,7 @@ class GapDiagnoser(GapEstimator):
                 v["second_candidates"] = self._second_candidates()
             if second is not None and second["explained_joint"] >= self.min_explained:
                 v.update(second_effect=second, confidence="medium" if second["explained_joint"] >= 0.6 and margin >= 0.03
-                         else "low", note=f"{best['effect']} explains {100 * best['explained']:.0f} % alone, "
+                         and survives else "low", note=f"{best['effect']} explains {100 * best['explained']:.0f} % alone, "
                                           f"{100 * second['explained_joint']:.0f} % with {second['effect']}")
                 self.verdict_ = v
                 return
@@ -710,10 +715,13 @@ class GapDiagnoser(GapEstimator):
                           "held-out gap above noise", best_candidate=best["effect"])
             self.verdict_ = v
             return
-        if best["explained"] >= 0.8 and margin >= 0.1:
+        if best["explained"] >= 0.8 and margin >= 0.1 and survives:
             v["confidence"] = "high"
-        elif best["explained"] >= 0.6 and margin >= 0.03:
+        elif best["explained"] >= 0.6 and margin >= 0.03 and survives:
             v["confidence"] = "medium"
+        if not survives:
+            v["note"] = (f"margin to {runner['effect']} ({margin:.3f}) within the spread a heave-noise redraw makes "
+                         f"of the explained shares ({spread:.3f}): confidence low")
         # second effect: joint fit of the best with the runners-up
         if self.second and best["explained"] < 0.95:
             v["second_effect"] = self._second(rows)
