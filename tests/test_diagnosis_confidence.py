@@ -35,3 +35,17 @@ def test_margin_must_survive_the_input_noise_spread(runner_plain, confidence):
     assert v["effect"] == "flow_loss"
     assert v["margin"] == pytest.approx(0.20)
     assert v["confidence"] == confidence
+
+
+def test_a_gap_in_the_stick_event_noise_tail_is_never_confident():
+    """Between none_ratio and none_tail x the input-noise envelope a run with no effect can sit from
+    stick-event noise alone: a candidate explaining 96 % of such a gap is named, but with low
+    confidence (the same rows at 10 x the envelope read high)."""
+    rows = [_row("sensor_offset", 0.98, 0.96, k=2), _row("sensor_gain", 0.02, 0.02)]
+    d = GapDiagnoser(paper_a("stribeck"), second=0)
+    d.gap_ = {"channels": {c: {"rms_validate": 1.6} for c in CH}}
+    d.noise_floor_ = {c: 1.0 for c in CH}
+    d.input_envelope_ = {c: 1.0 for c in CH}
+    d._verdict(rows, 100.0, 1.0)
+    assert d.verdict_["effect"] == "sensor_offset" and d.verdict_["confidence"] == "low"
+    assert _verdict(rows)["confidence"] == "high"

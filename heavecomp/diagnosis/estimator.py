@@ -722,6 +722,13 @@ class GapDiagnoser(GapEstimator):
         if not survives:
             v["note"] = (f"margin to {runner['effect']} ({margin:.3f}) within the spread a heave-noise redraw makes "
                          f"of the explained shares ({spread:.3f}): confidence low")
+        if input_ratio <= self.none_tail and v["confidence"] != "low":
+            # the stick-event-noise tail: runs with no effect reach 1.0-1.7 x their input-noise envelope,
+            # and there a candidate can fit most of that noise (tuning set: a no-effect run read as a
+            # 3.5 mm stroke offset, high) -- a named verdict there is never confident
+            v["confidence"] = "low"
+            v["note"] = (f"held-out gap only {input_ratio:.2f} x the input-noise envelope (runs without any effect "
+                         f"reach up to {self.none_tail:g} x): confidence low")
         # second effect: joint fit of the best with the runners-up
         if self.second and best["explained"] < 0.95:
             v["second_effect"] = self._second(rows)
