@@ -21,6 +21,8 @@ class FlowLoss(Effect):
     hook = "line"
     log = ("resistance",)
 
+    #: units of the equation-error coefficients (``features``)
+    feature_units = {"flow_loss": "Pa s/m"}
     @dataclass(frozen=True)
     class Params:
         resistance: float = q(3e4, "Pa s/m", bounds=(10.0, 1e7), symbol="R",

@@ -33,6 +33,8 @@ class GasHeatTransfer(Effect):
     states = ("warming",)
     log = ("loss_coefficient", "warming", "warming_time")
 
+    #: units of the equation-error coefficients (``features``)
+    feature_units = {"index": "-", "loss": "Pa s/m", "warming": "s^2/m^2"}
     @dataclass(frozen=True)
     class Params:
         effective_index: float = q(1.2, "-", bounds=(1.0, 1.67), symbol="n_eff", doc="effective polytropic index")

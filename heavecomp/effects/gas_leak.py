@@ -29,6 +29,8 @@ class GasLeak(Effect):
     hook = "gas_spring"
     states = ("charge_change",)
 
+    #: units of the equation-error coefficients (``features``)
+    feature_units = {"gas_leak": "1/s"}
     @dataclass(frozen=True)
     class Params:
         leak_rate: float = q(-2e-5, "1/s", bounds=(-1e-3, 1e-3), symbol="r",

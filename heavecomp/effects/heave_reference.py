@@ -31,6 +31,8 @@ class HeaveReference(HeaveEffect):
     name = "heave_reference"
     candidate = True
 
+    #: units of the equation-error coefficients (``features``)
+    feature_units = {"gain": "-", "delay": "-"}
     @dataclass(frozen=True)
     class Params:
         scale: float = q(1.0, "-", bounds=(0.5, 1.5), symbol="g", doc="factor from the measured to the seen heave")

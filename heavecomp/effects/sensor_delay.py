@@ -17,6 +17,8 @@ class SensorDelay(ChannelEffect):
     name = "sensor_delay"
     candidate = True
 
+    #: units of the equation-error coefficients (``features``)
+    feature_units = {"sensor_delay": "-"}
     @dataclass(frozen=True)
     class Params:
         delay: float = q(0.2, "s", bounds=(0.0, 3.0), symbol="t_d", doc="transport delay of the lagging channel")

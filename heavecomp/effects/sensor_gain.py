@@ -21,6 +21,8 @@ class SensorGain(ChannelEffect):
     candidate = True
     linear = True
 
+    #: units of the equation-error coefficients (``features``)
+    feature_units = {"sensor_gain": "-"}
     @dataclass(frozen=True)
     class Params:
         factor: float = q(1.0, "-", bounds=(-2.0, 2.0), symbol="g",

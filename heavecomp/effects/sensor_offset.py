@@ -21,6 +21,8 @@ class SensorOffset(ChannelEffect):
     candidate = True
     linear = True
 
+    #: units of the equation-error coefficients (``features``)
+    feature_units = {"offset": "unit of the channel", "drift": "unit of the channel/s"}
     @dataclass(frozen=True)
     class Params:
         offset: float = q(0.0, "unit of the channel (N, m or Pa)", bounds=(-1e7, 1e7), symbol="o",

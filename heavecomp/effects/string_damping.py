@@ -18,6 +18,8 @@ class StringDamping(Effect):
     hook = "string"
     log = ("damping",)
 
+    #: units of the equation-error coefficients (``features``)
+    feature_units = {"string_damping": "N s/m"}
     @dataclass(frozen=True)
     class Params:
         damping: float = q(3e4, "N s/m", bounds=(10.0, 2e6), symbol="c", doc="extra drill-string damping")

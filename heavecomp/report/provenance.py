@@ -71,7 +71,8 @@ UNITS: dict[str, str] = {
     # diagnose
     "schema": "-", "explained": "-", "explained_joint": "-", "explained_perturbed_heave": "-",
     "explained_replay": "-", "added_explained": "-", "score": "-", "shrink": "-", "margin": "-",
-    "gap_to_input_envelope": "-", "gap_to_noise": "-", "nrmse": "-", "n_params": "count", "settle": "s",
+    "gap_to_input_envelope": "-", "gap_to_noise": "-", "margin_input_noise": "-", "component_gap": "-",
+    "bic": "-", "delta_bic": "-", "n_terms": "count", "nrmse": "-", "n_params": "count", "settle": "s",
     "fit": "s", "validate": "s", "segments": "s", "above": "-", "below_wave": "-", "wave": "-", "resonance": "-",
     "breakaway": "-", "sliding_accelerating": "-", "sliding_decelerating": "-",
     # campaign
@@ -206,6 +207,15 @@ def unit_of(path: tuple[str, ...]) -> str | None:
 _PARAM_UNITS: dict[str, str] = {}
 
 
+def _effect_units(name: str):
+    """``(feature_units, shape unit)`` of the effect ``name``'s equation-error fit, or None."""
+    cls = CANDIDATES.get(name) if isinstance(CANDIDATES, dict) else None
+    if cls is None:
+        return None
+    shape = getattr(cls, "feature_shape", None)
+    return dict(getattr(cls, "feature_units", {})), (shape[1] if shape else None)
+
+
 def units_of(obj, path: tuple = ()) -> tuple[dict[str, str], list[str]]:
     """``({key: unit}, [dotted paths of numbers with no known unit])`` for a JSON-like result."""
     global _PARAM_UNITS
@@ -214,17 +224,27 @@ def units_of(obj, path: tuple = ()) -> tuple[dict[str, str], list[str]]:
     units: dict[str, str] = {}
     missing: list[str] = []
 
-    def walk(x, p, own=None):
+    def walk(x, p, own=None, coef=None):
         if isinstance(x, dict):
-            # an entry that names its own unit (e.g. a fitted parameter at its bound: value, bound, unit)
+            # an entry that names its own unit (e.g. a fitted parameter at its bound: value, bound, unit;
+            # a component row: rms and noise in its equation's unit)
             own_unit = x.get("unit") if isinstance(x.get("unit"), str) else None
+            # an equation-error fit of one effect: its coefficients and shape in the effect's own units
+            eff = _effect_units(x.get("effect")) if isinstance(x.get("effect"), str) else None
             for k, v in x.items():
                 if k in ("units", "provenance"):
                     continue
-                walk(v, p + (str(k),), own_unit if k in ("value", "bound") else None)
+                if coef is not None:
+                    walk(v, p + (str(k),), coef.get(str(k)))
+                elif eff is not None and k == "coefficients" and isinstance(v, dict):
+                    walk(v, p + (str(k),), None, eff[0])
+                elif eff is not None and k == "shape" and eff[1]:
+                    walk(v, p + (str(k),), eff[1])
+                else:
+                    walk(v, p + (str(k),), own_unit if k in ("value", "bound", "rms", "noise") else None)
         elif isinstance(x, (list, tuple)):
             for v in x:
-                walk(v, p)
+                walk(v, p, own)
         elif isinstance(x, (int, float)) and not isinstance(x, bool) and p:
             u = own or unit_of(p)
             name = p[-1] if not p[-1].isdigit() else ".".join(p[-2:])
