@@ -35,7 +35,8 @@ class HeaveReference(HeaveEffect):
     feature_units = {"gain": "-", "delay": "-"}
     @dataclass(frozen=True)
     class Params:
-        scale: float = q(1.0, "-", bounds=(0.5, 1.5), symbol="g", doc="factor from the measured to the seen heave")
+        scale: float = q(1.0, "-", bounds=(-1.5, 1.5), symbol="g",
+                         doc="factor from the measured to the seen heave (negative: the heave logged with the wrong sign)")
         delay: float = q(0.0, "s", bounds=(-2.0, 2.0), symbol="t_d",
                          doc="time by which the seen heave lags the measured one (negative: leads)")
 
