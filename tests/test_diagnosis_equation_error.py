@@ -111,3 +111,27 @@ def test_shape_is_chosen_on_the_fit_part_only():
     r = np.where(fit, np.sin(2.0 * t), np.sin(5.0 * t))
     ranked = rank_effects(r, {"t": t}, [Shaped], fit, ~fit)
     assert ranked[0]["shape"] == 2.0
+
+
+def test_rest_durations_match_the_sample_loop():
+    """The vectorised rest durations (one function for the dwell feature, the component signals and the
+    open search) equal the plain loop over samples, on uneven times with rests at both ends."""
+    from heavecomp.effects.features import rest_durations
+
+    rng = np.random.default_rng(3)
+    t = np.cumsum(rng.uniform(0.01, 0.03, 3000))
+    still = np.repeat(rng.random(300) < 0.4, 10)
+    still[:7] = True
+    still[-5:] = True
+    so_far, held = np.zeros(t.size), np.zeros(t.size)
+    start, last = None, 0.0
+    for i in range(t.size):
+        if still[i]:
+            start = t[i] if start is None else start
+            so_far[i] = held[i] = t[i] - start
+        else:
+            if start is not None:
+                last, start = t[i] - start, None
+            held[i] = last
+    got = rest_durations(t, still)
+    assert np.array_equal(got[0], so_far) and np.array_equal(got[1], held)

@@ -49,6 +49,7 @@ import numpy as np
 
 from heavecomp.diagnosis.data import derivative_zero_phase, fill_gaps, noise_floor, uniform, zero_phase_lowpass
 from heavecomp.effects.base import COMPONENTS
+from heavecomp.effects.features import rest_durations
 from heavecomp.friction.laws import friction_cont, friction_jump
 from heavecomp.plants.cmc import CF, D0, KF, MB, MC, G, gas_pressure, net_force, plant_vectors, tension
 
@@ -83,23 +84,6 @@ def _dilate(t, flag, width):
         return flag
     n = max(1, int(round(width / float(np.median(np.diff(t))))))
     return np.convolve(flag.astype(float), np.ones(2 * n + 1), mode="same") > 0
-
-
-def _dwell(t, still):
-    """Time at rest so far (0 while moving) and the duration of the last rest, held while moving [s]."""
-    so_far = np.zeros(t.size)
-    held = np.zeros(t.size)
-    start, last = None, 0.0
-    for i in range(t.size):
-        if still[i]:
-            start = t[i] if start is None else start
-            so_far[i] = t[i] - start
-            held[i] = so_far[i]
-        else:
-            if start is not None:
-                last, start = t[i] - start, None
-            held[i] = last
-    return so_far, held
 
 
 def equations(t, heave, stroke, pressure, wob, params, heave_reference=0.0, cutoff=CUTOFF):
@@ -137,7 +121,7 @@ def equations(t, heave, stroke, pressure, wob, params, heave_reference=0.0, cuto
     res = {"top_mass": np.where(clear, F_meas - F_nom, np.nan),
            "lower_mass": np.where(lifted, np.nan, T_meas - tension(s, v, yb, vb, zh, dzh, PP)),
            "gas": p - gas_pressure(s, PP)}
-    dwell, rest = _dwell(t, ~sliding)
+    dwell, rest = rest_durations(t, ~sliding)
     sig = {"t": t, "x": s, "v": v, "a": a, "p": p, "dp": dp, "wob": W, "dwob": dW, "zh": zh, "dzh": dzh,
            "ddzh": ddzh, "rel": zh + s - yb, "vrel": dzh + v - vb, "dwell": dwell, "rest": rest,
            "still": ~sliding}

@@ -37,6 +37,7 @@ import math
 
 import numpy as np
 
+from heavecomp.effects.features import rest_durations
 #: a discovered term must shrink the held-out component residual by at least this much [-]
 MIN_SHRINK = 0.05
 #: STLSQ thresholds tried, on the standardised coefficient relative to std(r) [-]
@@ -69,15 +70,21 @@ def _design(cols: dict, mask, base=None):
     return X, names, bnames
 
 
+def _scales(X):
+    """Per-column scale for a standardised least squares: the spread, or for a constant column (an
+    intercept, or a decimated column of ones whose spread is rounding) its size -- dividing by a
+    ~1e-16 spread would swamp every other coefficient."""
+    s = X.std(axis=0)
+    size = np.max(np.abs(X), axis=0) if X.shape[0] else np.ones(X.shape[1])
+    flat = s <= 1e-9 * np.maximum(size, 1e-300)
+    s[flat] = np.where(size[flat] > 0, size[flat], 1.0)
+    return s
+
+
 def _lstsq(X, y):
     if X.shape[1] == 0:
         return np.zeros(0)
-    s = X.std(axis=0)
-    size = np.max(np.abs(X), axis=0) if X.shape[0] else np.ones(X.shape[1])
-    # a constant column (an intercept, or a decimated column of ones whose spread is rounding) is
-    # scaled by its size, not by its spread: dividing by ~1e-16 would swamp every other coefficient
-    flat = s <= 1e-9 * np.maximum(size, 1e-300)
-    s[flat] = np.where(size[flat] > 0, size[flat], 1.0)
+    s = _scales(X)
     c, *_ = np.linalg.lstsq(X / s, y, rcond=None)
     return c / s
 
@@ -158,22 +165,6 @@ def rank_effects(r, sig, effects, fit, validate, base=None, component="") -> lis
 
 
 # ---------------------------------------------------------------------------- open search
-def _held_rest(t, still):
-    """Duration of the last rest, held while moving (0 before the first rest) [s]."""
-    out = np.zeros(t.size)
-    start, last = None, 0.0
-    for i in range(t.size):
-        if still[i]:
-            if start is None:
-                start = t[i]
-            out[i] = t[i] - start
-        else:
-            if start is not None:
-                last, start = t[i] - start, None
-            out[i] = last
-    return out
-
-
 def library(sig: dict) -> dict:
     """The open search's features from the signals present in ``sig`` (names as
     :meth:`heavecomp.effects.base.Effect.features`; optional ``rel`` relative displacement of a
@@ -193,7 +184,7 @@ def library(sig: dict) -> dict:
             L[f"v_lag{lag:g}"] = (np.interp(t - lag, t, v, left=v[0]), f"v(t-{lag:g}s)")
         still = sig.get("still")
         if still is not None:
-            rest = _held_rest(t, np.asarray(still, bool))
+            rest = sig["rest"] if "rest" in sig else rest_durations(t, still)[1]
             L["rest_sign_v"] = (np.log1p(rest) * sv * (~np.asarray(still, bool)), "log(1+t_rest)*sign(v)")
     else:
         sv = None
@@ -228,10 +219,7 @@ def stlsq(X, y, threshold, iters=10):
     """Sequentially thresholded least squares on standardised columns: refit on the surviving
     columns, drop those whose standardised coefficient is below ``threshold`` x std(y).
     Returns the boolean support."""
-    s = X.std(axis=0)
-    s[s == 0] = np.inf  # a constant column: handled through its own scale below
-    const = ~np.isfinite(s)
-    Z = np.where(const, 1.0, X / np.where(const, 1.0, s))
+    Z = X / _scales(X)
     keep = np.ones(X.shape[1], bool)
     sy = float(np.std(y)) or 1.0
     for _ in range(iters):

@@ -49,19 +49,24 @@ def first_order_lag(t, x, tau: float, y0: float = 0.0) -> np.ndarray:
     return y
 
 
+def rest_durations(t, still) -> tuple[np.ndarray, np.ndarray]:
+    """Time at rest so far (0 while moving) and the duration of the last rest, held while moving
+    (0 before the first rest) [s]; ``still`` is a boolean array (at rest).  A rest that ends at sample
+    i lasted t[i] - t[start]."""
+    t = np.asarray(t, dtype=float)
+    still = np.asarray(still, dtype=bool)
+    before = np.r_[False, still[:-1]]
+    start = np.maximum.accumulate(np.where(still & ~before, t, -np.inf))  # start of the current/last rest
+    so_far = np.where(still, t - start, 0.0)
+    ends = ~still & before                                                 # first moving sample after a rest
+    idx = np.maximum.accumulate(np.where(ends, np.arange(t.size), -1))     # the last such sample so far
+    last = np.where(idx >= 0, (t - start)[np.maximum(idx, 0)], 0.0)
+    return so_far, np.where(still, so_far, last)
+
+
 def dwell_time(t, v, dead_band: float) -> np.ndarray:
     """Time at rest so far [s]: grows while |v| <= ``dead_band`` [m/s], 0 while sliding."""
-    t = np.asarray(t, dtype=float)
-    rest = np.abs(np.asarray(v, dtype=float)) <= dead_band
-    out = np.zeros(t.size)
-    start = None
-    for i in range(t.size):
-        if rest[i]:
-            start = t[i] if start is None else start
-            out[i] = t[i] - start
-        else:
-            start = None
-    return out
+    return rest_durations(t, np.abs(np.asarray(v, dtype=float)) <= dead_band)[0]
 
 
 def breakaway_dwell(t, dwell, window: float) -> np.ndarray:
