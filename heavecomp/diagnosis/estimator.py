@@ -368,26 +368,7 @@ class GapDiagnoser(GapEstimator):
         if cls.kind == "output" and getattr(cls, "linear", False):
             out = self._fit_linear_output(cls, fixed, t_end)
         elif cls.kind == "output":
-            best = None
-            base = self.simulate(list(fixed), t_end)
-            grid = base["_grid"]
-            from heavecomp.diagnosis.stepper import CHANNELS as SC
-            for c in CH:
-                def obj(dly, c=c):
-                    pred = dict(base)
-                    pred[c] = np.interp(base["t"] - dly, grid[:, 0], grid[:, SC.index(c)])
-                    r = self._resid_vec(pred)
-                    return float(r @ r)
-                delays = np.linspace(0.0, 3.0, 151)
-                vals = [obj(d) for d in delays]
-                k = int(np.argmin(vals))
-                lo, hi = delays[max(k - 1, 0)], delays[min(k + 1, delays.size - 1)]
-                from scipy.optimize import minimize_scalar
-                r = minimize_scalar(obj, bounds=(lo, hi), method="bounded", options={"xatol": 1e-4})
-                if best is None or r.fun < best[0]:
-                    best = (r.fun, c, float(r.x))
-            values = {"channel": best[1], "delay": best[2]}
-            out = {"values": values, "sigma": {"delay": math.nan}, "nfev": 151 * 3, "cost": best[0]}
+            out = self._fit_delay_output(cls, fixed, t_end)
         else:
             x0 = cls.to_x(start) if start else cls.x0()
             lo, hi = cls.bounds_x()
@@ -419,6 +400,35 @@ class GapDiagnoser(GapEstimator):
             out = {"values": values, "sigma": sigma, "nfev": int(r.nfev), "cost": float(2 * r.cost)}
         out["wall_time"] = time.perf_counter() - t0
         return out
+
+    def _fit_delay_output(self, cls, fixed, t_end):
+        """A channel effect with one nonlinear parameter (sensor_delay): per channel, a scan of the
+        parameter over its bounds (151 points) refined by a bounded scalar search, the channel reading
+        made by the effect's own ``apply`` from the replay's grid (no re-simulation); the channel whose
+        fit leaves the smallest weighted residual wins."""
+        from scipy.optimize import minimize_scalar
+
+        from heavecomp.diagnosis.stepper import CHANNELS as SC
+
+        (field,) = cls.fields()
+        a, b = field.metadata["bounds"]
+        base = self.simulate(list(fixed), t_end)
+        grid = base["_grid"]
+        best = None
+        for c in CH:
+            def obj(x, c=c):
+                pred = dict(base)
+                pred[c] = cls.apply(base["t"], grid[:, 0], grid[:, SC.index(c)], x)
+                r = self._resid_vec(pred)
+                return float(r @ r)
+            xs = np.linspace(a, b, 151)
+            k = int(np.argmin([obj(x) for x in xs]))
+            r = minimize_scalar(obj, bounds=(xs[max(k - 1, 0)], xs[min(k + 1, xs.size - 1)]), method="bounded",
+                                options={"xatol": 1e-4})
+            if best is None or r.fun < best[0]:
+                best = (r.fun, c, float(r.x))
+        return {"values": {"channel": best[1], field.name: best[2]}, "sigma": {field.name: math.nan},
+                "nfev": 151 * len(CH), "cost": best[0]}
 
     def _least_squares(self, fun, x0, lo, hi):
         """Bounded least squares on the decimated fit residual (``max_nfev`` evaluations)."""
