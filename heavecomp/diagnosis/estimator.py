@@ -45,6 +45,7 @@ from heavecomp.effects.candidates import CANDIDATES, MISMATCH_KEYS, ParameterMis
 from heavecomp.effects.compose import library_composition
 from heavecomp.errors import InputError
 from heavecomp.estimator import GapEstimator
+from heavecomp.params.budget import MAX_REPLAY_STEPS
 from heavecomp.diagnosis import where as W
 from heavecomp.diagnosis.data import (derivative_zero_phase, HEAVE_CUTOFF, heave_samples, MeasuredRun,
                                       noise_floor, uniform, zero_phase_lowpass)
@@ -70,9 +71,6 @@ class Replay:
     plant: object  # PlantVectors of the nominal parameters
 
 
-#: longest replay the diagnosis takes (about 28 h at 10 ms; each replay ~3 s there, the diagnosis makes
-#: several hundred, and the replay grid of 1e7 steps x 8 channels is 0.6 GB per thread)
-MAX_REPLAY_STEPS = 10_000_000
 PRESCREEN_GAP = 1.0  #: a component gap (noise variances above noise and floor) at or below which its candidates are not replayed
 DISCOVER_SHRINK = 0.5  #: an open-search term this good on its held-out component residual turns inconclusive into discovered
 #: component of each parameter table of parameter_mismatch

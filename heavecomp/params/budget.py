@@ -14,7 +14,8 @@ Budgets (module constants, per run):
 
 - :data:`MAX_STEPS` = 2e8 RK4 steps (about a minute or two of the compiled
   stepper; 24 h of paper A at its default 25 ms step is 3.5e6);
-- :data:`MAX_BYTES` = 4 GiB for heave samples plus output rows.
+- :data:`MAX_BYTES` = 4 GiB for heave samples plus output rows;
+- :data:`MAX_REPLAY_STEPS` = 1e7 steps of one replay of the gap diagnosis (checked before any replay).
 """
 
 from __future__ import annotations
@@ -28,6 +29,9 @@ from heavecomp.errors import InputError
 MAX_STEPS = 200_000_000  #: largest number of RK4 steps of one run
 MAX_BYTES = 4 * 2 ** 30  #: largest memory for heave samples + output rows [bytes]
 HEAVE_BYTES_PER_STEP = 3 * 8 * 2  #: z, dz, ddz at every half step [bytes]
+#: longest replay the gap diagnosis takes (about 28 h at its 10 ms step; each replay ~3 s there, the
+#: diagnosis makes several hundred, and the replay grid of 1e7 steps x 8 channels is 0.6 GB per thread)
+MAX_REPLAY_STEPS = 10_000_000
 MIN_DEFAULT_STEP = 1e-5  #: a parameter set whose default step is shorter cannot run an hour within MAX_STEPS [s]
 
 
