@@ -61,10 +61,11 @@ REACH = 0.5  #: friction samples within REACH / cutoff [s] of rest or a reversal
 EDGE = 3.0  #: s at each end of the run left out (the filter's edges)
 UNITS = {"friction": "N", "gas_spring": "Pa", "flow_line": "Pa", "string_formation": "N", "sensors": "-",
          "heave_input": "N"}
-#: components whose residual sees every candidate there (the friction residual is blind at breakaway;
-#: the lower-mass balance missed a string damping whose WOB gap was 3.3x its noise on the tuning set,
-#: all its shares 0): the gap diagnosis' pre-screen skips replays only for candidates in these
-SCREENED = ("gas_spring", "flow_line")
+#: plant components whose equation residual the gap diagnosis' pre-screen reads: a candidate there
+#: that the residual sees (``Effect.screened``; not a breakaway force, to which the top-mass balance
+#: is blind, nor a string damping, which the lower-mass balance's noise hides) is not replayed when
+#: its component shows no gap
+SCREENED = ("friction", "gas_spring", "flow_line", "string_formation")
 #: the equation each component's residual comes from
 EQUATION = {"friction": "top_mass", "gas_spring": "gas", "flow_line": "gas", "string_formation": "lower_mass",
             "sensors": "gas+lower_mass", "heave_input": "top_mass+lower_mass"}

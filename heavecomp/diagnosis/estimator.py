@@ -72,6 +72,14 @@ class Replay:
 
 
 PRESCREEN_GAP = 1.0  #: a component gap (noise variances above noise and floor) at or below which its candidates are not replayed
+#: a component with less than this share of the equation-error gap shows only what the others leak into it
+PRESCREEN_SHARE = 0.02
+#: span of the fit part [s] on which the coarse start grid of a candidate is scored
+GRID_SPAN = 150.0
+#: points of the scan of a channel delay over its bounds (then refined by a bounded scalar search)
+DELAY_SCAN = 61
+#: a component holding this share of the gap (``where.components``) gets its best candidate tried as a second effect
+SECOND_SHARE = 0.1
 DISCOVER_SHRINK = 0.5  #: an open-search term this good on its held-out component residual turns inconclusive into discovered
 #: component of each parameter table of parameter_mismatch
 TABLE_COMPONENT = {"compensator": "gas_spring", "friction": "friction", "drill_string": "string_formation",
@@ -133,7 +141,9 @@ class GapDiagnoser(GapEstimator):
         Candidates fitted concurrently (threads; the stepper releases the GIL).
     progress : callable(fraction, message), optional
     second : int
-        How many runner-up candidates to try jointly with the best (0: none; None, the default: all).
+        How many runner-up candidates, best first, to try jointly with the best (0: none; None: all);
+        the best candidate of every other component whose equation-error share of the gap
+        (``where.components``) is at least :data:`SECOND_SHARE` is tried as well.
     segment : float [s] or None
         Multiple-shooting segment length: the replay restarts from the measured state every
         ``segment`` seconds, so one early stick-slip event does not decide the rest of the run
@@ -182,7 +192,7 @@ class GapDiagnoser(GapEstimator):
     _ranking_attr, _choice_attr = "candidates_", "verdict_"  # GapEstimator's ranking_ and effect_
 
     def __init__(self, nominal, candidates=None, *, split=0.67, settle=None, penalty=0.03, min_explained=0.5,
-                 none_ratio=1.2, max_nfev=40, decimate=2, n_jobs=2, progress=None, second=None, segment=None,
+                 none_ratio=1.2, max_nfev=40, decimate=2, n_jobs=2, progress=None, second=4, segment=None,
                  reinit=1.5, stuck_speed=2e-3, grid=7, input_draws=8, none_tail=2.0, none_explained=0.25, scan=6,
                  prescreen_gap=PRESCREEN_GAP, discover_shrink=DISCOVER_SHRINK):
         self.nominal = nominal
@@ -372,18 +382,20 @@ class GapDiagnoser(GapEstimator):
             lo, hi = cls.bounds_x()
             x0 = np.clip(x0, lo + 1e-9, hi - 1e-9)
 
-            def fun(x):
-                pred = self.simulate(list(fixed) + [(name, cls.from_x(x))], t_end)
+            def fun(x, t_stop=t_end):
+                pred = self.simulate(list(fixed) + [(name, cls.from_x(x))], t_stop)
                 return self._resid_vec(pred)
 
-            # stick-slip makes the cost rough: start from the best of a coarse grid (<= 2 parameters)
+            # stick-slip makes the cost rough: start from the best of a coarse grid (<= 2 parameters),
+            # scored on the first GRID_SPAN seconds of the fit part (it only picks the start)
             k = x0.size
             if k <= 2 and start is None:
+                t_grid = min(t_end, self.split_["settle"] + GRID_SPAN)
                 axes = [np.linspace(lo[i] + 0.1 * (hi[i] - lo[i]), hi[i] - 0.1 * (hi[i] - lo[i]),
                                     self.grid if k == 1 else max(3, (self.grid + 3) // 2)) for i in range(k)]
                 pts = np.array(np.meshgrid(*axes)).reshape(k, -1).T
-                costs = [float(np.sum(fun(x) ** 2)) for x in pts]
-                c0 = float(np.sum(fun(x0) ** 2))
+                costs = [float(np.sum(fun(x, t_grid) ** 2)) for x in pts]
+                c0 = float(np.sum(fun(x0, t_grid) ** 2))
                 if min(costs) < c0:
                     x0 = pts[int(np.argmin(costs))]
 
@@ -401,7 +413,7 @@ class GapDiagnoser(GapEstimator):
 
     def _fit_delay_output(self, cls, fixed, t_end):
         """A channel effect with one nonlinear parameter (sensor_delay): per channel, a scan of the
-        parameter over its bounds (151 points) refined by a bounded scalar search, the channel reading
+        parameter over its bounds (:data:`DELAY_SCAN` points) refined by a bounded scalar search, the channel reading
         made by the effect's own ``apply`` from the replay's grid (no re-simulation); the channel whose
         fit leaves the smallest weighted residual wins."""
         from scipy.optimize import minimize_scalar
@@ -419,14 +431,14 @@ class GapDiagnoser(GapEstimator):
                 pred[c] = cls.apply(base["t"], grid[:, 0], grid[:, SC.index(c)], x)
                 r = self._resid_vec(pred)
                 return float(r @ r)
-            xs = np.linspace(a, b, 151)
+            xs = np.linspace(a, b, DELAY_SCAN)
             k = int(np.argmin([obj(x) for x in xs]))
             r = minimize_scalar(obj, bounds=(xs[max(k - 1, 0)], xs[min(k + 1, xs.size - 1)]), method="bounded",
                                 options={"xatol": 1e-4})
             if best is None or r.fun < best[0]:
                 best = (r.fun, c, float(r.x))
         return {"values": {"channel": best[1], field.name: best[2]}, "sigma": {field.name: math.nan},
-                "nfev": 151 * len(CH), "cost": best[0]}
+                "nfev": DELAY_SCAN * len(CH), "cost": best[0]}
 
     def _least_squares(self, fun, x0, lo, hi):
         """Bounded least squares on the decimated fit residual (``max_nfev`` evaluations)."""
@@ -749,13 +761,14 @@ class GapDiagnoser(GapEstimator):
         (:meth:`~heavecomp.diagnosis.components.ComponentResiduals.gap`), its equation-error fit on the
         component residual where it has one (:func:`heavecomp.diagnosis.equation_error.rank_effects`),
         and whether it is replayed: a plant candidate whose component shows no gap
-        (<= :attr:`prescreen_gap`; only components whose residual sees all their candidates,
-        :data:`heavecomp.diagnosis.components.SCREENED`) and whose equation-error columns shrink nothing held out
+        (<= :attr:`prescreen_gap`, or under :data:`PRESCREEN_SHARE` of the whole gap: what a large gap
+        elsewhere leaks into it; only components in :data:`heavecomp.diagnosis.components.SCREENED`
+        and candidates their residual sees, ``Effect.screened``) and whose equation-error columns shrink nothing held out
         (< :data:`heavecomp.diagnosis.equation_error.MIN_SHRINK`) is not.  Output and nominal
         candidates (a channel delay, the six-parameter refit) are always replayed, and so is every
         candidate when none would be."""
         cr = self.components_
-        gap = cr.gap()
+        gap, shares = cr.gap(), self.where_["components"]
         fm, vm = self._fitmask & cr.mask, self._valmask & cr.mask
         out = {}
         for n in names:
@@ -766,7 +779,8 @@ class GapDiagnoser(GapEstimator):
             if comp in cr.residual:
                 ranked = EE.rank_effects(cr.residual[comp], cr.signals_for(comp), [cls], fm, vm, component=comp)
                 ee = ranked[0] if ranked else None
-            quiet = comp in CR.SCREENED and gap[comp] <= self.prescreen_gap and (ee is None or ee["shrink"] < EE.MIN_SHRINK)
+            small = gap.get(comp, 0.0) <= self.prescreen_gap or shares.get(comp, 0.0) < PRESCREEN_SHARE
+            quiet = comp in CR.SCREENED and cls.screened and small and (ee is None or ee["shrink"] < EE.MIN_SHRINK)
             replay = not (cls.kind == "plant" and quiet)
             out[n] = {"component": comp, "component_gap": float(gap.get(comp, math.nan)), "replay": replay,
                       "equation_error": ee, "wall_time": time.perf_counter() - t0}
@@ -783,8 +797,10 @@ class GapDiagnoser(GapEstimator):
         return {"effect": name, "parameters": {}, "rms_before": rms, "rms_after": rms, "shrink": 0.0,
                 "score": -self.penalty * get(name).n_params(), "explained": 0.0, "n_params": get(name).n_params(),
                 "at_bound": [], "fit_wall_time": pre["wall_time"],
-                "skipped": f"pre-screen: its component {pre['component']} shows no gap over its noise "
-                           f"(gap {pre['component_gap']:.2f} <= {self.prescreen_gap:g})",
+                "skipped": f"pre-screen: its component {pre['component']} shows no gap of its own "
+                           f"(gap {pre['component_gap']:.3g} noise variances, "
+                           f"{100 * self.where_['components'].get(pre['component'], 0.0):.1f} % of the whole; "
+                           f"equation-error shrink under {EE.MIN_SHRINK:g})",
                 "equation_error": pre["equation_error"]}
 
     def _moved_most(self, values) -> str:
@@ -881,11 +897,23 @@ class GapDiagnoser(GapEstimator):
         Any pair works except two output candidates (one transport delay per configuration): a
         sensor delay as the best is paired with the plant/nominal runners-up.  The ranking alone is
         a poor guide to the partner (alone, a candidate may mimic the dominant effect's remainder or
-        distort to absorb it), so by default every runner-up is tried."""
+        distort to absorb it), so besides the ``second`` best-ranked, the best candidate of each other
+        component that holds a real share of the equation-error gap is tried (the components see a
+        second effect without replaying it).  Default 4 + those: the joint fits were half of the
+        diagnosis' time with every runner-up tried (bench_600s)."""
         best = rows[0]
         fixed = [(best["effect"], best["_values"])]
         best_output = get(best["effect"]).kind == "output"
-        partners = [r for r in rows[1:] if not (best_output and get(r["effect"]).kind == "output")][: self.second]
+        allowed = [r for r in rows[1:] if not (best_output and get(r["effect"]).kind == "output")]
+        partners = allowed[: self.second]
+        # a second gap in another component: its best candidate, however it ranked alone
+        shares = self.where_.get("components", {})
+        have = {self._candidate_component(best)} | {self._candidate_component(r) for r in partners}
+        for r in allowed[self.second:]:
+            comp = self._candidate_component(r)
+            if comp not in have and shares.get(comp, 0.0) >= SECOND_SHARE:
+                partners.append(r)
+                have.add(comp)
 
         def joint(r):
             start = r["_values"] if get(r["effect"]).kind != "output" else None

@@ -84,6 +84,10 @@ class Effect:
     candidate: bool = False
     #: values of one nonlinear shape parameter searched by the equation-error fit (empty: none)
     feature_grid: tuple = ()
+    #: its component's equation residual sees the effect wherever it acts (the gap diagnosis may
+    #: then skip its replay when that component shows no gap); False where the residual is blind
+    #: to it (e.g. a breakaway force, a damping below the balance's noise)
+    screened: bool = True
     # hook methods (staticmethods in subclasses); None: the effect does not act there
     gas = line = string = jump = static = rates = initial = steady = None
 

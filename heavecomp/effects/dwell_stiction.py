@@ -24,6 +24,8 @@ class DwellStiction(Effect):
     candidate = True
     hook = "seal_friction"
     adds_stiction = True
+    #: the top-mass balance is blind at breakaway (the static force is whatever holds the piston)
+    screened = False
     log = ("gain",)
     #: exponents beta [-] searched by the equation-error fit
     feature_grid = (0.25, 0.5, 0.75, 1.0)
