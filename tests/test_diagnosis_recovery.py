@@ -110,3 +110,16 @@ def test_parameter_mismatch_rescan_leaves_the_stick_slip_side_minimum():
     assert got["friction.static_force"] == pytest.approx(23e3, rel=0.1)
     assert got["compensator.gas_stiffness"] == pytest.approx(60e3, rel=0.1)
     assert got["drill_string.stiffness"] == pytest.approx(1.2e6, rel=0.15)
+
+
+def test_constant_offset_is_not_charged_for_a_drift():
+    """An absolute-instead-of-gauge pressure (a constant offset) is fitted with its drift held at 0
+    and one parameter counted, so the parsimony penalty does not favour a calibration gain, which
+    reads the same when the pressure swings little about its mean; a drifting offset keeps both."""
+    nominal, run = _planted("sensor_offset", {"channel": "pressure", "offset": 101325.0}, amplitude_hs=2.5)
+    row = GapDiagnoser(nominal, ["sensor_offset"], n_jobs=1, second=0, settle=10.0).fit(run).candidates_[0]
+    assert row["parameters"]["offset"] == pytest.approx(101325.0, rel=0.05)
+    assert row["parameters"]["drift"] == 0.0 and row["n_params"] == 1
+    nominal, run = _planted("sensor_offset", {"channel": "pressure", "offset": 1e5, "drift": 100.0}, amplitude_hs=2.5)
+    row = GapDiagnoser(nominal, ["sensor_offset"], n_jobs=1, second=0, settle=10.0).fit(run).candidates_[0]
+    assert row["n_params"] == 2 and row["parameters"]["drift"] == pytest.approx(100.0, rel=0.05)

@@ -482,13 +482,17 @@ class GapDiagnoser(GapEstimator):
         """A channel effect whose reading is affine in its parameters (``linear``: sensor_gain,
         sensor_offset): per channel, linear least squares of the measured channel on the columns
         the effect's own ``apply`` makes of the replay (no re-simulation); the channel whose fit
-        leaves the smallest weighted residual wins.  Parameters are clipped to their bounds."""
+        leaves the smallest weighted residual wins.  Parameters are clipped to their bounds.  The
+        effect's ``optional`` parameters (a drift) are fitted only when they shrink the channel's fit
+        residual by at least :data:`heavecomp.diagnosis.equation_error.MIN_SHRINK`; ``n_params`` counts the
+        parameters used."""
         base = self.simulate(list(fixed), t_end)
         t = base["t"]
         m = self._fitmask[: t.size]
         names = [f.name for f in cls.fields()]
         lo, hi = (np.array([f.metadata["bounds"][i] for f in cls.fields()]) for i in (0, 1))
         best = None
+        used = np.array([n not in cls.optional for n in names])
         for c in CH:
             y = self._y[c][: t.size]
             ok = m & np.isfinite(y)
@@ -496,24 +500,35 @@ class GapDiagnoser(GapEstimator):
             a0 = cls.apply(t, t, base[c], *zero)
             X = np.column_stack([cls.apply(t, t, base[c], *np.eye(len(names))[i]) - a0 for i in range(len(names))])
             Xo, yo = X[ok], (y - a0)[ok]
-            coef, *_ = np.linalg.lstsq(Xo, yo, rcond=None)
-            coef = np.clip(coef, lo, hi)
-            r = yo - Xo @ coef
+
+            def lsq(cols):
+                coef = np.zeros(len(names))
+                coef[cols], *_ = np.linalg.lstsq(Xo[:, cols], yo, rcond=None)
+                coef = np.clip(coef, lo, hi)
+                return coef, yo - Xo @ coef
+
+            coef, r = lsq(used)
+            if not used.all():  # the optional parameters only when they shrink the fit residual >= MIN_SHRINK
+                coef_f, r_f = lsq(np.ones(len(names), bool))
+                if 1.0 - math.sqrt(float(r_f @ r_f) / max(float(r @ r), 1e-300)) >= EE.MIN_SHRINK:
+                    coef, r = coef_f, r_f
+            k_used = int(np.count_nonzero(used | (coef != 0.0)))
             pred = dict(base)
             pred[c] = a0 + X @ coef
             rv = self._resid_vec(pred)
             cost = float(rv @ rv)
             if best is None or cost < best[0]:
-                dof = max(int(ok.sum()) - len(names), 1)
+                dof = max(int(ok.sum()) - k_used, 1)
                 try:
                     cov = np.linalg.pinv(Xo.T @ Xo) * float(r @ r) / dof
                     sig = np.sqrt(np.maximum(np.diag(cov), 0.0))
                 except np.linalg.LinAlgError:
                     sig = np.full(len(names), math.nan)
-                best = (cost, c, coef, sig)
-        cost, c, coef, sig = best
+                best = (cost, c, coef, sig, k_used)
+        cost, c, coef, sig, k_used = best
         values = {"channel": c, **{n: float(v) for n, v in zip(names, coef)}}
-        return {"values": values, "sigma": {n: float(s) for n, s in zip(names, sig)}, "nfev": 1, "cost": cost}
+        return {"values": values, "sigma": {n: float(s) for n, s in zip(names, sig)}, "nfev": 1, "cost": cost,
+                "n_params": k_used}
 
     def _nelder_mead(self, fun, x0, lo, hi):
         """Derivative-free refinement (Nelder-Mead on the clipped parameters; stick-slip costs are
@@ -652,7 +667,7 @@ class GapDiagnoser(GapEstimator):
             if not math.isfinite(expl):  # the fitted model diverged on held-out data
                 log.warning("diagnose: %s diverged on the held-out data", n)
                 expl = -10.0
-            k = get(n).n_params()
+            k = fitted.get("n_params", get(n).n_params())  # optional parameters held at null are not counted
             rows.append({"effect": n, "parameters": self._public(n, fitted["values"]),
                          "uncertainty": fitted["sigma"],
                          "rms_before": math.sqrt(mse_b["wob"]), "rms_after": math.sqrt(mse_a["wob"]),
@@ -934,7 +949,7 @@ class GapDiagnoser(GapEstimator):
         for r, (fitted, pred, expl) in zip(partners, results):
             if not math.isfinite(expl):
                 continue
-            gain = expl - best["explained"] - self.penalty * get(r["effect"]).n_params()
+            gain = expl - best["explained"] - self.penalty * fitted.get("n_params", get(r["effect"]).n_params())
             self.second_tried_.append({"effect": r["effect"], "explained_joint": float(expl), "added_explained": float(gain)})
             if gain > 0.1 and (out is None or gain > out["added_explained"]):
                 mse_a = self._mse(pred, self._valmask)

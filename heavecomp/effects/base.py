@@ -88,6 +88,9 @@ class Effect:
     #: then skip its replay when that component shows no gap); False where the residual is blind
     #: to it (e.g. a breakaway force, a damping below the balance's noise)
     screened: bool = True
+    #: parameters the gap diagnosis fits only when they pay (held at their null value otherwise, and
+    #: then not counted in the parsimony penalty); empty: every parameter is always fitted
+    optional: tuple = ()
     # hook methods (staticmethods in subclasses); None: the effect does not act there
     gas = line = string = jump = static = rates = initial = steady = None
 

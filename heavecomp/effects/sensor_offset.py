@@ -20,6 +20,9 @@ class SensorOffset(ChannelEffect):
     name = "sensor_offset"
     candidate = True
     linear = True
+    #: fitted only when it pays (the diagnosis then counts it in the parsimony penalty): most offsets
+    #: are constant (absolute vs gauge pressure, a zero set elsewhere)
+    optional = ("drift",)
 
     #: units of the equation-error coefficients (``features``)
     feature_units = {"offset": "unit of the channel", "drift": "unit of the channel/s"}
