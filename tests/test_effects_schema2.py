@@ -56,6 +56,31 @@ def test_asymmetric_friction_ratio_of_extension_to_retraction():
     assert np.all(res["friction"][sliding] * v[sliding] >= 0.0)  # still dissipative
 
 
+def _breakaway_forces(res, direction):
+    """|friction| at the last stuck sample before each slip in ``direction`` (the holding force as the
+    static limit gives way) [N]."""
+    stuck, v, f = res["stuck"] > 0.5, res["stroke_velocity"], np.abs(res["friction"])
+    i = np.flatnonzero(stuck[:-1] & ~stuck[1:])
+    return f[i[np.sign(v[i + 1]) == direction]]
+
+
+@pytest.mark.parametrize("breakaway,ratio", [(1.0, 1.3 / 0.7), (0.0, 1.0)])
+def test_asymmetric_friction_breakaway_share(breakaway, ratio):
+    """``breakaway`` b: the static limit carries the share b of the asymmetry.  With a = 0.3 the
+    holding force at breakaway extending over retracting is (1 + a)/(1 - a) for b = 1 and 1 for
+    b = 0, while fast sliding (|v| >> v_S) keeps J (1 +- a) either way."""
+    p = paper_a("stribeck")
+    res = _run(p, [effect_class("asymmetric_friction")(asymmetry=0.3, breakaway=breakaway)])
+    up, down = _breakaway_forces(res, +1), _breakaway_forces(res, -1)
+    assert up.size >= 3 and down.size >= 3
+    assert np.median(up) / np.median(down) == pytest.approx(ratio, rel=0.1)
+    J, visc = _law_jump(res, p)
+    v = res["stroke_velocity"]
+    fast = (res["stuck"] < 0.5) & (v > 10 * cmc.plant_vectors(p).FP[laws.VS])
+    assert fast.sum() > 50
+    assert np.mean((res["friction"][fast] - visc[fast]) / J[fast]) == pytest.approx(1.3, rel=0.01)
+
+
 def test_position_friction_only_inside_its_band(nominal):
     """dF added inside the band of the stroke (centre, width), nothing outside."""
     p = paper_a("stribeck")

@@ -8,11 +8,12 @@ import numpy as np
 
 from heavecomp.effects.base import Effect
 from heavecomp.effects.features import need
+from heavecomp.friction.laws import VS
 from heavecomp.params.core import q
 
 
 class AsymmetricFriction(Effect):
-    """J -> (1 + a d) J: the friction law's jump scaled up in one direction and down in the other.
+    """J -> (1 + a d g) J: the friction law's jump scaled up in one direction and down in the other.
 
     Notes
     -----
@@ -21,6 +22,13 @@ class AsymmetricFriction(Effect):
     of the velocity (F v >= 0): the force is J (1 + a) extending and J (1 - a) retracting, their
     ratio (1 + a) / (1 - a).  At rest the static limit is taken in the direction the holding
     force pushes.
+
+    Whether the breakaway force is as asymmetric as the sliding friction depends on the seal: a
+    lip that tilts over only once the rod moves gives a symmetric breakaway and an asymmetry that
+    builds up with speed.  g = 1 - (1 - b) exp(-|v| / v_S) (v_S the friction law's Stribeck
+    speed) carries the share ``breakaway`` b of the asymmetry at rest (b = 1: the whole jump
+    scaled in every state; b = 0: a symmetric breakaway).  The equation error, which sees the
+    sliding friction only, fits ``a`` alone; the replay fits both.
     """
 
     name = "asymmetric_friction"
@@ -31,6 +39,8 @@ class AsymmetricFriction(Effect):
     class Params:
         asymmetry: float = q(0.1, "-", bounds=(-0.9, 0.9), symbol="a",
                              doc="relative friction excess extending (+) over retracting (-): J (1 + a sign(v))")
+        breakaway: float = q(1.0, "-", bounds=(0.0, 1.0), symbol="b",
+                             doc="share of the asymmetry the static limit carries (0: symmetric breakaway)")
 
     #: units of the feature coefficients [SI]
     feature_units = {"asymmetric_friction": "N", "asymmetric_pressure_friction": "N/Pa", "asymmetric_viscous": "N s/m"}
@@ -61,12 +71,13 @@ class AsymmetricFriction(Effect):
         return cols
 
     @staticmethod
-    def jump(code, a, p, J, s, d, x, FP, asymmetry):
-        return J * (1.0 + asymmetry * d)
+    def jump(code, a, p, J, s, d, x, FP, asymmetry, breakaway):
+        grown = 1.0 - (1.0 - breakaway) * np.exp(-np.maximum(a, 0.0) / (FP[VS] + 1e-9))
+        return J * (1.0 + asymmetry * d * grown)
 
     @classmethod
     def null(cls, plant):
-        return {"asymmetry": 0.0}
+        return {"asymmetry": 0.0, "breakaway": 1.0}
 
 
 EFFECT = AsymmetricFriction
