@@ -23,6 +23,9 @@ def test_at_bounds_reads_the_candidates_own_search_range():
     vals["gas_stiffness"] = 0.2
     hit = at_bounds("parameter_mismatch", vals)
     assert [(h["parameter"], h["side"], h["unit"]) for h in hit] == [("compensator.gas_stiffness", "lower", "x nominal")]
+    # a share whose search range is its physical range: 0 is an answer (a symmetric breakaway), not a bound hit
+    assert at_bounds("asymmetric_friction", {"asymmetry": -0.3, "breakaway": 0.0}) == []
+    assert at_bounds("asymmetric_friction", {"asymmetry": -0.9, "breakaway": 0.5})[0]["parameter"] == "asymmetry"
 
 
 @pytest.mark.slow

@@ -89,7 +89,8 @@ BOUND_TOL = 0.01  #: a fitted parameter within this share of its search range fr
 
 def at_bounds(name, values, tol=BOUND_TOL) -> list:
     """Fitted parameters of candidate ``name`` that sit at a bound of their search range
-    (within ``tol`` of the range, on the fit's own scale: log where the candidate fits in log).
+    (within ``tol`` of the range, on the fit's own scale: log where the candidate fits in log);
+    not those whose bounds are the ends of their physical range (``cls.limits``: a share of 0 or 1).
 
     Returns a list of {parameter, value, side ("lower" | "upper"), bound}.
     """
@@ -98,7 +99,7 @@ def at_bounds(name, values, tol=BOUND_TOL) -> list:
     out = []
     for f, a, b in zip(cls.fields(), lo, hi):
         v = values.get(f.name)
-        if not isinstance(v, (int, float)) or not math.isfinite(v):
+        if not isinstance(v, (int, float)) or not math.isfinite(v) or f.name in cls.limits:
             continue
         x = math.log(v) if f.name in cls.log and v > 0 else v
         span = tol * (b - a)

@@ -34,6 +34,8 @@ class AsymmetricFriction(Effect):
     name = "asymmetric_friction"
     candidate = True
     hook = "seal_friction"
+    #: a breakaway share of 0 or 1 is a physical answer (the search bounds are its range)
+    limits = ("breakaway",)
 
     @dataclass(frozen=True)
     class Params:

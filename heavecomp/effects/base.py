@@ -91,6 +91,9 @@ class Effect:
     #: parameters the gap diagnosis fits only when they pay (held at their null value otherwise, and
     #: then not counted in the parsimony penalty); empty: every parameter is always fitted
     optional: tuple = ()
+    #: parameters whose search bounds are the ends of their physical range (e.g. a share in [0, 1]):
+    #: a fit at such a bound is an answer, not a sign that the effect stands in for another
+    limits: tuple = ()
     # hook methods (staticmethods in subclasses); None: the effect does not act there
     gas = line = string = jump = static = rates = initial = steady = None
 
