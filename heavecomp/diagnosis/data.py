@@ -44,6 +44,8 @@ UNITS = {"t": "s", "heave": "m", "stroke": "m", "pressure": "Pa", "wob": "N"}
 #: optional vessel-angle columns [rad] (``heave_reference``'s lever arm): unit-checked, gaps bridged like the heave
 ANGLES = ("pitch",)
 MAX_ANGLE_RMS = 0.5  #: largest plausible rms of a vessel angle [rad] (28 deg): more is degrees read as radians
+#: s of the run the heave reference is read from (after the pre-filter's edge; :func:`heavecomp.diagnosis.start.estimate`)
+ZREF_WINDOW = (5.0, 30.0)
 MAX_MISSING = 0.2  #: largest tolerated fraction of missing samples per column
 MAX_GAP = 2.0      #: longest heave dropout (or hole in the time column) bridged by interpolation [s]
 MIN_SAMPLES = 50   #: fewest samples of a run
@@ -315,11 +317,9 @@ def heave_samples(run: MeasuredRun, h: float, n_steps: int, cutoff=HEAVE_CUTOFF,
 
 def _angle_reference(run, ca, reference) -> float:
     """sin(theta) [-] where the heave reference was read: the first sample (``reference`` None) or the
-    mean over :data:`heavecomp.diagnosis.start.ZREF_WINDOW` (the estimated operating point).  A heave
+    mean over :data:`ZREF_WINDOW` (where :func:`heavecomp.diagnosis.start.estimate` reads it).  A heave
     measured at a lever arm carries L sin(theta) into its reference; ``heave_reference`` removes
     L (sin(theta) - this) so that the seen heave keeps the operating point."""
-    from heavecomp.diagnosis.start import ZREF_WINDOW
-
     if reference is None:
         return float(np.sin(ca(run.t[0])))
     rel = run.t - run.t[0]
