@@ -166,7 +166,7 @@ def test_heave_reference_scales_and_delays_what_the_plant_sees():
 @pytest.mark.parametrize("name, values", [("sensor_gain", {"channel": "stroke", "factor": 1.0}),
                                           ("sensor_offset", {"channel": "wob", "offset": 0.0, "drift": 0.0}),
                                           ("sensor_delay", {"channel": "pressure", "delay": 0.0}),
-                                          ("heave_reference", {"scale": 1.0, "delay": 0.0})])
+                                          ("heave_reference", {"scale": 1.0, "delay": 0.0, "lever_arm": 0.0})])
 def test_channel_and_heave_effects_at_null_reproduce_the_nominal_run_bit_for_bit(nominal, name, values):
     cls = effect_class(name)
     assert values == {**values, **cls.null(None)}

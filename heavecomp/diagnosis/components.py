@@ -47,7 +47,7 @@ import math
 
 import numpy as np
 
-from heavecomp.diagnosis.data import derivative_zero_phase, fill_gaps, noise_floor, uniform, zero_phase_lowpass
+from heavecomp.diagnosis.data import ANGLES, derivative_zero_phase, fill_gaps, noise_floor, uniform, zero_phase_lowpass
 from heavecomp.effects.base import COMPONENTS
 from heavecomp.effects.features import rest_durations
 from heavecomp.friction.laws import friction_cont, friction_jump
@@ -261,6 +261,9 @@ def residuals(run, params, *, heave_reference=None, noise=None, mask=None, cutof
         m &= mask
     noise = dict(noise) if noise else {k: noise_floor(run[k], None if run.uniform else t) for k in ch}
     out = _split(t, ch, params, heave_reference, cutoff, noise, m, seed)
+    for a in ANGLES:  # a logged vessel angle [rad], filtered as the heave (heave_reference's lever arm)
+        if a in run.columns:
+            out.signals[a] = _smooth(t, fill_gaps(t, run[a]), cutoff)[0]
     if floor_channels is not None:
         ref = dict(ch, **{k: fill_gaps(t, np.asarray(floor_channels[k], float)) for k in ("stroke", "pressure", "wob")})
         nf = _split(t, ref, params, heave_reference, cutoff, None, m, seed, noise_of=out.noise)

@@ -1,7 +1,9 @@
 """Measured runs: load and check the CSV contract, derive heave velocity/acceleration.
 
 Contract: ``docs/contracts/measured-run.md`` — columns ``t`` [s], ``heave`` [m],
-``stroke`` [m], ``pressure`` [Pa], ``wob`` [N]; other columns are carried along.
+``stroke`` [m], ``pressure`` [Pa], ``wob`` [N]; optional ``pitch`` [rad] (:data:`ANGLES`: the vessel
+angle of ``heave_reference``'s lever arm; units converted like the others, gaps treated like the
+heave's, an rms over :data:`MAX_ANGLE_RMS` an error); other columns are carried along.
 
 Treatments (documented in ``docs/diagnosis.md``):
 
@@ -39,6 +41,11 @@ log = logging.getLogger(__name__)
 REQUIRED = ("t", "heave", "stroke", "pressure", "wob")
 CHANNELS = ("wob", "stroke", "pressure")
 UNITS = {"t": "s", "heave": "m", "stroke": "m", "pressure": "Pa", "wob": "N"}
+#: optional vessel-angle columns [rad] (``heave_reference``'s lever arm): unit-checked, gaps bridged like the heave
+ANGLES = ("pitch",)
+MAX_ANGLE_RMS = 0.5  #: largest plausible rms of a vessel angle [rad] (28 deg): more is degrees read as radians
+#: s of the run the heave reference is read from (after the pre-filter's edge; :func:`heavecomp.diagnosis.start.estimate`)
+ZREF_WINDOW = (5.0, 30.0)
 MAX_MISSING = 0.2  #: largest tolerated fraction of missing samples per column
 MAX_GAP = 2.0      #: longest heave dropout (or hole in the time column) bridged by interpolation [s]
 MIN_SAMPLES = 50   #: fewest samples of a run
@@ -105,7 +112,7 @@ def load_run(path, params=None, *, columns=None, units=None) -> MeasuredRun:
     spec = getattr(params, "extra", {}).get("measurement") if params is not None else None
     cols = {**(spec.columns if spec else {}), **(columns or {})}
     uns = {**(spec.units if spec else {}), **(units or {})}
-    s = read_series(path, REQUIRED, columns=cols, units=uns, what="measured run")
+    s = read_series(path, REQUIRED, optional=ANGLES, columns=cols, units=uns, what="measured run")
     data = dict(s.columns)
     t = data.pop("t")
     run = check_run(t, data, params=params, source=s.source, rows=s.rows)
@@ -123,7 +130,8 @@ def check_run(t, columns: dict, *, params=None, source="<array>", rows=None) -> 
 
     t = np.asarray(t, dtype=float)
     columns = {k: np.asarray(v, dtype=float) for k, v in columns.items()}
-    for col in REQUIRED[1:]:  # an inf cell is a dropout like an empty one (never averaged into a check)
+    checked = REQUIRED[1:] + tuple(a for a in ANGLES if a in columns)
+    for col in checked:  # an inf cell is a dropout like an empty one (never averaged into a check)
         if col in columns and np.isinf(columns[col]).any():
             columns[col] = np.where(np.isinf(columns[col]), np.nan, columns[col])
     line = (lambda i: int(rows[i])) if rows is not None else (lambda i: int(i) + 2)
@@ -150,7 +158,7 @@ def check_run(t, columns: dict, *, params=None, source="<array>", rows=None) -> 
         raise DataError(f"{source}: column 't', row {line(i + 1)}: {t[i + 1] - t[i]:.3g} s without samples "
                         f"({t[i]:g} -> {t[i + 1]:g} s; longest bridged gap {MAX_GAP:g} s)")
     warnings = []
-    for col in REQUIRED[1:]:
+    for col in checked:
         miss = ~np.isfinite(columns[col])
         frac = float(miss.mean())
         if frac > MAX_MISSING:
@@ -158,17 +166,20 @@ def check_run(t, columns: dict, *, params=None, source="<array>", rows=None) -> 
                             f"(at most {100 * MAX_MISSING:.0f} % tolerated)")
         if miss.any():
             warnings.append(f"column '{col}': {int(miss.sum())} missing samples "
-                            + ("interpolated in the replay input" if col == "heave" else "excluded from the residuals"))
-    z = columns["heave"]
-    miss = ~np.isfinite(z)
-    if miss.any():
-        holes = _runs(miss)
-        for a, b in holes:
+                            + ("interpolated in the replay input" if col not in CHANNELS else "excluded from the residuals"))
+    for col in ("heave",) + checked[4:]:  # the replay's inputs: gaps bridged by interpolation
+        miss = ~np.isfinite(columns[col])
+        for a, b in _runs(miss) if miss.any() else ():
             lo = t[max(a - 1, 0)]
             hi = t[min(b, t.size - 1)]
             if hi - lo > MAX_GAP:
-                raise DataError(f"{source}: column 'heave', row {line(a)}: dropout of {hi - lo:.3g} s "
+                raise DataError(f"{source}: column '{col}', row {line(a)}: dropout of {hi - lo:.3g} s "
                                 f"(longest bridged gap {MAX_GAP:g} s)")
+    for col in checked[4:]:
+        rms = float(np.sqrt(np.nanmean(columns[col] ** 2)))
+        if rms > MAX_ANGLE_RMS:
+            raise DataError(f"{source}: column '{col}': rms {rms:.4g} rad ({math.degrees(rms):.0f} deg) is no vessel "
+                            f"angle — degrees? convert the column to rad or declare --units {col}=deg")
     d = np.diff(t)
     if np.ptp(d) > 1e-6 * np.median(d):
         warnings.append(f"non-uniform sampling (intervals {d.min():.4g}..{d.max():.4g} s): replay uses the "
@@ -293,8 +304,27 @@ def heave_samples(run: MeasuredRun, h: float, n_steps: int, cutoff=HEAVE_CUTOFF,
     ref = float(cs(run.t[0])) if reference is None else float(reference)
     sp = 0.5 * h
     tg = np.minimum(np.arange(2 * n_steps + 2) * sp, run.t[-1])
-    return HeaveSamples(sp, cs(tg) - ref, cs(tg, 1), cs(tg, 2), {"kind": "measured", "cutoff_hz": cutoff,
-                                                                 "reference_m": ref})
+    info = {"kind": "measured", "cutoff_hz": cutoff, "reference_m": ref}
+    angle = None
+    for col in ANGLES:  # the logged vessel angle, filtered as the heave, on the same grid
+        if col in run.columns:
+            ca = heave_filtered(MeasuredRun(run.t, {"heave": run[col]}), cutoff)
+            angle = (ca(tg), ca(tg, 1), ca(tg, 2))
+            info.update(angle=col, angle_reference=_angle_reference(run, ca, reference))
+            break
+    return HeaveSamples(sp, cs(tg) - ref, cs(tg, 1), cs(tg, 2), info, angle=angle)
+
+
+def _angle_reference(run, ca, reference) -> float:
+    """sin(theta) [-] where the heave reference was read: the first sample (``reference`` None) or the
+    mean over :data:`ZREF_WINDOW` (where :func:`heavecomp.diagnosis.start.estimate` reads it).  A heave
+    measured at a lever arm carries L sin(theta) into its reference; ``heave_reference`` removes
+    L (sin(theta) - this) so that the seen heave keeps the operating point."""
+    if reference is None:
+        return float(np.sin(ca(run.t[0])))
+    rel = run.t - run.t[0]
+    w = (rel >= ZREF_WINDOW[0]) & (rel <= ZREF_WINDOW[1])
+    return float(np.mean(np.sin(ca(run.t[w])))) if w.sum() >= 8 else float(np.sin(ca(run.t[0])))
 
 
 def derivative_zero_phase(t, y, cutoff):

@@ -51,6 +51,7 @@ from heavecomp.diagnosis.data import (derivative_zero_phase, HEAVE_CUTOFF, heave
                                       noise_floor, uniform, zero_phase_lowpass)
 from heavecomp.plants.cmc import D0, KF, plant_vectors
 from heavecomp.diagnosis.data import heave_filtered
+from heavecomp.diagnosis.data import ANGLES
 from heavecomp.diagnosis import start as S
 from heavecomp.diagnosis import components as CR
 from heavecomp.diagnosis import equation_error as EE
@@ -369,9 +370,14 @@ class GapDiagnoser(GapEstimator):
         return r
 
     # --------------------------------------------------------------- fitting
+    def _candidate(self, name):
+        """The class fitted for candidate ``name`` on this run (``Effect.for_input``: heave_reference
+        without a logged angle fits g and t_d only)."""
+        return get(name).for_input(self._rp.hs)
+
     def _fit_candidate(self, name, start=None, fixed=()):
         """Fit one candidate (optionally jointly after ``fixed`` configs) on the fit part."""
-        cls = get(name)
+        cls = self._candidate(name)
         t0 = time.perf_counter()
         t_end = self.split_["fit"][1]
         if cls.kind == "output" and getattr(cls, "linear", False):
@@ -668,7 +674,7 @@ class GapDiagnoser(GapEstimator):
             if not math.isfinite(expl):  # the fitted model diverged on held-out data
                 log.warning("diagnose: %s diverged on the held-out data", n)
                 expl = -10.0
-            k = fitted.get("n_params", get(n).n_params())  # optional parameters held at null are not counted
+            k = fitted.get("n_params", self._candidate(n).n_params())  # optional parameters held at null are not counted
             rows.append({"effect": n, "parameters": self._public(n, fitted["values"]),
                          "uncertainty": fitted["sigma"],
                          "rms_before": math.sqrt(mse_b["wob"]), "rms_after": math.sqrt(mse_a["wob"]),
@@ -811,7 +817,8 @@ class GapDiagnoser(GapEstimator):
         pre = self.prescreen_[name]
         rms = math.sqrt(mse_b["wob"])
         return {"effect": name, "parameters": {}, "rms_before": rms, "rms_after": rms, "shrink": 0.0,
-                "score": -self.penalty * get(name).n_params(), "explained": 0.0, "n_params": get(name).n_params(),
+                "score": -self.penalty * self._candidate(name).n_params(), "explained": 0.0,
+                "n_params": self._candidate(name).n_params(),
                 "at_bound": [], "fit_wall_time": pre["wall_time"],
                 "skipped": f"pre-screen: its component {pre['component']} shows no gap of its own "
                            f"(gap {pre['component_gap']:.3g} noise variances, "
@@ -950,7 +957,7 @@ class GapDiagnoser(GapEstimator):
         for r, (fitted, pred, expl) in zip(partners, results):
             if not math.isfinite(expl):
                 continue
-            gain = expl - best["explained"] - self.penalty * fitted.get("n_params", get(r["effect"]).n_params())
+            gain = expl - best["explained"] - self.penalty * fitted.get("n_params", self._candidate(r["effect"]).n_params())
             self.second_tried_.append({"effect": r["effect"], "explained_joint": float(expl), "added_explained": float(gain)})
             if gain > 0.1 and (out is None or gain > out["added_explained"]):
                 mse_a = self._mse(pred, self._valmask)
@@ -977,7 +984,8 @@ class GapDiagnoser(GapEstimator):
         val = self._valmask
 
         def perturbed():
-            pert = MeasuredRun(run.t, {"heave": run["heave"] + rng.normal(0.0, sz, run.t.size)}, run.source)
+            pert = MeasuredRun(run.t, {**{a: run[a] for a in ANGLES if a in run.columns},
+                                       "heave": run["heave"] + rng.normal(0.0, sz, run.t.size)}, run.source)
             return heave_samples(pert, self._rp.h, self._rp.n_steps, reference=self._rp.hs.info["reference_m"])
 
         def ms(a, m):

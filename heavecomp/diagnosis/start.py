@@ -31,12 +31,11 @@ import dataclasses
 import math
 
 import numpy as np
-from heavecomp.diagnosis.data import noise_floor
+from heavecomp.diagnosis.data import noise_floor, ZREF_WINDOW
 
 WINDOW = 2.0  #: s of the measurement the initial state is estimated from
 STUCK_SPEED = 2e-3  #: m/s; below this measured stroke speed the compensator starts stuck
 LOWER_WINDOW = 0.15  #: s of WOB the lower-mass state is read from
-ZREF_WINDOW = (5.0, 30.0)  #: s of the run the heave reference is read from (after the pre-filter's edge)
 REST_SIGMAS = 4.0  #: an estimate within this many standard errors of the operating point counts as "at rest"
 
 

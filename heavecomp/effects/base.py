@@ -151,6 +151,14 @@ class Effect:
         return tuple(m for m in METHODS if getattr(cls, m) is not None)
 
     @classmethod
+    def for_input(cls, hs) -> type:
+        """The class to fit for the replay's heave samples ``hs``
+        (:class:`heavecomp.simulate.excitation.HeaveSamples`): this one; an effect with parameters
+        that need an input the run may lack returns a variant without them (``heave_reference``
+        without a logged angle)."""
+        return cls
+
+    @classmethod
     def null(cls, plant) -> dict | None:
         """Parameter values at which the effect reproduces the nominal plant bit for bit
         (``plant``: :class:`heavecomp.plants.cmc.PlantVectors`), or None when it has none
@@ -235,6 +243,8 @@ class HeaveEffect(Effect):
     hook = "heave"
     kind = "heave"
     seen = None
+    #: parameters that act through a logged vessel angle (``HeaveSamples.angle``), not through ``seen``
+    angle_params: tuple = ()
 
     def transform(self, hs):
         """The heave samples the plant sees (:class:`heavecomp.simulate.excitation.HeaveSamples`)

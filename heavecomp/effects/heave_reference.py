@@ -2,17 +2,20 @@
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
 
 from heavecomp.effects.base import HeaveEffect
+from heavecomp.errors import ParameterError
 from heavecomp.params.core import q
 
 
 class HeaveReference(HeaveEffect):
-    """z_seen(t) = g z_meas(t - t_d): the heave the compensator sees is the measured heave
-    scaled and shifted in time.
+    """z_seen(t) = g z_meas(t - t_d) - L sin(theta(t)): the heave the compensator sees is the measured
+    heave scaled and shifted in time, less a lever arm L [m] times the sine of a logged vessel angle
+    theta [rad] (column ``pitch``) when the run carries one.
 
     Notes
     -----
@@ -25,6 +28,11 @@ class HeaveReference(HeaveEffect):
     response, near-constant over the band).  Then z_meas ~ z_crown (1 + L c e^{i phi}): a gain and
     a phase, and a phase that is near-constant over a narrow band is a time shift t_d = phi /
     omega_peak.  So the lever-arm case shows as a gain plus a delay (negative t_d: a lead).
+    With the pitch logged the lever arm is fitted itself: z_crown = z_meas - L sin(theta).  The
+    angle comes with the heave samples (``HeaveSamples.angle``, the logged ``pitch`` filtered as the
+    heave, on its grid); the term is taken relative to sin(theta) where the heave reference was read
+    (``info["angle_reference"]``) so that the seen heave keeps the operating point.  A run without an
+    angle column fits g and t_d only (:meth:`for_input`: lever_arm fixed at 0, two parameters).
     Acts on the heave input, outside the stepper (the heave samples the stepper interpolates).
     """
 
@@ -32,13 +40,17 @@ class HeaveReference(HeaveEffect):
     candidate = True
 
     #: units of the equation-error coefficients (``features``)
-    feature_units = {"gain": "-", "delay": "-"}
+    feature_units = {"gain": "-", "delay": "-", "lever_arm": "m"}
+    angle_params = ("lever_arm",)
     @dataclass(frozen=True)
     class Params:
         scale: float = q(1.0, "-", bounds=(-1.5, 1.5), symbol="g",
                          doc="factor from the measured to the seen heave (negative: the heave logged with the wrong sign)")
         delay: float = q(0.0, "s", bounds=(-2.0, 2.0), symbol="t_d",
                          doc="time by which the seen heave lags the measured one (negative: leads)")
+        lever_arm: float = q(0.0, "m", bounds=(-30.0, 30.0), symbol="L",
+                             doc="lever arm from the compensator to where the heave is measured, times the "
+                                 "logged angle: z_meas = z_crown + L sin(pitch); 0 without an angle column")
 
     #: delays t_d [s] searched by the equation-error fit
     feature_grid = (-1.0, -0.5, -0.2, -0.1, 0.0, 0.1, 0.2, 0.5)
@@ -47,22 +59,66 @@ class HeaveReference(HeaveEffect):
     def features(cls, sig, shape=None):
         """``heave_input`` residual (the heave the plant saw, from the other channels, minus the
         measured ``heave``) [m]: ``gain`` z (coefficient g - 1) and ``delay`` z(t - t_d) - z(t)
-        (coefficient g) for t_d = ``shape``: g z(t - t_d) - z(t), the seen heave by :meth:`seen`."""
+        (coefficient g) for t_d = ``shape``: g z(t - t_d) - z(t), the seen heave by :meth:`seen`;
+        when ``sig`` has ``pitch`` [rad], ``lever_arm`` -sin(pitch) (coefficient L [m])."""
         if not all(k in sig for k in ("t", "heave")):
             return None
         t, z = np.asarray(sig["t"], dtype=float), np.asarray(sig["heave"], dtype=float)
         d = cls.Params().delay if shape is None else float(shape)
-        return {"gain": z, "delay": cls.seen(t, z, 1.0, d) - z}
+        cols = {"gain": z, "delay": cls.seen(t, z, 1.0, d) - z}
+        if "pitch" in sig and "lever_arm" in cls.feature_units:
+            cols["lever_arm"] = -np.sin(np.asarray(sig["pitch"], dtype=float))
+        return cols
 
     @staticmethod
-    def seen(t, z, scale, delay):
+    def seen(t, z, scale, delay, lever_arm=0.0):
         """The seen heave (or its derivative) on the uniform grid ``t`` [s] from the measured ``z``
-        (linear interpolation; held at the ends)."""
+        (linear interpolation; held at the ends), without the lever-arm term (:meth:`transform` adds
+        it from the angle)."""
         return scale * np.interp(t - delay, t, z)
+
+    def transform(self, hs):
+        """:meth:`HeaveEffect.transform` less L (sin(theta) - sin(theta_ref)) and its derivatives
+        (theta from ``hs.angle``); ParameterError when L != 0 and the samples carry no angle."""
+        out = super().transform(hs)
+        L = float(self.values.get("lever_arm", 0.0))
+        if L == 0.0:
+            return out
+        if hs.angle is None:
+            raise ParameterError(f"effect {self.name}: lever_arm = {L:g} m needs a logged vessel angle (column "
+                                 "'pitch', rad) with the heave; this heave has none: set lever_arm to 0")
+        th, dth, ddth = (np.asarray(a, dtype=float) for a in hs.angle)
+        s, c = np.sin(th), np.cos(th)
+        s0 = float(hs.info.get("angle_reference", 0.0))
+        return dataclasses.replace(out, z=out.z - L * (s - s0), dz=out.dz - L * c * dth,
+                                   ddz=out.ddz - L * (c * ddth - s * dth ** 2))
+
+    @classmethod
+    def for_input(cls, hs):
+        """The candidate for heave samples ``hs``: this class when they carry an angle, else
+        :class:`HeaveReferenceNoAngle` (g and t_d; lever_arm fixed at 0, not fitted)."""
+        return cls if getattr(hs, "angle", None) is not None else HeaveReferenceNoAngle
 
     @classmethod
     def null(cls, plant):
-        return {"scale": 1.0, "delay": 0.0}
+        return {f.name: {"scale": 1.0}.get(f.name, 0.0) for f in cls.fields()}
+
+
+class HeaveReferenceNoAngle(HeaveReference):
+    """``heave_reference`` on a run without an angle column: the same map with the lever arm fixed at 0
+    (two parameters, g and t_d; not registered: :meth:`HeaveReference.for_input` picks it)."""
+
+    feature_units = {"gain": "-", "delay": "-"}
+    candidate = False
+
+    Params = dataclasses.make_dataclass(
+        "Params", [(f.name, f.type, dataclasses.field(default=f.default, metadata=f.metadata))
+                   for f in dataclasses.fields(HeaveReference.Params) if f.name not in HeaveReference.angle_params],
+        frozen=True)
+
+    @classmethod
+    def for_input(cls, hs):
+        return HeaveReference.for_input(hs)
 
 
 EFFECT = HeaveReference

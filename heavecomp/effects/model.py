@@ -118,6 +118,10 @@ def heave_map(effects) -> tuple:
     a, b = 1.0, 0.0
     for e in effects:
         if e.kind == "heave":
+            if any(e.values.get(k, 0.0) != 0.0 for k in e.angle_params):
+                raise ParameterError(f"effect {e.name} ({', '.join(f'{k}={v:g}' for k, v in e.values.items())}): the "
+                                     "casadi model (linearise, MPC) has no vessel-angle input for its "
+                                     f"{', '.join(e.angle_params)}: set it to 0")
             g = _static_gain(e, e.seen)
             a, b = g * a, g * b
         elif e.kind == "output" and e.channel == "heave":

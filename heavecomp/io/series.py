@@ -40,9 +40,10 @@ from heavecomp.errors import did_you_mean
 log = logging.getLogger(__name__)
 
 #: contract name -> physical kind (docs/contracts/measured-run.md)
-KINDS = {"t": "time", "heave": "length", "stroke": "length", "pressure": "pressure", "wob": "force"}
+KINDS = {"t": "time", "heave": "length", "stroke": "length", "pressure": "pressure", "wob": "force",
+         "pitch": "angle"}
 #: SI unit of each kind
-SI = {"time": "s", "length": "m", "pressure": "Pa", "force": "N"}
+SI = {"time": "s", "length": "m", "pressure": "Pa", "force": "N", "angle": "rad"}
 P_ATM = 101325.0
 #: unit -> (kind, factor to SI, offset added after scaling [SI]); absolute pressures become gauge
 UNITS = {
@@ -58,10 +59,12 @@ UNITS = {
     "n": ("force", 1.0, 0.0), "kn": ("force", 1e3, 0.0), "mn": ("force", 1e6, 0.0),
     "t": ("force", 9810.0, 0.0), "tonnes": ("force", 9810.0, 0.0), "kip": ("force", 4448.22, 0.0),
     "lbf": ("force", 4.44822, 0.0), "klbf": ("force", 4448.22, 0.0),
+    "rad": ("angle", 1.0, 0.0), "mrad": ("angle", 1e-3, 0.0), "deg": ("angle", np.pi / 180.0, 0.0),
 }
 #: header spellings of the contract names (after normalisation: lower case, single spaces)
 ALIASES = {"t": ("t", "time", "timestamp", "datetime", "date time"), "heave": ("heave", "z_h", "zh"),
-           "stroke": ("stroke", "s"), "pressure": ("pressure", "p"), "wob": ("wob", "weight on bit")}
+           "stroke": ("stroke", "s"), "pressure": ("pressure", "p"), "wob": ("wob", "weight on bit"),
+           "pitch": ("pitch",)}
 #: largest file read (decompressed) [bytes]: a bigger one is refused before it fills the memory
 MAX_BYTES = 1 << 30
 DELIMITERS = (",", ";", "\t", "|")

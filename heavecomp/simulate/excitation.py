@@ -35,6 +35,9 @@ class HeaveSamples:
     #: (sample index, left-limit ddz) where the fade-in ends on a sample: d^2r/dt^2 jumps
     #: there (-pi^2/(2 T_r^2) -> 0), so the interval before it needs the left limit
     kink: tuple | None = None
+    #: a logged vessel angle on the same grid, (theta [rad], dtheta [rad/s], ddtheta [rad/s^2]), or None:
+    #: what a heave effect with a lever arm (``heave_reference``) needs besides the heave
+    angle: tuple | None = None
 
     @property
     def t(self) -> np.ndarray:
