@@ -209,6 +209,9 @@ def library(sig: dict) -> dict:
         m = np.nanmedian(rel)
         d = rel - m
         L["rel"] = (d, "(rel - median rel)")
+        # a spring that stiffens or softens with its stretch (odd and even powers)
+        L["rel_abs_rel"] = (d * np.abs(d), "(rel - median rel)*|rel - median rel|")
+        L["rel_cubed"] = (d ** 3, "(rel - median rel)^3")
         for q in (0.25, 0.5):
             w = float(np.nanquantile(np.abs(d), q))
             L[f"deadband{q:g}"] = (np.sign(d) * np.maximum(np.abs(d) - w, 0.0) - d,
