@@ -28,6 +28,13 @@ whole analysed span) into the parts other components explain:
   ``sensors`` (dW/dt: a lagging WOB channel); the rest is ``string_formation``;
 - top-mass balance: ``heave_input`` (ddz_h); the rest is ``friction``.
 
+A channel that misreads (a clipped load cell, a stroke read through a play) is one error in one
+reading, so it shows in every equation that reads that channel, with coefficients the equations fix;
+a seal, gas or string effect shows in its own equation only.  :func:`channel_search` fits generic
+misreadings of each channel's own reading to all the equations that read it at once and keeps a term
+only when two of them see it and shrink (cross-channel consistency); the gap diagnosis' open search
+puts such a term first, as component ``sensors`` with the channel named.
+
 The friction residual is blind near rest and reversals (the filtered sign(v) jump): effects acting at
 breakaway (dwell stiction, frictional memory) show little there; measured on generated runs, the
 largest holding force before a breakaway, read through the same filter, is dominated by the filter's
