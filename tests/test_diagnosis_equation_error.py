@@ -113,6 +113,26 @@ def test_shape_is_chosen_on_the_fit_part_only():
     assert ranked[0]["shape"] == 2.0
 
 
+def test_open_search_prunes_on_the_fit_part_only():
+    """The held-out part scores, never chooses the terms: a residual made of two features on the fit
+    part keeps both whatever the held-out part holds; with the held-out part made by the first
+    feature alone (the second one then only costs held-out shrink) pruning by held-out shrink would
+    drop the second term, a choice made by the data that is meant to judge it."""
+    sig, fit, val, rng = _signals(seed=3)
+    a = sig["v"] * np.abs(sig["v"])
+    b = (sig["v"] > 0).astype(float)
+    noise = rng.normal(0.0, 0.05, sig["t"].size)
+    both = 40.0 * a / np.std(a) + 12.0 * b / np.std(b) + noise
+    first_only = np.where(fit, both, 40.0 * a / np.std(a) + noise)
+    lib = {k: E.library(sig)[k] for k in ("v_abs_v", "sign_v_pos", "p", "x")}
+    d_same = E.open_search(both, sig, fit, val, features=lib)
+    d_other = E.open_search(first_only, sig, fit, val, features=lib)
+    assert sorted(d_same["features"]) == ["sign_v_pos", "v_abs_v"]
+    assert d_other["features"] == d_same["features"]
+    assert d_other["coefficients"] == pytest.approx(d_same["coefficients"])
+    assert d_other["shrink"] < d_same["shrink"]  # the held-out part still scores
+
+
 def test_rest_durations_match_the_sample_loop():
     """The vectorised rest durations (one function for the dwell feature, the component signals and the
     open search) equal the plain loop over samples, on uneven times with rests at both ends."""

@@ -28,6 +28,13 @@ whole analysed span) into the parts other components explain:
   ``sensors`` (dW/dt: a lagging WOB channel); the rest is ``string_formation``;
 - top-mass balance: ``heave_input`` (ddz_h); the rest is ``friction``.
 
+A channel that misreads (a clipped load cell, a stroke read through a play) is one error in one
+reading, so it shows in every equation that reads that channel, with coefficients the equations fix;
+a seal, gas or string effect shows in its own equation only.  :func:`channel_search` fits generic
+misreadings of each channel's own reading to all the equations that read it at once and keeps a term
+only when two of them see it and shrink (cross-channel consistency); the gap diagnosis' open search
+puts such a term first, as component ``sensors`` with the channel named.
+
 The friction residual is blind near rest and reversals (the filtered sign(v) jump): effects acting at
 breakaway (dwell stiction, frictional memory) show little there; measured on generated runs, the
 largest holding force before a breakaway, read through the same filter, is dominated by the filter's
@@ -43,10 +50,12 @@ above its noise).
 from __future__ import annotations
 
 import dataclasses
+import logging
 import math
 
 import numpy as np
 
+from heavecomp.diagnosis import equation_error as EE
 from heavecomp.diagnosis.data import ANGLES, derivative_zero_phase, fill_gaps, noise_floor, uniform, zero_phase_lowpass
 from heavecomp.effects.base import COMPONENTS
 from heavecomp.effects.features import rest_durations
@@ -59,6 +68,7 @@ SHARE_MIN = 1.0  #: a component gap below this (noise variances above noise and 
 LIFTOFF = 0.1  #: WOB below this share of its median: the bit is off the rock (lower-mass residual left out) [-]
 REACH = 0.5  #: friction samples within REACH / cutoff [s] of rest or a reversal are left out [-]
 EDGE = 3.0  #: s at each end of the run left out (the filter's edges)
+log = logging.getLogger(__name__)
 UNITS = {"friction": "N", "gas_spring": "Pa", "flow_line": "Pa", "string_formation": "N", "sensors": "-",
          "heave_input": "N"}
 #: plant components whose equation residual the gap diagnosis' pre-screen reads: a candidate there
@@ -175,6 +185,7 @@ class ComponentResiduals:
     signals: dict
     mask: np.ndarray
     floor: dict = dataclasses.field(default_factory=dict)
+    inputs: dict = dataclasses.field(default_factory=dict)
 
     def z(self, mask=None) -> dict:
         """{component: {equation: mean square of its part / noise variance of the equation}} [-]."""
@@ -265,6 +276,8 @@ def residuals(run, params, *, heave_reference=None, noise=None, mask=None, cutof
     for a in ANGLES:  # a logged vessel angle [rad], filtered as the heave (heave_reference's lever arm)
         if a in run.columns:
             out.signals[a] = _smooth(t, fill_gaps(t, run[a]), cutoff)[0]
+    out.inputs = {"channels": ch, "params": params, "heave_reference": heave_reference, "cutoff": cutoff,
+                  "channel_noise": noise}
     if floor_channels is not None:
         ref = dict(ch, **{k: fill_gaps(t, np.asarray(floor_channels[k], float)) for k in ("stroke", "pressure", "wob")})
         nf = _split(t, ref, params, heave_reference, cutoff, None, m, seed, noise_of=out.noise)
@@ -319,3 +332,157 @@ def _attribute(t, eq, sig, sig_noise, m):
             e = max(parts[c], key=lambda k: np.nanmean(parts[c][k][m] ** 2) / max(sig_noise[k], 1e-300) ** 2)
             resid[c] = parts[OWN[e]][e] + parts[c][e]
     return ComponentResiduals(t, eq, sig_noise, parts, resid, sig, m)
+
+
+# ---------------------------------------------------------------------------- sensors: one channel misreads
+#: the equations that read each measured channel: a channel that misreads shows in every one of them
+READS = {"stroke": ("gas", "lower_mass", "top_mass"), "pressure": ("gas", "top_mass"),
+         "wob": ("lower_mass", "top_mass")}
+PLAY_WIDTHS = (0.05, 0.1, 0.2)  #: widths of the play (backlash) features, x the reading's standard deviation [-]
+EDGE_SIGMAS = 3.0  #: a reading within this many noise sigmas of its extreme percentile is "at its limit" [-]
+#: an equation "sees" a channel term whose held-out part reaches this many noise variances [-]
+SEEN = 1.0
+CONSISTENT_SHRINK = 0.05  #: every equation that sees the channel term must shrink at least this much [-]
+
+
+def _play(y, width):
+    """The textbook play (backlash) operator of width ``width``: the output holds until the input has
+    moved half the width past it (Prandtl-Ishlinskii's elementary hysteron)."""
+    h = 0.5 * width
+    out = np.empty_like(y)
+    o = float(y[0])
+    for i, x in enumerate(y.tolist()):
+        o = min(max(o, x - h), x + h)
+        out[i] = o
+    return out
+
+
+def channel_features(y, sigma, motion=None) -> dict:
+    """Generic misreadings of one channel, functions of its own reading ``y`` only (noise ``sigma``):
+    ``abs``/``sq`` (a reading that bends away from linear, ``|y - median|``, ``(y - median)^2``),
+    ``top``/``bottom`` (a reading held at its limit: within :data:`EDGE_SIGMAS` noise of its 99th / 1st
+    percentile; with ``motion`` [m], the string top's position ``z_h + s``, also ``*_motion``: that
+    indicator times the motion, the part of the load the reading no longer follows), ``play*`` (a
+    reading through a play of :data:`PLAY_WIDTHS` x std, minus the reading).
+
+    Returns {name: (array, readable expression)} in the channel's unit."""
+    y = np.asarray(y, float)
+    d = y - float(np.median(y))
+    hi, lo = np.quantile(y, [0.99, 0.01])
+    out = {"abs": (np.abs(d), "|y - median y|"), "sq": (d * d, "(y - median y)^2"),
+           "top": ((y >= hi - EDGE_SIGMAS * sigma).astype(float), f"(y >= {hi - EDGE_SIGMAS * sigma:.4g})"),
+           "bottom": ((y <= lo + EDGE_SIGMAS * sigma).astype(float), f"(y <= {lo + EDGE_SIGMAS * sigma:.4g})")}
+    if motion is not None:
+        # held at its limit, the unread part follows what drives the channel: the string top's motion
+        for k in ("top", "bottom"):
+            at = out[k][0] > 0
+            if at.any():
+                m = motion - float(np.mean(motion[at]))
+                out[f"{k}_motion"] = (at * m, f"{out[k][1]}*(z_h + s - mean there)")
+    sd = float(np.std(y))
+    for k in PLAY_WIDTHS:
+        out[f"play{k:g}"] = (_play(y, k * sd) - y, f"(play(y, {k * sd:.3g}) - y)")
+    return out
+
+
+def _residualise(sig, eqs, n, fit, cols):
+    """Each block (equation) of the stacked ``cols`` minus its least-squares fit, on the fit part, by
+    that equation's attribution columns (:data:`SPLIT`) and a constant: the base refitted alongside
+    every channel term once for all (Frisch-Waugh-Lovell; the blocks' bases are disjoint)."""
+    out = {k: np.array(c, float) for k, c in cols.items()}
+    ok = fit.copy()
+    for c in out.values():
+        ok &= np.isfinite(c)
+    for j, e in enumerate(eqs):
+        names = sorted({"const"} | {f for fs in SPLIT[e].values() for f in fs})
+        B = np.column_stack([_column(sig, f) for f in names])
+        sl = slice(j * n, (j + 1) * n)
+        okj = ok[sl]
+        if okj.sum() <= B.shape[1]:
+            continue
+        Y = np.column_stack([out[k][sl][okj] for k in out])
+        sc = EE._scales(B[okj])
+        coef, *_ = np.linalg.lstsq(B[okj] / sc, Y, rcond=None)
+        fitted = (B / sc) @ coef
+        for i, k in enumerate(out):
+            out[k][sl] = out[k][sl] - fitted[:, i]
+    return out
+
+
+def _consistency(r, cols, fm, vm, eqs, n) -> dict:
+    """Joint fit of a channel term on the stacked (residualised) equations; per equation its held-out
+    part [noise variances] and shrink."""
+    joint = EE.fit_columns(r, cols, fm, vm)
+    term = sum(joint["coefficients"][k] * cols[k] for k in cols)
+    per = {}
+    for j, e in enumerate(eqs):
+        sl = slice(j * n, (j + 1) * n)
+        ok = vm[sl] & np.isfinite(r[sl]) & np.isfinite(term[sl])
+        if ok.any():
+            before = math.sqrt(np.mean(r[sl][ok] ** 2))
+            after = math.sqrt(np.mean((r[sl] - term[sl])[ok] ** 2))
+            per[e] = {"seen": float(np.mean(term[sl][ok] ** 2)), "shrink": 1.0 - after / before if before > 0 else 0.0}
+    agree = [e for e in per if per[e]["seen"] >= SEEN and per[e]["shrink"] >= CONSISTENT_SHRINK]
+    return {"coefficients": joint["coefficients"], "shrink": joint["shrink"], "equations": per,
+            "consistent": len(agree) >= 2}
+
+
+def channel_search(cr, fit, validate) -> dict | None:
+    """Cross-channel consistency: the best misreading of ONE channel (:func:`channel_features` of its
+    own reading) that explains the residual of every equation that reads it (:data:`READS`).
+
+    A channel feature ``f`` enters equation ``e`` as the change of its residual when the channel reads
+    ``y + f`` (the equations evaluated again, nothing restated); the residuals of the equations reading
+    the channel, each over its noise, are stacked and searched jointly
+    (:func:`heavecomp.diagnosis.equation_error.open_search`, the equations' own attribution columns as
+    base).  The term is *consistent* when at least two equations see it (its held-out part reaches
+    :data:`SEEN` noise variances) and shrink by :data:`CONSISTENT_SHRINK` held out with the same
+    coefficients: a string, seal or gas effect lives in one equation only (the others read the
+    channel right), so a channel term fitted to it is seen in one equation, or predicts a part in
+    another that is not there.  (An equation may see the term and not shrink: the top-mass balance
+    reads the stroke through its second derivative, where a generic play's shape is only roughly
+    right; measured on a backlash run, held-out shrinks 0.26 gas, 0.24 lower mass, -0.11 top mass.)
+
+    Returns the best consistent term (by stacked held-out shrink): {``component``: "sensors",
+    ``channel``, ``term``, ``features``, ``coefficients`` [-, per noise], ``shrink`` (stacked,
+    held out), ``equations`` {e: {``seen`` [noise variances], ``shrink``}}}, or None.
+    """
+    inp = cr.inputs
+    if not inp:
+        return None
+    t, ch = cr.t, inp["channels"]
+    args = (inp["params"], inp["heave_reference"], inp["cutoff"])
+    base_eq = cr.equations
+    best = None
+    for c, eqs in READS.items():
+        sigma = float(inp["channel_noise"].get(c, 0.0)) or float(np.std(ch[c])) * 1e-3
+        feats = channel_features(ch[c], sigma, cr.signals["zh"] + cr.signals["x"])
+        lib = {}
+        for name, (f, expr) in feats.items():
+            scale = float(np.std(f))
+            if not scale > 0:
+                continue
+            step = sigma / scale  # a perturbation of the reading's own noise size: linear
+            pert = dict(ch, **{c: ch[c] + step * f})
+            eq1, _, _ = equations(t, pert["heave"], pert["stroke"], pert["pressure"], pert["wob"], *args)
+            lib[f"{c}:{name}"] = (np.concatenate([(eq1[e] - base_eq[e]) / step / cr.noise[e] for e in eqs]),
+                                  f"{c}-misreading {expr}")
+        if not lib:
+            continue
+        n = t.size
+        fm = np.tile(fit & cr.mask, len(eqs))
+        vm = np.tile(validate & cr.mask, len(eqs))
+        stacked = _residualise(cr.signals, eqs, n, fm, dict(
+            {"": np.concatenate([base_eq[e] / cr.noise[e] for e in eqs])}, **{k: a for k, (a, _) in lib.items()}))
+        r = stacked.pop("")
+        found = EE.open_search(r, None, fm, vm, component="sensors", max_terms=2,
+                               features={k: (stacked[k], lib[k][1]) for k in lib})
+        trials = [[k] for k in lib] + ([found["features"]] if found and len(found["features"]) > 1 else [])
+        for feats in trials:
+            d = _consistency(r, {k: stacked[k] for k in feats}, fm, vm, eqs, n)
+            log.debug("channel %s: %s shrink %.2f per equation %s consistent %s", c, feats, d["shrink"],
+                      d["equations"], d["consistent"])
+            if d["consistent"] and d["shrink"] >= EE.MIN_SHRINK and (best is None or d["shrink"] > best["shrink"]):
+                term = " + ".join(f"{d['coefficients'][k]:.3g}*{lib[k][1]}" for k in feats)
+                best = dict(d, component="sensors", channel=c, features=feats, term=term)
+    return best

@@ -42,7 +42,7 @@ from heavecomp.effects.features import rest_durations
 MIN_SHRINK = 0.05
 #: STLSQ thresholds tried, on the standardised coefficient relative to std(r) [-]
 THRESHOLDS = (0.02, 0.05, 0.1, 0.2, 0.4)
-PRUNE = 0.02  #: a term of the discovered model must add at least this much held-out shrink [-]
+PRUNE = 0.02  #: a term of the discovered model must add at least this much fit-part shrink [-]
 STROKE_BANDS = 4  #: stroke-band indicators (equal-count bands of the position)
 LAGS = (0.2, 1.0)  #: lagged-velocity features [s]
 
@@ -106,7 +106,7 @@ def fit_columns(r, cols: dict, fit, validate, base=None) -> dict:
     -------
     dict: ``coefficients`` {name: value [unit of r / unit of column]}, ``base`` coefficients,
     ``rms_before`` / ``rms_after`` on ``validate`` (before: ``r`` after the base-only refit),
-    ``shrink`` = 1 - rms_after/rms_before, ``bic`` on the fit part (effective sample size,
+    ``shrink`` = 1 - rms_after/rms_before, ``shrink_fit`` the same on the fit part, ``bic`` on the fit part (effective sample size,
     :func:`effective_n`), ``n_terms``.
     """
     r = np.asarray(r, float)
@@ -125,6 +125,7 @@ def fit_columns(r, cols: dict, fit, validate, base=None) -> dict:
     ra_f = r[fm] - X_f @ c
     ra_v = r[vm] - X_v @ c
     before, after = math.sqrt(_ms(rb_v)), math.sqrt(_ms(ra_v))
+    before_f, after_f = math.sqrt(_ms(rb_f)), math.sqrt(_ms(ra_f))
     n_eff = effective_n(rb_f)
     k = len(names)
     bic = n_eff * math.log(max(_ms(ra_f), 1e-300)) + k * math.log(max(n_eff, 2.0))
@@ -133,6 +134,7 @@ def fit_columns(r, cols: dict, fit, validate, base=None) -> dict:
             "base": {n: float(x) for n, x in zip(bn, c[k:])},
             "rms_before": before, "rms_after": after,
             "shrink": 1.0 - after / before if before > 0 else 0.0,
+            "shrink_fit": 1.0 - after_f / before_f if before_f > 0 else 0.0,
             "bic": float(bic), "delta_bic": float(bic - bic0), "n_terms": k}
 
 
@@ -207,6 +209,9 @@ def library(sig: dict) -> dict:
         m = np.nanmedian(rel)
         d = rel - m
         L["rel"] = (d, "(rel - median rel)")
+        # a spring that stiffens or softens with its stretch (odd and even powers)
+        L["rel_abs_rel"] = (d * np.abs(d), "(rel - median rel)*|rel - median rel|")
+        L["rel_cubed"] = (d ** 3, "(rel - median rel)^3")
         for q in (0.25, 0.5):
             w = float(np.nanquantile(np.abs(d), q))
             L[f"deadband{q:g}"] = (np.sign(d) * np.maximum(np.abs(d) - w, 0.0) - d,
@@ -240,8 +245,9 @@ def open_search(r, sig, fit, validate, *, base=None, component="", max_terms=3, 
 
     STLSQ at each of :data:`THRESHOLDS` on the fit part; among the supports with at most
     ``max_terms`` terms, the one with the lowest fit-part BIC (effective sample size) that lowers the
-    BIC at all; then terms that add less than :data:`PRUNE` of held-out shrink are dropped; the
-    held-out shrink must reach ``min_shrink``, else None (pure noise is rejected).
+    BIC at all; then terms that add less than :data:`PRUNE` of the *fit part's* shrink are dropped
+    (the held-out part never chooses, as in :func:`rank_effects`: it only scores); the held-out
+    shrink of the chosen model must reach ``min_shrink``, else None (pure noise is rejected).
 
     Returns {``term``: readable sum of coefficient x feature, SI; ``features``: names; ``coefficients``;
     ``shrink``: held-out; ``component``; ``bic``, ``delta_bic``, ``rms_before``, ``rms_after``} or None.
@@ -279,14 +285,14 @@ def open_search(r, sig, fit, validate, *, base=None, component="", max_terms=3, 
             best = dict(res, features=list(sel))
     if best is None:
         return None
-    # parsimony: drop a term whose removal costs less than PRUNE of held-out shrink
+    # parsimony: drop a term whose removal costs less than PRUNE of the fit part's shrink
     while len(best["features"]) > 1:
         trials = []
         for n in best["features"]:
             sub = [m for m in best["features"] if m != n]
             trials.append(dict(fit_columns(r, {m: lib[m][0] for m in sub}, fit, validate, base), features=sub))
-        alt = max(trials, key=lambda d: d["shrink"])
-        if alt["shrink"] < best["shrink"] - PRUNE:
+        alt = max(trials, key=lambda d: d["shrink_fit"])
+        if alt["shrink_fit"] < best["shrink_fit"] - PRUNE:
             break
         best = alt
     if best["shrink"] < min_shrink:

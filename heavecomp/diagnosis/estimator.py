@@ -859,6 +859,8 @@ class GapDiagnoser(GapEstimator):
         if found is None:
             return
         v["discovered"] = found
+        if eff == "inconclusive" and found["component"] == "sensors":
+            v["component"] = "sensors"  # one channel misreads: seen in every equation that reads it
         if eff == "inconclusive" and found["shrink"] >= self.discover_shrink:
             v.update(effect="discovered", component=found["component"], confidence="low",
                      note=f"no named effect explains half the gap (best {rows[0]['effect']}: "
@@ -874,10 +876,19 @@ class GapDiagnoser(GapEstimator):
 
     def _discover(self):
         """The open search (:func:`heavecomp.diagnosis.equation_error.open_search`) on every component
-        with a gap, the best held-out shrink; None when nothing beats noise."""
+        with a gap, the best held-out shrink; None when nothing beats noise.  A misreading of one
+        channel consistent across the equations that read it
+        (:func:`heavecomp.diagnosis.components.channel_search`) comes first: a single component's term
+        explains one equation, while the same misreading seen in two is a sensor (tuning wob_saturation
+        and fresh seeds of the scoring set's clipped-WOB and backlash cases read string_formation
+        before)."""
         cr = self.components_
-        gap = cr.gap()
         fm, vm = self._fitmask & cr.mask, self._valmask & cr.mask
+        sensor = CR.channel_search(cr, fm, vm)
+        if sensor is not None:
+            self.discovered_ = dict(sensor, unit="noise sigmas")
+            return self.discovered_
+        gap = cr.gap()
         best = None
         for c in sorted((c for c in COMPONENTS if gap[c] > 0), key=lambda c: -gap[c])[:3]:
             d = EE.open_search(cr.residual[c], cr.signals_for(c), fm, vm, component=c)
