@@ -75,6 +75,8 @@ class Replay:
 PRESCREEN_GAP = 1.0  #: a component gap (noise variances above noise and floor) at or below which its candidates are not replayed
 #: a component with less than this share of the equation-error gap shows only what the others leak into it
 PRESCREEN_SHARE = 0.02
+#: Gauss-Newton steps of a stroke or WOB reading through the replay it starts (GapDiagnoser._refine_reading)
+START_ITERATIONS = 2
 #: span of the fit part [s] on which the coarse start grid of a candidate is scored
 GRID_SPAN = 150.0
 #: points of the scan of a channel delay over its bounds (then refined by a bounded scalar search)
@@ -294,7 +296,8 @@ class GapDiagnoser(GapEstimator):
     def simulate(self, config, t_end=None, hs=None):
         """Model channels at the run's times (up to ``t_end``) for a configuration
         ``[(effect name, values), ...]`` (empty: the nominal model), driven by the replay's heave
-        or by ``hs`` (heave samples on the same grid)."""
+        or by ``hs`` (heave samples on the same grid).  A stroke or WOB reading in the configuration
+        also moves the start (:meth:`_start_for`)."""
         from heavecomp.diagnosis.stepper import CHANNELS as SC, run_segments
 
         rp = self._rp
@@ -302,6 +305,10 @@ class GapDiagnoser(GapEstimator):
         plant = rp.plant
         comp = library_composition()
         effects, sensors = [], []
+        # a channel that misreads also misled the start estimate: start from its true reading
+        shift, starts = self._start_for([(n, v) for n, v in config if get(n).kind == "output"])
+        if shift:
+            hs = dataclasses.replace(hs, z=hs.z + shift)
         for name, values in config:
             cls = get(name)
             if cls.kind == "plant":
@@ -314,7 +321,7 @@ class GapDiagnoser(GapEstimator):
                 sensors.append(cls(**values))
         EP = comp.ep(effects)
         n = rp.n_steps if t_end is None else min(rp.n_steps, int(math.ceil(t_end / rp.h)) + 2)
-        out = run_segments(plant, comp, EP, hs, rp.h, rp.bounds, rp.starts, n + 1)
+        out = run_segments(plant, comp, EP, hs, rp.h, rp.bounds, starts, n + 1)
         tg = out[:, 0]
         t = rp.t if t_end is None else rp.t[rp.t <= tg[-1]]
         res = {}
@@ -329,6 +336,35 @@ class GapDiagnoser(GapEstimator):
         res["t"] = t
         res["_grid"] = out
         return res
+
+    def _start_for(self, readings):
+        """Shift of the heave reference [m] and segment starts for a configuration whose ``readings`` (output candidates,
+        ``[(name, values)]``) misread stroke or WOB: the initial state and the heave reference are
+        estimated from what those channels truly read (the measured channel through the inverse of the
+        effect's affine reading ``apply``), not from the misread one -- a stroke read 4 cm off, or a WOB
+        zero that is off, otherwise starts the replay 4 cm off and leaves a transient and a mean shift no
+        reading of the channel can undo.  Delays and channels the start does not read keep the run's
+        start.  Cached per configuration."""
+        rp = self._rp
+        fixes = [(get(n), v) for n, v in readings
+                 if getattr(get(n), "linear", False) and v.get("channel") in ("stroke", "wob")]
+        if not fixes:
+            return 0.0, rp.starts
+        key = tuple((cls.name, tuple(sorted(v.items()))) for cls, v in fixes)
+        if key not in self._starts:
+            run = self._run
+            cols = dict(run.columns)
+            names = {cls.name: [f.name for f in cls.fields()] for cls, _ in fixes}
+            for cls, v in fixes:
+                c, y = v["channel"], cols[v["channel"]]
+                par = [v[k] for k in names[cls.name]]
+                a0 = cls.apply(run.t, run.t, np.zeros_like(y), *par)
+                a1 = cls.apply(run.t, run.t, np.ones_like(y), *par) - a0
+                cols[c] = (y - a0) / np.where(np.abs(a1) > 1e-9, a1, np.nan)
+            fixed = MeasuredRun(run.t, cols, run.source)
+            st = S.estimate(fixed, self.nominal, heave_filtered(run), stuck_speed=self.stuck_speed)
+            self._starts[key] = (self.initial_.heave_reference - st.heave_reference, [st.start()] + list(rp.starts[1:]))
+        return self._starts[key]
 
     # --------------------------------------------------------------- metrics
     def _mse(self, pred, mask):
@@ -492,15 +528,16 @@ class GapDiagnoser(GapEstimator):
         leaves the smallest weighted residual wins.  Parameters are clipped to their bounds.  The
         effect's ``optional`` parameters (a drift) are fitted only when they shrink the channel's fit
         residual by at least :data:`heavecomp.diagnosis.equation_error.MIN_SHRINK`; ``n_params`` counts the
-        parameters used."""
-        base = self.simulate(list(fixed), t_end)
-        t = base["t"]
-        m = self._fitmask[: t.size]
+        parameters used.  On stroke and WOB, which also set the replay's start (:meth:`_start_for`), the
+        fit is refined through the replay (:meth:`_refine_reading`)."""
+        base0 = self.simulate(list(fixed), t_end)
         names = [f.name for f in cls.fields()]
         lo, hi = (np.array([f.metadata["bounds"][i] for f in cls.fields()]) for i in (0, 1))
-        best = None
         used = np.array([n not in cls.optional for n in names])
-        for c in CH:
+
+        def fit_channel(base, c):
+            t = base["t"]
+            m = self._fitmask[: t.size]
             y = self._y[c][: t.size]
             ok = m & np.isfinite(y)
             zero = np.zeros(len(names))
@@ -523,19 +560,59 @@ class GapDiagnoser(GapEstimator):
             pred = dict(base)
             pred[c] = a0 + X @ coef
             rv = self._resid_vec(pred)
-            cost = float(rv @ rv)
-            if best is None or cost < best[0]:
-                dof = max(int(ok.sum()) - k_used, 1)
-                try:
-                    cov = np.linalg.pinv(Xo.T @ Xo) * float(r @ r) / dof
-                    sig = np.sqrt(np.maximum(np.diag(cov), 0.0))
-                except np.linalg.LinAlgError:
-                    sig = np.full(len(names), math.nan)
-                best = (cost, c, coef, sig, k_used)
+            dof = max(int(ok.sum()) - k_used, 1)
+            try:
+                cov = np.linalg.pinv(Xo.T @ Xo) * float(r @ r) / dof
+                sig = np.sqrt(np.maximum(np.diag(cov), 0.0))
+            except np.linalg.LinAlgError:
+                sig = np.full(len(names), math.nan)
+            return float(rv @ rv), c, coef, sig, k_used
+
+        best = None
+        for c in CH:
+            got = fit_channel(base0, c)
+            if c in ("stroke", "wob"):  # they also set the replay's start: Gauss-Newton on every channel
+                got = self._refine_reading(cls, fixed, t_end, c, got, used)
+            if best is None or got[0] < best[0]:
+                best = got
         cost, c, coef, sig, k_used = best
         values = {"channel": c, **{n: float(v) for n, v in zip(names, coef)}}
         return {"values": values, "sigma": {n: float(s) for n, s in zip(names, sig)}, "nfev": 1, "cost": cost,
                 "n_params": k_used}
+
+    def _refine_reading(self, cls, fixed, t_end, c, got, used):
+        """A stroke or WOB reading also sets the replay's start and heave reference (:meth:`_start_for`),
+        so a misreading there shows in every channel (a stroke read 3 cm off: the pressure and WOB of the
+        gas law and the string), not in the channel itself, which the start follows.  From the channel's
+        linear fit ``got``, :data:`START_ITERATIONS` Gauss-Newton steps on the weighted fit residual of all
+        channels (finite differences through the replay; the parameters used by the linear fit only);
+        the better of the two is kept."""
+        names = [f.name for f in cls.fields()]
+        lo, hi = (np.array([f.metadata["bounds"][i] for f in cls.fields()]) for i in (0, 1))
+        idx = np.flatnonzero(used | (got[2] != 0.0))
+        scale = float(np.nanstd(self._y[c][self._fitmask])) or 1.0
+
+        def resid(coef):
+            vals = {"channel": c, **{n: float(v) for n, v in zip(names, coef)}}
+            return self._resid_vec(self.simulate(list(fixed) + [(cls.name, vals)], t_end))
+
+        coef = np.array(got[2], dtype=float)
+        r = resid(coef)
+        best = (float(r @ r), coef.copy())
+        for _ in range(START_ITERATIONS):
+            J = np.empty((r.size, idx.size))
+            for j, i in enumerate(idx):
+                step = 1e-3 * (scale if abs(coef[i]) < 1e-12 or names[i] == "offset" else abs(coef[i]))
+                x = coef.copy()
+                x[i] += step
+                J[:, j] = (resid(x) - r) / step
+            coef[idx] = np.clip(coef[idx] - np.linalg.lstsq(J, r, rcond=None)[0], lo[idx], hi[idx])
+            r = resid(coef)
+            if float(r @ r) < best[0]:
+                best = (float(r @ r), coef.copy())
+        if best[0] >= got[0]:
+            return got
+        return (best[0], c, best[1], got[3], got[4])
 
     def _nelder_mead(self, fun, x0, lo, hi):
         """Derivative-free refinement (Nelder-Mead on the clipped parameters; stick-slip costs are
@@ -597,6 +674,7 @@ class GapDiagnoser(GapEstimator):
         t_split = self.split * T_end
         self.split_ = {"fit": [0.0, t_split], "validate": [t_split, T_end], "settle": settle}
         self._rp = self._setup(run)
+        self._run, self._starts = run, {}
         self.warnings_ = list(run.warnings) + self.start_warnings_
         self._y = {c: run[c] for c in CH}
         t = run.t
