@@ -1,4 +1,4 @@
-"""Speed of the gap diagnosis: a 600 s run at 50 Hz, all eight candidates, both cores.
+"""Speed of the gap diagnosis: a 600 s run at 50 Hz, every candidate, both cores.
 
 Goal (issue 4): <= 120 s on a 2-core machine; issue 12 item 8: <= 10 s (equation-error pre-screen).  Peers: the budget itself, and the
 foundation's ``simulate()`` of the same 600 s (how many nominal simulations the whole
