@@ -99,3 +99,14 @@ def test_where_figure_is_binned_not_overplotted():
     ax = fig.axes[0]
     marks = sum(len(c.get_offsets()) if hasattr(c, "get_offsets") else 0 for c in ax.collections)
     assert 0 < marks < n / 10, marks  # a few hundred bins, not one dot per sample
+
+
+def test_channel_effect_parameters_in_their_channels_unit():
+    """A sensor offset on the pressure reads in Pa and Pa/s, on the stroke in m and m/s (not "unit of
+    the channel (N, m or Pa)"); without a channel the effect's own generic unit stays."""
+    from heavecomp.report.diagnosis import _effect_units, _with_unit
+
+    u = _effect_units("sensor_offset", {"channel": "pressure", "offset": 101325.0, "drift": 0.0})
+    assert u == {"offset": "Pa", "drift": "Pa/s"}
+    assert _with_unit("offset", -0.0328, units=_effect_units("sensor_offset", {"channel": "stroke"})) == "offset = -0.0328 m"
+    assert "unit of the channel" in _effect_units("sensor_offset")["offset"]

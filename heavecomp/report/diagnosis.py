@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -27,11 +28,21 @@ def named_modes(freqs_hz) -> str:
     return ", ".join(f"{f:.2f} Hz ({n})" for f, n in sorted(zip(freqs_hz, names)))
 
 
-def _effect_units(effect: str) -> dict:
-    """Parameter name -> unit from the effect class's own metadata ({} for an unknown name)."""
+#: SI unit of each measured channel (a channel effect's parameters are in its channel's unit)
+CHANNEL_SI = {"wob": "N", "stroke": "m", "pressure": "Pa", "heave": "m"}
+
+
+def _effect_units(effect: str, values=None) -> dict:
+    """Parameter name -> unit from the effect class's own metadata ({} for an unknown name); for a
+    channel effect with its fitted ``values``, "unit of the channel" becomes that channel's SI unit."""
 
     cls = CANDIDATES.get(effect)
-    return {d["name"]: d["unit"] for d in cls.describe()} if cls is not None else {}
+    units = {d["name"]: d["unit"] for d in cls.describe()} if cls is not None else {}
+    si = CHANNEL_SI.get((values or {}).get("channel"))
+    if si:
+        units = {k: re.sub(r"unit of the channel( \([^)]*\))?( per s)?", lambda m: si + ("/s" if m.group(2) else ""), u)
+                 for k, u in units.items()}
+    return units
 
 
 def _with_unit(name: str, val, sigma=None, units=None) -> str:
@@ -220,7 +231,7 @@ def write_report(diag, out_dir, *, title="Sim-to-real gap diagnosis") -> dict:
     if v.get("parameters"):
         unc = v.get("uncertainty", {})
         lines.append("\nFitted parameters: " + ", ".join(
-            _with_unit(k, val, unc.get(k), _effect_units(v["effect"])) for k, val in v["parameters"].items()) + ".")
+            _with_unit(k, val, unc.get(k), _effect_units(v["effect"], v["parameters"])) for k, val in v["parameters"].items()) + ".")
     if v.get("second_effect"):
         se = v["second_effect"]
         lines.append(f"\nSecond effect: `{se['effect']}` adds {100 * se['added_explained']:.0f} % of the held-out "
@@ -254,7 +265,7 @@ def write_report(diag, out_dir, *, title="Sim-to-real gap diagnosis") -> dict:
                        [[c["effect"], f"{c['explained']:.2f}", f"{c['score']:.2f}", f"{c['rms_before'] / 1e3:.4g}",
                          f"{c['rms_after'] / 1e3:.4g}", f"{c['channels']['wob']['shrink']:.2f}",
                          f"{c['channels']['stroke']['shrink']:.2f}", f"{c['channels']['pressure']['shrink']:.2f}",
-                         ", ".join(_with_unit(k, val, units=_effect_units(c["effect"]))
+                         ", ".join(_with_unit(k, val, units=_effect_units(c["effect"], c["parameters"]))
                                    for k, val in c["parameters"].items())]
                         for c in diag.candidates_ if not c.get("skipped")]),
               *_skipped_lines(diag),
