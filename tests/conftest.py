@@ -1,4 +1,6 @@
 from pathlib import Path
+import subprocess
+import sys
 
 import pytest
 
@@ -20,3 +22,15 @@ def paper_a_toml(tmp_path) -> Path:
     p = tmp_path / "paper_a.toml"
     p.write_text(dumps(paper_a()))
     return p
+
+
+@pytest.fixture
+def diagnose_cli(tmp_path):
+    """``heavecomp diagnose CSV --params TOML --out <tmp>/o [extra...]`` in a fresh interpreter (the
+    user's command: exit code and stderr as a shell sees them)."""
+
+    def run(csv, params, *extra):
+        return subprocess.run([sys.executable, "-m", "heavecomp.cli", "diagnose", str(csv), "--params", str(params),
+                               "--out", str(tmp_path / "o"), *extra], capture_output=True, text=True)
+
+    return run

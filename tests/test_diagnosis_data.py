@@ -1,8 +1,6 @@
 """Measured-run contract: every bad-input case is one line naming the column (exit 2 from the CLI);
 documented treatments (dropouts, non-uniform sampling) are accepted and reported."""
 
-import subprocess
-import sys
 
 import numpy as np
 import pytest
@@ -128,18 +126,16 @@ def test_zero_phase_filter_has_no_lag():
     assert lags[int(np.argmax(corr))] == 0 and np.std(f[mid] - y[mid]) < 0.02
 
 
-def test_cli_bad_input_exit_2_one_line(tmp_path):
+def test_cli_bad_input_exit_2_one_line(tmp_path, diagnose_cli):
     t, c = _good()
     c["pressure"] = c["pressure"] * 1e-5
     f = _write(tmp_path / "r.csv", t, c)
     toml = tmp_path / "nom.toml"
     toml.write_text(dumps(P))
-    r = subprocess.run([sys.executable, "-m", "heavecomp.cli", "diagnose", str(f), "--params", str(toml),
-                        "--out", str(tmp_path / "o")], capture_output=True, text=True)
+    r = diagnose_cli(f, toml)
     assert r.returncode == 2
     lines = r.stderr.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("heavecomp diagnose: error:") and "'pressure'" in lines[0]
     assert "bar" in lines[0]
-    r = subprocess.run([sys.executable, "-m", "heavecomp.cli", "diagnose", str(f), "--params", str(toml),
-                        "--out", str(tmp_path / "o"), "--candidates", "flow_los"], capture_output=True, text=True)
+    r = diagnose_cli(f, toml, "--candidates", "flow_los")
     assert r.returncode == 2 and "did you mean 'flow_loss'" in r.stderr and len(r.stderr.strip().splitlines()) == 1

@@ -3,8 +3,6 @@
 is mapped back to the crown's heave, fitted by the diagnosis, refused where no angle exists, and a bad
 pitch column is one line (exit 2)."""
 
-import subprocess
-import sys
 
 import numpy as np
 import pytest
@@ -88,15 +86,14 @@ def test_pitch_in_degrees_is_declared_or_refused(tmp_path):
 
 
 @pytest.mark.parametrize("bad", ["degrees", "text"])
-def test_cli_bad_pitch_column_exit_2_one_line(tmp_path, bad):
+def test_cli_bad_pitch_column_exit_2_one_line(tmp_path, bad, diagnose_cli):
     if bad == "degrees":
         f = _good(tmp_path, lambda t: 2.0 * np.sin(2 * np.pi * t / 9))
     else:
         f = _good(tmp_path, lambda t: np.where(t > 10, "n/a?", "0.01"))
     toml = tmp_path / "nom.toml"
     toml.write_text(dumps(P))
-    r = subprocess.run([sys.executable, "-m", "heavecomp.cli", "diagnose", str(f), "--params", str(toml),
-                        "--out", str(tmp_path / "o")], capture_output=True, text=True)
+    r = diagnose_cli(f, toml)
     assert r.returncode == 2
     lines = r.stderr.strip().splitlines()
     assert len(lines) == 1 and "'pitch'" in lines[0], r.stderr
