@@ -14,6 +14,7 @@ from heavecomp.effects.dwell_stiction import DwellStiction
 from heavecomp.effects.features import breakaway_dwell, dwell_time, first_order_lag
 from heavecomp.effects.friction_lag import FrictionLag
 from heavecomp.effects.pressure_friction import PressureFriction
+from heavecomp.friction import laws
 
 
 def _signals(with_pressure=True):
@@ -109,7 +110,9 @@ def test_asymmetric_friction_columns_are_the_kernel_term_while_sliding():
     v = sig["v"]
     sliding = v != 0
     J, a = 12.0, -0.2
-    kernel = np.array([AsymmetricFriction.jump(0, abs(vi), 0.0, J, 0.0, np.sign(vi), (), None, a) * np.sign(vi)
+    FP = np.zeros(len(laws.FP_NAMES))
+    FP[laws.VS] = 0.01  # the breakaway share's speed scale (b = 1: not used)
+    kernel = np.array([AsymmetricFriction.jump(0, abs(vi), 0.0, J, 0.0, np.sign(vi), (), FP, a, 1.0) * np.sign(vi)
                        for vi in v[sliding]])
     assert np.allclose(kernel, J * np.sign(v[sliding]) + a * J * cols["asymmetric_friction"][sliding], rtol=1e-12)
     assert np.array_equal(cols["asymmetric_viscous"], np.abs(v))

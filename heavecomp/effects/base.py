@@ -183,7 +183,14 @@ class Effect:
 
     @classmethod
     def x0(cls) -> np.ndarray:
-        return cls.to_x({f.name: f.default for f in cls.fields()})
+        """The fit's start: the defaults, a ``limits`` parameter at a bound moved 1e-9 inside (the
+        fitters clip their start into the open box the same way)."""
+        x = cls.to_x({f.name: f.default for f in cls.fields()})
+        if cls.limits:
+            lo, hi = cls.bounds_x()
+            at = np.array([f.name in cls.limits for f in cls.fields()])
+            x = np.where(at, np.clip(x, lo + 1e-9, hi - 1e-9), x)
+        return x
 
     @classmethod
     def bounds_x(cls):

@@ -70,7 +70,7 @@ UNITS: dict[str, str] = {
     "minimum_velocity_exhaust_area_m2": "m^2", "minimum_velocity_linear_m_s": "m/s",
     # diagnose
     "schema": "-", "explained": "-", "explained_joint": "-", "explained_perturbed_heave": "-",
-    "explained_replay": "-", "added_explained": "-", "score": "-", "shrink": "-", "margin": "-",
+    "explained_replay": "-", "added_explained": "-", "score": "-", "shrink": "-", "shrink_fit": "-", "margin": "-",
     "gap_to_input_envelope": "-", "gap_to_noise": "-", "margin_input_noise": "-", "component_gap": "-",
     "bic": "-", "delta_bic": "-", "n_terms": "count", "nrmse": "-", "n_params": "count", "settle": "s",
     "fit": "s", "validate": "s", "segments": "s", "above": "-", "below_wave": "-", "wave": "-", "resonance": "-",
