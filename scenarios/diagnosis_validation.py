@@ -213,7 +213,7 @@ def _fmt(x, pct=False):
     return str(x)
 
 
-def _settings_check(which, settings, digest, allow):
+def _settings_check(which, digest):
     """(ok, message): the scoring set needs the settings frozen by the committed tuning report."""
     if which != "scoring":
         return True, f"settings hash `{digest}` (this tuning report freezes them for the scoring set)"
@@ -298,7 +298,7 @@ def main(argv=None) -> int:
 
     settings = frozen_settings(validation_parameter_sets()["paper_a"])
     digest = settings_hash(settings)
-    ok, note = _settings_check(args.which, settings, digest, args.allow_unfrozen)
+    ok, note = _settings_check(args.which, digest)
     if not ok and not args.allow_unfrozen:
         print(f"diagnosis_validation: {note} (--allow-unfrozen scores anyway, flagged)", file=sys.stderr)
         return 2

@@ -212,9 +212,6 @@ def prepare(campaign, runs, base=None):
         t_stat[i] = min(p.heave.ramp, 0.5 * s.duration)
         W0[i] = p.operating_point.wob_setpoint
         half[i] = campaign.band.half_width(W0[i])
-    for i, run in enumerate(runs):
-        p = campaign.params_for(run, base=base)
-        h = hsteps[i]
         heaves.append(jonswap_samples(run.hs, run.tp, s.gamma, run.seed, p.heave.ramp, nsteps[i] * h, 0.5 * h,
                                       spectra))
     kink_step = np.full(n, -1, dtype=np.int64)

@@ -35,7 +35,7 @@ import dataclasses
 
 import numpy as np
 
-from heavecomp.effects.model import casadi_model, heave_map, initial_effect_states
+from heavecomp.effects.model import casadi_model, heave_map, initial_effect_states, seen_heave
 from heavecomp.effects.registry import resolve
 from heavecomp.friction.laws import FORCE_KEYS
 from heavecomp.plants.symbolic import casadi
@@ -91,8 +91,7 @@ def earth_frame(f, heave=(1.0, 0.0)):
     n = f.size1_in(0)  # 4 plant states, then the effects' states (unchanged by the frame)
     xe = ca.SX.sym("xe", n)
     u = ca.SX.sym("u", 4)
-    ga, gb = heave
-    z, dz, ddz = (u[0], u[1], u[2]) if (ga, gb) == (1.0, 0.0) else (ga * u[0] + gb, ga * u[1], ga * u[2])
+    z, dz, ddz = seen_heave(u, heave)
     x = ca.vertcat(xe[0] - z, xe[1] - dz, xe[2:])
     xdot, y = f(x, u)
     xedot = xdot + ca.vertcat(dz, ddz, ca.SX.zeros(n - 2))

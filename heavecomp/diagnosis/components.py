@@ -56,7 +56,7 @@ import math
 import numpy as np
 
 from heavecomp.diagnosis import equation_error as EE
-from heavecomp.diagnosis.data import ANGLES, derivative_zero_phase, fill_gaps, noise_floor, uniform, zero_phase_lowpass
+from heavecomp.diagnosis.data import ANGLES, fill_gaps, lowpass_zero_phase, noise_floor
 from heavecomp.effects.base import COMPONENTS
 from heavecomp.effects.features import rest_durations
 from heavecomp.friction.laws import friction_cont, friction_jump
@@ -77,17 +77,6 @@ UNITS = {"friction": "N", "gas_spring": "Pa", "flow_line": "Pa", "string_formati
 #: is blind at breakaway, and a frictional lag of 6.5x its noise floor on the WOB (tuning seed 20000)
 #: left it no gap at all -- the lag acts at reversals, where the balance's derivatives are noisiest
 SCREENED = ("gas_spring", "flow_line", "string_formation")
-#: the equation each component's residual comes from
-EQUATION = {"friction": "top_mass", "gas_spring": "gas", "flow_line": "gas", "string_formation": "lower_mass",
-            "sensors": "gas+lower_mass", "heave_input": "top_mass+lower_mass"}
-
-
-def _smooth(t, y, cutoff):
-    """Zero-phase low-passed channel at the original times, and its first two derivatives."""
-    tu, yu = uniform(t, y)
-    yf = np.interp(t, tu, zero_phase_lowpass(yu, tu[1] - tu[0], cutoff))
-    d1, d2 = derivative_zero_phase(t, y, cutoff)
-    return yf, d1, d2
 
 
 def _dilate(t, flag, width):
@@ -113,11 +102,11 @@ def equations(t, heave, stroke, pressure, wob, params, heave_reference=0.0, cuto
     (residuals {top_mass [N], lower_mass [N], gas [Pa]}, signals {name: array}, sliding mask)
     """
     code, FP, PP, _ = plant_vectors(params)
-    zh, dzh, ddzh = _smooth(t, heave, cutoff)
+    zh, dzh, ddzh = lowpass_zero_phase(t, heave, cutoff)
     zh = zh - heave_reference
-    s, v, a = _smooth(t, stroke, cutoff)
-    p, dp, _ = _smooth(t, pressure, cutoff)
-    W, dW, ddW = _smooth(t, wob, cutoff)
+    s, v, a = lowpass_zero_phase(t, stroke, cutoff)
+    p, dp, _ = lowpass_zero_phase(t, pressure, cutoff)
+    W, dW, ddW = lowpass_zero_phase(t, wob, cutoff)
     vb, ab = -dW / PP[KF], -ddW / PP[KF]
     yb = PP[D0] - (W + PP[CF] * vb) / PP[KF]
     T_meas = PP[MB] * (ab + PP[G]) - W                      # lower-mass balance: the tension it needs
@@ -267,7 +256,7 @@ def residuals(run, params, *, heave_reference=None, noise=None, mask=None, cutof
     t = run.t
     ch = {k: fill_gaps(t, run[k]) for k in ("heave", "stroke", "pressure", "wob")}
     if heave_reference is None:
-        heave_reference = float(_smooth(t, ch["heave"], cutoff)[0][0])
+        heave_reference = float(lowpass_zero_phase(t, ch["heave"], cutoff)[0][0])
     m = (t >= t[0] + EDGE) & (t <= t[-1] - EDGE)
     if mask is not None:
         m &= mask
@@ -275,7 +264,7 @@ def residuals(run, params, *, heave_reference=None, noise=None, mask=None, cutof
     out = _split(t, ch, params, heave_reference, cutoff, noise, m, seed)
     for a in ANGLES:  # a logged vessel angle [rad], filtered as the heave (heave_reference's lever arm)
         if a in run.columns:
-            out.signals[a] = _smooth(t, fill_gaps(t, run[a]), cutoff)[0]
+            out.signals[a] = lowpass_zero_phase(t, fill_gaps(t, run[a]), cutoff)[0]
     out.inputs = {"channels": ch, "params": params, "heave_reference": heave_reference, "cutoff": cutoff,
                   "channel_noise": noise}
     if floor_channels is not None:

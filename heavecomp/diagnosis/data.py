@@ -327,15 +327,21 @@ def _angle_reference(run, ca, reference) -> float:
     return float(np.mean(np.sin(ca(run.t[w])))) if w.sum() >= 8 else float(np.sin(ca(run.t[0])))
 
 
-def derivative_zero_phase(t, y, cutoff):
-    """Velocity and acceleration of a channel by zero-phase FIR filtering and spline differentiation,
-    returned at the original times ``t``."""
+def lowpass_zero_phase(t, y, cutoff):
+    """A channel zero-phase FIR low-passed (linear interpolation back to the original times ``t``),
+    and its velocity and acceleration by spline differentiation of the same filtered samples."""
     from scipy.interpolate import CubicSpline
 
     tu, yu = uniform(t, y)
     yf = zero_phase_lowpass(yu, tu[1] - tu[0], cutoff)
     cs = CubicSpline(tu, yf)
-    return cs(t, 1), cs(t, 2)
+    return np.interp(t, tu, yf), cs(t, 1), cs(t, 2)
+
+
+def derivative_zero_phase(t, y, cutoff):
+    """Velocity and acceleration of a channel by zero-phase FIR filtering and spline differentiation,
+    returned at the original times ``t`` (:func:`lowpass_zero_phase`)."""
+    return lowpass_zero_phase(t, y, cutoff)[1:]
 
 
 NOISE_ORDERS = (2, 3, 4, 5, 6)  #: difference orders of the noise estimate

@@ -47,11 +47,9 @@ from heavecomp.errors import InputError
 from heavecomp.estimator import GapEstimator
 from heavecomp.params.budget import MAX_REPLAY_STEPS
 from heavecomp.diagnosis import where as W
-from heavecomp.diagnosis.data import (derivative_zero_phase, HEAVE_CUTOFF, heave_samples, MeasuredRun,
-                                      noise_floor, uniform, zero_phase_lowpass)
+from heavecomp.diagnosis.data import (ANGLES, derivative_zero_phase, HEAVE_CUTOFF, heave_filtered, heave_samples,
+                                      MeasuredRun, noise_floor, uniform, zero_phase_lowpass)
 from heavecomp.plants.cmc import D0, KF, plant_vectors
-from heavecomp.diagnosis.data import heave_filtered
-from heavecomp.diagnosis.data import ANGLES
 from heavecomp.diagnosis import start as S
 from heavecomp.diagnosis import components as CR
 from heavecomp.diagnosis import equation_error as EE
@@ -252,7 +250,8 @@ class GapDiagnoser(GapEstimator):
         the first seconds of the run (:func:`heavecomp.diagnosis.start.estimate`); a warning when the
         log does not start at rest at the operating point."""
 
-        st = S.estimate(run, self.nominal, heave_filtered(run), stuck_speed=self.stuck_speed)
+        self._heave_spline = heave_filtered(run)  # also read by _start_for
+        st = S.estimate(run, self.nominal, self._heave_spline, stuck_speed=self.stuck_speed)
         self.initial_ = st
         self.start_warnings_ = []
         if not st.at_rest:
@@ -362,7 +361,7 @@ class GapDiagnoser(GapEstimator):
                 a1 = cls.apply(run.t, run.t, np.ones_like(y), *par) - a0
                 cols[c] = (y - a0) / np.where(np.abs(a1) > 1e-9, a1, np.nan)
             fixed = MeasuredRun(run.t, cols, run.source)
-            st = S.estimate(fixed, self.nominal, heave_filtered(run), stuck_speed=self.stuck_speed)
+            st = S.estimate(fixed, self.nominal, self._heave_spline, stuck_speed=self.stuck_speed)
             self._starts[key] = (self.initial_.heave_reference - st.heave_reference, [st.start()] + list(rp.starts[1:]))
         return self._starts[key]
 
@@ -532,7 +531,7 @@ class GapDiagnoser(GapEstimator):
         fit is refined through the replay (:meth:`_refine_reading`)."""
         base0 = self.simulate(list(fixed), t_end)
         names = [f.name for f in cls.fields()]
-        lo, hi = (np.array([f.metadata["bounds"][i] for f in cls.fields()]) for i in (0, 1))
+        lo, hi = cls.bounds_x()  # a reading is affine in its parameters: none is fitted in log
         used = np.array([n not in cls.optional for n in names])
 
         def fit_channel(base, c):
@@ -588,7 +587,7 @@ class GapDiagnoser(GapEstimator):
         channels (finite differences through the replay; the parameters used by the linear fit only);
         the better of the two is kept."""
         names = [f.name for f in cls.fields()]
-        lo, hi = (np.array([f.metadata["bounds"][i] for f in cls.fields()]) for i in (0, 1))
+        lo, hi = cls.bounds_x()
         idx = np.flatnonzero(used | (got[2] != 0.0))
         scale = float(np.nanstd(self._y[c][self._fitmask])) or 1.0
 

@@ -91,19 +91,6 @@ def breakaway_dwell(t, dwell, window: float) -> np.ndarray:
     return out
 
 
-def position_harmonics(x, harmonics: int = 3) -> dict:
-    """cos and sin of 2 pi k (x - x_min) / L, k = 1..``harmonics``, over the travelled span
-    L = max(x) - min(x) [m]: a smooth function of position as a few Fourier terms."""
-    x = np.asarray(x, dtype=float)
-    x0, length = float(x.min()), float(x.max() - x.min())
-    out = {}
-    for k in range(1, harmonics + 1):
-        arg = 2.0 * np.pi * k * (x - x0) / length
-        out[f"cos{k}"] = np.cos(arg)
-        out[f"sin{k}"] = np.cos(arg - 0.5 * np.pi)
-    return out
-
-
 def need(sig: dict, *names) -> bool:
     """True when every signal of ``names`` is in ``sig``."""
     return all(n in sig for n in names)

@@ -60,7 +60,7 @@ def casadi_model(params, *, eps: float | None = None, sym: str = "SX", effects=(
     X = [x[i] for i in range(4 + n_eff)]  # the stepper's state: the plant's four, then the effects'
     ua = u[3]
     a, b = heave_map(heave_fx + sensor_fx)  # the heave the plant sees from the measured one
-    zh, dzh, ddzh = (u[0], u[1], u[2]) if (a, b) == (1.0, 0.0) else (a * u[0] + b, a * u[1], a * u[2])
+    zh, dzh, ddzh = seen_heave(u, (a, b))
     fn = comp.functions
     p, T, hold, dvb = fn["plant_fx"](s, v, yb, vb, X, zh, dzh, ddzh, ua, 1.0, PP, EP)
     dvb = lower_accel_wob(T, yb, vb, PP)  # the clamped contact law (smooth model)
@@ -108,6 +108,13 @@ def _static_affine(e):
     if e.channel == "heave" and g[20] == 0.0:
         raise ParameterError(f"effect {e.name} on heave: a gain of 0 leaves no heave to compensate")
     return float(g[20]), float(o[20])
+
+
+def seen_heave(u, ab) -> tuple:
+    """(z_h, dz_h, ddz_h) the plant sees from the measured heave in the input ``u`` [m, m/s, m/s^2] under the
+    heave map ``ab`` = (a, b) of :func:`heave_map`: (a u0 + b, a u1, a u2); the input itself when (1, 0)."""
+    a, b = ab
+    return (u[0], u[1], u[2]) if (a, b) == (1.0, 0.0) else (a * u[0] + b, a * u[1], a * u[2])
 
 
 def heave_map(effects) -> tuple:

@@ -13,6 +13,7 @@ from heavecomp.diagnosis.where import residual_spectrum
 from heavecomp.report.figures import _plt, save
 from heavecomp.report.scenario import md_table
 from heavecomp.report.provenance import stamp, stamp_report
+from heavecomp.simulate.core import CHANNEL_UNITS
 from heavecomp.report.scenario import _clean as clean
 from heavecomp.effects import CANDIDATES
 
@@ -28,17 +29,13 @@ def named_modes(freqs_hz) -> str:
     return ", ".join(f"{f:.2f} Hz ({n})" for f, n in sorted(zip(freqs_hz, names)))
 
 
-#: SI unit of each measured channel (a channel effect's parameters are in its channel's unit)
-CHANNEL_SI = {"wob": "N", "stroke": "m", "pressure": "Pa", "heave": "m"}
-
-
 def _effect_units(effect: str, values=None) -> dict:
     """Parameter name -> unit from the effect class's own metadata ({} for an unknown name); for a
     channel effect with its fitted ``values``, "unit of the channel" becomes that channel's SI unit."""
 
     cls = CANDIDATES.get(effect)
     units = {d["name"]: d["unit"] for d in cls.describe()} if cls is not None else {}
-    si = CHANNEL_SI.get((values or {}).get("channel"))
+    si = CHANNEL_UNITS.get((values or {}).get("channel"))
     if si:
         units = {k: re.sub(r"unit of the channel( \([^)]*\))?( per s)?", lambda m: si + ("/s" if m.group(2) else ""), u)
                  for k, u in units.items()}
@@ -299,21 +296,5 @@ def fig_confusion(summary):
     ax.set_ylabel("withheld effect (dominant) [-]")
     ax.set_title(f"Withheld-effect benchmark: {summary['n_runs']} runs, accuracy {100 * summary['accuracy']:.0f} % "
                  "(diagonal = correct)", fontsize=10)
-    fig.tight_layout()
-    return fig
-
-
-def fig_shrink(rows):
-    """Held-out shrink of the verdict per benchmark run, coloured by correctness."""
-    plt = _plt()
-    fig, ax = plt.subplots(figsize=(10, 4))
-    labels = [r["truth"] + (f"+{r['truth_second']}" if r["truth_second"] else "") for r in rows]
-    vals = [r["shrink"] for r in rows]
-    cols = ["tab:green" if r["correct"] else "tab:red" for r in rows]
-    ax.bar(range(len(rows)), vals, color=cols)
-    ax.set_xticks(range(len(rows)), labels, rotation=60, ha="right", fontsize=7)
-    ax.set_ylabel("held-out shrink 1 - rms_after/rms_before [-]")
-    ax.set_title("How far the gap shrinks on held-out data (green: verdict names the withheld effect)", fontsize=10)
-    ax.grid(alpha=0.3, axis="y")
     fig.tight_layout()
     return fig
