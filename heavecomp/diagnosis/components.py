@@ -22,7 +22,8 @@ Derivatives and the values themselves come through the same zero-phase FIR low-p
 frequency response.  Each equation residual is split by a joint least-squares regression (on the
 whole analysed span) into the parts other components explain:
 
-- gas law: ``flow_line`` (v, v|v|: a pressure drop growing with flow), ``sensors`` (dp/dt: a lagging
+- gas law: ``flow_line`` (v, v|v|: a pressure drop growing with flow; a: the line's inertance, the
+  drop that accelerates its oil column), ``sensors`` (dp/dt: a lagging
   pressure channel); the rest (preload, stiffness, drift) is ``gas_spring``;
 - lower-mass balance: ``heave_input`` (z_h, dz_h: a heave that is not the one the compensator sees),
   ``sensors`` (dW/dt: a lagging WOB channel); the rest is ``string_formation``;
@@ -131,14 +132,25 @@ def equations(t, heave, stroke, pressure, wob, params, heave_reference=0.0, cuto
 
 #: per equation: {component: feature names} of the joint attribution regression (the equation's own
 #: component is the rest; its nominal structure (constant, drift, stiffness) is listed under it)
-SPLIT = {"gas": {"gas_spring": ("const", "t", "x"), "flow_line": ("v", "v_abs_v"), "sensors": ("dp",)},
+SPLIT = {"gas": {"gas_spring": ("const", "t", "x"), "flow_line": ("v", "v_abs_v", "a"), "sensors": ("dp",)},
          "lower_mass": {"string_formation": ("const", "rel", "vrel"), "heave_input": ("zh", "dzh"),
                         "sensors": ("dwob",)},
          "top_mass": {"friction": (), "heave_input": ("ddzh",)}}
 OWN = {"gas": "gas_spring", "lower_mass": "string_formation", "top_mass": "friction"}
 
 
+#: per component: the features of its nominal structure whose coefficients a *constant* parameter error
+#: keeps fixed over the run (:meth:`ComponentResiduals.stationarity`)
+STRUCTURE = {"friction": ("sign_v", "v"), "gas_spring": ("const", "x"), "string_formation": ("const", "rel", "vrel")}
+WINDOWS = 4  #: time windows of the stationarity test
+#: a coefficient moving across the windows by this many standard errors (of the difference of two
+#: windows) and by this share of its mean magnitude is not constant; fixed a priori, not tuned
+DRIFT_SIGMAS, DRIFT_SHARE = 4.0, 0.25
+
+
 def _column(sig, name):
+    if name == "sign_v":
+        return np.sign(sig["v"])
     if name == "const":
         return np.ones(sig["t"].size)
     if name == "t":
@@ -218,6 +230,52 @@ class ComponentResiduals:
         if component == "string_formation":
             sig["x"], sig["v"] = sig["rel"], sig["vrel"]
         return sig
+
+    def stationarity(self, component, mask=None, windows=WINDOWS) -> dict:
+        """Does the component's residual keep its shape over the run?  Its least-squares coefficients on
+        the component's nominal structure (:data:`STRUCTURE`: a wrong constant parameter of the nominal
+        law) in ``windows`` equal time windows, with standard errors for the residual's correlation
+        (about 2 x :data:`CUTOFF` independent samples per second).
+
+        Returns {features, windows [s], coefficients (per window, unit of the residual per feature unit),
+        stderr, drifting: the features whose coefficient moves by >= :data:`DRIFT_SIGMAS` standard errors
+        and >= :data:`DRIFT_SHARE` of its mean magnitude between two windows}; None when the component has
+        no structure listed or too few samples."""
+        feats = STRUCTURE.get(component)
+        r = self.residual.get(component)
+        if feats is None or r is None:
+            return None
+        m = (self.mask if mask is None else (mask & self.mask)) & np.isfinite(r)
+        if m.sum() < 50 * windows:
+            return None
+        t = self.t
+        dt = float(np.median(np.diff(t)))
+        edges = np.linspace(t[m][0], t[m][-1] + dt, windows + 1)
+        X = np.column_stack([_column(self.signals, f) for f in feats])
+        coefs, errs, spans = [], [], []
+        for a, b in zip(edges[:-1], edges[1:]):
+            w = m & (t >= a) & (t < b)
+            n = int(w.sum())
+            if n <= 2 * len(feats):
+                return None
+            A = X[w]
+            coef, *_ = np.linalg.lstsq(A, r[w], rcond=None)
+            e = r[w] - A @ coef
+            n_eff = max(n * dt * 2.0 * CUTOFF, len(feats) + 1.0)
+            cov = np.linalg.pinv(A.T @ A) * float(np.mean(e * e)) * n / n_eff
+            coefs.append(coef)
+            errs.append(np.sqrt(np.maximum(np.diag(cov), 0.0)))
+            spans.append([float(a), float(b)])
+        C, E = np.array(coefs), np.array(errs)
+        drifting = []
+        for j, f in enumerate(feats):
+            i, k = int(np.argmax(C[:, j])), int(np.argmin(C[:, j]))
+            move = C[i, j] - C[k, j]
+            se = math.hypot(E[i, j], E[k, j])
+            if move >= DRIFT_SIGMAS * se and move >= DRIFT_SHARE * abs(float(np.mean(C[:, j]))):
+                drifting.append(f)
+        return {"features": list(feats), "windows": spans, "coefficients": C.tolist(), "stderr": E.tolist(),
+                "drifting": drifting, "unit": UNITS[component]}
 
     def table(self, mask=None) -> list:
         """Rows for the report: component, share, rms of its residual [unit], noise [unit], gap/noise."""
