@@ -121,5 +121,7 @@ def test_stationarity_tells_a_constant_friction_error_from_a_warming_seal():
     st_w = _residuals_of(warming, v, t).stationarity("friction")
     assert st_c["drifting"] == []
     assert st_w["drifting"] == ["sign_v"]
-    first, last = st_w["coefficients"][0][0], st_w["coefficients"][-1][0]
+    sign_v = st_w["coefficients"][0]
+    assert sign_v["feature"] == "sign_v" and sign_v["unit"] == "N"
+    first, last = sign_v["value"][0], sign_v["value"][-1]
     assert first > 0.6 * last  # less negative early: the seal had not warmed yet

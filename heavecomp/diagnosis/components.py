@@ -142,6 +142,8 @@ OWN = {"gas": "gas_spring", "lower_mass": "string_formation", "top_mass": "frict
 #: per component: the features of its nominal structure whose coefficients a *constant* parameter error
 #: keeps fixed over the run (:meth:`ComponentResiduals.stationarity`)
 STRUCTURE = {"friction": ("sign_v", "v"), "gas_spring": ("const", "x"), "string_formation": ("const", "rel", "vrel")}
+#: unit of a structure coefficient: the residual's unit (:data:`UNITS`) followed by this
+PER_FEATURE = {"sign_v": "", "const": "", "v": " s/m", "vrel": " s/m", "x": "/m", "rel": "/m"}
 WINDOWS = 4  #: time windows of the stationarity test
 #: a coefficient moving across the windows by this many standard errors (of the difference of two
 #: windows) and by this share of its mean magnitude is not constant; fixed a priori, not tuned
@@ -237,10 +239,10 @@ class ComponentResiduals:
         law) in ``windows`` equal time windows, with standard errors for the residual's correlation
         (about 2 x :data:`CUTOFF` independent samples per second).
 
-        Returns {features, windows [s], coefficients (per window, unit of the residual per feature unit),
-        stderr, drifting: the features whose coefficient moves by >= :data:`DRIFT_SIGMAS` standard errors
-        and >= :data:`DRIFT_SHARE` of its mean magnitude between two windows}; None when the component has
-        no structure listed or too few samples."""
+        Returns {windows [s], drifting: the features whose coefficient moves by >= :data:`DRIFT_SIGMAS`
+        standard errors and >= :data:`DRIFT_SHARE` of its mean magnitude between two windows,
+        coefficients: per feature {feature, unit, value (per window), stderr (per window)}}; None when
+        the component has no structure listed or too few samples."""
         feats = STRUCTURE.get(component)
         r = self.residual.get(component)
         if feats is None or r is None:
@@ -274,8 +276,9 @@ class ComponentResiduals:
             se = math.hypot(E[i, j], E[k, j])
             if move >= DRIFT_SIGMAS * se and move >= DRIFT_SHARE * abs(float(np.mean(C[:, j]))):
                 drifting.append(f)
-        return {"features": list(feats), "windows": spans, "coefficients": C.tolist(), "stderr": E.tolist(),
-                "drifting": drifting, "unit": UNITS[component]}
+        return {"windows": spans, "drifting": drifting,
+                "coefficients": [{"feature": f, "unit": UNITS[component] + PER_FEATURE[f], "value": C[:, j].tolist(),
+                                  "stderr": E[:, j].tolist()} for j, f in enumerate(feats)]}
 
     def table(self, mask=None) -> list:
         """Rows for the report: component, share, rms of its residual [unit], noise [unit], gap/noise."""

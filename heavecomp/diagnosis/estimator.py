@@ -992,11 +992,10 @@ class GapDiagnoser(GapEstimator):
             return
         was = v["confidence"]
         v["confidence"] = "low"
-        moved = ", ".join(
-            f"{f}: {min(c[j] for c in st['coefficients']):.4g} to {max(c[j] for c in st['coefficients']):.4g}"
-            for j, f in enumerate(st["features"]) if f in st["drifting"])
+        moved = ", ".join(f"{c['feature']}: {min(c['value']):.4g} to {max(c['value']):.4g} {c['unit']}"
+                          for c in st["coefficients"] if c["feature"] in st["drifting"])
         self.warnings_.append(f"verdict parameter_mismatch: the {v['component']} residual's coefficients move over "
-                              f"the run ({moved}; {st['unit']} per feature unit, {len(st['windows'])} windows), "
+                              f"the run ({moved}; {len(st['windows'])} windows), "
                               f"so the mismatch is not constant; a time-varying effect may be averaged -- "
                               f"confidence lowered from {was} to low")
 

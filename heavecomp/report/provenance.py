@@ -71,7 +71,7 @@ UNITS: dict[str, str] = {
     # diagnose
     "schema": "-", "explained": "-", "explained_joint": "-", "explained_perturbed_heave": "-",
     "explained_replay": "-", "added_explained": "-", "score": "-", "shrink": "-", "shrink_fit": "-", "margin": "-",
-    "gap_to_input_envelope": "-", "gap_to_noise": "-", "margin_input_noise": "-", "component_gap": "-",
+    "gap_to_input_envelope": "-", "predicted_shrink": "-", "windows": "s", "gap_to_noise": "-", "margin_input_noise": "-", "component_gap": "-",
     "bic": "-", "delta_bic": "-", "n_terms": "count", "nrmse": "-", "n_params": "count", "settle": "s",
     "fit": "s", "validate": "s", "segments": "s", "above": "-", "below_wave": "-", "wave": "-", "resonance": "-",
     "breakaway": "-", "sliding_accelerating": "-", "sliding_decelerating": "-",
@@ -241,7 +241,7 @@ def units_of(obj, path: tuple = ()) -> tuple[dict[str, str], list[str]]:
                 elif eff is not None and k == "shape" and eff[1]:
                     walk(v, p + (str(k),), eff[1])
                 else:
-                    walk(v, p + (str(k),), own_unit if k in ("value", "bound", "rms", "noise") else None)
+                    walk(v, p + (str(k),), own_unit if k in ("value", "bound", "rms", "noise", "stderr") else None)
         elif isinstance(x, (list, tuple)):
             for v in x:
                 walk(v, p, own)
