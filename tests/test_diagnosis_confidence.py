@@ -93,3 +93,20 @@ def test_a_refit_that_moves_another_component_than_the_equation_error_is_not_con
     d._component_verdict([{"effect": "parameter_mismatch", "explained": 0.74, "_values": values}])
     assert d.verdict_["component"] == component and d.verdict_["confidence"] == confidence
     assert bool(d.warnings_) == (confidence == "low")
+
+
+@pytest.mark.parametrize("ee_shrink, share, effect", [(0.70, 1.0, "asymmetric_friction"), (0.20, 1.0, "inconclusive"),
+                                                      (0.70, 0.3, "inconclusive")])
+def test_a_replay_short_of_half_is_named_when_its_equation_error_confirms(ee_shrink, share, effect):
+    """The best candidate explains 45 % of the held-out replay gap (under min_explained: the replay drifts
+    on stick timing).  Its own equation, fitted on its component's residual, shrinks that residual held
+    out by 70 % in the component holding the gap: named, low.  A weak equation-error fit, or a component
+    that holds only 30 % of the gap, leaves it inconclusive."""
+    d = GapDiagnoser(paper_a("stribeck"), second=0)
+    d.gap_ = {"channels": {c: {"rms_validate": 10.0} for c in CH}}
+    d.noise_floor_ = {c: 1.0 for c in CH}
+    d.input_envelope_ = {c: 1.0 for c in CH}
+    d.prescreen_ = {"asymmetric_friction": {"component": "friction", "equation_error": {"shrink": ee_shrink}}}
+    d.where_ = {"components": {"friction": share, "string_formation": 1.0 - share}}
+    d._verdict([_row("asymmetric_friction", 0.45, 0.52, k=2), _row("sensor_offset", 0.19, 0.19, k=2)], 100.0, 1.0)
+    assert d.verdict_["effect"] == effect and d.verdict_["confidence"] == "low"
