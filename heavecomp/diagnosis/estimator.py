@@ -1135,23 +1135,8 @@ class GapDiagnoser(GapEstimator):
         stiction one heave-noise draw can flip a stick event and shift a whole stretch of the
         replay, so the residual from input noise is heavy-tailed and one draw under-estimates what
         a run with no effect can show.  The envelope is the largest held-out mean square over
-        ``input_draws`` independent draws, plus the pre-processing term (:meth:`_input_noise`)."""
-        self.heave_noise_ = noise_floor(run["heave"], run.t if not run.uniform else None)
-        self._hs_pert, alt, alt2, self._env_ms = self._input_noise(run, [], nom)
-        self._mse_b_pert = self._mse(alt, self._valmask)
-        a, b = self._ms(alt, nom, mask), self._ms(alt2, nom, mask)
-        return {c: float(np.sqrt(a[c] + b[c])) for c in CH}
-
-    @staticmethod
-    def _ms(a, ref, m):
-        return {c: float(np.mean((a[c][m] - ref[c][m]) ** 2)) for c in CH}
-
-    def _input_noise(self, run, config, ref):
-        """What the heave noise and the heave pre-processing make of the replay of ``config``
-        (effects; [] the nominal) whose noise-free replay is ``ref``: the first heave-noise draw's
-        samples and replay, the replay with a 1.5 x higher pre-filter cut-off, and the held-out
-        envelope (largest mean square over ``input_draws`` draws plus the pre-processing's) [SI^2]."""
-        sz = self.heave_noise_
+        ``input_draws`` independent draws, plus the pre-processing term."""
+        sz = noise_floor(run["heave"], run.t if not run.uniform else None)
         rng = np.random.default_rng(12345)
         val = self._valmask
 
@@ -1160,17 +1145,24 @@ class GapDiagnoser(GapEstimator):
                                        "heave": run["heave"] + rng.normal(0.0, sz, run.t.size)}, run.source)
             return heave_samples(pert, self._rp.h, self._rp.n_steps, reference=self._rp.hs.info["reference_m"])
 
-        hs = perturbed()
-        alt = self.simulate(config, hs=hs)
-        env = self._ms(alt, ref, val)
+        def ms(a, m):
+            return {c: float(np.mean((a[c][m] - nom[c][m]) ** 2)) for c in CH}
+
+        self._hs_pert = perturbed()
+        alt = self.simulate([], hs=self._hs_pert)
+        self._mse_b_pert = self._mse(alt, val)
+        env = ms(alt, val)
         for _ in range(self.input_draws - 1):
-            other = self._ms(self.simulate(config, hs=perturbed()), ref, val)
+            other = ms(self.simulate([], hs=perturbed()), val)
             env = {c: max(env[c], other[c]) for c in CH}
         # sensitivity to the heave pre-processing: cut-off 1.5 x higher
-        alt2 = self.simulate(config, hs=heave_samples(run, self._rp.h, self._rp.n_steps, cutoff=1.5 * HEAVE_CUTOFF,
-                                                      reference=self._rp.hs.info["reference_m"]))
-        pre = self._ms(alt2, ref, val)
-        return hs, alt, alt2, {c: env[c] + pre[c] for c in CH}
+        alt2 = self.simulate([], hs=heave_samples(run, self._rp.h, self._rp.n_steps, cutoff=1.5 * HEAVE_CUTOFF,
+                                                  reference=self._rp.hs.info["reference_m"]))
+        self.heave_noise_ = sz
+        pre = ms(alt2, val)
+        self._env_ms = {c: env[c] + pre[c] for c in CH}
+        a, b = ms(alt, mask), ms(alt2, mask)
+        return {c: float(np.sqrt(a[c] + b[c])) for c in CH}
 
     def _report(self, frac, msg):
         log.info("diagnose: %s", msg)
