@@ -85,6 +85,8 @@ DISCOVER_SHRINK = 0.5  #: an open-search term this good on its held-out componen
 #: component of each parameter table of parameter_mismatch
 TABLE_COMPONENT = {"compensator": "gas_spring", "friction": "friction", "drill_string": "string_formation",
                    "formation": "string_formation"}
+#: share of ``max_nfev`` a joint second-effect fit gets (it starts from the candidate's own fit)
+JOINT_NFEV = 0.5
 BOUND_TOL = 0.01  #: a fitted parameter within this share of its search range from a bound is "at the bound"
 
 
@@ -449,6 +451,8 @@ class GapDiagnoser(GapEstimator):
             # stick-slip makes the cost rough: start from the best of a coarse grid (<= 2 parameters),
             # scored on the first GRID_SPAN seconds of the fit part (it only picks the start)
             k = x0.size
+            # a joint fit starts from the candidate's own fit, next to its optimum: half the budget
+            budget = max(1, int(JOINT_NFEV * self.max_nfev)) if fixed else self.max_nfev
             if k <= 2 and start is None:
                 t_grid = min(t_end, self.split_["settle"] + GRID_SPAN)
                 axes = [np.linspace(lo[i] + 0.1 * (hi[i] - lo[i]), hi[i] - 0.1 * (hi[i] - lo[i]),
@@ -460,9 +464,9 @@ class GapDiagnoser(GapEstimator):
                     x0 = pts[int(np.argmin(costs))]
 
             if k <= 2:
-                r = self._nelder_mead(fun, x0, lo, hi)
+                r = self._nelder_mead(fun, x0, lo, hi, budget)
             else:
-                r = self._least_squares(fun, x0, lo, hi)
+                r = self._least_squares(fun, x0, lo, hi, budget)
                 if start is None:
                     r = self._rescan(cls, fun, r, lo, hi)
             values = cls.from_x(r.x)
@@ -500,13 +504,13 @@ class GapDiagnoser(GapEstimator):
         return {"values": {"channel": best[1], field.name: best[2]}, "sigma": {field.name: math.nan},
                 "nfev": DELAY_SCAN * len(CH), "cost": best[0]}
 
-    def _least_squares(self, fun, x0, lo, hi):
+    def _least_squares(self, fun, x0, lo, hi, budget=None):
         """Bounded least squares on the decimated fit residual (``max_nfev`` evaluations)."""
         import inspect
 
         from scipy.optimize import least_squares
 
-        opts = dict(bounds=(lo, hi), diff_step=0.03, max_nfev=self.max_nfev, x_scale=1.0, xtol=1e-3, ftol=1e-4, gtol=1e-6)
+        opts = dict(bounds=(lo, hi), diff_step=0.03, max_nfev=budget or self.max_nfev, x_scale=1.0, xtol=1e-3, ftol=1e-4, gtol=1e-6)
         if self.n_jobs > 1 and "workers" in inspect.signature(least_squares).parameters:  # scipy >= 1.16
             # the finite-difference Jacobian's replays (one per parameter) on n_jobs threads: the same
             # points and differences as the serial one, so the same fit
@@ -638,7 +642,7 @@ class GapDiagnoser(GapEstimator):
             return got
         return (best[0], c, best[1], got[3], got[4])
 
-    def _nelder_mead(self, fun, x0, lo, hi):
+    def _nelder_mead(self, fun, x0, lo, hi, budget=None):
         """Derivative-free refinement (Nelder-Mead on the clipped parameters; stick-slip costs are
         piecewise smooth, so finite-difference gradients mislead), then a forward-difference
         Jacobian at the optimum for the uncertainty.  Returns an object like least_squares'."""
@@ -654,7 +658,7 @@ class GapDiagnoser(GapEstimator):
         simplex = np.vstack([x0] + [x0 + np.where(np.arange(x0.size) == i, np.where(x0 + step <= hi, step, -step), 0.0)
                                     for i in range(x0.size)])
         res = minimize(cost, x0, method="Nelder-Mead",
-                       options={"initial_simplex": simplex, "maxfev": self.max_nfev, "xatol": 1e-3, "fatol": 1e-4})
+                       options={"initial_simplex": simplex, "maxfev": budget or self.max_nfev, "xatol": 1e-3, "fatol": 1e-4})
         x = np.clip(res.x, lo, hi)
         f0 = fun(x)
         J = np.empty((f0.size, x.size))
