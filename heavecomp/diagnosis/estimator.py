@@ -320,7 +320,7 @@ class GapDiagnoser(GapEstimator):
             else:  # a channel that misreads (sensor_delay, sensor_gain, sensor_offset)
                 sensors.append(cls(**values))
         # no plant effect on: the plain stepper (the composition of none), bit for bit the library's
-        # stepper with every effect off and ~2.7x faster (it integrates no effect states, calls no hooks)
+        # stepper with every effect off and ~1.5x faster (it integrates no effect states, calls no hooks)
         comp = library_composition() if effects else composition(())
         EP = comp.ep(effects)
         n = rp.n_steps if t_end is None else min(rp.n_steps, int(math.ceil(t_end / rp.h)) + 2)
@@ -417,9 +417,10 @@ class GapDiagnoser(GapEstimator):
     def _fit_cost(self, name) -> float:
         """Rough wall time of fitting candidate ``name`` alone (relative; bench_600s): the thread pool
         starts the costliest first so that no long fit is left running alone at the end.  A plant effect
-        replays on the library stepper (~2.7x the plain one) ~40 times (grid + Nelder-Mead); the
+        replays on the library stepper (~1.5x the plain one) ~40 times (grid + Nelder-Mead), weighted
+        2.7 per replay (the order bench_600s was measured with; 1.5 measured the same under load); the
         six-parameter refit ~100 times on the plain stepper (least squares + rescan); an output
-        candidate a few times."""
+        candidate a few times.  The order changes no result (every fit is independent)."""
         cls = self._candidate(name)
         if cls.kind == "output":
             return 1.0
