@@ -49,7 +49,7 @@ import time
 import numpy as np
 
 from heavecomp.effects.candidates import CANDIDATES, MISMATCH_KEYS, ParameterMismatch, get
-from heavecomp.effects.compose import library_composition
+from heavecomp.effects.compose import composition, library_composition
 from heavecomp.errors import InputError
 from heavecomp.estimator import GapEstimator
 from heavecomp.params.budget import MAX_REPLAY_STEPS
@@ -94,6 +94,8 @@ TABLE_COMPONENT = {"compensator": "gas_spring", "friction": "friction", "drill_s
                    "formation": "string_formation"}
 #: a best candidate whose held-out prediction shrinks the gap's rms by this share rules out `none`
 NONE_PREDICTED = 0.5
+#: share of ``max_nfev`` a joint second-effect fit gets (it starts from the candidate's own fit)
+JOINT_NFEV = 0.5
 BOUND_TOL = 0.01  #: a fitted parameter within this share of its search range from a bound is "at the bound"
 
 
@@ -311,7 +313,6 @@ class GapDiagnoser(GapEstimator):
         rp = self._rp
         hs = rp.hs if hs is None else hs
         plant = rp.plant
-        comp = library_composition()
         effects, sensors = [], []
         # a channel that misreads also misled the start estimate: start from its true reading
         shift, starts = self._start_for([(n, v) for n, v in config if get(n).kind == "output"])
@@ -327,6 +328,9 @@ class GapDiagnoser(GapEstimator):
                 hs = cls(**values).transform(hs)
             else:  # a channel that misreads (sensor_delay, sensor_gain, sensor_offset)
                 sensors.append(cls(**values))
+        # no plant effect on: the plain stepper (the composition of none), bit for bit the library's
+        # stepper with every effect off and ~1.5x faster (it integrates no effect states, calls no hooks)
+        comp = library_composition() if effects else composition(())
         EP = comp.ep(effects)
         n = rp.n_steps if t_end is None else min(rp.n_steps, int(math.ceil(t_end / rp.h)) + 2)
         out = run_segments(plant, comp, EP, hs, rp.h, rp.bounds, starts, n + 1)
@@ -419,6 +423,19 @@ class GapDiagnoser(GapEstimator):
         without a logged angle fits g and t_d only)."""
         return get(name).for_input(self._rp.hs)
 
+    def _fit_cost(self, name) -> float:
+        """Rough wall time of fitting candidate ``name`` alone (relative; bench_600s): the thread pool
+        starts the costliest first so that no long fit is left running alone at the end.  A plant effect
+        replays on the library stepper (~1.5x the plain one) ~40 times (grid + Nelder-Mead), weighted
+        2.7 per replay (the order bench_600s was measured with; 1.5 measured the same under load); the
+        six-parameter refit ~100 times on the plain stepper (least squares + rescan); an output
+        candidate a few times.  The order changes no result (every fit is independent)."""
+        cls = self._candidate(name)
+        if cls.kind == "output":
+            return 1.0
+        per_replay = 2.7 if cls.kind == "plant" else 1.0
+        return per_replay * (40.0 if cls.n_params() <= 2 else 100.0)
+
     def _fit_candidate(self, name, start=None, fixed=()):
         """Fit one candidate (optionally jointly after ``fixed`` configs) on the fit part."""
         cls = self._candidate(name)
@@ -433,13 +450,19 @@ class GapDiagnoser(GapEstimator):
             lo, hi = cls.bounds_x()
             x0 = np.clip(x0, lo + 1e-9, hi - 1e-9)
 
+            seen = {}  # residual by (span, parameter vector): e.g. Nelder-Mead's optimum is evaluated again for its Jacobian
+
             def fun(x, t_stop=t_end):
-                pred = self.simulate(list(fixed) + [(name, cls.from_x(x))], t_stop)
-                return self._resid_vec(pred)
+                key = (t_stop, np.asarray(x, dtype=float).tobytes())
+                if key not in seen:
+                    seen[key] = self._resid_vec(self.simulate(list(fixed) + [(name, cls.from_x(x))], t_stop))
+                return seen[key].copy()
 
             # stick-slip makes the cost rough: start from the best of a coarse grid (<= 2 parameters),
             # scored on the first GRID_SPAN seconds of the fit part (it only picks the start)
             k = x0.size
+            # a joint fit starts from the candidate's own fit, next to its optimum: half the budget
+            budget = max(1, int(JOINT_NFEV * self.max_nfev)) if fixed else self.max_nfev
             if k <= 2 and start is None:
                 t_grid = min(t_end, self.split_["settle"] + GRID_SPAN)
                 axes = [np.linspace(lo[i] + 0.1 * (hi[i] - lo[i]), hi[i] - 0.1 * (hi[i] - lo[i]),
@@ -451,9 +474,9 @@ class GapDiagnoser(GapEstimator):
                     x0 = pts[int(np.argmin(costs))]
 
             if k <= 2:
-                r = self._nelder_mead(fun, x0, lo, hi)
+                r = self._nelder_mead(fun, x0, lo, hi, budget)
             else:
-                r = self._least_squares(fun, x0, lo, hi)
+                r = self._least_squares(fun, x0, lo, hi, budget)
                 if start is None:
                     r = self._rescan(cls, fun, r, lo, hi)
             values = cls.from_x(r.x)
@@ -491,12 +514,19 @@ class GapDiagnoser(GapEstimator):
         return {"values": {"channel": best[1], field.name: best[2]}, "sigma": {field.name: math.nan},
                 "nfev": DELAY_SCAN * len(CH), "cost": best[0]}
 
-    def _least_squares(self, fun, x0, lo, hi):
+    def _least_squares(self, fun, x0, lo, hi, budget=None):
         """Bounded least squares on the decimated fit residual (``max_nfev`` evaluations)."""
+        import inspect
+
         from scipy.optimize import least_squares
 
-        return least_squares(fun, x0, bounds=(lo, hi), diff_step=0.03, max_nfev=self.max_nfev, x_scale=1.0,
-                             xtol=1e-3, ftol=1e-4, gtol=1e-6)
+        opts = dict(bounds=(lo, hi), diff_step=0.03, max_nfev=budget or self.max_nfev, x_scale=1.0, xtol=1e-3, ftol=1e-4, gtol=1e-6)
+        if self.n_jobs > 1 and "workers" in inspect.signature(least_squares).parameters:  # scipy >= 1.16
+            # the finite-difference Jacobian's replays (one per parameter) on n_jobs threads: the same
+            # points and differences as the serial one, so the same fit
+            with cf.ThreadPoolExecutor(self.n_jobs) as ex:
+                return least_squares(fun, x0, workers=ex.map, **opts)
+        return least_squares(fun, x0, **opts)
 
     def _rescan(self, cls, fun, r, lo, hi):
         """Second start for the parameters whose cost is rugged (``cls.rugged``, e.g. the static
@@ -622,7 +652,7 @@ class GapDiagnoser(GapEstimator):
             return got
         return (best[0], c, best[1], got[3], got[4])
 
-    def _nelder_mead(self, fun, x0, lo, hi):
+    def _nelder_mead(self, fun, x0, lo, hi, budget=None):
         """Derivative-free refinement (Nelder-Mead on the clipped parameters; stick-slip costs are
         piecewise smooth, so finite-difference gradients mislead), then a forward-difference
         Jacobian at the optimum for the uncertainty.  Returns an object like least_squares'."""
@@ -638,7 +668,7 @@ class GapDiagnoser(GapEstimator):
         simplex = np.vstack([x0] + [x0 + np.where(np.arange(x0.size) == i, np.where(x0 + step <= hi, step, -step), 0.0)
                                     for i in range(x0.size)])
         res = minimize(cost, x0, method="Nelder-Mead",
-                       options={"initial_simplex": simplex, "maxfev": self.max_nfev, "xatol": 1e-3, "fatol": 1e-4})
+                       options={"initial_simplex": simplex, "maxfev": budget or self.max_nfev, "xatol": 1e-3, "fatol": 1e-4})
         x = np.clip(res.x, lo, hi)
         f0 = fun(x)
         J = np.empty((f0.size, x.size))
@@ -673,7 +703,18 @@ class GapDiagnoser(GapEstimator):
 
     # ------------------------------------------------------------------- fit
     def fit(self, run):
-        """Diagnose a :class:`~heavecomp.diagnosis.data.MeasuredRun`; returns self."""
+        """Diagnose a :class:`~heavecomp.diagnosis.data.MeasuredRun`; returns self.
+
+        The BLAS library runs on one thread meanwhile (process-wide, ``threadpoolctl``): the diagnosis
+        keeps both cores busy with its own threads, and a multi-threaded BLAS call on a busy core (the
+        dot product of every fit residual, 28 000 samples for 600 s) then waits milliseconds for a
+        thread instead of taking microseconds (bench_600s: a third of the CPU time)."""
+        from threadpoolctl import threadpool_limits
+
+        with threadpool_limits(limits=1, user_api="blas"):
+            return self._fit(run)
+
+    def _fit(self, run):
         t_wall = time.perf_counter()
         T_end = float(run.t[-1])
         settle = self.settle if self.settle is not None else min(30.0, 0.1 * T_end)
@@ -731,31 +772,35 @@ class GapDiagnoser(GapEstimator):
         results = {}
         done = 0
 
-        def finish(name, fitted):
+        def finish(name, got):
             nonlocal done
-            results[name] = fitted
+            results[name] = got
             done += 1
             self._report(0.05 + 0.8 * done / len(names),
-                         f"{name}: fitted in {fitted['wall_time']:.1f} s ({fitted['nfev']} evaluations)")
+                         f"{name}: fitted in {got[0]['wall_time']:.1f} s ({got[0]['nfev']} evaluations)")
+
+        def fit_and_replay(name):
+            # the fit, then its held-out replays (plain and heave-perturbed) in the same worker
+            fitted = self._fit_candidate(name)
+            cfg = [(name, fitted["values"])]
+            return fitted, self.simulate(cfg), self._with_hs(self._hs_pert, cfg)
 
         if self.n_jobs > 1 and len(names) > 1:
-            with cf.ThreadPoolExecutor(self.n_jobs) as ex:
-                futs = {ex.submit(self._fit_candidate, n): n for n in names}
+            with cf.ThreadPoolExecutor(self.n_jobs) as ex:  # the costliest first: the pool ends balanced
+                futs = {ex.submit(fit_and_replay, n): n for n in sorted(names, key=self._fit_cost, reverse=True)}
                 for f in cf.as_completed(futs):
                     finish(futs[f], f.result())
         else:
             for n in names:
-                finish(n, self._fit_candidate(n))
+                finish(n, fit_and_replay(n))
         rows = []
         for n in names:
-            fitted = results[n]
-            pred = self.simulate([(n, fitted["values"])])
+            fitted, pred, pred_pert = results[n]
             mse_a = self._mse(pred, self._valmask)
             expl_plain = self._explained(mse_b, mse_a)
             # robustness: the same comparison with the heave-perturbed replay; a gain that comes
             # from lucky stick-event timing does not survive it, a real effect does
-            expl_pert = self._explained(self._mse_b_pert, self._mse(self._with_hs(self._hs_pert, [(n, fitted["values"])]),
-                                                                    self._valmask))
+            expl_pert = self._explained(self._mse_b_pert, self._mse(pred_pert, self._valmask))
             expl = min(expl_plain, expl_pert)
             if not math.isfinite(expl):  # the fitted model diverged on held-out data
                 log.warning("diagnose: %s diverged on the held-out data", n)
@@ -1107,11 +1152,10 @@ class GapDiagnoser(GapEstimator):
                        self._explained(self._mse_b_pert, self._mse(self._with_hs(self._hs_pert, cfg), self._valmask)))
             return fitted, pred, expl
 
-        if self.n_jobs > 1 and len(partners) > 1:
-            with cf.ThreadPoolExecutor(self.n_jobs) as ex:
-                results = list(ex.map(joint, partners))
-        else:
-            results = [joint(r) for r in partners]
+        order = sorted(range(len(partners)), key=lambda i: -self._fit_cost(partners[i]["effect"]))  # costliest first
+        results = [None] * len(partners)
+        for i, got in zip(order, self._map(joint, [partners[i] for i in order])):
+            results[i] = got
         out = None
         self.second_tried_ = []
         for r, (fitted, pred, expl) in zip(partners, results):
@@ -1151,21 +1195,29 @@ class GapDiagnoser(GapEstimator):
         def ms(a, m):
             return {c: float(np.mean((a[c][m] - nom[c][m]) ** 2)) for c in CH}
 
-        self._hs_pert = perturbed()
-        alt = self.simulate([], hs=self._hs_pert)
+        draws = [perturbed() for _ in range(self.input_draws)]  # the noise drawn in order, replayed concurrently
+        self._hs_pert = draws[0]
+        # sensitivity to the heave pre-processing: cut-off 1.5 x higher
+        cut = heave_samples(run, self._rp.h, self._rp.n_steps, cutoff=1.5 * HEAVE_CUTOFF,
+                            reference=self._rp.hs.info["reference_m"])
+        alt, *others, alt2 = self._map(lambda hs: self.simulate([], hs=hs), draws + [cut])
         self._mse_b_pert = self._mse(alt, val)
         env = ms(alt, val)
-        for _ in range(self.input_draws - 1):
-            other = ms(self.simulate([], hs=perturbed()), val)
+        for o in others:
+            other = ms(o, val)
             env = {c: max(env[c], other[c]) for c in CH}
-        # sensitivity to the heave pre-processing: cut-off 1.5 x higher
-        alt2 = self.simulate([], hs=heave_samples(run, self._rp.h, self._rp.n_steps, cutoff=1.5 * HEAVE_CUTOFF,
-                                                  reference=self._rp.hs.info["reference_m"]))
         self.heave_noise_ = sz
         pre = ms(alt2, val)
         self._env_ms = {c: env[c] + pre[c] for c in CH}
         a, b = ms(alt, mask), ms(alt2, mask)
         return {c: float(np.sqrt(a[c] + b[c])) for c in CH}
+
+    def _map(self, fn, items) -> list:
+        """``[fn(x) for x in items]``, on ``n_jobs`` threads (the stepper releases the GIL)."""
+        if self.n_jobs > 1 and len(items) > 1:
+            with cf.ThreadPoolExecutor(self.n_jobs) as ex:
+                return list(ex.map(fn, items))
+        return [fn(x) for x in items]
 
     def _report(self, frac, msg):
         log.info("diagnose: %s", msg)

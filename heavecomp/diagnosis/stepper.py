@@ -135,7 +135,7 @@ def run_segments(plant, comp, EP, hs, h, bounds, starts, n_out):
     FP, PP, EP = plant.FP, plant.PP, np.asarray(EP, dtype=float)
     smooth = smooth_fx(plant, comp, EP)
     stats = np.zeros(NSTATS)
-    out = np.empty((n_out, NCH))
+    out = np.zeros((n_out, NCH))  # zeros: the columns of effect states a composition does not have read 0
     prev = None  # where the previous segment ended (slow effect states carry on from there)
     for (i0, i1), st in zip(bounds, starts):
         if i0 >= n_out - 1:
