@@ -74,10 +74,11 @@ UNITS = {"friction": "N", "gas_spring": "Pa", "flow_line": "Pa", "string_formati
          "heave_input": "N"}
 #: plant components whose equation residual the gap diagnosis' pre-screen reads: a candidate there
 #: that the residual sees (``Effect.screened``; not a string damping, which the lower-mass balance's
-#: noise hides) is not replayed when its component shows no gap.  Not friction: the top-mass balance
-#: is blind at breakaway, and a frictional lag of 6.5x its noise floor on the WOB (tuning seed 20000)
-#: left it no gap at all -- the lag acts at reversals, where the balance's derivatives are noisiest
-SCREENED = ("gas_spring", "flow_line", "string_formation")
+#: noise hides) is not replayed when its component shows no gap.  In friction only the sliding
+#: friction's candidates (pressure, position, direction): the top-mass balance is blind at breakaway
+#: and at reversals, where dwell stiction and frictional lag act (a lag of 6.5x its noise floor on the
+#: WOB, tuning seed 20000, left the friction residual no gap at all): those two are never screened
+SCREENED = ("friction", "gas_spring", "flow_line", "string_formation")
 
 
 def _dilate(t, flag, width):
