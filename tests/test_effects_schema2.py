@@ -297,3 +297,25 @@ def test_controllers_predict_with_the_heave_the_plant_sees():
     for cls in (LinearMPC, NonlinearMPC):
         with pytest.raises(ParameterError, match="heave_reference.*delay"):
             cls(p, None, effects=[("heave_reference", {"scale": 0.9, "delay": 0.3})])
+
+
+def test_position_friction_start_from_its_equation_error_is_the_same_band():
+    """The equation-error fit's band is in shares of the travelled stroke; the replay's start it stands
+    for (``from_equation_error``) is that band in metres, so the kernel's band at those parameters is
+    the feature column the fit used, and its coefficient the extra force (at least the lower bound)."""
+    import numpy as np
+    from heavecomp.effects.position_friction import PositionFriction
+
+    t = np.linspace(0.0, 60.0, 3001)
+    x = -0.3 + 0.8 * (0.5 + 0.5 * np.sin(2 * np.pi * t / 9.0))  # travels -0.3 .. 0.5 m
+    sig = {"t": t, "x": x, "v": np.gradient(x, t)}
+    shape = (0.3, 0.2)
+    start = PositionFriction.from_equation_error({"shape": shape, "coefficients": {"position_friction": 4.2e3}}, sig)
+    assert start["centre"] == pytest.approx(-0.3 + 0.3 * 0.8, abs=1e-4)
+    assert start["width"] == pytest.approx(0.2 * 0.8, abs=1e-4)
+    assert start["extra_force"] == pytest.approx(4.2e3)
+    column = PositionFriction.features(sig, shape)["position_friction"]
+    band = np.sign(sig["v"]) * PositionFriction.band(x, start["centre"], start["width"])
+    assert np.allclose(column, band)
+    low = PositionFriction.from_equation_error({"shape": shape, "coefficients": {"position_friction": -50.0}}, sig)
+    assert low["extra_force"] == PositionFriction.Params.__dataclass_fields__["extra_force"].metadata["bounds"][0]

@@ -159,6 +159,14 @@ class Effect:
         return cls
 
     @classmethod
+    def from_equation_error(cls, fit, sig) -> dict | None:
+        """Parameter values [SI] that the equation-error fit ``fit`` (a row of
+        :func:`heavecomp.diagnosis.equation_error.rank_effects`: ``coefficients``, ``shape``) of this
+        effect's :meth:`features` on signals ``sig`` stands for: a start for the replay's fit; None
+        when the features do not fix every parameter (the default)."""
+        return None
+
+    @classmethod
     def null(cls, plant) -> dict | None:
         """Parameter values at which the effect reproduces the nominal plant bit for bit
         (``plant``: :class:`heavecomp.plants.cmc.PlantVectors`), or None when it has none

@@ -60,6 +60,19 @@ class PositionFriction(Effect):
         c, w = shape
         return {"position_friction": np.sign(sig["v"]) * cls.band(x, x0 + c * span, w * span)}
 
+    @classmethod
+    def from_equation_error(cls, fit, sig):
+        """The band (``shape``: centre and width as shares of the travelled span of ``sig["x"]``) in
+        metres of stroke, and its coefficient as the extra force (at least the lower bound) [SI]."""
+        if fit is None or fit.get("shape") is None or not need(sig, "x"):
+            return None
+        x = np.asarray(sig["x"], dtype=float)
+        x0, span = float(np.nanmin(x)), float(np.nanmax(x) - np.nanmin(x))
+        c, w = fit["shape"]
+        low = cls.Params.__dataclass_fields__["extra_force"].metadata["bounds"][0]
+        return {"extra_force": max(float(fit["coefficients"]["position_friction"]), low),
+                "centre": x0 + float(c) * span, "width": float(w) * span}
+
     @staticmethod
     def jump(code, a, p, J, s, d, x, FP, extra_force, centre, width):
         e = EDGE * width
