@@ -113,3 +113,24 @@ def test_a_replay_short_of_half_is_named_when_its_equation_error_confirms(ee_shr
     d.where_ = {"components": {"friction": share, "string_formation": 1.0 - share}}
     d._verdict([_row("asymmetric_friction", 0.45, 0.52, k=2), _row("sensor_offset", 0.19, 0.19, k=2)], 100.0, 1.0)
     assert d.verdict_["effect"] == effect and d.verdict_["confidence"] == "low"
+
+
+def test_an_inconclusive_refit_takes_the_equation_errors_component_when_they_disagree():
+    """Inconclusive, the best candidate parameter_mismatch (48 %) moved a friction parameter most while
+    the equation error puts 99 % of the gap in the line (spent scoring seed 90028, a line inertance):
+    the verdict's component is the line's, not friction."""
+    import numpy as np
+    from heavecomp.diagnosis.components import ComponentResiduals
+
+    d = GapDiagnoser(paper_a("stribeck"), second=0)
+    comps = ("friction", "gas_spring", "flow_line", "string_formation", "sensors", "heave_input")
+    d.where_ = {"components": {c: (0.99 if c == "flow_line" else 0.002) for c in comps}}
+    d.components_ = ComponentResiduals(np.zeros(1), {}, {}, {}, {}, {}, np.ones(1, bool))
+    d._fitmask = d._valmask = np.ones(1, bool)
+    d.warnings_, d.discovered_ = [], None
+    d._discover = lambda: None
+    d.verdict_ = {"effect": "inconclusive", "confidence": "low"}
+    values = {"gas_stiffness": 1.0, "static_force": 1.0, "coulomb_force": 1.0, "viscous_coefficient": 0.35,
+              "drill_string_stiffness": 1.1, "formation_stiffness": 1.0}
+    d._component_verdict([{"effect": "parameter_mismatch", "explained": 0.48, "_values": values}])
+    assert d.verdict_["component"] == "flow_line"
