@@ -42,6 +42,7 @@ from __future__ import annotations
 
 import concurrent.futures as cf
 import dataclasses
+import functools
 import logging
 import math
 import time
@@ -101,6 +102,16 @@ PERTURBED_DRAWS = 3
 #: share of ``max_nfev`` a joint second-effect fit gets (it starts from the candidate's own fit)
 JOINT_NFEV = 0.5
 BOUND_TOL = 0.01  #: a fitted parameter within this share of its search range from a bound is "at the bound"
+
+
+@functools.cache
+def _least_squares_has_workers() -> bool:
+    """Whether scipy's least_squares takes ``workers`` (scipy >= 1.16; read once)."""
+    import inspect
+
+    from scipy.optimize import least_squares
+
+    return "workers" in inspect.signature(least_squares).parameters
 
 
 def at_bounds(name, values, tol=BOUND_TOL) -> list:
@@ -500,7 +511,7 @@ class GapDiagnoser(GapEstimator):
     def _equation_error_start(self, name, cls):
         """The fit vector the candidate's equation-error fit stands for
         (:meth:`heavecomp.effects.base.Effect.from_equation_error`), or None."""
-        pre = getattr(self, "prescreen_", {}).get(name) or {}
+        pre = self.prescreen_.get(name) or {}
         ee, comp = pre.get("equation_error"), pre.get("component")
         if ee is None or comp not in self.components_.residual:
             return None
@@ -538,12 +549,10 @@ class GapDiagnoser(GapEstimator):
 
     def _least_squares(self, fun, x0, lo, hi, budget=None):
         """Bounded least squares on the decimated fit residual (``max_nfev`` evaluations)."""
-        import inspect
-
         from scipy.optimize import least_squares
 
         opts = dict(bounds=(lo, hi), diff_step=0.03, max_nfev=budget or self.max_nfev, x_scale=1.0, xtol=1e-3, ftol=1e-4, gtol=1e-6)
-        if self.n_jobs > 1 and "workers" in inspect.signature(least_squares).parameters:  # scipy >= 1.16
+        if self.n_jobs > 1 and _least_squares_has_workers():  # scipy >= 1.16
             # the finite-difference Jacobian's replays (one per parameter) on n_jobs threads: the same
             # points and differences as the serial one, so the same fit
             with cf.ThreadPoolExecutor(self.n_jobs) as ex:
@@ -881,9 +890,6 @@ class GapDiagnoser(GapEstimator):
              "shrink": best["channels"][ch]["shrink"], "shrink_channel": ch, "uncertainty": best["uncertainty"], "explained": best["explained"],
              "gap_to_noise": gap_ratio, "gap_to_input_envelope": input_ratio, "margin": margin,
              "margin_input_noise": spread}
-        def is_none(ratio):
-            return ratio <= self.none_ratio or (ratio <= self.none_tail and best["explained"] < self.none_explained)
-
         # held-out noise cannot be predicted: a candidate fitted on the fit part that halves the held-out
         # gap's rms on its channel has found something the noise floor estimate hides (scoring seed 70005:
         # on a soft formation the replay's sensitivity to the heave pre-filter is as large as the gap,
@@ -891,7 +897,8 @@ class GapDiagnoser(GapEstimator):
         # WOB gap from 2.3 kN to 0.6 kN)
         predicts = best["channels"][ch]["shrink"] >= NONE_PREDICTED and best["explained_perturbed_heave"] >= self.min_explained
         v["predicted_shrink"] = best["channels"][ch]["shrink"]
-        if is_none(input_ratio) and not predicts:
+        if (input_ratio <= self.none_ratio or (input_ratio <= self.none_tail and best["explained"] < self.none_explained)) \
+                and not predicts:
             # between none_ratio and none_tail x the envelope: a gap that no candidate (not even the
             # six-parameter refit) explains a quarter of is read as the tail of the stick-event noise
             tail = input_ratio > self.none_ratio
@@ -915,10 +922,10 @@ class GapDiagnoser(GapEstimator):
                                           f"{100 * second['explained_joint']:.0f} % with {second['effect']}")
                 self.verdict_ = v
                 return
-            pre = getattr(self, "prescreen_", {}).get(best["effect"], {})
+            pre = self.prescreen_.get(best["effect"], {})
             ee = pre.get("equation_error")
             if (ee and ee["shrink"] >= self.discover_shrink and best["explained"] >= self.none_explained
-                    and getattr(self, "where_", {}).get("components", {}).get(pre.get("component"), 0.0) >= 0.5):
+                    and self.where_["components"].get(pre.get("component"), 0.0) >= 0.5):
                 # the replay drifts on stick-event timing (spent scoring seed 70008: an asymmetry of 0.18
                 # held out 0.45, of 0.20 0.89, on the same fit cost); the candidate's own equation, fitted
                 # on its component's residual (blind to stick timing), shrinks that residual held out as
@@ -1032,7 +1039,8 @@ class GapDiagnoser(GapEstimator):
                               largest or best_comp)
         else:
             v["component"] = self._candidate_component(rows[0])
-            if eff == "parameter_mismatch" and self._refit_disagrees(v["component"], shares, largest):
+        if eff == "parameter_mismatch":
+            if self._refit_disagrees(v["component"], shares, largest):
                 # the six-parameter refit can bend any gap into the nominal's parameters; when the
                 # parameter it moved most is of a component where the equation error sees (almost) no
                 # gap, while another holds most of it, the two readings disagree: the gap lives where the
@@ -1046,8 +1054,7 @@ class GapDiagnoser(GapEstimator):
                     f"verdict parameter_mismatch: the refit moved a {moved} parameter most, but "
                     f"{100 * shares[largest]:.0f} % of the equation-error gap lies in {largest}; the refit "
                     "may stand in for an unmodelled effect there -- confidence low")
-            if eff == "parameter_mismatch":
-                self._stationarity(v)
+            self._stationarity(v)
         if rows[0]["explained"] >= self.min_explained:
             return
         found = self._discover()
