@@ -67,13 +67,23 @@ from heavecomp.plants.cmc import MC
 
 
 
+#: the sources compiled code is built from: the packages whose functions numba compiles or
+#: inlines (physics, effects, steppers), the modules holding a jitted stepper, and the constants
+#: they read (``params/cmc.py``: g, p_atm; ``params/budget.py``).  Editing anything else (reports, the diagnosis'
+#: decisions, commands) leaves the compiled kernels valid.
+COMPILED_SOURCES = ("friction", "plants", "effects", "simulate", "pneumatic", "test_rig",
+                    "diagnosis/stepper.py", "campaign/batch.py", "closed_loop/loop.py", "params/cmc.py",
+                    "params/budget.py")
+
+
 def _numba_cache_dir():
-    """A numba cache folder keyed to the hash of every heavecomp source file.
+    """A numba cache folder keyed to the hash of the sources compiled code is built from.
 
     numba invalidates a cached function only when *its own* file changes, but the
     compiled steppers inline physics from other files (friction/laws.py,
     plants/cmc.py, ...): after an edit or an upgrade, a stale cache would run old
-    physics.  Keying the whole cache to all sources makes that impossible.
+    physics.  Keying the whole cache to every file in :data:`COMPILED_SOURCES` makes that
+    impossible, and an edit elsewhere recompiles nothing.
     ``NUMBA_CACHE_DIR`` set by the user wins.
     """
     import hashlib
@@ -82,7 +92,11 @@ def _numba_cache_dir():
 
     root = Path(__file__).resolve().parents[1]
     h = hashlib.sha256()
-    for p in sorted(root.rglob("*.py")):
+    files = set()
+    for rel in COMPILED_SOURCES:
+        path = root / rel
+        files.update(path.rglob("*.py") if path.is_dir() else [path])
+    for p in sorted(files):
         h.update(p.relative_to(root).as_posix().encode())
         h.update(p.read_bytes())
     base = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "heavecomp"
