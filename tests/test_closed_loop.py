@@ -336,3 +336,18 @@ def test_cli_closed_loop_switches_need_a_controller(tmp_path, flag):
     assert r.returncode == 2
     assert r.stderr.strip() == f"heavecomp simulate: error: {flag} needs --controller pid|linear-mpc|nonlinear-mpc"
 
+
+def test_the_closed_loop_wob_figure_has_an_actuator_force_panel(tmp_path, monkeypatch):
+    """issue 21: ``wob.png`` of a run with an active controller shows the force it applied [kN] and u_max."""
+    import heavecomp.report.simulation as sim
+
+    p = paper_a("stribeck")
+    res = simulate_closed_loop(p, "pid", 10.0, noise=None)
+    figs = []
+    monkeypatch.setattr(sim, "save", lambda fig, path, **kw: figs.append(fig))
+    sim.write_closed_loop_outputs(res, tmp_path, title="pid")
+    axu = figs[0].axes[-1]
+    assert len(figs[0].axes) == 3 and "[kN]" in axu.get_ylabel() and "force" in axu.get_ylabel()
+    drawn = np.concatenate([ln.get_ydata() for ln in axu.get_lines() if len(ln.get_ydata()) > 2])
+    assert np.max(np.abs(drawn)) == pytest.approx(np.max(np.abs(res["u_active"])) / 1e3)
+    assert {ln.get_ydata()[0] for ln in axu.get_lines() if len(ln.get_ydata()) == 2} == {-60.0, 60.0}
