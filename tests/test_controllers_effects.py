@@ -122,6 +122,19 @@ def test_the_nonlinear_mpc_builds_no_qp():
     assert type(nl.solver).__module__.startswith("casadi") and not hasattr(nl, "Gu")
 
 
+@pytest.mark.parametrize("name, values", [("sensor_gain", {"factor": 1.1}), ("sensor_offset", {"offset": 2e3})])
+def test_both_mpcs_aim_at_the_reading_the_set_point_gives_on_a_known_wob_channel(name, values):
+    """A WOB sensor the controllers know reads g W + o: both aim at g W_0 + o, so the true WOB goes to W_0
+    (the linear MPC through its model's y0, the nonlinear one through its target; before, the nonlinear MPC
+    drove the reading to W_0, i.e. the true WOB to (W_0 - o) / g)."""
+    eff = [(name, {"channel": "wob", **values})]
+    w0 = paper_a("stribeck").operating_point.wob_setpoint
+    reading = values.get("factor", 1.0) * w0 + values.get("offset", 0.0)
+    assert _mpc("nonlinear-mpc", eff, horizon=3).wob_target == pytest.approx(reading, rel=1e-12)
+    assert _mpc("linear-mpc", eff, horizon=3).model.y0[0] == pytest.approx(reading, rel=1e-12)
+    assert _mpc("nonlinear-mpc", [], horizon=3).wob_target == w0
+
+
 @pytest.mark.parametrize("effect, values", [("pressure_friction", {"extra_pressure_coefficient": 2e-3}),
                                             ("position_friction", {"extra_force": 4e3, "centre": 0.1, "width": 0.4})])
 def test_stiction_effects_are_smoothed_with_the_controllers_friction_eps(effect, values):

@@ -89,7 +89,10 @@ class NonlinearMPC(PredictiveController):
         self._f = f
         n = f.size1_in(0)  # 4 plant states, then the known effects' states
         self._x_op = np.r_[np.zeros(4), initial_effect_states(mp, self.effects)]  # operating point
-        W0 = mp.operating_point.wob_setpoint
+        # the WOB reading the set-point gives: W_0 itself unless the controller knows a WOB channel
+        # effect (g W + o), as the linear MPC's deviation from its y0
+        W0 = float(f(self._x_op, np.zeros(4))[1][0])
+        self.wob_target = W0
         Ts, M = cfg.dt, self.substeps
         h = Ts / M
         x = ca.SX.sym("x", n)
