@@ -55,7 +55,7 @@ def states_from_run(duration=60.0, every=5):
     def rec(t, m, pv):
         u = orig(t, m, pv)
         if t > 24.0:
-            xs.append(ctrl.observer.x.copy())
+            xs.append(ctrl.estimation.observer.x.copy())
         return u
 
     ctrl._step = rec

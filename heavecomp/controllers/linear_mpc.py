@@ -10,7 +10,10 @@ with w_k the predicted heave (online preview, :class:`HeavePredictor`), f_k the
 friction model (paper A eq. 4/6/7, smoothed with width ``friction_eps``) at the
 stroke velocity full compensation would need, v = -dz_h (the friction jumps at
 every stroke reversal, which the preview sees coming), and d the Kalman
-estimate of the friction the model misses (:class:`DisturbanceObserver`).
+estimate of the friction the model misses (:class:`DisturbanceObserver`).  The friction
+model is the law's and every seal-hook effect's the controller knows (``effects=``), all
+smoothed with ``friction_eps`` (:class:`~heavecomp.controllers.model.ControllerFriction`); the
+estimation is the one both MPCs hold (:class:`~heavecomp.controllers.predictive.StateEstimation`).
 
 Condensed QP in the forces U = (u_0 .. u_{N-1}) [kN]::
 
@@ -25,44 +28,30 @@ return "solved", the previous plan shifted by one interval is used (counted in
 
 from __future__ import annotations
 
-import logging
-
 import numpy as np
 
-from heavecomp.controllers.base import Controller, ControllerConfig
-from heavecomp.controllers.estimation import DisturbanceObserver, HeavePredictor
-from heavecomp.controllers.model import controller_params, discrete_model
-from heavecomp.friction.laws import FrictionLaw
-from heavecomp.effects.registry import resolve
-
-log = logging.getLogger(__name__)
-KN = 1e3
+from heavecomp.controllers.predictive import KN, PredictiveController
 
 
-def controller_friction(cparams):
-    """The friction law the controller believes (of :func:`controller_params`: forces scaled)."""
+class LinearMPC(PredictiveController):
+    """Linear MPC on the WOB with osqp (see module docstring).
 
-    return FrictionLaw.from_params(cparams.friction)
-
-
-class LinearMPC(Controller):
-    """Linear MPC on the WOB with osqp (see module docstring)."""
+    Parameters
+    ----------
+    params, config, effects
+        As :class:`~heavecomp.controllers.predictive.PredictiveController` (``effects``: what its model knows).
+    """
 
     name = "linear-mpc"
+    log_name = "linear MPC"
 
     def __init__(self, params, config=None, effects=()):
         import osqp
         import scipy.sparse as sp
 
-        config = config or ControllerConfig.from_params(params)
-        self.params, self.config = params, config
-        self.cparams = controller_params(params, config)
-
-        self.effects = resolve(effects)  # effects at the plant's hooks the controller's model knows
-        self.model = m = discrete_model(self.cparams, config.dt, config.model_frame, self.effects)
-        self.law = controller_friction(self.cparams)
-        N, n = config.horizon, m.Ad.shape[0]
-        self.N = N
+        super().__init__(params, config, effects)
+        config, m, N = self.config, self.model, self.N
+        n = m.Ad.shape[0]
         # condensed prediction x_k (k = 1..N) = Sx x0 + Su U + Sd Wd
         Apow = [np.eye(n)]
         for _ in range(N):
@@ -91,10 +80,6 @@ class LinearMPC(Controller):
         self.solver.setup(sp.csc_matrix(np.triu(P)), np.zeros(N), sp.csc_matrix(Acon), l0, u0,
                           verbose=False, warm_starting=True, polishing=False, eps_abs=1e-4, eps_rel=1e-4,
                           max_iter=4000)
-        self.predictor = HeavePredictor(config.dt, config.predictor_order, config.predictor_window,
-                                        horizon=max(config.horizon, 40))
-        self.observer = DisturbanceObserver(m, sigma_d=config.observer_sigma_d)
-        super().__init__(params, config)
 
     def _bounds(self, u_prev_kN):
         N = self.N
@@ -104,43 +89,14 @@ class LinearMPC(Controller):
         u[N] += u_prev_kN
         return l, u
 
-    def reset(self):
-        super().reset()
-        if hasattr(self, "predictor"):
-            self.predictor.reset()
-            self.observer.reset()
-        self.plan = None
-        self._last = None  # (u_applied, w, f_ff) for the observer's time update
-        self.last_preview = None
-
-    def friction_ff(self, dz: np.ndarray, p: float) -> np.ndarray:
-        """Friction model force at v = -dz_h [N] (zero when feed-forward is off)."""
-        if not self.config.friction_feedforward:
-            return np.zeros_like(dz)
-        return self.law.smooth(-dz, p, eps=self.config.friction_eps)
-
-    def _estimate(self, t, meas, preview):
-        """Heave trajectory (N+1, 3), friction forecast (N+1,), observer update."""
-        self.predictor.update(t, meas.heave)
-        H = self.predictor.trajectory(t, self.N) if preview is None else np.asarray(preview, dtype=float)
-        self.last_preview = (t, H[:, 0].copy())
-        f = self.friction_ff(H[:, 1], meas.pressure)
-        w_now = H[0]
-        if self._last is not None:
-            u_prev, w_prev, f_prev = self._last
-            u_avg = 0.5 * (u_prev + meas.u_active)
-            self.observer.predict(u_avg, 0.5 * (w_prev + w_now), 0.5 * (f_prev + f[0]))
-        self.observer.correct(np.array([meas.wob, meas.stroke, meas.pressure]), w_now)
-        return H, f
-
     def _step(self, t, meas, preview):
-        H, f = self._estimate(t, meas, preview)
-        self._last = (meas.u_active, H[0].copy(), float(f[0]))
+        H, f = self.estimation.update(t, meas, preview)
+        obs = self.estimation.observer
         m, N = self.model, self.N
         wbar = 0.5 * (H[:-1] + H[1:])                       # (N, 3) interval means
-        fbar = 0.5 * (f[:-1] + f[1:]) + self.observer.d      # (N,)
+        fbar = 0.5 * (f[:-1] + f[1:]) + obs.d                # (N,)
         Wd = (wbar @ m.Bw.T + fbar[:, None] * m.Bf[:, 0][None, :]).ravel()
-        e0 = self.Gx @ self.observer.x + self.Gd @ Wd + m.Dw[0] @ H[1:].T  # free WOB deviation [N]
+        e0 = self.Gx @ obs.x + self.Gd @ Wd + m.Dw[0] @ H[1:].T  # free WOB deviation [N]
         e0_kN = e0 / KN
         u_prev = self.u_prev / KN
         q = 2.0 * self.qw * self.Gu.T @ e0_kN
@@ -152,11 +108,4 @@ class LinearMPC(Controller):
         if status == "solved" and np.all(np.isfinite(res.x)):
             self.plan = res.x * KN
             return float(self.plan[0])
-        self.stats["solver_failures"] += 1
-        self.stats["fallbacks"] += 1
-        (log.warning if self.stats["solver_failures"] <= 5 else log.debug)(
-            "linear MPC: osqp status %r at t = %.2f s; using the shifted previous plan", status, t)
-        if self.plan is not None and self.plan.size > 1:
-            self.plan = np.r_[self.plan[1:], self.plan[-1]]
-            return float(self.plan[0])
-        return self.u_prev
+        return self.fall_back(t, f"osqp status {status!r}")

@@ -1,7 +1,9 @@
 """The controller's discrete linear model, from the plant's casadi jacobians.
 
 No plant equation is restated: :func:`heavecomp.effects.model.casadi_model`
-(friction ``none``; the friction is a force input handled as a disturbance) is
+(without seal friction, ``friction=False``: neither the law's nor a seal-hook effect's; the
+friction is a force input, forecast by :class:`ControllerFriction` and estimated as a
+disturbance) is
 differentiated at the operating point (x = 0, heave 0, u = 0) and discretised
 exactly for piecewise-constant inputs (zero-order hold) with the control
 interval Ts.
@@ -35,9 +37,11 @@ import dataclasses
 
 import numpy as np
 
-from heavecomp.effects.model import casadi_model, heave_map, initial_effect_states, seen_heave
-from heavecomp.effects.registry import resolve
+from heavecomp.effects.compose import composition
+from heavecomp.effects.model import casadi_model, heave_map, initial_effect_states, seen_heave, smooth_seal_friction
+from heavecomp.effects.registry import resolve, split_effects
 from heavecomp.friction.laws import FORCE_KEYS
+from heavecomp.plants.cmc import plant_vectors
 from heavecomp.plants.symbolic import casadi
 
 OUT = ("wob", "stroke", "pressure")
@@ -101,18 +105,24 @@ def earth_frame(f, heave=(1.0, 0.0)):
     return ca.Function("cmc_earth", [xe, u], [xedot, y], ["x", "u"], ["xdot", "y"])
 
 
-def controller_model(params, *, eps=None, frame: str = "earth", effects=()):
+def controller_model(params, *, eps=None, frame: str = "earth", effects=(), friction: bool = True):
     """The casadi model the controllers predict with (``frame``: see the module docstring;
-    ``effects``: effects at the plant's hooks the controller knows, :mod:`heavecomp.effects`)."""
+    ``effects``: effects at the plant's hooks the controller knows, :mod:`heavecomp.effects`;
+    ``eps`` [m/s]: the smoothing width of every friction term, the law's and the effects';
+    ``friction=False``: no seal friction, :func:`heavecomp.effects.model.casadi_model`)."""
     if frame not in FRAMES:
         raise ValueError(f"model frame {frame!r}: not one of {', '.join(FRAMES)}")
     effects = resolve(effects)
-    f = casadi_model(params, eps=eps, effects=effects)
+    f = casadi_model(params, eps=eps, effects=effects, friction=friction)
     return earth_frame(f, heave_map(effects)) if frame == "earth" else f
 
 
 def discrete_model(params, Ts: float, frame: str = "earth", effects=()) -> DiscreteModel:
-    """Linearise the frictionless CMC at the operating point and discretise (ZOH).
+    """Linearise the CMC without seal friction at the operating point and discretise (ZOH).
+
+    The seal friction, the law's and every seal-hook effect's, is left out (a force input
+    ``f``, like ``-u``): linearised at rest its smoothed sign would be a damping J / eps that
+    the sliding cylinder never has.  :class:`ControllerFriction` forecasts it instead.
 
     Parameters
     ----------
@@ -130,7 +140,7 @@ def discrete_model(params, Ts: float, frame: str = "earth", effects=()) -> Discr
 
     ca = casadi()
     nominal = params.replace(friction={"model": "none"})
-    f = controller_model(nominal, frame=frame, effects=effects)
+    f = controller_model(nominal, frame=frame, effects=effects, friction=False)
     nx = f.size1_in(0)
     x = ca.SX.sym("x", nx)
     u = ca.SX.sym("u", 4)
@@ -152,3 +162,66 @@ def discrete_model(params, Ts: float, frame: str = "earth", effects=()) -> Discr
     rows = [0, 1, 2]  # wob, stroke, pressure
     return DiscreteModel(Ts=Ts, Ad=Ad, Bu=Bd[:, 0:1], Bw=Bd[:, 1:4], Bf=Bd[:, 4:5], C=Cy[rows], Dw=Dy[rows, 0:3],
                          y0=y0[rows], Ac=Ac, Bc=Bc)
+
+
+class ControllerFriction:
+    """The seal friction the controllers believe, smoothed with the controller's ``friction_eps``.
+
+    The friction law of ``cparams`` (:func:`controller_params`: forces scaled) and the seal-hook
+    effects among ``effects`` (the same expression as the nonlinear MPC's casadi model,
+    :func:`heavecomp.effects.model.smooth_seal_friction`, evaluated on numpy arrays).  An effect
+    that adds stiction (``dwell_stiction``, ``pressure_friction``, ``position_friction``) is
+    smooth here like the law; a static-limit hook (the dwell gain) has no part in a smooth model.
+
+    Parameters
+    ----------
+    cparams : CMCParams
+        The parameters the controller believes.
+    eps : float [m/s]
+        Regularisation width of sign(v) (``ControllerConfig.friction_eps``).
+    effects : sequence, optional
+        Effects the controller knows (instances or names; only the plant effects matter here).
+    """
+
+    def __init__(self, cparams, eps: float, effects=()):
+        plant = plant_vectors(cparams)
+        self.code, self.FP, self.PP = plant.code, plant.FP, plant.PP
+        self.eps = float(eps)
+        fx = split_effects(resolve(effects))[0]
+        self.comp = composition(tuple(dict.fromkeys(type(e) for e in fx)))
+        self.EP = self.comp.ep(fx)
+        self.effects = fx
+        #: indices into the model state x of the effect states the seal friction reads
+        self.seal_slots = tuple(i for e in fx if e.hook == "seal_friction" for i in self.comp.slots[e.name])
+        self.x_rest = initial_effect_states(cparams, fx)
+
+    def _states(self, v, x_eff):
+        """The stepper-state tuple X for :meth:`force`: effect states at their steady value sliding
+        at ``v`` where the effect has one (a friction memory), else ``x_eff`` (the estimate)."""
+        x_eff = self.x_rest if x_eff is None else np.asarray(x_eff, dtype=float)
+        X = [0.0, 0.0, 0.0, 0.0] + [x_eff[i] + 0.0 * v for i in range(x_eff.size)]
+        for e in self.effects:
+            sl = self.comp.slots[e.name]
+            if sl and e.steady is not None:
+                for i, val in zip(sl, e.steady(v, self.FP, self.PP, *e.prm)):
+                    X[i] = val + 0.0 * v
+        return tuple(X)
+
+    def force(self, v, p, s=0.0, x_eff=None) -> np.ndarray:
+        """Smoothed seal friction at stroke velocity ``v`` [m/s], pressure ``p`` [Pa] and stroke
+        ``s`` [m] (arrays broadcast) [N]; ``x_eff``: the effect states (default: at rest)."""
+        v = np.asarray(v, dtype=float)
+        fn = self.comp.functions
+        if not self.comp.n_ep:  # the law alone: no effect state to set up
+            return smooth_seal_friction(fn, self.code, v, np.asarray(p, dtype=float), s, (), self.FP, self.EP,
+                                        self.eps)
+        return smooth_seal_friction(fn, self.code, v, np.asarray(p, dtype=float), np.asarray(s, dtype=float),
+                                    self._states(v, x_eff), self.FP, self.EP, self.eps)
+
+    def static_limit(self, p, s=0.0, x_eff=None) -> float:
+        """Largest friction that holds the piston at rest [N] (the law's and the seal-hook effects'
+        jump at zero velocity, the larger of the two directions)."""
+        fn = self.comp.functions
+        X = self._states(0.0, x_eff) if self.comp.n_ep else ()
+        p = np.asarray(p, dtype=float)
+        return float(max(fn["jump_fx"](self.code, 0.0 * p, p, s, d, X, self.FP, self.EP) for d in (1.0, -1.0)))

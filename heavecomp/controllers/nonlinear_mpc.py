@@ -8,7 +8,13 @@ sub-steps per control interval (multiple shooting).  The heave over the horizon
 is the online preview of :class:`~heavecomp.controllers.estimation.HeavePredictor`;
 the initial state comes from the same Kalman observer as the linear MPC, and the
 part of its disturbance estimate the smooth friction model does not explain is
-added as a constant force over the horizon.
+added as a constant force over the horizon.  Both MPCs hold one
+:class:`~heavecomp.controllers.predictive.StateEstimation` each (heave preview, friction
+forecast, observer); this one builds no QP.  Every friction term of the model, the law's and
+each seal-hook effect's the controller knows (``effects=``; stiction included), is smoothed
+with ``friction_eps``.  The states of seal-hook effects (a friction memory) do not reach the
+observer's frictionless linear model; they start each horizon where the previous solution put
+them one interval on (at rest before the first solve and after a failed one).
 
 NLP (N intervals, decision variables X_0..X_N, U_0..U_{N-1})::
 
@@ -30,16 +36,12 @@ a non-finite iterate) falls back to the previous plan shifted (counted in
 
 from __future__ import annotations
 
-import logging
-
 import numpy as np
 
-from heavecomp.controllers.linear_mpc import KN, LinearMPC
 from heavecomp.controllers.model import controller_model
+from heavecomp.controllers.predictive import KN, PredictiveController
 from heavecomp.plants.symbolic import casadi
 from heavecomp.effects.model import initial_effect_states
-
-log = logging.getLogger(__name__)
 
 #: ipopt return statuses accepted as a solution
 _OK = ("Solve_Succeeded", "Solved_To_Acceptable_Level")
@@ -57,14 +59,21 @@ def rk4_steps(f, x, u, h, M):
         x = x + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
     return x
 
-class NonlinearMPC(LinearMPC):
-    """Nonlinear MPC with casadi/ipopt (see module docstring).
+class NonlinearMPC(PredictiveController):
+    """Nonlinear MPC with casadi (see module docstring).
 
-    Re-uses the linear MPC's estimation (heave predictor, Kalman observer) so
-    the two controllers differ only in the prediction model and the solver.
+    Holds the same estimation as the linear MPC (heave predictor, friction forecast, Kalman
+    observer: :class:`~heavecomp.controllers.predictive.StateEstimation`), so the two
+    controllers differ only in the prediction model and the solver.
+
+    Parameters
+    ----------
+    params, config, effects
+        As :class:`~heavecomp.controllers.predictive.PredictiveController` (``effects``: what its model knows).
     """
 
     name = "nonlinear-mpc"
+    log_name = "nonlinear MPC"
     substeps = 2
 
     def __init__(self, params, config=None, effects=()):
@@ -80,7 +89,10 @@ class NonlinearMPC(LinearMPC):
         self._f = f
         n = f.size1_in(0)  # 4 plant states, then the known effects' states
         self._x_op = np.r_[np.zeros(4), initial_effect_states(mp, self.effects)]  # operating point
-        W0 = mp.operating_point.wob_setpoint
+        # the WOB reading the set-point gives: W_0 itself unless the controller knows a WOB channel
+        # effect (g W + o), as the linear MPC's deviation from its y0
+        W0 = float(f(self._x_op, np.zeros(4))[1][0])
+        self.wob_target = W0
         Ts, M = cfg.dt, self.substeps
         h = Ts / M
         x = ca.SX.sym("x", n)
@@ -145,20 +157,26 @@ class NonlinearMPC(LinearMPC):
         self._lam_x = None
         self._lam_g = None
         self._fric = ca.Function("fric", [x, uu], [f(x, uu)[1][4]])
+        # seal-hook effect states: unseen by the observer's frictionless model, carried by this one
+        self._carried = list(self.estimation.friction.seal_slots)
 
     def reset(self):
         super().reset()
         self._w0 = None
+        self._x_next = None  # the model state one interval on, from the last solution
 
     def _step(self, t, meas, preview):
-        H, fff = self._estimate(t, meas, preview)
-        self._last = (meas.u_active, H[0].copy(), float(fff[0]))
+        est = self.estimation
+        H, fff = est.update(t, meas, preview)
         N = self.N
-        xh = self.observer.x + self._x_op
+        xh = est.observer.x + self._x_op
+        if self._carried and self._x_next is not None:
+            xh[self._carried] = self._x_next[self._carried]
         # the friction the observer attributes to the top mass minus what the smooth model predicts now
         f_model = float(self._fric(xh, np.r_[H[0], 0.0]))
-        d_res = self.observer.d + float(fff[0]) - f_model
-        lim = 2.0 * float(self.law.static_limit(meas.pressure)) + 5e3  # twice the law's static limit
+        d_res = est.observer.d + float(fff[0]) - f_model
+        # twice the static limit the controller believes (law and seal-hook effects)
+        lim = 2.0 * est.friction.static_limit(meas.pressure, meas.stroke) + 5e3
         d_res = float(np.clip(d_res, -lim, lim))
         P = np.r_[xh, H.ravel(), d_res / KN, self.u_prev / KN]
         if self._w0 is None:
@@ -184,15 +202,9 @@ class NonlinearMPC(LinearMPC):
             self._w0 = np.r_[Xn.ravel(order="F"), Un]
             self._lam_x = np.array(sol["lam_x"]).ravel()
             self._lam_g = np.array(sol["lam_g"]).ravel()
+            self._x_next = Xs[:, 1].copy()
             self.plan = Us * KN
             return float(self.plan[0])
-        self.stats["solver_failures"] += 1
-        self.stats["fallbacks"] += 1
         self._w0 = None
-        (log.warning if self.stats["solver_failures"] <= 5 else log.debug)(
-            "nonlinear MPC: %s status %r at t = %.2f s; using the shifted previous plan",
-            self.config.nlp_solver, status, t)
-        if self.plan is not None and self.plan.size > 1:
-            self.plan = np.r_[self.plan[1:], self.plan[-1]]
-            return float(self.plan[0])
-        return self.u_prev
+        self._x_next = None
+        return self.fall_back(t, f"{self.config.nlp_solver} status {status!r}")

@@ -18,7 +18,7 @@ from heavecomp.plants.cmc import MC, lower_accel_wob, plant_vectors, wob
 from heavecomp.plants.symbolic import casadi
 
 
-def casadi_model(params, *, eps: float | None = None, sym: str = "SX", effects=()):
+def casadi_model(params, *, eps: float | None = None, sym: str = "SX", effects=(), friction: bool = True):
     """The CMC as a casadi Function ``f(x, u) -> (xdot, y)`` with smooth friction.
 
     Parameters
@@ -37,6 +37,10 @@ def casadi_model(params, *, eps: float | None = None, sym: str = "SX", effects=(
         regularised model, which never sticks.  A heave effect scales the heave input (its gain;
         a delay is refused: ParameterError), a channel effect scales and shifts its output
         (``g y + o``; a heave sensor's inverse on the input; a delay or a drift is refused).
+    friction : bool
+        False: no seal friction at all, neither the law's nor the seal-hook effects' (the
+        friction output is 0; ``eps`` is then not needed).  The linear MPC's model: it takes the
+        friction as a force input (:func:`heavecomp.controllers.model.discrete_model`).
 
     Returns
     -------
@@ -49,8 +53,10 @@ def casadi_model(params, *, eps: float | None = None, sym: str = "SX", effects=(
     effects, heave_fx, sensor_fx = split_effects(resolve(effects))
     comp = composition(tuple(dict.fromkeys(type(e) for e in effects)))
     EP = comp.ep(effects)
-    if (plant.has_stiction or comp.adds_stiction(EP)) and not (eps and eps > 0):
-        raise ValueError("casadi_model: friction with stiction needs an explicit eps > 0 [m/s]")
+    if friction and (plant.has_stiction or comp.adds_stiction(EP)) and not (eps and eps > 0):
+        what = ", ".join([f"the friction law {params.friction.model!r}"] * plant.has_stiction
+                         + [f"effect {e.name}" for e in effects if e.adds_stiction])
+        raise ValueError(f"casadi_model: {what} has stiction; a smooth model needs an explicit eps > 0 [m/s]")
     code, FP, PP = plant.code, plant.FP, plant.PP
     n_eff = comp.n_states
     S = getattr(ca, sym)
@@ -64,8 +70,7 @@ def casadi_model(params, *, eps: float | None = None, sym: str = "SX", effects=(
     fn = comp.functions
     p, T, hold, dvb = fn["plant_fx"](s, v, yb, vb, X, zh, dzh, ddzh, ua, 1.0, PP, EP)
     dvb = lower_accel_wob(T, yb, vb, PP)  # the clamped contact law (smooth model)
-    sv = np.tanh(v / (eps or 1.0))  # the direction of motion, smoothed
-    Ff = fn["jump_fx"](code, np.abs(v), p, s, sv, X, FP, EP) * sv + friction_cont(code, v, p, FP)
+    Ff = smooth_seal_friction(fn, code, v, p, s, X, FP, EP, eps or 1.0) if friction else 0.0 * v
     dv = (hold - Ff) / PP[MC]
     rates = fn["effect_rates"](s, v, p, X, PP, FP, EP)
     xdot = ca.vertcat(v, dv, vb, dvb, *rates)
@@ -76,6 +81,38 @@ def casadi_model(params, *, eps: float | None = None, sym: str = "SX", effects=(
             y[e.channel] = g * y[e.channel] + o
     y = ca.vertcat(y["wob"], y["stroke"], y["pressure"], T, Ff)
     return ca.Function("cmc", [x, u], [xdot, y], ["x", "u"], ["xdot", "y"])
+
+
+def smooth_seal_friction(fn, code, v, p, s, X, FP, EP, eps):
+    """The seal friction regularised with width ``eps`` [m/s]: ``J tanh(v/eps) + K`` [N].
+
+    J is the composition's ``jump_fx`` (the friction law's jump and every seal-hook effect's,
+    at the smoothed direction of motion), K the law's continuous part: the same expression for
+    casadi symbols (:func:`casadi_model`) and numpy arrays (the controllers' friction
+    feed-forward, :class:`heavecomp.controllers.model.ControllerFriction`).  Without effects it
+    is :func:`heavecomp.friction.laws.friction_smooth`, operation for operation.
+
+    Parameters
+    ----------
+    fn : dict
+        The composition's generated functions (:attr:`heavecomp.effects.compose.Composition.functions`).
+    code : int
+        Friction-law code.
+    v : float or array [m/s]
+        Stroke velocity.
+    p : float or array [Pa]
+        Cylinder gauge pressure.
+    s : float or array [m]
+        Stroke.
+    X : sequence
+        The stepper's state (the effects' states at their slots, 4 onwards).
+    FP, EP : array
+        Friction and effect parameter vectors.
+    eps : float [m/s]
+        Regularisation width of sign(v) -> tanh(v / eps).
+    """
+    sv = np.tanh(v / eps)  # the direction of motion, smoothed
+    return fn["jump_fx"](code, np.abs(v), p, s, sv, X, FP, EP) * sv + friction_cont(code, v, p, FP)
 
 
 #: probe times [s] and values for the static maps of heave and channel effects

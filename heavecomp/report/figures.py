@@ -54,11 +54,16 @@ def envelope(t, y, max_points: int = 4000):
     return t[idx], y[idx]
 
 
-def plot_wob(results: dict, *, title: str | None = None, static_estimate: bool = True, window=None):
+def plot_wob(results: dict, *, title: str | None = None, static_estimate: bool = True, window=None,
+             force: bool = False):
     """WOB over time for several runs (label -> SimulationResult), with heave and
-    paper A's static estimate W_0 - k_eff z_h (eqs. 13-14)."""
+    paper A's static estimate W_0 - k_eff z_h (eqs. 13-14); ``force``: a third panel with each
+    closed-loop run's actuator force ``u_active`` [kN] and its limits +-u_max."""
     plt = _plt()
-    fig, (ax, axh) = plt.subplots(2, 1, figsize=(10, 6.2), sharex=True, gridspec_kw={"height_ratios": [3, 1]})
+    ratios = [3, 1, 1.4] if force else [3, 1]
+    fig, axes = plt.subplots(len(ratios), 1, figsize=(10, 6.2 + 2.0 * force), sharex=True,
+                             gridspec_kw={"height_ratios": ratios})
+    ax, axh = axes[0], axes[1]
     first = next(iter(results.values()))
     for label, res in results.items():
         t = res["t"]
@@ -78,8 +83,22 @@ def plot_wob(results: dict, *, title: str | None = None, static_estimate: bool =
     ax.grid(alpha=0.3)
     axh.plot(*envelope(t[m], first["heave"][m]), color="tab:blue", lw=1 if t[m].size < 4000 else 0.6)
     axh.set_ylabel("heave z_h [m]")
-    axh.set_xlabel("time t [s]")
     axh.grid(alpha=0.3)
+    if force:
+        axu = axes[2]
+        for label, res in results.items():
+            t = res["t"]
+            m = slice(None) if window is None else (t >= window[0]) & (t <= window[1])
+            axu.plot(*envelope(t[m], res["u_active"][m] / 1e3), color=REGIME_COLORS.get(label), lw=1.0,
+                     label=REGIME_LABELS.get(label, label))
+        u_max = first.control["u_max"] / 1e3
+        for sgn in (-1, 1):
+            axu.axhline(sgn * u_max, color="0.5", ls="--", lw=0.8)
+        axu.set_ylabel("actuator force u [kN]")
+        axu.set_title(f"active cylinder: the force the actuator applied (|u| <= u_max = {u_max:g} kN)",
+                      fontsize=9)
+        axu.grid(alpha=0.3)
+    axes[-1].set_xlabel("time t [s]")
     fig.tight_layout()
     return fig
 

@@ -44,5 +44,5 @@ def write_closed_loop_outputs(res: ClosedLoopResult, out_dir, *, title: str | No
     metrics = res.metrics()
     metrics["heave"] = {k: v for k, v in res.heave_info.items() if isinstance(v, (int, float, str))}
     (out_dir / "metrics.json").write_text(json.dumps(metrics, indent=2) + "\n")
-    save(plot_wob({res.controller: res}, title=title), out_dir / "wob.png")
+    save(plot_wob({res.controller: res}, title=title, force=res.controller != "passive"), out_dir / "wob.png")
     return metrics
