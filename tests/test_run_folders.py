@@ -203,3 +203,36 @@ def test_campaign_runs_csv_has_a_unit_per_column(tmp_path):
     u = pd.read_csv(tmp_path / "runs.units.csv", index_col="column", keep_default_na=False)["unit"]
     assert list(u.index) == list(head)
     assert u["wob_std"] == "N" and u["n_stick"] == "count" and u["dev_000"] == "count" and u["hs"] == "m"
+
+
+def test_a_command_that_takes_no_heave_needs_no_heave_file(rig_with_heave_file, tmp_path):
+    """Issue 21.2: the diagnosis (whose heave is the measured run's) and analyse crashed in
+    write_params, after all their work, when [heave] path named a file that was not there."""
+    from heavecomp.errors import ParameterError
+    from heavecomp.params import load
+    from heavecomp.report.provenance import finish
+
+    params = load(rig_with_heave_file)
+    (rig_with_heave_file.parent / "data" / "heave.csv").unlink()
+    out = tmp_path / "diag"
+    finish(out, params=params, json_files=(), heave_used=False)
+    back = load(out / "params.toml")
+    assert back.heave is None and not (out / "heave.csv").exists()  # neither copied nor recorded
+    assert back.compensator == params.compensator
+    with pytest.raises(ParameterError, match=r"^heave.path: .*heave.csv is not a file"):
+        finish(tmp_path / "sim", params=params, json_files=())  # a command that uses the heave: named, one line
+    r = _run("analyse", str(rig_with_heave_file), "--points", "20", "--out", str(tmp_path / "a"), "-q")
+    assert r.returncode == 0, r.stderr
+    assert "[heave]" not in (tmp_path / "a" / "params.toml").read_text()
+
+
+def test_diagnose_source_passes_heave_used_false():
+    """``heavecomp diagnose`` writes its folder with ``heave_used=False`` (its heave is the measured run's)."""
+    import ast
+    import inspect
+
+    from heavecomp.commands import diagnose
+
+    calls = [n for n in ast.walk(ast.parse(inspect.getsource(diagnose)))
+             if isinstance(n, ast.Call) and getattr(n.func, "id", None) == "finish"]
+    assert calls and all(any(k.arg == "heave_used" and k.value.value is False for k in c.keywords) for c in calls)

@@ -151,7 +151,8 @@ def check_run(t, columns: dict, *, params=None, source="<array>", rows=None) -> 
     dt_med = float(np.median(np.diff(t)))
     if dt_med > MAX_DT_S:
         raise DataError(f"{source}: column 't': median interval {dt_med:.4g} s is too coarse for heave "
-                        "(waves need > 1 Hz) — time in milliseconds? convert to s or declare --units t=ms")
+                        "(waves need > 1 Hz) — time in milliseconds? convert to s or declare its unit, t=ms",
+                        option="units", example="t=ms")
     hole = gaps(t, MAX_GAP)
     if hole.size:
         i = hole[0]
@@ -179,7 +180,8 @@ def check_run(t, columns: dict, *, params=None, source="<array>", rows=None) -> 
         rms = float(np.sqrt(np.nanmean(columns[col] ** 2)))
         if rms > MAX_ANGLE_RMS:
             raise DataError(f"{source}: column '{col}': rms {rms:.4g} rad ({math.degrees(rms):.0f} deg) is no vessel "
-                            f"angle — degrees? convert the column to rad or declare --units {col}=deg")
+                            f"angle — degrees? convert the column to rad or declare its unit, {col}=deg",
+                            option="units", example=f"{col}=deg")
     d = np.diff(t)
     if np.ptp(d) > 1e-6 * np.median(d):
         warnings.append(f"non-uniform sampling (intervals {d.min():.4g}..{d.max():.4g} s): replay uses the "
@@ -204,7 +206,8 @@ def _check_mean(run, src, column, unit, symbol, nominal, band, other_units, hint
     for factor, other in other_units:
         if abs(m / (nominal * factor) - 1.0) < 0.5:
             raise DataError(f"{src}: column '{column}': mean {m:.4g} looks like {other}, expected {unit} "
-                            f"(nominal {symbol} = {nominal:.4g} {unit}); convert the column to {unit}")
+                            f"(nominal {symbol} = {nominal:.4g} {unit}); convert the column to {unit} or declare "
+                            f"its unit, {column}={other}", option="units", example=f"{column}={other}")
     if not (band[0] * nominal < m < band[1] * nominal):
         raise DataError(f"{src}: column '{column}': mean {m:.4g} {unit} is far from the nominal {symbol} = "
                         f"{nominal:.4g} {unit} ({hint})")
@@ -234,10 +237,12 @@ def check_units(run: MeasuredRun, params) -> None:
     ss = float(np.nanstd(run["stroke"]))
     if sz > 0 and ss > 100 * sz and ss > 1.0:
         raise DataError(f"{src}: column 'stroke': spread {ss:.4g} is {ss / sz:.0f} x the heave's — looks like mm, "
-                        "expected m; convert the column to m")
+                        "expected m; convert the column to m or declare its unit, stroke=mm",
+                        option="units", example="stroke=mm")
     if ss > 0 and sz > 100 * ss and sz > 1.0:
         raise DataError(f"{src}: column 'heave': spread {sz:.4g} is {sz / ss:.0f} x the stroke's — looks like mm, "
-                        "expected m; convert the column to m")
+                        "expected m; convert the column to m or declare its unit, heave=mm",
+                        option="units", example="heave=mm")
 
 
 def fill_gaps(t, y):

@@ -23,6 +23,7 @@ import shlex
 import shutil
 import sys
 from pathlib import Path
+from heavecomp.errors import ParameterError
 from heavecomp.report import invocation
 from heavecomp.report.html import write_html
 from heavecomp.params import dumps
@@ -320,17 +321,33 @@ def stamp_markdown(st: dict) -> str:
     return "*Provenance: " + "; ".join(parts) + ".*"
 
 
-def write_params(out_dir, params, name: str = "params.toml") -> Path:
+def heave_file(params) -> Path | None:
+    """The heave file a parameter set names (``heave.kind = "file"``), resolved against its folder."""
+    heave = getattr(params, "heave", None)
+    if heave is None or getattr(heave, "kind", None) != "file" or not heave.path:
+        return None
+    src = Path(heave.path)
+    if not src.is_absolute() and params.base_dir is not None:
+        src = Path(params.base_dir) / src
+    return src
+
+
+def write_params(out_dir, params, name: str = "params.toml", *, heave_used: bool = True) -> Path:
     """Write the resolved parameter set; a heave file is copied in beside it so the folder re-runs
-    by itself (``heave.path`` names the copy)."""
+    by itself (``heave.path`` names the copy).
+
+    ``heave_used=False`` (a command that takes no heave from the parameter file, e.g. the diagnosis,
+    whose heave is the measured run's): a ``[heave]`` table naming a file is left out -- the file is
+    neither copied nor recorded, and need not exist."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    heave = getattr(params, "heave", None)
-    if heave is not None and getattr(heave, "kind", None) == "file" and heave.path:
-        src = Path(heave.path)
-        if not src.is_absolute() and params.base_dir is not None:
-            src = Path(params.base_dir) / src
+    src = heave_file(params)
+    if src is not None and not heave_used:
+        params = params.replace(heave=None)
+    elif src is not None:
         copy = out / f"heave{src.suffix or '.csv'}"
+        if not src.is_file():
+            raise ParameterError(f"heave.path: {src} is not a file (the heave input of this run)")
         if src.resolve() != copy.resolve():
             shutil.copyfile(src, copy)
         params = params.replace(heave={"path": copy.name})
@@ -408,15 +425,17 @@ def stamp_report(md_path, st: dict) -> Path:
 
 
 def finish(out_dir, *, params=None, params_name: str = "params.toml", params_file: str | None = None,
-           json_files=("metrics.json",), csv_files=(), report: str = "report.md", **extra) -> dict:
+           json_files=("metrics.json",), csv_files=(), report: str = "report.md", heave_used: bool = True,
+           **extra) -> dict:
     """Make ``out_dir`` self-describing (see the module docstring); returns the stamp.
 
     ``params`` (a CMC parameter set) is written as ``params_name``; a command that wrote its
     own parameter file (e.g. paper B's pneumatic set) names it with ``params_file``.
+    ``heave_used=False``: the command took no heave from ``params`` (see :func:`write_params`).
     """
     out = Path(out_dir)
     if params is not None:
-        params_file = write_params(out, params, params_name).name
+        params_file = write_params(out, params, params_name, heave_used=heave_used).name
     st = stamp(params_file, **extra)
     for name in json_files:
         if (out / name).exists():
