@@ -236,3 +236,57 @@ def test_diagnose_source_passes_heave_used_false():
     calls = [n for n in ast.walk(ast.parse(inspect.getsource(diagnose)))
              if isinstance(n, ast.Call) and getattr(n.func, "id", None) == "finish"]
     assert calls and all(any(k.arg == "heave_used" and k.value.value is False for k in c.keywords) for c in calls)
+
+
+def test_a_declared_unit_beats_the_name_lookup():
+    """Issue 21.6: units attached where each value is made -- a stroke offset in m is not given the N
+    that the key name 'offset' has elsewhere (the diagnosis.json defect)."""
+    from heavecomp.report.provenance import declare_units, strip_declared, undeclared, units_of
+
+    guessed, _ = units_of({"stroke": {"offset": 0.01}})
+    assert guessed == {"offset": "N"}  # what the name alone gives: wrong for a stroke
+    r = {"stroke": declare_units({"offset": 0.01, "gain": 1.02}, {"offset": "m", "gain": "-"}),
+         "wob": declare_units({"offset": 250.0}, {"offset": "N"}),
+         "noise": 1.0}
+    declare_units(r, {"window": "s"})
+    r["window"] = [0.0, 30.0]
+    units, missing = units_of(r)
+    assert units["offset"] == "m" and units["wob.offset"] == "N" and units["gain"] == "-" and units["window"] == "s"
+    assert missing == ["noise"] and undeclared(r) == ["noise"]
+    assert "_units" not in json.dumps(strip_declared(r))
+
+
+def test_simulate_metrics_declare_every_unit(paper_a_toml, tmp_path):
+    """metrics.json of simulate cannot name a wrong unit: every number's unit is declared where it is made."""
+    from heavecomp.params import load
+    from heavecomp.report.provenance import finish, undeclared
+    from heavecomp.report.simulation import write_outputs
+    from heavecomp.simulate import simulate
+    from heavecomp.simulate.core import SimulationResult
+
+    params = load(paper_a_toml).replace(heave={"kind": "jonswap", "hs": 2.0, "tp": 10.0, "amplitude": None,
+                                                "period": None})
+    res = simulate(params, 20.0)
+    assert set(res.metrics()) <= set(SimulationResult.METRIC_UNITS)  # a new metric needs its unit
+    m = write_outputs(res, tmp_path)
+    assert undeclared(m) == []
+    finish(tmp_path, params=params, csv_files=("timeseries.csv",))
+    written = json.loads((tmp_path / "metrics.json").read_text())
+    assert "_units" not in json.dumps(written)
+    u = written["units"]
+    assert u["wob_std"] == "N" and u["stroke_max"] == "m" and u["hs"] == "m" and u["repeat_period"] == "s"
+    assert u["n_stick"] == "count" and u["k_eff_eq14"] == "N/m" and u["stats_window"] == "s"
+
+
+def test_campaign_metrics_declare_every_unit():
+    from pathlib import Path
+
+    from heavecomp.report.campaign import summary
+    from heavecomp.report.provenance import undeclared, units_of
+
+    st = json.loads((Path(__file__).resolve().parents[1] / "reports" / "campaign_default" / "statistics.json")
+                    .read_text())
+    m = summary(st)
+    assert undeclared(m) == []
+    units, missing = units_of(m)
+    assert missing == [] and units["band_exits_per_hour"] == "1/h" and units["dev_max_in_exposure"] == "N"

@@ -103,8 +103,18 @@ class SimulationResult:
         """Boolean mask of samples at t >= start (default: after the fade-in)."""
         return self.t >= (self.stats_start if start is None else start) - 1e-12
 
+    #: unit of each entry of :meth:`metrics`, declared beside it (metrics.json's units come from here)
+    METRIC_UNITS = {"wob_mean": "N", "wob_std": "N", "wob_min": "N", "wob_max": "N", "wob_p2p": "N",
+                    "wob_setpoint": "N", "stick_fraction": "-", "stick_fraction_total": "-", "n_stick": "count",
+                    "n_breakaway": "count", "n_reversal": "count", "event_cap_hits": "count",
+                    "event_cap_first_t": "s", "friction_power_min": "W", "n_negative_friction_power": "count",
+                    "stroke_max": "m", "pressure_min": "Pa", "pressure_max": "Pa", "heave_std": "m",
+                    "k_eff_eq14": "N/m", "stats_window": "s", "duration": "s", "dt": "s", "friction_model": "",
+                    "wall_time_s": "s"}
+
     def metrics(self, start: float | None = None) -> dict:
-        """WOB statistics over t >= start (default: after the heave fade-in) [N, m, -]."""
+        """WOB statistics over t >= start (default: after the heave fade-in) [N, m, -];
+        units in :attr:`METRIC_UNITS`."""
         m = self.window(start)
         w = self["wob"][m]
         duration = float(self.t[-1])
