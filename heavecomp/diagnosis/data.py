@@ -31,7 +31,7 @@ import numpy as np
 from heavecomp.errors import DataError
 from heavecomp.simulate.excitation import HeaveSamples
 from heavecomp.io.series import MAX_DT_S, gaps
-from heavecomp.io.series import read_series
+from heavecomp.io.series import UNITS as SOURCE_UNITS, check_spec, read_series
 from heavecomp.signals import design_flat_lowpass, filtfilt_fir
 
 P_ATM = 101325.0  #: atmospheric pressure [Pa] (cmc-reference.md)
@@ -94,7 +94,9 @@ def load_run(path, params=None, *, columns=None, units=None) -> MeasuredRun:
 
     Parameters
     ----------
-    path : str or Path
+    path : str or Path, or pandas.DataFrame
+        A file, or a frame with the contract columns (time as column ``t`` or as the index,
+        e.g. ``SimulationResult.to_pandas()``); ``columns``/``units`` apply to a frame too.
     params : CMCParams, optional
         Nominal parameters; when given, the channel magnitudes are checked
         against the operating point (wrong-unit detection), and its ``[measurement]``
@@ -112,12 +114,42 @@ def load_run(path, params=None, *, columns=None, units=None) -> MeasuredRun:
     spec = getattr(params, "extra", {}).get("measurement") if params is not None else None
     cols = {**(spec.columns if spec else {}), **(columns or {})}
     uns = {**(spec.units if spec else {}), **(units or {})}
+    if hasattr(path, "columns") and hasattr(path, "index") and not isinstance(path, (str, bytes)):
+        return _frame_run(path, params, cols, uns)
     s = read_series(path, REQUIRED, optional=ANGLES, columns=cols, units=uns, what="measured run")
     data = dict(s.columns)
     t = data.pop("t")
     run = check_run(t, data, params=params, source=s.source, rows=s.rows)
     run.warnings[:0] = s.warnings
     run.measurement = s.measurement
+    return run
+
+
+def _frame_run(df, params, columns: dict, units: dict) -> MeasuredRun:
+    """:func:`load_run` of a pandas DataFrame: contract columns (or mapped ones), time as a column or the index."""
+    columns, units = check_spec(columns, units, "measurement")
+    src = "<DataFrame>"
+    names = [str(c) for c in df.columns]
+    data = {}
+    for name in REQUIRED + ANGLES:
+        want = columns.get(name, name)
+        if want in names:
+            data[name] = np.asarray(df[df.columns[names.index(want)]], dtype=float)
+        elif name == "t" and (df.index.name in (want, "time") or (want == "t" and df.index.name == "t")):
+            data[name] = np.asarray(df.index, dtype=float)
+        elif name in REQUIRED:
+            raise DataError(f"{src}: missing column '{name}' (columns: {', '.join(names[:12])}; index "
+                            f"{df.index.name!r}); map it in a column mapping, {name}=NAME",
+                            option="columns", example=f"{name}=NAME")
+    conversions = []
+    for name, unit in units.items():
+        if name in data:
+            _kind, scale, offset = SOURCE_UNITS[unit.strip().lower()]
+            data[name] = data[name] * scale + offset
+            conversions.append(f"{name}: {unit} -> SI")
+    t = data.pop("t")
+    run = check_run(t, data, params=params, source=src)
+    run.measurement = {"format": "pandas.DataFrame", "units": dict(units), "conversions": conversions}
     return run
 
 
