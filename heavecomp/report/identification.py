@@ -7,7 +7,7 @@ import numpy as np
 
 from heavecomp.plants.axis import BASE_NAMES, EMPS_PUBLISHED, EMPS_UNITS
 from heavecomp.report.figures import _plt as plt
-from heavecomp.report.scenario import md_table
+from heavecomp.report.scenario import md_table, write_report
 
 
 def _plt():
@@ -191,8 +191,6 @@ def seal_fits_table(m: dict) -> str:
 
 def emps_report(out, m: dict, source: str) -> None:
     """``report.md`` (+ ``report.html``) of ``heavecomp identify emps`` (figures already in ``out``)."""
-    from heavecomp.report.scenario import write_report
-
     sel = m["selection"]
     write_report(out, f"EMPS axis identification — {source}", [
         f"Inverse-model least squares on the whole record ({m['settings']}); the residual diagnosis fits "
@@ -209,8 +207,6 @@ def emps_report(out, m: dict, source: str) -> None:
 
 def seal_report(out, m: dict, n_strokes: int) -> None:
     """``report.md`` (+ ``report.html``) of ``heavecomp identify seal`` (figure already in ``out``)."""
-    from heavecomp.report.scenario import write_report
-
     write_report(out, "Seal friction against pressure", [
         f"**C_p = {m['C_p_N_per_bar']:.3f} +- {m['C_p_uncertainty_N_per_bar']:.3f} N/bar**, "
         f"F_C = {m['F_C_N']:.2f} N over {n_strokes} steady strokes (headline fit: `{m['headline_fit']}`).",
