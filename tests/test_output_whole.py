@@ -122,6 +122,19 @@ def test_a_folder_of_other_files_is_never_replaced_but_gets_the_results_file_by_
     assert _siblings(mine) == []
 
 
+def test_out_whose_parent_takes_no_files_is_staged_inside(tmp_path, monkeypatch):
+    here = tmp_path / "cwd"
+    here.mkdir()
+    (here / "notes.txt").write_text("mine")
+    real = os.access
+    monkeypatch.setattr(os, "access", lambda p, mode, **kw: False if Path(p) == tmp_path else real(p, mode, **kw))
+    with Staged(here) as work:
+        assert work.parent == here and lock_path(here).parent == here
+        (work / "metrics.json").write_text("{}")
+    assert sorted(p.name for p in here.iterdir()) == ["metrics.json", "notes.txt"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["cwd"]
+
+
 def test_lock_refuses_a_second_owner_and_a_dead_owners_lock_is_taken_over(tmp_path):
     from heavecomp.report.output import OutputBusy
 

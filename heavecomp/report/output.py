@@ -21,6 +21,10 @@ place (it holds the marker :data:`MARKER`).  Any other folder (``--out .``, a fo
 result folder of an older heavecomp) is never deleted: the finished results are moved into it file by
 file, each file whole (``os.replace``), and files already there that this run did not write stay.
 
+An existing ``DIR`` whose parent takes no files (``--out .`` under a read-only folder) keeps its lock
+and staging folder inside itself (``DIR/.heavecomp.lock``, ``DIR/.heavecomp.partial``) and gets the
+results file by file.
+
 Single files (``params -o FILE``) are written with :func:`write_text_atomic`: a temporary file in
 the same folder, ``fsync``, then ``os.replace``.
 """
@@ -55,7 +59,15 @@ class OutputBusy(InputError):
     """Another live process writes the same output folder."""
 
 
+def _inside(final: Path) -> bool:
+    """Stage inside ``final``: an existing folder whose parent takes no files (``--out .`` in a
+    read-only parent, ``--out /``); its results are then moved in file by file."""
+    return final.is_dir() and (final.parent == final or not os.access(final.parent, os.W_OK))
+
+
 def _side(final: Path, what: str) -> Path:
+    if _inside(final):
+        return final / f".heavecomp.{what}"
     return final.parent / f".{final.name}.{what}"
 
 
@@ -251,7 +263,7 @@ class Staged:
             _fsync_tree(self.work)
             if not self.final.exists():
                 os.rename(self.work, self.final)
-            elif any(self.final.iterdir()) and not is_result_folder(self.final):
+            elif self.work.parent == self.final or (any(self.final.iterdir()) and not is_result_folder(self.final)):
                 _merge(self.work, self.final)
             elif _exchange(self.work, self.final):
                 _remove(self.work)  # now the old result
