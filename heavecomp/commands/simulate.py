@@ -105,10 +105,13 @@ def _need_space(args) -> None:
     import math
 
     from heavecomp.commands._output import final
+    from heavecomp.params.budget import MAX_BYTES
     from heavecomp.report.output import need_space
     from heavecomp.simulate.core import CSV_COLUMNS
 
     if not (math.isfinite(args.duration) and math.isfinite(args.rate)) or args.duration <= 0 or args.rate <= 0:
         return  # the simulation's own checks name these
     rows = args.duration * args.rate + 1
+    if 8 * rows * (len(CSV_COLUMNS) + 1) > MAX_BYTES:
+        return  # over the run-size budget: the simulation refuses it, naming --duration and --rate
     need_space(args.out, rows * (len(CSV_COLUMNS) + 1) * CSV_BYTES_PER_VALUE, "--out", final(args))
