@@ -182,6 +182,25 @@ def test_second_process_on_the_same_out_is_refused_in_one_line(paper_a_toml, tmp
         assert not out.exists()
 
 
+@pytest.mark.parametrize("ending", ["interrupted", "failed"])
+def test_interrupted_or_failed_command_leaves_nothing(paper_a_toml, tmp_path, monkeypatch, capsys, ending):
+    """Ctrl-C (exit 130) or a command returning non-zero: the half-written staging folder is dropped."""
+    from heavecomp import cli
+    from heavecomp.commands import analyse
+
+    def run(args):
+        (Path(args.out) / "analysis.json").write_text("{half")
+        if ending == "interrupted":
+            raise KeyboardInterrupt
+        return 1
+
+    monkeypatch.setattr(analyse, "run", run)
+    out = tmp_path / "a"
+    code = cli.main(["analyse", str(paper_a_toml), "--out", str(out)])
+    assert code == (130 if ending == "interrupted" else 1)
+    assert not out.exists() and _siblings(out) == []
+
+
 def test_params_output_is_written_whole(tmp_path):
     f = tmp_path / "p.toml"
     r = _cli("params", "paper_a", "-o", f)
