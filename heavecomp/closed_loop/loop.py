@@ -143,7 +143,7 @@ def simulate_closed_loop(params, controller="passive", duration: float = 120.0, 
     from heavecomp.simulate import _kernel as K  # numba-compiled stepper: loaded on first use
 
     if not (duration > 0 and math.isfinite(duration)):
-        raise InputError(f"--duration must be a positive number of seconds, got {duration}")
+        raise InputError(f"duration must be a positive number of seconds, got {duration}", option="duration")
     if preview not in ("predicted", "perfect"):
         raise InputError(f"preview {preview!r}: not one of predicted, perfect")
     act = active(params)
@@ -155,7 +155,7 @@ def simulate_closed_loop(params, controller="passive", duration: float = 120.0, 
     Tc = 1.0 / act.control_rate
     h = dt if dt is not None else default_dt(params, act.control_rate)
     if not (h > 0 and math.isfinite(h)):
-        raise InputError(f"--dt must be a positive number of seconds, got {dt}")
+        raise InputError(f"dt must be a positive number of seconds, got {dt}", option="dt")
     n_sub = max(1, int(round(Tc / h)))
     if dt is not None and abs(n_sub * dt - Tc) > 1e-9 * Tc:
         log.warning("dt = %g s does not divide the control interval %g s; using %g s", dt, Tc, Tc / n_sub)
@@ -288,6 +288,6 @@ def output_every(rate: float | None, control_rate: float) -> int:
     ratio = control_rate / rate if rate > 0 else math.inf
     every = int(round(ratio)) if math.isfinite(ratio) else 0
     if not (every >= 1 and abs(ratio - every) < 1e-9):
-        raise InputError(f"--rate {rate:g} Hz: a closed-loop run writes at the control rate "
-                         f"[active].control_rate = {control_rate:g} Hz or an integer fraction of it")
+        raise InputError(f"rate {rate:g} Hz: a closed-loop run writes at the control rate "
+                         f"[active].control_rate = {control_rate:g} Hz or an integer fraction of it", option="rate")
     return every

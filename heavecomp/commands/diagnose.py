@@ -26,7 +26,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--settle", type=float, default=None, metavar="S",
                    help="start-up window left out of the residuals [s] (default min(30 s, 10 %% of the run))")
     p.add_argument("--jobs", type=int, default=2, metavar="N", help="candidates fitted concurrently (default 2)")
-    p.add_argument("--quiet", action="store_true", help="no progress output")
+    p.add_argument("-q", "--quiet", action="store_true", help="no progress output")
 
 
 def run(args) -> int:
@@ -68,12 +68,13 @@ def run(args) -> int:
     write_report(d, args.out, title=f"Sim-to-real gap diagnosis — {run_.source}")
     _record_measurement(Path(args.out) / "diagnosis.json", run_.measurement)
     from heavecomp.report.provenance import finish
+    from heavecomp.commands._output import final
 
-    finish(args.out, params=params, json_files=("diagnosis.json",), measured_run=str(Path(args.run).resolve()))
+    finish(args.out, params=params, json_files=("diagnosis.json",), heave_used=False, measured_run=str(Path(args.run).resolve()))
     v = d.verdict_
     extra = f", second effect {v['second_effect']['effect']}" if v.get("second_effect") else ""
     print(f"verdict: {v['effect']} (confidence {v['confidence']}), held-out shrink {v['shrink']:.2f} "
-          f"on {v.get('shrink_channel', 'wob')}{extra} -> {args.out}/diagnosis.json")
+          f"on {v.get('shrink_channel', 'wob')}{extra} -> {Path(final(args)) / 'diagnosis.json'}")
     return 0
 
 

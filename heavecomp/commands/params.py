@@ -43,7 +43,9 @@ def run(args) -> int:
     params = _heave_path_for(params, args.output)
     text = dumps(params, header=header)
     if args.output:
-        Path(args.output).write_text(text, encoding="utf-8")
+        from heavecomp.report.output import write_text_atomic
+
+        write_text_atomic(args.output, text)
     else:
         sys.stdout.write(text)
     return 0

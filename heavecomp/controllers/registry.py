@@ -56,7 +56,8 @@ def make(name, params, config: ControllerConfig | None = None, **options):
                              f"configure your {type(name).__name__} object directly")
         return name
     if name not in CONTROLLERS:
-        raise InputError(f"--controller {name!r}: not one of {', '.join(CONTROLLERS)}{did_you_mean(name, CONTROLLERS)}")
+        raise InputError(f"controller {name!r}: not one of {', '.join(CONTROLLERS)}{did_you_mean(name, CONTROLLERS)}",
+                         option="controller")
     if config is None:
         config = ControllerConfig.from_params(params, **options)
     elif options:

@@ -103,8 +103,18 @@ class SimulationResult:
         """Boolean mask of samples at t >= start (default: after the fade-in)."""
         return self.t >= (self.stats_start if start is None else start) - 1e-12
 
+    #: unit of each entry of :meth:`metrics`, declared beside it (metrics.json's units come from here)
+    METRIC_UNITS = {"wob_mean": "N", "wob_std": "N", "wob_min": "N", "wob_max": "N", "wob_p2p": "N",
+                    "wob_setpoint": "N", "stick_fraction": "-", "stick_fraction_total": "-", "n_stick": "count",
+                    "n_breakaway": "count", "n_reversal": "count", "event_cap_hits": "count",
+                    "event_cap_first_t": "s", "friction_power_min": "W", "n_negative_friction_power": "count",
+                    "stroke_max": "m", "pressure_min": "Pa", "pressure_max": "Pa", "heave_std": "m",
+                    "k_eff_eq14": "N/m", "stats_window": "s", "duration": "s", "dt": "s", "friction_model": "",
+                    "wall_time_s": "s"}
+
     def metrics(self, start: float | None = None) -> dict:
-        """WOB statistics over t >= start (default: after the heave fade-in) [N, m, -]."""
+        """WOB statistics over t >= start (default: after the heave fade-in) [N, m, -];
+        units in :attr:`METRIC_UNITS`."""
         m = self.window(start)
         w = self["wob"][m]
         duration = float(self.t[-1])
@@ -215,12 +225,12 @@ def simulate(params, duration: float, *, dt: float | None = None, rate: float = 
         ``sensor_delay``, each with its ``channel``) changes the recorded channel.
     """
     if not (duration > 0 and math.isfinite(duration)):
-        raise InputError(f"--duration must be a positive number of seconds, got {duration}")
+        raise InputError(f"duration must be a positive number of seconds, got {duration}", option="duration")
     if not (rate > 0 and math.isfinite(rate)):
-        raise InputError(f"--rate must be a positive number of Hz, got {rate}")
+        raise InputError(f"rate must be a positive number of Hz, got {rate}", option="rate")
     h = dt if dt is not None else default_dt(params, rate)
     if not (h > 0 and math.isfinite(h)):
-        raise InputError(f"--dt must be a positive number of seconds, got {dt}")
+        raise InputError(f"dt must be a positive number of seconds, got {dt}", option="dt")
     out_every = max(1, int(round(1.0 / (rate * h))))
     if dt is not None and abs(out_every * h * rate - 1.0) > 1e-6:
         log.warning("output interval 1/rate = %g s is not a multiple of dt = %g s; output every %d steps",
@@ -315,7 +325,7 @@ def run_kernel(plant, hs, h, n_steps, out_every, *, u_active=0.0, progress=None,
                                   f"{spike[0]:.3g} m/s^2 at t = {spike[1]:g} s, beyond the {HEAVE_ACCEL_MAX:g} m/s^2 "
                                   f"a rig floor can reach: check the heave input for a spike or a gap there")
         raise SimulationError(f"the stepper diverged near t = {t_div:g} s (non-finite state); "
-                              f"reduce --dt (now {h:g} s) or check the parameters")
+                              f"reduce the step dt (now {h:g} s) or check the parameters", option="dt")
     spike = heave_accel_outlier(hs, data[-1, 0] if len(data) else 0.0)
     if spike is not None:
         log.warning("the heave input accelerates at %.3g m/s^2 at t = %g s, beyond the %g m/s^2 a rig floor can "
