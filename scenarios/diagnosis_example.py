@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from heavecomp.diagnosis.data import load_run
 from heavecomp.diagnosis.estimator import GapDiagnoser
-from heavecomp.diagnosis.generator import generate
+from heavecomp.benchmark.generator import generate
 from heavecomp.report.diagnosis import write_report
 from heavecomp.params import dumps
 from heavecomp.report.provenance import annotate_json, stamp

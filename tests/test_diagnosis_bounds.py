@@ -6,7 +6,7 @@ stuck at its 3 s search limit: the candidate stood in for a defect it cannot des
 import pytest
 
 from heavecomp.diagnosis.estimator import GapDiagnoser, at_bounds
-from heavecomp.diagnosis.generator import generate
+from heavecomp.benchmark.generator import generate
 
 
 def test_at_bounds_reads_the_candidates_own_search_range():

@@ -10,9 +10,9 @@ import math
 import numpy as np
 import pytest
 
-from heavecomp.diagnosis import generator as G
+from heavecomp.benchmark import generator as G
 from heavecomp.diagnosis.stepper import CHANNELS as SC, replay_dt, run_fx
-from heavecomp.diagnosis.truth import TRUTH, truth_composition
+from heavecomp.benchmark.truth import TRUTH, truth_composition
 from heavecomp.effects.registry import library
 from heavecomp.plants.cmc import plant_vectors
 from heavecomp.simulate import excitation

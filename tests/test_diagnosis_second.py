@@ -9,7 +9,7 @@ best candidate skipped the joint fit altogether, and a best under 50 % was `inco
 import pytest
 
 from heavecomp.diagnosis.estimator import GapDiagnoser
-from heavecomp.diagnosis.generator import generate
+from heavecomp.benchmark.generator import generate
 
 CANDIDATES = ["sensor_delay", "flow_loss", "string_damping", "gas_heat_transfer"]
 

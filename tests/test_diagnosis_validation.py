@@ -9,8 +9,8 @@ import json
 import numpy as np
 import pytest
 
-from heavecomp.diagnosis import generator as G
-from heavecomp.diagnosis import truth as T
+from heavecomp.benchmark import generator as G
+from heavecomp.benchmark import truth as T
 from heavecomp.plants.cmc import plant_vectors
 from heavecomp.report.scenario import ROOT
 

@@ -15,7 +15,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 @pytest.mark.slow
 def test_withheld_effects_quick(tmp_path):
-    from heavecomp.diagnosis.generator import run_benchmark
+    from heavecomp.benchmark.generator import run_benchmark
 
     rows, summary = run_benchmark(quick=True)
     m = {"runs": rows, "summary": summary}
@@ -48,7 +48,7 @@ def test_withheld_effects_quick(tmp_path):
 
 @pytest.mark.slow
 def test_cli_diagnose_contract_json(tmp_path):
-    from heavecomp.diagnosis.generator import generate
+    from heavecomp.benchmark.generator import generate
     from heavecomp.params import dumps
 
     tr = generate("sensor_delay", seed=5, duration=90.0, jitter=True, dropouts=True)

@@ -29,7 +29,7 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
 
     from heavecomp.diagnosis.estimator import GapDiagnoser
-    from heavecomp.diagnosis.generator import generate
+    from heavecomp.benchmark.generator import generate
     from heavecomp.simulate import simulate
 
     tr = generate(args.effect, seed=11, duration=args.duration, rate=50.0)

@@ -1,7 +1,7 @@
 """Withheld-effect benchmark: runs generated with an effect the diagnosis does not know.
 
 Each effect is generated with its *truth* law (the generator's own effect classes,
-:mod:`heavecomp.diagnosis.truth`, plugged into the plant's hooks), never with the candidate's
+:mod:`heavecomp.benchmark.truth`, plugged into the plant's hooks), never with the candidate's
 equations:
 
 ======================  =====================================  ===========================================
@@ -34,7 +34,7 @@ from heavecomp.diagnosis.data import check_run, heave_samples, MeasuredRun
 from heavecomp.diagnosis.estimator import GapDiagnoser
 from heavecomp.params import paper_a
 from heavecomp.simulate import excitation
-from heavecomp.diagnosis.truth import (COMPONENT, first_order_lag, heave_lever_arm, heave_mru, OUT_OF_LIBRARY,
+from heavecomp.benchmark.truth import (COMPONENT, first_order_lag, heave_lever_arm, heave_mru, OUT_OF_LIBRARY,
                                       plant_truth, sensor_gain, sensor_offset, stroke_backlash, synthetic_pitch, TRUTH,
                                       truth_composition, validation_composition, wob_saturation)
 from heavecomp.plants.cmc import plant_vectors
@@ -112,7 +112,7 @@ STICK_MIN = 0.15  #: dwell stiction is planted only where the compensator is stu
 
 
 def _draw_effect(name, rng, params):
-    """Random truth parameters of one effect (its truth law, :mod:`heavecomp.diagnosis.truth`).
+    """Random truth parameters of one effect (its truth law, :mod:`heavecomp.benchmark.truth`).
 
     Returns ``(parameters, magnitude, cap)``: ``magnitude`` names the parameter that sets the size of
     the effect (``None``: no size knob, only a redraw changes it) and ``cap`` its largest plausible value.
