@@ -29,11 +29,10 @@ import math
 
 import numpy as np
 
-from heavecomp.data import WAVERIDER
 from heavecomp.diagnosis.data import check_run, heave_samples, MeasuredRun
 from heavecomp.diagnosis.estimator import GapDiagnoser
 from heavecomp.params import paper_a
-from heavecomp.simulate import excitation
+from heavecomp.benchmark.sea import make_sea
 from heavecomp.benchmark.truth import (COMPONENT, first_order_lag, heave_lever_arm, heave_mru, OUT_OF_LIBRARY,
                                       plant_truth, sensor_gain, sensor_offset, stroke_backlash, synthetic_pitch, TRUTH,
                                       truth_composition, validation_composition, wob_saturation)
@@ -182,7 +181,7 @@ class _Sea:
 
     OUT = ("stroke", "pressure", "wob")
 
-    def __init__(self, nominal, rng, duration, rate, sea=None, noise=1.0):
+    def __init__(self, nominal, rng, duration, rate, sea="jonswap", noise=1.0):
         from heavecomp.diagnosis.stepper import replay_dt
 
         self.nominal = nominal
@@ -190,14 +189,7 @@ class _Sea:
         self.h = h = replay_dt(nominal, rate)
         self.out_every = max(1, int(round(1.0 / (rate * h))))
         self.n_steps = int(math.ceil(duration / h - 1e-9))
-        if sea is None:  # the withheld-effect benchmark's seas (draw order kept: its runs are unchanged)
-            self.hsig, self.tp = rng.uniform(1.5, 3.0), rng.uniform(9.0, 13.0)
-            self.phase_seed = int(rng.integers(2**31))
-            self.hs = excitation.jonswap(self.hsig, self.tp, 3.3, self.phase_seed, 2 * self.tp, self.n_steps * h,
-                                         0.5 * h)
-            self.info = {"hs": self.hsig, "tp": self.tp, "phase_seed": self.phase_seed}
-        else:
-            self.hs, self.info = make_sea(sea, rng, self.n_steps * h, 0.5 * h)
+        self.hs, self.info = make_sea(sea, rng, self.n_steps * h, 0.5 * h)
         self._rep_clean = None
         self.t, self.base, grid = self.sim([], grid=True)
         self.heave_noise = rng.normal(0.0, self.noise["heave"], self.t.size)
@@ -529,72 +521,6 @@ def validation_parameter_sets():
     sets["long_soft_string"] = p.replace(drill_string={"stiffness": 0.9e6, "lower_mass": 45e3})
     sets["soft_rock"] = p.replace(formation={"stiffness": 2.5e5, "damping": 8e3})
     return sets
-
-
-def rao_heave(f, natural_period=22.0, damping_ratio=0.2):
-    """The validation's vessel heave RAO at frequencies ``f`` [Hz] (complex, -):
-    H(s) = (2 zeta w_n s + w_n^2) / (s^2 + 2 zeta w_n s + w_n^2), a floating hull whose heave is driven
-    through its waterplane stiffness and its radiation damping; |H| -> 1 below resonance."""
-    wn = 2 * np.pi / natural_period
-    s = 2j * np.pi * np.asarray(f, dtype=float)
-    return (2 * damping_ratio * wn * s + wn ** 2) / (s ** 2 + 2 * damping_ratio * wn * s + wn ** 2)
-
-
-def vessel_response(t, z, natural_period=22.0, damping_ratio=0.2):
-    """Vessel heave [m] from sea-surface heave ``z`` [m] on the uniform grid ``t`` [s]: the RAO of
-    :func:`rao_heave` integrated in the time domain (``scipy.signal.lsim``, zero initial state)."""
-    from scipy.signal import lsim
-
-    wn = 2 * np.pi / natural_period
-    _, y, _ = lsim(([2 * damping_ratio * wn, wn ** 2], [1.0, 2 * damping_ratio * wn, wn ** 2]), z, t)
-    return y
-
-
-def _ramped(t, z, dz, ddz, ramp):
-    """A heave series faded in over ``ramp`` [s] (the plant starts at rest at the operating point)."""
-    r, dr, ddr = excitation.ramp_factor(t, ramp)
-    return r * z, r * dz + dr * z, r * ddz + 2 * dr * dz + ddr * z
-
-
-def make_sea(kind, rng, duration, spacing):
-    """Heave samples of a validation sea and its description.
-
-    kind: ``jonswap`` (H_s 1.5-3 m, T_p 9-13 s, as the benchmark), ``mixed`` (swell H_s 1-2 m,
-    T_p 13-17 s, gamma 5, plus wind sea H_s 0.8-1.5 m, T_p 5-8 s, gamma 2), ``calm`` (H_s 0.4-0.8 m,
-    T_p 7-10 s) or ``buoy`` (the shipped Waverider record from a random start, through
-    :func:`vessel_response` with T_n 18-26 s, zeta 0.1-0.25).  Every sea fades in over 2 T_p.
-    """
-    from scipy.interpolate import CubicSpline
-
-    if kind in ("jonswap", "calm"):
-        hs, tp = (rng.uniform(1.5, 3.0), rng.uniform(9.0, 13.0)) if kind == "jonswap" else \
-            (rng.uniform(0.4, 0.8), rng.uniform(7.0, 10.0))
-        seed = int(rng.integers(2**31))
-        return excitation.jonswap(hs, tp, 3.3, seed, 2 * tp, duration, spacing), \
-            {"kind": kind, "hs": hs, "tp": tp, "phase_seed": seed}
-    if kind == "mixed":
-        hs1, tp1, hs2, tp2 = rng.uniform(1.0, 2.0), rng.uniform(13.0, 17.0), rng.uniform(0.8, 1.5), rng.uniform(5.0, 8.0)
-        s1, s2 = int(rng.integers(2**31)), int(rng.integers(2**31))
-        a = excitation.jonswap(hs1, tp1, 5.0, s1, 2 * tp1, duration, spacing)
-        b = excitation.jonswap(hs2, tp2, 2.0, s2, 2 * tp1, duration, spacing)
-        n = min(a.z.size, b.z.size)
-        hs = excitation.HeaveSamples(spacing, a.z[:n] + b.z[:n], a.dz[:n] + b.dz[:n], a.ddz[:n] + b.ddz[:n],
-                                     {"kind": "mixed"})
-        return hs, {"kind": "mixed", "swell": {"hs": hs1, "tp": tp1, "phase_seed": s1},
-                    "wind_sea": {"hs": hs2, "tp": tp2, "phase_seed": s2}}
-    if kind == "buoy":
-        tb, zb = excitation.load_waverider(WAVERIDER)
-        t0 = float(rng.uniform(0.0, tb[-1] - duration - 120.0))
-        tn, zeta = rng.uniform(18.0, 26.0), rng.uniform(0.1, 0.25)
-        tu = np.arange(0.0, duration + 100.0, 0.1)  # 100 s lead-in lets the RAO settle
-        zu = CubicSpline(tb, zb)(t0 + tu)
-        zv = vessel_response(tu, zu - zu.mean(), tn, zeta)
-        cs = CubicSpline(tu[1000:] - 100.0, zv[1000:])
-        tg = np.arange(int(math.ceil(duration / spacing)) + 2) * spacing
-        z, dz, ddz = _ramped(tg, cs(tg) - cs(0.0), cs(tg, 1), cs(tg, 2), 25.0)
-        return excitation.HeaveSamples(spacing, z, dz, ddz, {"kind": "buoy"}), \
-            {"kind": "buoy", "record_start_s": t0, "natural_period": tn, "damping_ratio": zeta}
-    raise ValueError(f"unknown sea {kind!r}")
 
 
 def _lever(t, cols, lever_arm, pitch_rms, pitch_period, pitch_seed):
