@@ -16,6 +16,7 @@ the scoring run refuses to run when the settings differ from the committed tunin
 from __future__ import annotations
 
 import concurrent.futures as cf
+import dataclasses
 import hashlib
 import json
 import logging
@@ -29,7 +30,7 @@ import numpy as np
 
 from heavecomp.diagnosis import GapDiagnoser, load_run
 from heavecomp.errors import InputError
-from heavecomp.benchmark.generator import NEAR_NOISE, generate_case, validation_cases
+from heavecomp.benchmark import generate, NEAR_NOISE, parameter_sets, validation_cases
 from heavecomp.params import load
 from heavecomp.report.provenance import write_params
 from heavecomp.report.scenario import ROOT, md_table, parse_args, run, write_metrics, write_report
@@ -87,9 +88,9 @@ def _diagnose(tr, kind, workdir: Path, n_jobs: int) -> dict:
 def run_case(case, workdir, n_jobs=1) -> dict:
     """Generate one case, diagnose it (and its cropped twin) from CSV; the row of the report."""
     t0 = time.perf_counter()
-    row = {"case": case, "label": case["label"], "category": case["category"], "seed": case["seed"]}
+    row = {"case": dataclasses.asdict(case), "label": case.label, "category": case.category, "seed": case.seed}
     try:
-        tr = generate_case(case)
+        tr = generate(case)
     except RuntimeError as exc:  # a sea that cannot carry the effect: reported, never hidden
         row["error"] = str(exc)
         return row
@@ -98,10 +99,10 @@ def run_case(case, workdir, n_jobs=1) -> dict:
     row["generate_wall_time"] = time.perf_counter() - t0
     try:
         row["full"] = _diagnose(tr, "full", Path(workdir), n_jobs)
-        if case["pair_cut"]:
-            row["cut"] = _diagnose(tr.cropped(case["pair_cut"]), "cut", Path(workdir), n_jobs)
+        if case.pair_cut:
+            row["cut"] = _diagnose(tr.cropped(case.pair_cut), "cut", Path(workdir), n_jobs)
     except Exception as exc:  # noqa: BLE001 - one crashing run is reported, the set goes on
-        log.exception("%s (seed %s): the diagnosis failed", case["label"], case["seed"])
+        log.exception("%s (seed %s): the diagnosis failed", case.label, case.seed)
         row.pop("full", None)
         row["error"] = f"diagnosis failed: {exc!r}"
     row["wall_time"] = time.perf_counter() - t0
@@ -294,9 +295,7 @@ def main(argv=None) -> int:
         args.out = args.out / args.which
         args.out.mkdir(parents=True, exist_ok=True)
     cases = validation_cases(args.which, quick=args.quick)
-    from heavecomp.benchmark.generator import validation_parameter_sets
-
-    settings = frozen_settings(validation_parameter_sets()["paper_a"])
+    settings = frozen_settings(parameter_sets()["paper_a"])
     digest = settings_hash(settings)
     ok, note = _settings_check(args.which, digest)
     if not ok and not args.allow_unfrozen:
