@@ -129,8 +129,8 @@ def generate(case: Case) -> TestRun:
         else:
             break
     else:
-        raise RuntimeError(f"no sea of {case.max_draws} carries {'+'.join(labels) or 'none'}"
-                           f"{f' ({case.variant})' if case.variant else ''}")
+        # the text is the one the scoring report records
+        raise RuntimeError(f"no sea of {case.max_draws} carries {case.label} ({case.variant})")
     parts = [p for _, _, p, _ in planted]
     t, clean = bed.sim(parts)
     cols = dict(clean)
