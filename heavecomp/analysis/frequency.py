@@ -100,7 +100,8 @@ def transmissibility(sys, omega):
     Parameters
     ----------
     sys : control.StateSpace
-        Linear CMC model with named signals (:func:`heavecomp.analysis.linear.linearise`). Input ``heave``, output ``wob``.
+        Linear CMC model with named signals (:func:`heavecomp.analysis.linear.linearise`).
+        Input ``heave``, output ``wob``.
     omega : array_like [rad/s]
         Frequencies.
 
@@ -202,7 +203,8 @@ def response_table(sys, omega) -> dict[str, np.ndarray]:
     Parameters
     ----------
     sys : control.StateSpace
-        Linear CMC model with named signals (:func:`heavecomp.analysis.linear.linearise`). Input ``heave``, output ``wob`` among others.
+        Linear CMC model with named signals (:func:`heavecomp.analysis.linear.linearise`).
+        Input ``heave``, output ``wob`` among others.
     omega : array_like [rad/s]
         Frequencies.
 

@@ -29,7 +29,8 @@ def cmc_stick_map(params, amplitudes, periods, models=("stribeck", "rotating_eq6
     Parameters
     ----------
     params : CMCParams
-        The parameter set (:class:`heavecomp.params.CMCParams`). Its heave and friction model are replaced for each cell.
+        The parameter set (:class:`heavecomp.params.CMCParams`). Its heave and friction model
+        are replaced for each cell.
     amplitudes : sequence of float [m]
         Heave amplitudes of the sine.
     periods : sequence of float [s]

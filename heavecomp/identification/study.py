@@ -178,7 +178,8 @@ def method_sensitivity(records, fit: SealFrictionFit, variants=None) -> dict:
     fit : SealFrictionFit
         The fitted headline (its settings are the base each variant changes).
     variants : dict, optional
-        label -> settings of :class:`SealFrictionFit` changed; default :data:`~heavecomp.identification.seal.METHOD_VARIANTS`.
+        label -> settings of :class:`SealFrictionFit` changed; default
+        :data:`~heavecomp.identification.seal.METHOD_VARIANTS`.
     """
     base = {"v_min": fit.v_min, "trim": fit.trim, "area": fit.area, "velocity": fit.velocity,
             "statistic": fit.statistic}
