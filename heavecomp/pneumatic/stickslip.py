@@ -140,7 +140,8 @@ def window(lin, periods: float = 8.0) -> float:
     lin : Linearisation
         The cylinder's linearisation (:func:`heavecomp.pneumatic.linear.linearise`), for omega_n.
     periods : float
-        Length of the window after the restart, in natural periods 2 pi / omega_n [-].
+        Length of the window after the restart, in natural periods 2 pi / omega_n [-]
+        (0.05 s are added).
     """
     return periods * 2 * math.pi / lin.omega_n + 0.05
 
