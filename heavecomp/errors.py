@@ -36,6 +36,14 @@ class DataError(InputError):
 
 
 def did_you_mean(word: str, choices) -> str:
-    """Return ``" (did you mean 'x'?)"`` for the closest match, or ``""``."""
+    """Return ``" (did you mean 'x'?)"`` for the closest match, or ``""``.
+
+    Parameters
+    ----------
+    word : str
+        The unknown name as given (converted with ``str``).
+    choices : iterable
+        The known names.
+    """
     close = difflib.get_close_matches(str(word), [str(c) for c in choices], n=1, cutoff=0.6)
     return f" (did you mean '{close[0]}'?)" if close else ""

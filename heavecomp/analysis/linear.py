@@ -253,6 +253,20 @@ def linearise_details(params, *, friction: str = "none", velocity: float | None 
     """Linearise the CMC; returns the LTI model with the raw jacobians and the state shift.
 
     See :func:`linearise` for the parameters.
+
+    Parameters
+    ----------
+    params : CMCParams
+        The parameter set (:class:`heavecomp.params.CMCParams`).
+    friction : {"none", "viscous", "sliding"}
+        Friction in the linear model (:func:`linearise`).
+    velocity : float [m/s], optional
+        Sliding velocity v0 (``friction="sliding"`` only; non-zero).
+    eps : float [m/s], optional
+        Regularisation width of sign(v) (default |v0|/25).
+    effects : sequence, optional
+        Effects at the plant's hooks (:mod:`heavecomp.effects`: instances, registered names or
+        ``(name, values)``).
     """
     import control as ct
 
@@ -446,7 +460,17 @@ def batch_matrices(*, gas_stiffness, moving_mass, lower_mass, string_stiffness, 
 
 
 def batch_matrices_from_params(params, *, friction_slope=0.0, friction_stiffness=0.0):
-    """:func:`batch_matrices` for one :class:`CMCParams` (frictionless unless a slope is given)."""
+    """:func:`batch_matrices` for one :class:`CMCParams` (frictionless unless a slope is given).
+
+    Parameters
+    ----------
+    params : CMCParams
+        The parameter set (:class:`heavecomp.params.CMCParams`).
+    friction_slope : float [N s/m]
+        Friction slope dF_f/dv on the stroke (0: frictionless).
+    friction_stiffness : float [N/m]
+        Friction stiffness dF_f/ds on the stroke (e.g. the pressure term C_p sign(v0) dp/ds; 0: none).
+    """
     c, ds, fo = params.compensator, params.drill_string, params.formation
     return batch_matrices(gas_stiffness=c.gas_stiffness, moving_mass=c.moving_mass, lower_mass=ds.lower_mass,
                           string_stiffness=ds.stiffness, string_damping=ds.damping,
