@@ -33,7 +33,7 @@ from heavecomp.controllers.base import Controller, ControllerConfig
 from heavecomp.controllers.estimation import DisturbanceObserver, HeavePredictor
 from heavecomp.controllers.model import controller_params, discrete_model
 from heavecomp.friction.laws import FrictionLaw
-from heavecomp.effects.registry import resolve
+from heavecomp.effects.spec import effects_for
 
 log = logging.getLogger(__name__)
 KN = 1e3
@@ -50,7 +50,7 @@ class LinearMPC(Controller):
 
     name = "linear-mpc"
 
-    def __init__(self, params, config=None, effects=()):
+    def __init__(self, params, config=None, effects=None):
         import osqp
         import scipy.sparse as sp
 
@@ -58,7 +58,7 @@ class LinearMPC(Controller):
         self.params, self.config = params, config
         self.cparams = controller_params(params, config)
 
-        self.effects = resolve(effects)  # effects at the plant's hooks the controller's model knows
+        self.effects = effects_for(params, effects)  # None: the file's [[effects]]; effects at the plant's hooks the controller's model knows
         self.model = m = discrete_model(self.cparams, config.dt, config.model_frame, self.effects)
         self.law = controller_friction(self.cparams)
         N, n = config.horizon, m.Ad.shape[0]

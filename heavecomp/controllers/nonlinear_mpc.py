@@ -67,7 +67,7 @@ class NonlinearMPC(LinearMPC):
     name = "nonlinear-mpc"
     substeps = 2
 
-    def __init__(self, params, config=None, effects=()):
+    def __init__(self, params, config=None, effects=None):
         super().__init__(params, config, effects)
         self._build()
 
