@@ -109,3 +109,15 @@ def test_discovered_term_adds_friction_by_direction_and_never_pushes():
     assert jump(0, 0.1, 2e6, J, 0.0, -1.0, (), None, *args.values()) == pytest.approx(J - 200.0)
     assert jump(0, 0.1, 2e6, 100.0, 0.0, -1.0, (), None, *args.values()) == 0.0  # clipped: friction >= 0
     assert jump(0, 0.1, 2e6, J, 0.0, 1.0, (), None, *DiscoveredTerm.null(None).values()) == J
+
+
+def test_simulate_runs_the_files_plant_effects_and_not_its_reading_effects():
+    from heavecomp.simulate import simulate
+
+    base = paper_a()
+    p = base.replace(effects=FX)
+    got = simulate(p, 30.0).data
+    want = simulate(base, 30.0, effects=[FX[0]]).data  # the plant effect only: the WOB gain reads logs
+    np.testing.assert_array_equal(got, want)
+    assert not np.array_equal(got, simulate(base, 30.0).data)  # the damping acts
+    np.testing.assert_array_equal(simulate(p, 30.0, effects=()).data, simulate(base, 30.0).data)
