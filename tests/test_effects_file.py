@@ -121,3 +121,10 @@ def test_simulate_runs_the_files_plant_effects_and_not_its_reading_effects():
     np.testing.assert_array_equal(got, want)
     assert not np.array_equal(got, simulate(base, 30.0).data)  # the damping acts
     np.testing.assert_array_equal(simulate(p, 30.0, effects=()).data, simulate(base, 30.0).data)
+
+
+def test_a_run_folders_params_toml_records_the_effects(tmp_path):
+    from heavecomp.report.provenance import write_params
+
+    p = paper_a().replace(effects=FX)
+    assert spec.load(write_params(tmp_path, p)) == p
