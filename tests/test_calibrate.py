@@ -95,3 +95,15 @@ def test_a_second_effect_is_added_and_the_joint_shrink_expected():
     cal = calibrate(NOM, diag)
     assert [n for n, _ in cal.params.effects] == ["string_damping", "pressure_friction"]
     assert cal.expected_shrink == 0.8
+
+
+def test_values_that_cannot_make_a_valid_file_leave_the_nominal_and_say_why(tmp_path):
+    from heavecomp.diagnosis.calibrate import write
+
+    # a refit beyond the table's possible range (gas stiffness <= 1e8 N/m)
+    cal = write(NOM, _diag("parameter_mismatch", {"compensator.gas_stiffness": 5e8}), tmp_path)
+    assert cal.params == NOM and cal.changes == []
+    assert "compensator.gas_stiffness" in (tmp_path / "calibrated.toml").read_text()
+    # a fit a rounding beyond its bound is written at the bound
+    cal = calibrate(NOM, _diag("string_damping", {"damping": 2e6 * (1 + 1e-15)}))
+    assert cal.params.effects[0][1]["damping"] == 2e6

@@ -44,6 +44,7 @@ from heavecomp.effects.compose import composition_for
 from heavecomp.effects.discovered_term import COMPONENT as DISCOVERED_COMPONENT
 from heavecomp.effects.discovered_term import FEATURES as DISCOVERED_FEATURES
 from heavecomp.effects.spec import build, classes, plant_effects, reading_effects
+from heavecomp.errors import InputError
 from heavecomp.params import dumps
 from heavecomp.plants.cmc import plant_vectors
 
@@ -74,6 +75,10 @@ def _entry(name: str, values: dict) -> tuple:
     did not carry, e.g. heave_reference's lever arm on a log without an angle, is at its null value)."""
     cls = classes()[name]
     vals = {k: v for k, v in values.items() if k != "channel"}
+    for f in cls.fields():  # a fit at its bound may sit a rounding outside it (exp(log(bound)))
+        if f.name in vals and not isinstance(vals[f.name], str):
+            lo, hi = f.metadata["bounds"]
+            vals[f.name] = min(max(float(vals[f.name]), lo), hi)
     null = cls.null(None) or {}
     for f in cls.fields():
         if f.name not in vals and f.name in null:
@@ -212,7 +217,12 @@ def write(nominal, diagnosis: dict, out_dir, source: str = "") -> Calibrated:
     """Write ``out_dir/calibrated.toml`` and return the :class:`Calibrated` model."""
     from pathlib import Path
 
-    cal = calibrate(nominal, diagnosis)
+    try:
+        cal = calibrate(nominal, diagnosis)
+    except InputError as exc:  # e.g. a refitted value outside its table's possible range: the nominal, and why
+        cal = Calibrated(nominal, verdict=diagnosis["verdict"]["effect"],
+                         why=[f"diagnosis verdict: {diagnosis['verdict']['effect']} -- its values cannot be written "
+                              f"into a valid parameter file ({exc}); this is the nominal file"])
     (Path(out_dir) / FILE).write_text(to_toml(cal, source), encoding="utf-8")
     return cal
 
