@@ -107,3 +107,19 @@ def test_values_that_cannot_make_a_valid_file_leave_the_nominal_and_say_why(tmp_
     # a fit a rounding beyond its bound is written at the bound
     cal = calibrate(NOM, _diag("string_damping", {"damping": 2e6 * (1 + 1e-15)}))
     assert cal.params.effects[0][1]["damping"] == 2e6
+
+
+def test_what_next_names_the_change_the_file_and_the_commands():
+    from heavecomp.report.calibrated import what_next
+
+    par = {"compensator.gas_stiffness": 0.6 * NOM.compensator.gas_stiffness,
+           "drill_string.stiffness": 1.001 * NOM.drill_string.stiffness}
+    text = "\n".join(what_next(calibrate(NOM, _diag("parameter_mismatch", par)), "out", run_path="log.csv",
+                               params_path="rig.toml"))
+    assert "Change `compensator.gas_stiffness`" in text and "Change `drill_string.stiffness`" not in text
+    assert "heavecomp diagnose log.csv --params out/calibrated.toml" in text
+    assert "heavecomp simulate out/calibrated.toml" in text and "--controller linear-mpc" in text
+    text = "\n".join(what_next(calibrate(NOM, _diag("sensor_gain", {"channel": "wob", "factor": 1.08})), "out"))
+    assert "**wob** sensor misreads" in text
+    text = "\n".join(what_next(calibrate(NOM, _diag("none")), "out", params_path="rig.toml"))
+    assert "Nothing to change in `rig.toml`" in text

@@ -4,10 +4,15 @@
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 
 from heavecomp.diagnosis.calibrate import FILE, Calibrated, write
 from heavecomp.effects.spec import field_units
+
+
+#: a refitted parameter that moved less than this share is listed as refit noise, not as a change to make
+SMALL = 0.02
 
 
 def _value(name: str, key: str, value) -> str:
@@ -26,9 +31,16 @@ def what_next(cal: Calibrated, out_dir, *, run_path: str = "LOG", params_path: s
     if not cal.changes:
         lines.append(f"Nothing to change in `{params_path}`: {cal.why[0] if cal.why else 'no change'}. "
                      f"`{f}` is that file, unchanged.")
+    params = sorted((c for c in cal.changes if c["kind"] == "parameter"), key=lambda c: -abs(math.log(c["ratio"])))
+    moved = [c for c in params if abs(c["ratio"] - 1.0) >= SMALL]
+    for c in moved:
+        lines.append(f"- Change `{c['name']}` from {c['from']:.6g} to **{c['to']:.6g}** (x {c['ratio']:.3f}).")
+    if len(moved) < len(params):
+        lines.append(f"- Refitted within {100 * SMALL:.0f} % (written too, so the file replays as the fit did): "
+                     + ", ".join(f"`{c['name']}` x {c['ratio']:.3f}" for c in params if c not in moved) + ".")
     for c in cal.changes:
         if c["kind"] == "parameter":
-            lines.append(f"- Change `{c['name']}` from {c['from']:.6g} to **{c['to']:.6g}** (x {c['ratio']:.3f}).")
+            continue
         elif c["role"] == "reading":
             prm = dict(c["parameters"])
             ch = prm.pop("channel", "heave")
