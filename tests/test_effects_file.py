@@ -128,3 +128,23 @@ def test_a_run_folders_params_toml_records_the_effects(tmp_path):
 
     p = paper_a().replace(effects=FX)
     assert spec.load(write_params(tmp_path, p)) == p
+
+
+def test_linearise_and_the_mpc_model_take_the_files_plant_effects():
+    from heavecomp.analysis.linear import linearise_details
+    from heavecomp.controllers.linear_mpc import LinearMPC
+
+    base, p = paper_a(), paper_a().replace(effects=FX)
+    damped, nominal = linearise_details(p), linearise_details(base)
+    assert not np.allclose(damped.sys.A, nominal.sys.A)  # the string damping enters the dynamics
+    np.testing.assert_allclose(damped.sys.A, linearise_details(base, effects=[FX[0]]).sys.A)
+    assert [e.name for e in LinearMPC(p).effects] == ["string_damping"]
+
+
+def test_a_campaign_refuses_plant_effects_it_would_not_simulate(tmp_path):
+    from heavecomp.campaign import spec as campaign
+
+    (tmp_path / "rig.toml").write_text(dumps(paper_a().replace(effects=FX)))
+    text = (campaign.DEFAULT_FILE.read_text().replace('base = "paper_a"', 'base = "rig.toml"'))
+    with pytest.raises(ParameterError, match="plant effects in \\[\\[effects\\]\\] \\(string_damping, sensor_gain\\)"):
+        campaign.loads(text, base_dir=tmp_path).base_params()
