@@ -82,6 +82,7 @@ def test_a_discovered_friction_term_is_carried_as_discovered_term():
     cal = calibrate(NOM, _diag("discovered", component="friction", discovered=d))
     (e,) = spec.plant_effects(_round_trip(cal))
     assert e.name == "discovered_term" and e.values["sign_v_pos"] == 1.9e3 and e.values["v"] == 0.0
+    assert cal.expected_shrink == 0.0 and cal.changes[0]["component_shrink"] == 0.6  # verdict.shrink is a candidate's
     # a term elsewhere (no model form at its hook): the nominal, and the file says why
     d = dict(d, component="gas_spring", features=["x"], coefficients={"x": 3e5}, term="3e5*(x - mean x)")
     cal = calibrate(NOM, _diag("discovered", component="gas_spring", discovered=d))

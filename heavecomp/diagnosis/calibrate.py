@@ -174,8 +174,13 @@ def calibrate(nominal, diagnosis: dict) -> Calibrated:
         feats = list(d.get("features", []))
         if d.get("component") == DISCOVERED_COMPONENT and feats and all(f in DISCOVERED_FEATURES for f in feats):
             add("discovered_term", {f: float(d["coefficients"][f]) for f in feats})
+            out.changes[-1]["component_shrink"] = float(d.get("shrink", 0.0))
+            # verdict.shrink is the best *named* candidate's; the term's own replay shrink is unknown until
+            # replayed (replay_shrink): nothing is promised for it
+            out.expected_shrink = 0.0
             out.why.append(f"diagnosis verdict: discovered -- the open search's term on the friction residual, "
-                           f"{d.get('term', '')}, carried as effect discovered_term")
+                           f"{d.get('term', '')}, carried as effect discovered_term (it shrinks the held-out friction "
+                           f"residual by {d.get('shrink', 0.0):.2f}; its replay shrink is not known until replayed)")
         else:
             out.why.append(f"diagnosis verdict: discovered -- the open search's term on the "
                            f"{d.get('component', '?')} residual, {d.get('term', '')}, has no model form at its hook "
