@@ -148,3 +148,29 @@ def test_a_campaign_refuses_plant_effects_it_would_not_simulate(tmp_path):
     text = (campaign.DEFAULT_FILE.read_text().replace('base = "paper_a"', 'base = "rig.toml"'))
     with pytest.raises(ParameterError, match="plant effects in \\[\\[effects\\]\\] \\(string_damping, sensor_gain\\)"):
         campaign.loads(text, base_dir=tmp_path).base_params()
+
+
+def test_discovered_term_is_the_open_search_term_it_carries():
+    """Round trip: a plant with discovered_term, its friction residual (simulated friction minus the
+    nominal law at the same v and p, the friction component's residual) is exactly the term, and the
+    open search reads back the features and coefficients the effect was given."""
+    from heavecomp.diagnosis.equation_error import open_search
+    from heavecomp.friction.laws import friction_cont, friction_jump
+    from heavecomp.plants.cmc import plant_vectors
+    from heavecomp.simulate import simulate
+
+    c, k = 2.5e3, 1.0e-3
+    base = paper_a()
+    r = simulate(base.replace(effects=[("discovered_term", {"sign_v_pos": c, "p_sign_v": k})]), 200.0,
+                 rate=50.0).to_dict()
+    pv = plant_vectors(base)
+    t, v, p = r["t"], r["stroke_velocity"], r["pressure"]
+    nominal = np.array([friction_jump(pv.code, abs(a), b, pv.FP) * np.sign(a) + friction_cont(pv.code, a, b, pv.FP)
+                        for a, b in zip(v, p)])
+    sliding = np.abs(v) > 1e-3
+    res = np.where(sliding, r["friction"] - nominal, np.nan)
+    np.testing.assert_allclose(res[sliding], (c * (v > 0) + k * p * np.sign(v))[sliding], atol=1e-6 * c)
+    got = open_search(res, {"t": t, "v": v, "p": p}, sliding & (t < 130.0), sliding & (t >= 130.0),
+                      component="friction")
+    assert got["features"] == ["sign_v_pos", "p_sign_v"]
+    assert got["coefficients"]["sign_v_pos"] == pytest.approx(c) and got["coefficients"]["p_sign_v"] == pytest.approx(k)
