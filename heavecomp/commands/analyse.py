@@ -41,7 +41,7 @@ def run(args) -> int:
     from pathlib import Path
 
     from heavecomp.report.analysis import write_analysis
-    from heavecomp.params import load
+    from heavecomp.effects.spec import load  # the file with its [[effects]] checked
 
     _check(args)
     params = load(args.params)

@@ -17,7 +17,8 @@ def run(args) -> int:
     from pathlib import Path
 
     from heavecomp.errors import ParameterError, did_you_mean
-    from heavecomp.params import SETS, dumps, load
+    from heavecomp.params import SETS, dumps
+    from heavecomp.effects.spec import load  # the file with its [[effects]] checked
 
     if args.source in SETS:
         factory = SETS[args.source]
