@@ -216,6 +216,7 @@ class CMCParams:
                 f"suspended weight (M_c + m_b) g = {g_load:g} N (the cylinder pressure would be <= 0)")
 
         plausibility.check(self)  # cross-key plausibility: unit slips inside each key's bounds
+        check_heave_path(self.heave, self.base_dir)
 
     # ---- derived quantities (cmc-reference.md) ---------------------------------
     @property
@@ -271,6 +272,37 @@ class CMCParams:
         return out
 
 
+def check_heave_path(heave, base_dir) -> None:
+    """``heave.path`` (kind ``file``) names a readable, non-empty regular file: one-line
+    :class:`ParameterError` naming ``heave.path`` for an empty string, a missing file, a folder, a device
+    (``/dev/null``) or an empty file.  A relative path is resolved against ``base_dir`` (the parameter
+    file's folder); without one (a set built in Python) it is checked when it is read."""
+    if heave is None or heave.kind != "file":
+        return
+    if not heave.path.strip():
+        raise ParameterError('heave.path = "": empty; give the heave CSV (columns t, heave), relative to the '
+                             "parameter file's folder")
+    path = Path(heave.path)
+    if not path.is_absolute():
+        if base_dir is None:
+            return
+        path = Path(base_dir) / path
+    try:
+        st = path.stat()
+    except FileNotFoundError:
+        raise ParameterError(f"heave.path = {heave.path!r}: file not found ({path})") from None
+    except OSError as exc:
+        raise ParameterError(f"heave.path = {heave.path!r}: cannot read ({type(exc).__name__})") from None
+    import stat
+
+    if stat.S_ISDIR(st.st_mode):
+        raise ParameterError(f"heave.path = {heave.path!r}: a folder, not a heave file")
+    if not stat.S_ISREG(st.st_mode):
+        raise ParameterError(f"heave.path = {heave.path!r}: not a regular file (a device or pipe); give the heave CSV")
+    if st.st_size == 0:
+        raise ParameterError(f"heave.path = {heave.path!r}: empty file ({path})")
+
+
 #: optional tables other modules add: name -> callable(table_dict) -> object (validated)
 OPTIONAL_EXTRA: dict[str, Any] = {}
 
@@ -301,6 +333,9 @@ def loads(text_: str, *, base_dir: Path | None = None, source: str = "<string>")
         data = tomllib.loads(text_)
     except (tomllib.TOMLDecodeError, ValueError) as exc:  # ValueError: an integer of > 4300 digits
         raise ParameterError(toml_error_message(text_, exc, source)) from None
+    except RecursionError:  # tomllib parses nested inline tables / arrays recursively
+        raise ParameterError(f"{source}: not valid TOML for a parameter file: tables or arrays nested too deep "
+                             "(a parameter file is one level of tables)") from None
     return from_dict(data, base_dir=base_dir)
 
 
