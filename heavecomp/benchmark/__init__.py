@@ -1,0 +1,1 @@
+"""Benchmarks of the toolbox against generated truth: withheld effects, corrupted logs."""
