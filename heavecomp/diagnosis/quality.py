@@ -17,8 +17,9 @@ section *Corrupted logs*):
 =================  ==================================================================  ===============
 check              criterion                                                           outcome
 =================  ==================================================================  ===============
-torn last row      the last sample departs from the one before by a spike's margin     row dropped,
-                   (a row cut mid-number loses digits: a factor 10 or more)             warning
+torn last row      the last sample off the line through the two before by              row dropped,
+                   ``TORN_NOISE`` robust second-difference sigmas (a row cut           warning
+                   mid-number loses digits; dropping a row costs nothing)
 spike              one sample departs from the median of itself and its neighbours     sample excluded,
                    by > ``SPIKE_NOISE`` x the channel's sample-to-sample scale and     warning, cap low
                    > ``SPIKE_SPREAD`` x the channel's 1-99 % range
@@ -62,6 +63,8 @@ CONFIDENCE = ("low", "medium", "high")  #: verdict confidences, lowest first
 # ---- spikes: one-sample departures that no plant motion makes
 SPIKE_NOISE = 30.0  #: spike margin in robust sample-to-sample standard deviations of the channel [-]
 SPIKE_SPREAD = 0.25  #: spike margin as a share of the channel's 1-99 % range [-]
+TORN_NOISE = 30.0  #: torn last row: off the line through the two samples before by this many robust second-difference sigmas [-]
+TORN_SPREAD = 1e-3  #: ... and by more than this share of the channel's 1-99 % range (a noise-free channel) [-]
 # ---- frozen sensors
 FROZEN_PERIODS = 2.0  #: a live channel changes within this many dominant heave periods [-]
 FROZEN_MIN_S = 10.0  #: ... and never stays exactly constant this long [s]
@@ -174,8 +177,15 @@ def spikes(y, last=True):
     hit = list(idx[1:-1][r > margin])
     if abs(yv[0] - yv[1]) > margin and abs(yv[1] - yv[2]) <= margin:
         hit.insert(0, idx[0])
-    torn = last and abs(yv[-1] - yv[-2]) > margin and abs(yv[-2] - yv[-3]) <= margin
-    return np.asarray(hit, dtype=int), bool(torn and idx[-1] == y.size - 1)
+    # the last row: a file cut mid-write loses digits; dropping one row costs nothing, so the test is the
+    # noise's: the last sample off the line through the two before by TORN_NOISE robust second differences
+    d2 = np.diff(yv, 2)
+    s2 = 1.4826 * float(np.median(np.abs(d2 - np.median(d2))))
+    off = abs(yv[-1] - (2 * yv[-2] - yv[-3]))
+    floor = max(TORN_NOISE * s2, TORN_SPREAD * float(hi - lo))  # a tear under 0.1 % of the range does no harm
+    torn = last and off > floor and abs(d2[-2]) <= floor
+    return np.asarray(hit[:-1] if hit and hit[-1] == idx[-2] and torn else hit, dtype=int), \
+        bool(torn and idx[-1] == y.size - 1)
 
 
 def frozen_runs(y, min_len):
@@ -213,7 +223,7 @@ def _lag(t, a, b, max_lag):
 
 def _mode_peak(t, w, f_mode, f_wave):
     """Frequency [Hz] of the WOB's resonance near ``f_mode`` (the largest of f^2 x PSD between the wave
-    band's edge and 2.5 f_mode) when it stands ``MODE_PROMINENCE`` x above the band's median, else None."""
+    band's edge and 3.5 f_mode) when it stands ``MODE_PROMINENCE`` x above the band's median, else None."""
     from scipy.signal import welch
 
     tu, wu = _uniform(t, w)
@@ -223,7 +233,7 @@ def _mode_peak(t, w, f_mode, f_wave):
         return None
     f, P = welch(wu - wu.mean(), fs, nperseg=n)
     lo = max(f_mode / (MODE_RATIO * 1.7), 2.0 * f_wave)
-    hi = min(2.5 * f_mode, 0.4 * fs)
+    hi = min(3.5 * f_mode, 0.4 * fs)
     m = (f >= lo) & (f <= hi)
     if m.sum() < 8:
         return None
@@ -340,12 +350,13 @@ def assess(run, params=None, *, rows=None) -> Quality:
         _issue(q, "time_base", "t", f"the heave's mean period is {T_wave:.3g} s, outside the {WAVE_PERIOD[0]:g}-"
                                     f"{WAVE_PERIOD[1]:g} s of sea states: time base wrong (scale, unit)? confidence low")
     elif params is not None:
-        f_mode = float(natural_frequencies(params)[0][0])
-        f_pk = _mode_peak(t, w, f_mode, 1.0 / T_wave)
-        if f_pk is not None and not 1.0 / MODE_RATIO <= f_pk / f_mode <= MODE_RATIO:
-            _issue(q, "time_base", "t", f"the WOB resonates at {f_pk:.3g} Hz, {f_pk / f_mode:.2f} x the rig's mode "
-                                        f"({f_mode:.3g} Hz from the parameter file): time base at the wrong scale "
-                                        "(or the wrong parameter file)? confidence low")
+        modes = [float(f) for f in natural_frequencies(params)[0] if f > 0]
+        f_pk = _mode_peak(t, w, modes[0], 1.0 / T_wave) if modes else None
+        near = min(modes, key=lambda f: abs(math.log(f_pk / f))) if f_pk is not None else None
+        if near is not None and not 1.0 / MODE_RATIO <= f_pk / near <= MODE_RATIO:  # off every mode of the rig
+            _issue(q, "time_base", "t", f"the WOB resonates at {f_pk:.3g} Hz, {f_pk / near:.2f} x the nearest of the rig's "
+                                        f"modes ({', '.join(f'{f:.3g}' for f in modes)} Hz from the parameter file): time "
+                                        "base at the wrong scale (or the wrong parameter file)? confidence low")
     # ---- clock skew: stroke and pressure follow the heave through the gas spring
     max_lag = min(30.0, 0.25 * float(t[-1] - t[0]))
     lags = {}
