@@ -216,7 +216,9 @@ class CMCParams:
                 f"suspended weight (M_c + m_b) g = {g_load:g} N (the cylinder pressure would be <= 0)")
 
         plausibility.check(self)  # cross-key plausibility: unit slips inside each key's bounds
-        check_heave_path(self.heave, self.base_dir)
+        if self.heave is not None and self.heave.kind == "file" and not self.heave.path.strip():
+            raise ParameterError('heave.path = "": empty; give the heave CSV (columns t, heave), relative to the '
+                                 "parameter file's folder")
 
     # ---- derived quantities (cmc-reference.md) ---------------------------------
     @property
@@ -274,14 +276,13 @@ class CMCParams:
 
 def check_heave_path(heave, base_dir) -> None:
     """``heave.path`` (kind ``file``) names a readable, non-empty regular file: one-line
-    :class:`ParameterError` naming ``heave.path`` for an empty string, a missing file, a folder, a device
-    (``/dev/null``) or an empty file.  A relative path is resolved against ``base_dir`` (the parameter
-    file's folder); without one (a set built in Python) it is checked when it is read."""
-    if heave is None or heave.kind != "file":
+    :class:`ParameterError` naming ``heave.path`` for a missing file, a folder, a device (``/dev/null``)
+    or an empty file (an empty string is refused by :class:`CMCParams` itself).  A relative path is
+    resolved against ``base_dir`` (the parameter file's folder).  :func:`load` calls it: a file's
+    heave is checked when the file is read; a set built or changed in code is checked when its heave
+    is read (:func:`heavecomp.simulate.excitation.read_heave_csv`)."""
+    if heave is None or heave.kind != "file" or not heave.path.strip():
         return
-    if not heave.path.strip():
-        raise ParameterError('heave.path = "": empty; give the heave CSV (columns t, heave), relative to the '
-                             "parameter file's folder")
     path = Path(heave.path)
     if not path.is_absolute():
         if base_dir is None:
@@ -343,7 +344,9 @@ def load(path: str | Path) -> CMCParams:
     """Read and validate a CMC parameter file."""
     path = Path(path)
     raw = read_text(path, "parameter file")
-    return loads(raw, base_dir=path.resolve().parent, source=str(path))
+    p = loads(raw, base_dir=path.resolve().parent, source=str(path))
+    check_heave_path(p.heave, p.base_dir)  # a file's heave.path names a file beside it (not a set built in code)
+    return p
 
 
 def dumps(params: CMCParams, header: str = "") -> str:
