@@ -51,7 +51,9 @@ def cases(which, quick=False):
     if which == "tuning":
         s = iter(range(30000, 31000))
         out = [_c(lab, next(s)) for lab in ("operating", "formation", "pressure_friction", "gas_leak", "sensor_gain")]
-        out += [_c("none", next(s), duration=3600.0), _c("none", next(s), sea="buoy", duration=3600.0)]
+        out += [_c("none", next(s), duration=3600.0), _c("none", next(s), sea="buoy", duration=3600.0),
+                _c("none", next(s), duration=7200.0), _c("none", next(s), sea="buoy", duration=3600.0),
+                _c("none", next(s), rate=50.0, duration=3600.0)]
     elif which == "scoring":
         s = iter(range(130000, 131000))
         out = []
@@ -98,7 +100,7 @@ def one(case, cache):
     wall = time.perf_counter() - t1
     tp = _peak_period(tr.t, tr.columns["heave"])
     alarms = res.changes
-    row = {"case": case, "peak_period": tp, "monitor_s": wall, "generate_s": gen, "changes": alarms,
+    row = {"case": case, "peak_period": tp, "monitor_wall_s": wall, "generate_wall_s": gen, "changes": alarms,
            "truth": tr.truth["changes"], "hours": tr.t[-1] / 3600.0}
     if case["label"] == "none":
         row.update(false_alarms=len(alarms), exposure_h=row["hours"])
@@ -140,7 +142,7 @@ def summarise(rows) -> dict:
             "right_of_all": (sum(r["right"] for r in det) / len(eff)) if eff else None,
             "false_alarms": tot_fa, "false_alarm_hours": tot_h,
             "false_alarms_per_24h": tot_fa / tot_h * 24.0 if tot_h else None, "false_alarms_by_setting": fa,
-            "monitor_s_per_hour": float(np.mean([r["monitor_s"] / r["hours"] for r in rows]))}
+            "monitor_wall_s_per_hour": float(np.mean([r["monitor_wall_s"] / r["hours"] for r in rows]))}
 
 
 def _figure(rows, path):
@@ -212,7 +214,7 @@ def main(argv=None) -> int:
                f"= {f(s['median_delay_periods'], '{:.1f}')} wave periods (goal <= 3); right component "
                f"{f(s['component_accuracy'], '{:.0%}')} of the detected (goal >= 90 %); false alarms "
                f"{s['false_alarms']} in {s['false_alarm_hours']:.1f} h = {f(s['false_alarms_per_24h'], '{:.2f}')} per 24 h "
-               f"(goal <= 1). Monitor pass {s['monitor_s_per_hour']:.2f} s per hour of log.")
+               f"(goal <= 1). Monitor pass {s['monitor_wall_s_per_hour']:.2f} s per hour of log.")
     write_report(out, f"Monitor validation — {args.set} set", [
         summary, "![delays](delays.png)", "## Logs", table, "## False alarms by sea and sampling rate", fa,
         "Settings: " + ", ".join(f"{k} = {v}" for k, v in settings.items()) + ".", (__doc__ or "").split("\n\n")[1]])

@@ -23,6 +23,8 @@ from __future__ import annotations
 import numpy as np
 
 from heavecomp.diagnosis import generator as G  # the one import of the withheld-effect generator
+from heavecomp.diagnosis.stepper import CHANNELS as SC, run_segments
+from heavecomp.plants.cmc import plant_vectors
 
 BLEND = 20.0  #: s over which two configurations are blended at an effect change (raised cosine)
 BLEND_OP = 60.0  #: s over which a set-point change is blended
@@ -87,12 +89,17 @@ def long_log(changes, *, seed=0, duration=3600.0, rate=10.0, sea="jonswap", para
     t = s.t
     cols = dict(s.base)
     for k, (tc, label) in enumerate(sorted(changes)):
+        eff = parts[k][1]
+        if eff and k == 0:  # a plant truth law: switched on at tc, the state carried on (no blend)
+            cols = _onset(s, nominal, eff, tc)
+            continue
         _, cfg = s.sim(parts[:k + 1])  # parameter changes apply on top of each other
         width = BLEND_OP if label == "operating" else BLEND
         w = 0.5 - 0.5 * np.cos(np.pi * np.clip((t - tc) / width, 0.0, 1.0))  # smooth: no kink in a
         for c in s.OUT:
             cols[c] = (1 - w) * cols[c] + w * cfg[c]
     cols["heave"] = s.base["heave"] + s.heave_noise
+    cols = {c: np.asarray(y, float) for c, y in cols.items()}
     for c in s.OUT:
         cols[c] = cols[c] + rng.normal(0.0, s.noise[c], t.size)
     truth = {"label": "+".join(lab for _, lab in sorted(changes)) or "none", "changes": info, "seed": seed,
@@ -100,3 +107,22 @@ def long_log(changes, *, seed=0, duration=3600.0, rate=10.0, sea="jonswap", para
              "size": size}
     return G.TestRun(t=t, columns=cols, nominal=nominal, truth=truth).cropped(LEAD)
 
+
+
+def _onset(sea, nominal, effects, tc):
+    """Clean channels of the nominal plant until ``tc`` and of the plant with the truth laws ``effects``
+    from there, one continuous run: the second part starts from the state the first reached
+    (:func:`heavecomp.diagnosis.stepper.run_segments`; the effects' own states from their initial
+    values: a leak starts with the full charge)."""
+    comp = G.validation_composition(effects[0].name)
+    plant = plant_vectors(nominal)
+    h, n = sea.h, sea.n_steps
+    ic = int(round(tc / h))
+    off = run_segments(plant, comp, comp.ep([]), sea.hs, h, [(0, ic + 1)], [None], ic + 2)
+    r = off[ic]
+    start = (r[SC.index("stroke")], r[SC.index("stroke_velocity")], r[SC.index("lower_displacement")],
+             r[SC.index("lower_velocity")], bool(r[SC.index("stuck")] > 0.5))
+    on = run_segments(plant, comp, comp.ep(effects), sea.hs, h, [(ic, n)], [start], n + 1)
+    on[:ic] = off[:ic]
+    grid = on[::sea.out_every][:sea.t.size]
+    return {c: grid[:, SC.index(c)].copy() for c in ("heave",) + sea.OUT}
