@@ -1,0 +1,57 @@
+"""Monitor a long measured log: when and where the sim-to-real gap appears or changes, segment by segment."""
+
+from __future__ import annotations
+
+import argparse
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("run", metavar="LOG", help="measured log: columns t, heave, stroke, pressure, wob; CSV (any "
+                   "delimiter, decimal comma, .gz/.bz2/.xz/.zip), Parquet or .mat (docs/contracts/measured-run.md)")
+    p.add_argument("--columns", default=None, metavar="t=NAME,...",
+                   help="map contract columns to the file's, e.g. t=Time,heave=MRU_heave,wob=WOB")
+    p.add_argument("--units", default=None, metavar="t=ms,...",
+                   help="declare units, e.g. t=ms,pressure=bar,wob=kN,stroke=mm (converted to SI and recorded)")
+    p.add_argument("--params", required=True, metavar="NOMINAL.toml", help="nominal CMC parameter file")
+    p.add_argument("--out", required=True, metavar="DIR", help="output folder (monitor.json, report.md/html, timeline.png)")
+    p.add_argument("--block", type=float, default=None, metavar="S",
+                   help="statistic block [s] (default 10 s, about one wave period)")
+
+
+def run(args) -> int:
+    import sys
+    import time
+    from pathlib import Path
+
+    from heavecomp.diagnosis import monitor as M
+    from heavecomp.diagnosis.data import load_run
+    from heavecomp.errors import InputError
+    from heavecomp.io.series import check_spec, parse_mapping
+    from heavecomp.params import load
+    from heavecomp.report.monitor import write_report
+    from heavecomp.report.provenance import finish
+
+    columns, units = check_spec(parse_mapping(args.columns, "--columns"), parse_mapping(args.units, "--units"),
+                                "cli")
+    params = load(args.params)
+    block = M.BLOCK if args.block is None else args.block
+    if not block > 0:
+        raise InputError(f"--block must be > 0 s, got {args.block}")
+    run_ = load_run(args.run, params, columns=columns, units=units)
+    if run_.duration < M.MIN_DURATION:
+        raise InputError(f"{run_.source}: column 't': the log spans {run_.duration:.3g} s; monitor needs at least "
+                         f"{M.MIN_DURATION:g} s (a reference stretch and a few blocks to compare)")
+    t0 = time.perf_counter()
+
+    def progress(frac, msg):
+        if not getattr(args, "quiet", False):
+            print(f"[{time.perf_counter() - t0:6.1f} s {100 * frac:3.0f} %] {msg}", file=sys.stderr, flush=True)
+
+    res = M.monitor(run_, params, block=block, progress=progress)
+    write_report(res, args.out, source=run_.source, extra={"measurement": run_.measurement} if run_.measurement else None)
+    finish(args.out, params=params, json_files=("monitor.json",), measured_run=str(Path(args.run).resolve()))
+    eff = [c for c in res.changes if c["kind"] == "effect"]
+    ops = [c for c in res.changes if c["kind"] == "operating"]
+    print(f"{len(eff)} effect change(s), {len(ops)} operating change(s), {len(res.segments)} segment(s)"
+          + "".join(f"; {c['component']} at {c['t']:.0f} s" for c in eff[:5]) + f" -> {args.out}/monitor.json")
+    return 0

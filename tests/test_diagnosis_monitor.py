@@ -1,0 +1,95 @@
+"""The monitor (heavecomp.diagnosis.monitor): change detection on window statistics, operating vs
+effect changes by the load balance, and the command's bad-input handling."""
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from heavecomp.diagnosis import monitor as M
+from heavecomp.params.sets import paper_a
+
+
+def test_cusum_finds_a_step_after_it_and_not_noise():
+    rng = np.random.default_rng(3)
+    u = rng.normal(size=3000)
+    assert M.cusum(u) is None  # 3000 blocks (8 h) of white noise: no alarm at h = 12
+    u[1500:] += 2.0
+    b, j, onset, size = M.cusum(u)
+    # a 2-sigma step: the sum grows by ~1.5 sigma per block past the allowance, crossing 12 in ~8 blocks
+    assert 1500 <= b <= 1520 and abs(onset - 1500) <= 5
+    assert 1.0 < size < 3.5
+
+
+def test_cusum_skips_gaps_and_names_the_column():
+    rng = np.random.default_rng(4)
+    u = rng.normal(size=(800, 3))
+    u[400:, 1] -= 3.0
+    u[100:120, :] = np.nan
+    b, j, onset, _ = M.cusum(u)
+    assert j == 1 and 400 <= b < 420
+
+
+def test_robust_sigma_ignores_a_step():
+    rng = np.random.default_rng(5)
+    x = rng.normal(0.0, 2.0, 5000)
+    x[2500:] += 50.0
+    assert abs(M.robust_sigma(x) - 2.0) < 0.1
+
+
+def _op(n, w0, p0, dw=0.0, dp=0.0, at=None, seed=0):
+    rng = np.random.default_rng(seed)
+    w = w0 + rng.normal(0.0, 1e3, n)
+    p = p0 + rng.normal(0.0, 2e3, n)
+    if at is not None:
+        w[at:] += dw
+        p[at:] += dp
+    return {"wob": w, "pressure": p, "stroke": np.zeros(n), "heave": np.zeros(n)}
+
+
+def test_a_new_set_point_is_operating_a_wob_alone_is_a_misreading():
+    """The load balance p A + W = (M_c + m_b) g: a set-point change moves the mean pressure by -dW/A; a WOB
+    channel that starts to misread moves the WOB alone."""
+    p = paper_a("stribeck")
+    n = 600
+    bt = np.arange(n) * 10.0
+    dw = 12e3
+    ch, bounds = M.operating_changes(_op(n, p.operating_point.wob_setpoint, p.p0, dw, -dw / p.area, 300), bt, 10.0, p)
+    assert [c["kind"] for c in ch] == ["operating"] and bounds and abs(bounds[0] - 300) <= 3
+    ch, bounds = M.operating_changes(_op(n, p.operating_point.wob_setpoint, p.p0, dw, 0.0, 300), bt, 10.0, p)
+    assert [(c["kind"], c["component"]) for c in ch] == [("effect", "sensors")] and not bounds
+
+
+@pytest.mark.slow
+def test_monitor_finds_a_seal_friction_onset_on_a_generated_log(tmp_path):
+    """A 40-minute 10 Hz log with pressure friction switched on at 1200 s at 5x its noise: one effect
+    change, in friction, within a few wave periods; none before it."""
+    from heavecomp.diagnosis.monitor_logs import long_log
+
+    tr = long_log([(1200.0, "pressure_friction")], seed=11, duration=2400.0, rate=10.0)
+    res = M.monitor(tr.to_run(), tr.nominal)
+    eff = [c for c in res.changes if c["kind"] == "effect"]
+    assert eff and all(c["t"] > 1200.0 for c in res.changes)
+    assert eff[0]["component"] == "friction" and eff[0]["t"] - 1200.0 < 120.0
+    d = res.to_json()
+    assert d["schema"] == 1 and set(d["changes"][0]) >= {"t", "component", "size_to_noise", "kind"}
+    assert set(d["segments"][0]) >= {"start", "end", "operating_point", "gap_to_noise"}
+    assert math.isclose(d["segments"][-1]["end"], tr.t[-1], rel_tol=1e-9)
+
+
+def test_cli_bad_input_is_one_line(tmp_path, capsys):
+    from heavecomp.cli import main
+
+    p = paper_a("stribeck")
+    prm = tmp_path / "p.toml"
+    from heavecomp.params import save
+
+    save(p, prm)
+    t = np.arange(0.0, 300.0, 0.1)
+    log = tmp_path / "log.csv"
+    log.write_text("t,heave,stroke,wob\n" + "\n".join(f"{x:.1f},0,0,{p.operating_point.wob_setpoint}" for x in t))
+    rc = main(["monitor", str(log), "--params", str(prm), "--out", str(tmp_path / "o")])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert rc == 2 and len(err) == 1 and "pressure" in err[0]
+    assert not (tmp_path / "o" / "monitor.json").exists()
