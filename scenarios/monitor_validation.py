@@ -5,7 +5,7 @@ vessel response) in which conditions change once, half-way (40-60 % of the log):
 set-point (operating), a softer formation, the onset of a seal-friction effect (pressure or
 position friction), a gas leak, a WOB channel that starts to misread (gain). Effects use the
 withheld-effect generator's truth laws and are sized at 5x their noise (the largest channel gap of
-the effect alone over the noise floor; heavecomp.diagnosis.monitor_logs). No-effect logs give the
+the effect alone over the noise floor; heavecomp.benchmark.long_logs). No-effect logs give the
 false-alarm rate, and so does every stretch before a change.
 
 The monitor runs with its committed settings (heavecomp.diagnosis.monitor: BLOCK, THRESHOLD,
@@ -34,7 +34,7 @@ from pathlib import Path
 import numpy as np
 
 from heavecomp.diagnosis import monitor as M
-from heavecomp.diagnosis.monitor_logs import COMPONENT, long_log
+from heavecomp.benchmark.long_logs import COMPONENT, long_log
 from heavecomp.report.scenario import md_table, parse_args, run, write_metrics, write_report
 
 log = logging.getLogger("monitor_validation")

@@ -65,7 +65,7 @@ def test_a_new_set_point_is_operating_a_wob_alone_is_a_misreading():
 def test_monitor_finds_a_seal_friction_onset_on_a_generated_log(tmp_path):
     """A 40-minute 10 Hz log with pressure friction switched on at 1200 s at 5x its noise: one effect
     change, in friction, within a few wave periods; none before it."""
-    from heavecomp.diagnosis.monitor_logs import long_log
+    from heavecomp.benchmark.long_logs import long_log
 
     tr = long_log([(1200.0, "pressure_friction")], seed=11, duration=2400.0, rate=10.0)
     res = M.monitor(tr.to_run(), tr.nominal)

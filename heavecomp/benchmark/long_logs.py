@@ -3,26 +3,28 @@
 A log of one sea (JONSWAP or the shipped Waverider buoy record through a vessel response) in which
 conditions step at given times: a new WOB set-point (an operating change), a softer or stiffer
 formation, the onset of a seal-friction effect, a gas leak, a WOB channel that starts to misread.
-Effects use the withheld-effect generator's *truth* laws (never the candidates' equations) and are
-sized like its near-noise runs: alone, over the whole log, the effect's largest channel gap is
-``size`` x the noise floor (:func:`heavecomp.diagnosis.generator._plant` with ``near``).
+Effects use the benchmark's *truth* laws (:mod:`heavecomp.benchmark.truth`, never the candidates'
+equations) and are sized like its near-noise runs: alone, over the whole log, the effect's largest
+channel gap is ``size`` x the noise floor (:func:`heavecomp.benchmark.sizing.plant` with ``near``).
 
-Each configuration (the conditions after each change, cumulative) is simulated over the whole log
-from the same heave; the log is spliced from them at the change times with a raised-cosine blend of
-:data:`BLEND` seconds (:data:`BLEND_OP` for a set-point change: a driller turns the set-point over
-a minute).  The blend is not a simulation of the transition: the states of two runs are mixed over
-a few seconds.  A gas leak's run has drifted since t = 0, so at its onset the charge steps by the
-leak so far and then keeps drifting (a seal that lets go).
-
-The generator's internals are imported here only (the ``bench`` work moves them to
-``heavecomp.benchmark``: fix this one import).
+A plant law that is the first change is switched on at its time with the state carried on (one
+continuous run, :func:`_onset`: a leak starts from the full charge).  Any other configuration (the
+conditions after each change, cumulative) is simulated over the whole log from the same heave and
+spliced in at its change time with a raised-cosine blend of :data:`BLEND` seconds (:data:`BLEND_OP`
+for a set-point change: a driller turns the set-point over a minute); the blend is not a simulation
+of the transition: the states of two runs are mixed over a few seconds.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from heavecomp.diagnosis import generator as G  # the one import of the withheld-effect generator
+from heavecomp.benchmark.case import MAX_DRAWS, parameter_sets
+from heavecomp.benchmark.generate import TestRun
+from heavecomp.benchmark.sizing import plant
+from heavecomp.benchmark.testbed import Testbed
+from heavecomp.benchmark.truth import LAWS, Part, Setting, truth_composition, TruthLaw
+from heavecomp.benchmark.truth.base import Draw
 from heavecomp.diagnosis.stepper import CHANNELS as SC, run_segments
 from heavecomp.plants.cmc import plant_vectors
 
@@ -36,60 +38,61 @@ LEAD = 120.0  #: s simulated before the log starts (cut: the log starts mid-oper
 NEAR = 0.1  #: the planted size is within +- this share of the asked one [-]
 
 
-def _draw(label, duration, nominal):
-    """``draw(rng, sea)`` of a change (generator._plant's protocol) or None for an operating change."""
-    if label == "formation":
-        k = nominal.formation.stiffness
+def _formation_draw(rng, setting):
+    """A softer formation: its stiffness 20-40 % lower; the size knob is the drop, at most 80 %."""
+    return Draw({"drop": float(rng.uniform(0.2, 0.4))}, "drop", 0.8)
 
-        def draw(rng, sea):
-            return ({"drop": float(rng.uniform(0.2, 0.4))}, "drop", 0.8,
-                    lambda d: ([], ("params", {"formation": {"stiffness": k * (1.0 - d["drop"])}})))
 
-        return draw
-    if label == "sensor_gain":
-        return G._validation_draw(label, "wob", duration, nominal)
-    return G._validation_draw(label, None, duration, nominal)
+#: the formation change as a truth law: wrong nominal parameters (the formation's stiffness) from its time on
+FORMATION = TruthLaw("formation", "string_formation", _formation_draw,
+                     changes=lambda d, nominal: {"formation": {"stiffness": nominal.formation.stiffness
+                                                               * (1.0 - d["drop"])}})
+
+
+def _law(label):
+    """The truth law of a change label (the variant of ``sensor_gain``: the WOB channel)."""
+    return FORMATION if label == "formation" else LAWS[label]
 
 
 def long_log(changes, *, seed=0, duration=3600.0, rate=10.0, sea="jonswap", params="paper_a", size=5.0):
     """A generated log with ``changes`` = [(t [s], label), ...] (labels :data:`LABELS`).
 
-    Returns a :class:`heavecomp.diagnosis.generator.TestRun`; ``truth["changes"]`` lists each change's
+    Returns a :class:`heavecomp.benchmark.TestRun`; ``truth["changes"]`` lists each change's
     ``t``, ``label``, ``component``, parameters and its own gap per channel (over the noise floor)."""
     rng = np.random.default_rng(seed)
-    nominal = G.validation_parameter_sets()[params]
+    nominal = parameter_sets()[params]
     changes = [(float(tc) + LEAD, label) for tc, label in changes]  # on the simulation's clock
-    for _ in range(G.VALIDATION_DRAWS):
-        s = G._Sea(nominal, rng, duration + LEAD, rate, sea=sea)
+    for _ in range(MAX_DRAWS["validation"]):
+        s = Testbed(nominal, rng, duration + LEAD, rate, sea, 1.0)
         parts, info = [], []
         ok = True
         for tc, label in sorted(changes):
             if label == "operating":
                 w0 = nominal.operating_point.wob_setpoint
                 f = float(rng.choice([-1, 1]) * rng.uniform(0.1, 0.2))
-                part = ("operating", [], ("params", {"operating_point": {"wob_setpoint": w0 * (1 + f)}}))
+                part = Part("operating", changes={"operating_point": {"wob_setpoint": w0 * (1 + f)}})
                 parts.append(part)
                 info.append({"t": float(tc) - LEAD, "label": label, "component": COMPONENT[label],
                              "parameters": {"wob_setpoint": w0 * (1 + f)}})
                 continue
-            got = G._plant(label, rng, s, nominal, draw=_draw(label, duration + LEAD, nominal),
-                           near=(size * (1 - NEAR), size * (1 + NEAR)))
+            setting = Setting(nominal, duration + LEAD, "wob" if label == "sensor_gain" else None, s.base)
+            got = plant(_law(label), rng, s, setting, near=(size * (1 - NEAR), size * (1 + NEAR)))
             if got is None:
                 ok = False
                 break
-            desc, part, gap = got
+            drawn, part, gap = got
             parts.append(part)
             info.append({"t": float(tc) - LEAD, "label": label, "component": COMPONENT[label],
-                         "parameters": {k: (v if isinstance(v, str) else float(v)) for k, v in desc.items()},
+                         "parameters": {k: (v if isinstance(v, str) else float(v)) for k, v in drawn.parameters.items()},
                          "gap_channels": gap, "gap_to_noise": max(gap.values())})
         if ok:
             break
     else:
-        raise RuntimeError(f"no sea of {G.VALIDATION_DRAWS} carries {changes} at {size} x the noise floor")
+        raise RuntimeError(f"no sea of {MAX_DRAWS['validation']} carries {changes} at {size} x the noise floor")
     t = s.t
     cols = dict(s.base)
     for k, (tc, label) in enumerate(sorted(changes)):
-        eff = parts[k][1]
+        eff = parts[k].effects
         if eff and k == 0:  # a plant truth law: switched on at tc, the state carried on (no blend)
             cols = _onset(s, nominal, eff, tc)
             continue
@@ -105,8 +108,7 @@ def long_log(changes, *, seed=0, duration=3600.0, rate=10.0, sea="jonswap", para
     truth = {"label": "+".join(lab for _, lab in sorted(changes)) or "none", "changes": info, "seed": seed,
              "sea": s.info, "rate": rate, "duration": duration, "param_set": params, "noise_floor": s.floor,
              "size": size}
-    return G.TestRun(t=t, columns=cols, nominal=nominal, truth=truth).cropped(LEAD)
-
+    return TestRun(t=t, columns=cols, nominal=nominal, truth=truth).cropped(LEAD)
 
 
 def _onset(sea, nominal, effects, tc):
@@ -114,15 +116,15 @@ def _onset(sea, nominal, effects, tc):
     from there, one continuous run: the second part starts from the state the first reached
     (:func:`heavecomp.diagnosis.stepper.run_segments`; the effects' own states from their initial
     values: a leak starts with the full charge)."""
-    comp = G.validation_composition(effects[0].name)
-    plant = plant_vectors(nominal)
+    comp = truth_composition(effects[0].name)
+    pv = plant_vectors(nominal)
     h, n = sea.h, sea.n_steps
     ic = int(round(tc / h))
-    off = run_segments(plant, comp, comp.ep([]), sea.hs, h, [(0, ic + 1)], [None], ic + 2)
+    off = run_segments(pv, comp, comp.ep([]), sea.hs, h, [(0, ic + 1)], [None], ic + 2)
     r = off[ic]
     start = (r[SC.index("stroke")], r[SC.index("stroke_velocity")], r[SC.index("lower_displacement")],
              r[SC.index("lower_velocity")], bool(r[SC.index("stuck")] > 0.5))
-    on = run_segments(plant, comp, comp.ep(effects), sea.hs, h, [(ic, n)], [start], n + 1)
+    on = run_segments(pv, comp, comp.ep(effects), sea.hs, h, [(ic, n)], [start], n + 1)
     on[:ic] = off[:ic]
     grid = on[::sea.out_every][:sea.t.size]
     return {c: grid[:, SC.index(c)].copy() for c in ("heave",) + sea.OUT}
