@@ -10,7 +10,10 @@ false-alarm rate, and so does every stretch before a change.
 
 The monitor runs with its committed settings (heavecomp.diagnosis.monitor: BLOCK, THRESHOLD,
 THRESHOLD_OP, LEARN, WINDOW, DRIFT), the same pass as `heavecomp monitor LOG --params P --out DIR`
-after the log is read. Tuning seeds 30000+, scoring seeds 130000+ (never used for tuning), run once.
+after the log is read. Tuning seeds 30000+; the first scoring set, seeds 130000+, was scored once with
+the first method and its failures then studied: it is spent (`--set spent`, kept for the record);
+the fresh scoring set, seeds 150000+, was generated and scored once after the second method was
+frozen (`--set scoring`).
 
 Scores: detection delay (alarm time minus change time; a change is detected by the first alarm from
 one block before it to MAX_DELAY after it), in seconds and in wave periods (the heave's spectral
@@ -20,6 +23,7 @@ change, and every alarm of a no-effect log, over those hours), per sea and sampl
 
     python scenarios/monitor_validation.py --set tuning
     python scenarios/monitor_validation.py --set scoring
+    python scenarios/monitor_validation.py --set spent
 """
 
 from __future__ import annotations
@@ -47,6 +51,13 @@ def _c(label, seed, *, sea="jonswap", rate=10.0, duration=2400.0, params="paper_
     return {"label": label, "seed": seed, "sea": sea, "rate": rate, "duration": duration, "params": params}
 
 
+LABELS = ("operating", "formation", "pressure_friction", "position_friction", "gas_leak", "sensor_gain")
+#: first seed of each set: the tuning set (30000+), the first scoring set (130000+: run once with the first
+#: method, then its failures were studied, so it is spent: kept for the record) and the fresh scoring set
+#: (150000+, never used before the method was frozen)
+SEEDS = {"tuning": 30000, "spent": 130000, "scoring": 150000}
+
+
 def cases(which, quick=False):
     if which == "tuning":
         s = iter(range(30000, 31000))
@@ -54,12 +65,13 @@ def cases(which, quick=False):
         out += [_c("none", next(s), duration=3600.0), _c("none", next(s), sea="buoy", duration=3600.0),
                 _c("none", next(s), duration=7200.0), _c("none", next(s), sea="buoy", duration=3600.0),
                 _c("none", next(s), rate=50.0, duration=3600.0)]
-    elif which == "scoring":
-        s = iter(range(130000, 131000))
+        # added for the second method (monitor2): position friction, and every change under the buoy at 50 Hz
+        out += [_c("position_friction", next(s))] + [_c(lab, next(s), sea="buoy", rate=50.0) for lab in LABELS]
+    elif which in ("spent", "scoring"):
+        s = iter(range(SEEDS[which], SEEDS[which] + 1000))
         out = []
         for sea, rate in (("jonswap", 10.0), ("buoy", 50.0)):
-            out += [_c(lab, next(s), sea=sea, rate=rate) for lab in
-                    ("operating", "formation", "pressure_friction", "position_friction", "gas_leak", "sensor_gain")]
+            out += [_c(lab, next(s), sea=sea, rate=rate) for lab in LABELS]
         out += [_c("none", next(s), sea=sea, rate=rate, duration=3600.0)
                 for sea in ("jonswap", "buoy") for rate in (10.0, 50.0)]
     else:
@@ -172,7 +184,7 @@ def _figure(rows, path):
 
 def main(argv=None) -> int:
     def extra(p):
-        p.add_argument("--set", choices=("tuning", "scoring"), default="tuning")
+        p.add_argument("--set", choices=("tuning", "spent", "scoring"), default="tuning")
         p.add_argument("--jobs", type=int, default=2)
         p.add_argument("--cache", default=str(Path(tempfile.gettempdir()) / "heavecomp_monitor_validation"),
                        help="folder of the generated logs (reused when present)")
@@ -194,7 +206,8 @@ def main(argv=None) -> int:
     s = summarise(rows)
     _figure(rows, out / "delays.png")
     settings = {k: getattr(M, k) for k in ("BLOCK", "CHUNK", "THRESHOLD", "THRESHOLD_OP", "LEARN", "WINDOW", "DRIFT",
-                                           "CONSISTENT", "SIGMA_MIN")}
+                                           "CLIP", "CONSISTENT", "SIGMA_MIN", "MOVED", "MOVED_SHARE", "COEF_MOVED",
+                                           "MIN_EXCITATION")}
     write_metrics(out, {"set": args.set, "summary": s, "goals": GOALS, "settings": settings, "rows": rows})
     table = md_table(["log", "sea", "rate [Hz]", "change at [s]", "size [x noise]", "detected at +[s]",
                       "[periods]", "component", "right", "false alarms before", "alarms after"],

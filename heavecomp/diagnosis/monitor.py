@@ -18,13 +18,22 @@ Three passes, each streaming over the log (peak memory set by :data:`CHUNK`, not
    median block-mean WOB, the heave reference from its median block-mean heave), so a new
    operating point does not read as a gap; blocks within :data:`BLANK` of an operating change are
    left out (the filters straddle it);
-3. **changes**: a two-sided, self-starting, clipped CUSUM (:func:`cusum`) per equation on
-   log(1 + block statistic), standardised by its block-to-block noise (1.4826 MAD of first
-   differences / sqrt 2, robust to steps, floored at :data:`SIGMA_MIN`).  The component of a change
-   comes from the structure: the equations that moved with it (:func:`_moved`) are those that read
-   one channel -> ``sensors`` (or ``heave_input``); else the component part of the alarming
-   equation that grew.  Every CUSUM then restarts.  Effect alarms an operating change explains
-   (:func:`absorbed`) are dropped.
+3. **changes**: a two-sided, self-starting, clipped CUSUM (:func:`cusum`) on every monitored series
+   (:func:`columns`): per equation, log(1 + block statistic), standardised by its block-to-block noise
+   (1.4826 MAD of first differences / sqrt 2, robust to steps, floored at :data:`SIGMA_MIN`); and per
+   equation and feature of its split (``components.SPLIT``; the seal friction's sign(v) and v in the
+   top-mass balance), the block's joint least-squares **coefficient** of the equation residual on
+   those features (:meth:`BlockSums.coefficients`), signed and standardised the same way.  A
+   coefficient series carries its own baseline (what the nominal model's filters and stick events
+   leave in it), which the self-starting CUSUM learns at the start of each stretch and subtracts: a
+   softer formation moves the lower-mass coefficient of the relative displacement by Delta k although
+   the equation's mean square, dominated by that baseline, hardly moves.  The component of a change
+   comes from the structure (:func:`_attribute_change`): the equations that moved with it (any of
+   their series by :data:`MOVED` sigmas); exactly the equations that read one channel
+   (``components.READS``) -> ``sensors`` (or ``heave_input``); else the component of the feature
+   coefficient that moved most in the equations that moved (its law's own shape); else the
+   component part of the alarming equation that grew.  Every CUSUM then restarts.  Effect alarms
+   an operating change explains (:func:`absorbed`) are dropped.
 
 Why CUSUM and not ``ruptures``: ruptures' PELT (l2 cost, exact search in Python) took 3 s on 500
 blocks, 15 s on 1000 and 77 s on 2000 here (O(n^2.3) when changes are few): a 24 h log has 8640
@@ -38,9 +47,9 @@ statistic between onset and alarm [block noise sigmas] (for an operating change:
 WOB).  ``segments[].gap_to_noise``: per component, sqrt(1 + gap) over the segment, the gap as
 :meth:`ComponentResiduals.gap` computes it (no nominal-replay floor: the monitor runs no replay).
 
-Settings (:data:`DRIFT`, :data:`THRESHOLD`, :data:`THRESHOLD_OP`, :data:`LEARN`, :data:`CLIP`) were
-chosen on the tuning set of ``scenarios/monitor_validation.py`` (false alarms first: 0 in 7.6 h at
-THRESHOLD 10, one in 3.6 h at 8) and frozen before its scoring set ran.
+Settings (:data:`DRIFT`, :data:`THRESHOLD`, :data:`THRESHOLD_OP`, :data:`LEARN`, :data:`CLIP`,
+:data:`MOVED`, :data:`MIN_EXCITATION`) were chosen on the tuning set of ``scenarios/monitor_validation.py``
+(false alarms first) and frozen before its scoring set ran; docs/monitoring.md gives each one's reason.
 
 The chunked residuals are fitted on the chunk (the split of an equation residual into components is
 a least-squares fit over the chunk): the monitor is offline over a finished log; a block's statistic
@@ -52,6 +61,7 @@ from __future__ import annotations
 import dataclasses
 import logging
 import math
+import warnings
 
 import numpy as np
 
@@ -69,7 +79,11 @@ WINDOW = 180  #: blocks of the CUSUM's reference (30 min of 10 s blocks): a slow
 LEARN = 30  #: blocks the reference is learnt from before any alarm, at the log's start and after an operating change [-]
 RELEARN = 12  #: the same after an effect alarm (shorter: the detector is blind meanwhile) [-]
 MOVED_BLOCKS = 3  #: the last blocks up to an alarm compared with the reference to see what moved [-]
-MOVED, MOVED_SHARE = 1.0, 0.3  #: an equation moved with a change: by this many sigmas and share of the largest move
+#: an equation moved with a change: one of its series (mean square or a block coefficient) by this many
+#: sigmas and this share of the alarming series' move (monitor2, tuning set: at 1 sigma one of 20 series
+#: moved by chance at almost every alarm, and a seal friction read as a misread stroke)
+MOVED, MOVED_SHARE = 3.0, 0.3
+COEF_MOVED = 1.0  #: a block coefficient that moved less than this [sigmas] does not name the component
 OP_SLACK = 120.0  #: s around an operating change within which an effect alarm is the operating change
 CLIP = 4.0  #: largest deviation one block adds to a CUSUM [block sigmas]
 DRIFT = 1.0  #: CUSUM allowance k [block sigmas]: shifts below it are not accumulated
@@ -81,6 +95,18 @@ BLANK = 2  #: blocks on each side of an operating change left out of the compone
 #: block at the noise level, z a mean of about 2 x CUTOFF x BLOCK independent squares, is ~sqrt(2/20)/2
 SIGMA_MIN = 0.15
 REFERENCE = 30  #: blocks before an onset the naming compares with [-]
+#: features of the equations' own split (components.SPLIT) left out of the block coefficients: within
+#: one block the time ``t`` is the constant again
+NOT_PER_BLOCK = ("t",)
+MIN_BLOCK_SAMPLES = 10  #: a block coefficient needs this many analysed samples (else NaN) [-]
+#: a block coefficient needs its feature's sum of squares to reach this share of the median block's
+#: (else NaN): a block in which the feature hardly varies (a small stroke for a position feature) gives a
+#: coefficient of heavy tails, which a CUSUM reads as a change [-]
+MIN_EXCITATION = 0.5
+#: smallest block-to-block noise of a standardised block coefficient, as a share of its median
+#: magnitude (a feature the residual never carries would otherwise be standardised by ~0) [-]
+COEF_SIGMA_MIN = 1e-3
+RIDGE = 1e-6  #: relative ridge of a block's normalised normal equations (features of unit scale) [-]
 OP_CHANNELS = ("heave", "stroke", "pressure", "wob")
 MIN_DURATION = 120.0  #: shortest log monitored [s]: a reference stretch of LEARN blocks and as many to compare
 
@@ -118,8 +144,9 @@ class MonitorResult:
         return {"schema": SCHEMA, "changes": self.changes, "segments": self.segments,
                 "sensors": list(self.sensors), "block_s": self.block, "duration_s": self.duration,
                 "noise": self.noise,
-                "method": {"statistic": "log of the block mean square of each component's residual parts over "
-                                        "the noise variance of their equations",
+                "method": {"statistic": "log of the block mean square of each equation residual over its noise "
+                                        "variance, and the block least-squares coefficients of each equation "
+                                        "residual on its split's features",
                            "detector": "two-sided CUSUM", "drift_sigmas": DRIFT, "threshold_sigmas": THRESHOLD,
                            "threshold_op_sigmas": THRESHOLD_OP, "learn_blocks": LEARN, "chunk_s": CHUNK}}
 
@@ -258,6 +285,33 @@ class BlockSums:
     parts: dict
     count: dict
     noise: dict
+    xtx: dict = dataclasses.field(default_factory=dict)
+    xtr: dict = dataclasses.field(default_factory=dict)
+
+    def coefficients(self, e) -> np.ndarray:
+        """Block least-squares coefficients of equation ``e``'s residual on its features
+        (:func:`coefficient_features`), jointly per block (blocks x features) [residual unit per feature
+        unit]; NaN where the block has fewer than :data:`MIN_BLOCK_SAMPLES`, and for a feature whose
+        sum of squares in the block is below :data:`MIN_EXCITATION` of the median block's (it is left
+        out of that block's fit)."""
+        A, y = self.xtx[e], self.xtr[e]
+        nb, m = y.shape
+        d = np.einsum("bii->bi", A).copy()
+        ok_b = self.count[e] >= MIN_BLOCK_SAMPLES
+        ex = np.zeros((nb, m), bool)
+        for k in range(m):
+            good = ok_b & (d[:, k] > 0)
+            if good.any():
+                ex[:, k] = good & (d[:, k] >= MIN_EXCITATION * float(np.median(d[good, k])))
+        sc = np.where(ex, np.sqrt(np.where(ex, d, 1.0)), 1.0)
+        An = A / (sc[:, :, None] * sc[:, None, :])
+        yn = y / sc
+        mask2 = ex[:, :, None] & ex[:, None, :]
+        eye = np.broadcast_to(np.eye(m), An.shape)
+        An = np.where(mask2, An, eye) + RIDGE * eye  # a feature left out: its own row, coefficient 0
+        yn = np.where(ex, yn, 0.0)
+        beta = np.linalg.solve(An, yn[..., None])[..., 0] / sc
+        return np.where(ex, beta, np.nan)
 
     def z_eq(self, e) -> np.ndarray:
         """Block mean square of equation ``e``'s residual over its noise variance [-]."""
@@ -278,6 +332,21 @@ class BlockSums:
         return out
 
 
+def coefficient_features() -> dict:
+    """{equation: ((component, feature), ...)}: the features whose block coefficients the monitor follows
+    (the equation's own split, :data:`heavecomp.diagnosis.components.SPLIT`, less :data:`NOT_PER_BLOCK`;
+    the own component's nominal structure, ``components.STRUCTURE``, where the split lists none: the
+    seal friction's sign(v) and v in the top-mass balance)."""
+    out = {}
+    for e, split in CR.SPLIT.items():
+        keys = [(c, f) for c, fs in split.items() for f in fs if f not in NOT_PER_BLOCK]
+        own = CR.OWN[e]
+        if not split.get(own):
+            keys += [(own, f) for f in CR.STRUCTURE.get(own, ())]
+        out[e] = tuple(keys)
+    return out
+
+
 def component_blocks(run, params, edges, op_bounds, op, noise, *, block=BLOCK, chunk=CHUNK, pad=PAD,
                      progress=None) -> BlockSums:
     """Block sums of the equation residuals and their component parts (pass 2), chunk by chunk, each
@@ -288,6 +357,7 @@ def component_blocks(run, params, edges, op_bounds, op, noise, *, block=BLOCK, c
     seg_edges = [0] + sorted(op_bounds) + [nb]
     per = max(1, int(round(chunk / block)))
     done = 0
+    feats = coefficient_features()
     for s0, s1 in zip(seg_edges[:-1], seg_edges[1:]):
         if s1 <= s0:
             continue
@@ -305,11 +375,20 @@ def component_blocks(run, params, edges, op_bounds, op, noise, *, block=BLOCK, c
             if sums is None:
                 sums = BlockSums({e: np.zeros(nb) for e in cr.equations}, {}, {e: np.zeros(nb) for e in cr.equations},
                                  dict(cr.noise))
+                for e in cr.equations:
+                    m = len(feats.get(e, ()))
+                    sums.xtx[e], sums.xtr[e] = np.zeros((nb, m, m)), np.zeros((nb, m))
             loc = edges[a:b + 1] - j0
             for e, r in cr.equations.items():
                 ok = cr.mask & np.isfinite(r)
                 sums.eq[e][a:b] = np.add.reduceat(np.where(ok, r * r, 0.0), loc[:-1])
                 sums.count[e][a:b] = np.add.reduceat(ok.astype(float), loc[:-1])
+                X = [np.where(ok, CR._column(cr.signals, f), 0.0) for _, f in feats.get(e, ())]
+                r0 = np.where(ok, r, 0.0)
+                for i, xi in enumerate(X):
+                    sums.xtr[e][a:b, i] = np.add.reduceat(xi * r0, loc[:-1])
+                    for k in range(i + 1):
+                        sums.xtx[e][a:b, i, k] = sums.xtx[e][a:b, k, i] = np.add.reduceat(xi * X[k], loc[:-1])
                 for c in COMPONENTS:
                     part = cr.parts.get(c, {}).get(e)
                     if part is not None:
@@ -349,18 +428,6 @@ def _name(sums, e, onset, alarm, start):
     return best
 
 
-def _moved(u, eqs, onset, alarm, start, j):
-    """Equations whose standardised statistic moved between the reference blocks before ``onset`` and
-    onset..alarm: by at least :data:`MOVED` sigmas and :data:`MOVED_SHARE` of the alarming equation's
-    (column ``j``) move."""
-    ref = slice(max(start, onset - REFERENCE), onset)
-    new = slice(max(onset, alarm + 1 - MOVED_BLOCKS), alarm + 1)  # where the change has arrived
-    d = np.array([abs(np.nanmean(u[new, k]) - np.nanmean(u[ref, k])) if np.isfinite(u[ref, k]).any() else 0.0
-                  for k in range(len(eqs))])
-    d = np.nan_to_num(d)
-    return {eqs[k] for k in range(len(eqs)) if k == j or (d[k] >= MOVED and d[k] >= MOVED_SHARE * d[j])}
-
-
 def _component(sums, moved, e, onset, alarm, start):
     """The component of a change from the equations that moved (the structure,
     :mod:`heavecomp.diagnosis.structure`): one equation -> the part of it that grew; the set of
@@ -385,11 +452,73 @@ def _growth(sums, keys, onset, alarm, start) -> float:
     return g
 
 
+def _standardised_coef(c):
+    """A block coefficient over its block-to-block noise (floored at :data:`COEF_SIGMA_MIN` of its median
+    magnitude): signed, so a change of the law's coefficient is seen with its sign."""
+    c = np.asarray(c, float)
+    sig = robust_sigma(c)
+    med = float(np.nanmedian(np.abs(c))) if np.isfinite(c).any() else 0.0
+    floor = max(COEF_SIGMA_MIN * med, 1e-300)
+    return c / max(sig if math.isfinite(sig) else floor, floor)
+
+
+def columns(sums):
+    """The monitored block series: (names, components, equations, standardised matrix).
+
+    One column per equation (its mean square, :func:`_standardised`; component None: named from its
+    parts) and one per (equation, feature) block coefficient (:func:`coefficient_features`; the
+    component whose law the feature belongs to)."""
+    names, comps, eqs, cols = [], [], [], []
+    for e in sums.eq:
+        names.append(e), comps.append(None), eqs.append(e), cols.append(_standardised(sums.z_eq(e)))
+    for e, keys in coefficient_features().items():
+        if e not in sums.xtr:
+            continue
+        beta = sums.coefficients(e)
+        for k, (c, f) in enumerate(keys):
+            names.append(f"{e}:{f}"), comps.append(c), eqs.append(e)
+            cols.append(_standardised_coef(beta[:, k]))
+    return names, comps, eqs, np.column_stack(cols)
+
+
+def _shift(u, onset, alarm, start):
+    """Per column: |mean over the last :data:`MOVED_BLOCKS` up to the alarm - mean over the reference
+    blocks before the onset| [block sigmas] (0 where the reference has no finite block)."""
+    ref = slice(max(start, onset - REFERENCE), onset)
+    new = slice(max(onset, alarm + 1 - MOVED_BLOCKS), alarm + 1)
+    with warnings.catch_warnings():  # an all-NaN column (nothing analysed): no move
+        warnings.simplefilter("ignore", RuntimeWarning)
+        d = np.abs(np.nanmean(u[new], axis=0) - np.nanmean(u[ref], axis=0))
+    return np.nan_to_num(d)
+
+
+def _attribute_change(sums, names, comps, eqs, u, j, onset, alarm, start):
+    """(component, equations that moved) of an alarm in column ``j``, from the structure.
+
+    The columns that moved with it (:data:`MOVED` sigmas and :data:`MOVED_SHARE` of the alarming
+    column's move) give the equations that moved.  Exactly the equations that read one channel
+    (``components.READS``), more than one -> ``sensors`` (or ``heave_input``: :func:`_component`).
+    Otherwise the component of the feature coefficient that moved most among the moved equations'
+    features (the law's own shape: a softer formation moves the lower-mass coefficient of the
+    relative displacement, a leak the gas law's constant, a seal friction the top-mass coefficients
+    of sign(v)); if no coefficient moved, the part of the alarming equation that grew."""
+    d = _shift(u, onset, alarm, start)
+    move = {}
+    for k, e in enumerate(eqs):
+        move[e] = max(move.get(e, 0.0), d[k])
+    moved = {e for e, x in move.items() if x >= MOVED and x >= MOVED_SHARE * d[j]} | {eqs[j]}
+    if len(moved) > 1 and any(moved == set(r) for r in CR.READS.values()):
+        return _component(sums, moved, eqs[j], onset, alarm, start), moved
+    coef = [k for k in range(len(names)) if comps[k] is not None and eqs[k] in moved and d[k] >= COEF_MOVED]
+    if coef:
+        return comps[max(coef, key=lambda k: d[k])], moved
+    return _name(sums, eqs[j], onset, alarm, start), moved
+
+
 def component_changes(sums, block_t, block, op_bounds, *, threshold=THRESHOLD, learn=LEARN):
-    """CUSUM changes of the equation statistics (pass 3), named from the equations that moved and the
-    component parts that grew, restarting at every operating boundary and after every alarm."""
-    eqs = list(sums.eq)
-    u = np.column_stack([_standardised(sums.z_eq(e)) for e in eqs])
+    """CUSUM changes of the equation statistics and block coefficients (pass 3), named by
+    :func:`_attribute_change`, restarting at every operating boundary and after every alarm."""
+    names, comps, eqs, u = columns(sums)
     out = []
     nb = u.shape[0]
     restarts = sorted(set(op_bounds) | {0})
@@ -401,10 +530,9 @@ def component_changes(sums, block_t, block, op_bounds, *, threshold=THRESHOLD, l
             start = stop
             continue
         b, j, onset, size = hit
-        moved = _moved(u, eqs, onset, b, start, j)
-        out.append({"t": float(block_t[b] + block), "component": _component(sums, moved, eqs[j], onset, b, start),
-                    "size_to_noise": size, "kind": "effect", "onset": float(block_t[onset]),
-                    "equations": sorted(moved)})
+        comp, moved = _attribute_change(sums, names, comps, eqs, u, j, onset, b, start)
+        out.append({"t": float(block_t[b] + block), "component": comp, "size_to_noise": size, "kind": "effect",
+                    "onset": float(block_t[onset]), "equations": sorted(moved), "column": names[j]})
         start = b + 1
     return out
 
@@ -485,3 +613,4 @@ def monitor(run, params, *, block=BLOCK, chunk=CHUNK, threshold=THRESHOLD, thres
     segs = segments(changes, block_t, block, op, sums, run.duration)
     return MonitorResult(block_t, block, sums.stats(), op, sums, changes, segs,
                          {k: float(v) for k, v in noise.items()}, _sensors(run), run.duration)
+
