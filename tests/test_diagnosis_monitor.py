@@ -138,3 +138,51 @@ def test_a_coefficient_step_is_found_and_named_by_its_feature():
     assert ch and 2000.0 <= ch[0]["t"] <= 2150.0
     assert ch[0]["column"] == "lower_mass:rel" and ch[0]["component"] == "string_formation"
 
+
+def test_a_segment_is_sliced_with_its_own_clock_and_only_effect_segments_carry_a_gap():
+    from heavecomp.diagnosis.data import MeasuredRun
+
+    t = np.arange(0.0, 100.0, 0.5)
+    run = MeasuredRun(t, {"heave": np.sin(t), "wob": t.copy()}, source="x")
+    sub = M.segment_run(run, 20.0, 30.0)
+    assert sub.t[0] == 0.0 and math.isclose(sub.duration, 10.0) and sub["wob"][0] == 20.0
+    changes = [{"kind": "operating", "onset": 40.0}, {"kind": "effect", "onset": 70.0}]
+    segs = [{"start": 0.0}, {"start": 40.0}, {"start": 70.0}]
+    assert [M.carries_gap(s, changes) for s in segs] == [False, False, True]
+
+
+def test_diagnose_segments_fits_each_effect_segment_on_its_own_slice(monkeypatch):
+    """--diagnose: the diagnoser is given the segment's own slice (clock at 0, at most DIAGNOSE_SPAN long);
+    its verdict lands in segments[].verdict; a segment without an effect change is left alone and a too
+    short one says why."""
+    from heavecomp.diagnosis.data import MeasuredRun
+
+    seen = []
+
+    class Fake:
+        def __init__(self, nominal, candidates=None, **kw):
+            self.nominal = nominal
+
+        def fit(self, run):
+            seen.append((run.t[0], run.duration, run["wob"][0]))
+            self.verdict_ = {"effect": "pressure_friction", "confidence": "high", "component": "friction",
+                             "shrink": 0.5}
+            return self
+
+        def to_json(self):
+            return {"schema": 2, "verdict": self.verdict_}
+
+    monkeypatch.setattr(M, "GapDiagnoser", Fake)
+    t = np.arange(0.0, 3000.0, 1.0)
+    run = MeasuredRun(t, {"wob": t.copy()}, source="x")
+    res = M.MonitorResult(np.arange(300) * 10.0, 10.0, {}, {}, None,
+                          [{"kind": "effect", "onset": 1000.0, "t": 1030.0},
+                           {"kind": "effect", "onset": 2950.0, "t": 2990.0}],
+                          [{"start": 0.0, "end": 1000.0}, {"start": 1000.0, "end": 2950.0},
+                           {"start": 2950.0, "end": 2999.0}], {}, ["wob"], 2999.0)
+    out = M.diagnose_segments(res, run, paper_a("stribeck"))
+    assert seen == [(0.0, M.DIAGNOSE_SPAN, 1000.0)] and list(out) == [1]
+    assert "verdict" not in res.segments[0]
+    assert res.segments[1]["verdict"]["effect"] == "pressure_friction"
+    assert res.segments[1]["verdict"]["span"] == [1000.0, 1000.0 + M.DIAGNOSE_SPAN]
+    assert res.segments[2]["verdict"]["effect"] == "not_diagnosed"

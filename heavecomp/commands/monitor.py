@@ -16,6 +16,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--out", required=True, metavar="DIR", help="output folder (monitor.json, report.md/html, timeline.png)")
     p.add_argument("--block", type=float, default=None, metavar="S",
                    help="statistic block [s] (default 10 s, about one wave period)")
+    p.add_argument("--diagnose", action="store_true",
+                   help="diagnose each segment that starts at an effect change (the gap diagnosis on its first "
+                        "600 s; segments[].verdict in monitor.json, segment_<i>/diagnosis.json)")
+    p.add_argument("--jobs", type=int, default=1, metavar="N", help="candidates fitted concurrently by --diagnose")
 
 
 def run(args) -> int:
@@ -28,7 +32,7 @@ def run(args) -> int:
     from heavecomp.errors import InputError
     from heavecomp.io.series import check_spec, parse_mapping
     from heavecomp.params import load
-    from heavecomp.report.monitor import write_report
+    from heavecomp.report.monitor import write_report, write_segment_diagnoses
     from heavecomp.report.provenance import finish
 
     columns, units = check_spec(parse_mapping(args.columns, "--columns"), parse_mapping(args.units, "--units"),
@@ -37,6 +41,8 @@ def run(args) -> int:
     block = M.BLOCK if args.block is None else args.block
     if not block > 0:
         raise InputError(f"--block must be > 0 s, got {args.block}")
+    if args.jobs < 1:
+        raise InputError(f"--jobs must be >= 1, got {args.jobs}")
     run_ = load_run(args.run, params, columns=columns, units=units)
     if run_.duration < M.MIN_DURATION:
         raise InputError(f"{run_.source}: column 't': the log spans {run_.duration:.3g} s; monitor needs at least "
@@ -48,10 +54,14 @@ def run(args) -> int:
             print(f"[{time.perf_counter() - t0:6.1f} s {100 * frac:3.0f} %] {msg}", file=sys.stderr, flush=True)
 
     res = M.monitor(run_, params, block=block, progress=progress)
+    diagnoses = M.diagnose_segments(res, run_, params, n_jobs=args.jobs, progress=progress) if args.diagnose else {}
     write_report(res, args.out, source=run_.source, extra={"measurement": run_.measurement} if run_.measurement else None)
+    write_segment_diagnoses(diagnoses, args.out)
     finish(args.out, params=params, json_files=("monitor.json",), measured_run=str(Path(args.run).resolve()))
     eff = [c for c in res.changes if c["kind"] == "effect"]
     ops = [c for c in res.changes if c["kind"] == "operating"]
     print(f"{len(eff)} effect change(s), {len(ops)} operating change(s), {len(res.segments)} segment(s)"
-          + "".join(f"; {c['component']} at {c['t']:.0f} s" for c in eff[:5]) + f" -> {args.out}/monitor.json")
+          + "".join(f"; {c['component']} at {c['t']:.0f} s" for c in eff[:5])
+          + "".join(f"; segment {i}: {res.segments[i]['verdict']['effect']}" for i in diagnoses)
+          + f" -> {args.out}/monitor.json")
     return 0

@@ -51,6 +51,10 @@ Settings (:data:`DRIFT`, :data:`THRESHOLD`, :data:`THRESHOLD_OP`, :data:`LEARN`,
 :data:`MOVED`, :data:`MIN_EXCITATION`) were chosen on the tuning set of ``scenarios/monitor_validation.py``
 (false alarms first) and frozen before its scoring set ran; docs/monitoring.md gives each one's reason.
 
+``--diagnose`` (:func:`diagnose_segments`): each segment that starts at an effect change is diagnosed
+by :class:`heavecomp.diagnosis.estimator.GapDiagnoser` on that segment, sliced from the log
+(:func:`segment_run`; the diagnosis estimates the state it starts from).
+
 The chunked residuals are fitted on the chunk (the split of an equation residual into components is
 a least-squares fit over the chunk): the monitor is offline over a finished log; a block's statistic
 may use up to one chunk of data after it.
@@ -67,6 +71,7 @@ import numpy as np
 
 from heavecomp.diagnosis import components as CR
 from heavecomp.diagnosis.data import MeasuredRun, noise_floor
+from heavecomp.diagnosis.estimator import GapDiagnoser
 from heavecomp.effects.base import COMPONENTS
 
 log = logging.getLogger(__name__)
@@ -614,3 +619,57 @@ def monitor(run, params, *, block=BLOCK, chunk=CHUNK, threshold=THRESHOLD, thres
     return MonitorResult(block_t, block, sums.stats(), op, sums, changes, segs,
                          {k: float(v) for k, v in noise.items()}, _sensors(run), run.duration)
 
+
+# ---------------------------------------------------------------------------- --diagnose: one verdict per segment
+DIAGNOSE_SPAN = 600.0  #: a segment is diagnosed on at most its first this many seconds (the diagnosis' benchmarked length) [s]
+DIAGNOSE_MIN = 120.0  #: a segment shorter than this is not diagnosed (a fitted and a held-out part of several wave periods) [s]
+
+
+def carries_gap(segment, changes) -> bool:
+    """A segment carries a gap when it starts at an effect change (the monitor saw the gap appear or
+    change there).  The first segment is the log's reference stretch: its gap, if any, is the one
+    ``heavecomp diagnose`` of the log's start finds."""
+    return any(c["kind"] == "effect" and math.isclose(c["onset"], segment["start"], abs_tol=1e-6) for c in changes)
+
+
+def segment_run(run, start, end) -> MeasuredRun:
+    """The part of ``run`` from ``start`` to ``end`` [s, log time] as a run of its own, its clock restarted
+    at 0 (the diagnosis estimates the state it starts from, as for any log that starts mid-operation)."""
+    k = (run.t >= start) & (run.t <= end)
+    t = run.t[k]
+    return MeasuredRun(t - t[0], {c: y[k] for c, y in run.columns.items()},
+                       source=f"{run.source} [{start:.0f}-{end:.0f} s]", measurement=dict(run.measurement))
+
+
+def diagnose_segments(result, run, params, *, candidates=None, n_jobs=1, span=DIAGNOSE_SPAN, progress=None) -> dict:
+    """Diagnose every segment of ``result`` (:func:`monitor`) that carries a gap (:func:`carries_gap`) with
+    :class:`heavecomp.diagnosis.estimator.GapDiagnoser` on that segment (at most its first ``span`` s).
+
+    Adds ``verdict`` (``effect``, ``confidence``, ``component``, ``shrink``, ``span`` [s, log time]) to
+    each diagnosed segment of ``result.segments``, and ``verdict = {"effect": "not_diagnosed",
+    "reason": ...}`` to a segment that carries a gap but is shorter than :data:`DIAGNOSE_MIN`.
+
+    Returns
+    -------
+    dict
+        Segment index -> the segment's full ``diagnosis.json`` content (``GapDiagnoser.to_json``).
+    """
+    out = {}
+    todo = [i for i, s in enumerate(result.segments) if carries_gap(s, result.changes)]
+    for n, i in enumerate(todo):
+        seg = result.segments[i]
+        a, b = seg["start"], min(seg["end"], seg["start"] + span)
+        if b - a < DIAGNOSE_MIN:
+            seg["verdict"] = {"effect": "not_diagnosed",
+                              "reason": f"segment of {b - a:.0f} s, shorter than {DIAGNOSE_MIN:g} s"}
+            continue
+        if progress:
+            progress(n / len(todo), f"diagnosing segment {i} ({a:.0f}-{b:.0f} s)")
+        d = GapDiagnoser(params, candidates, n_jobs=n_jobs)
+        d.fit(segment_run(run, a, b))
+        v = d.verdict_
+        seg["verdict"] = {"effect": v["effect"], "confidence": v.get("confidence"), "component": v.get("component"),
+                          "shrink": v.get("shrink"), "span": [float(a), float(b)]}
+        out[i] = d.to_json()
+        log.info("segment %d (%.0f-%.0f s): %s (%s)", i, a, b, v["effect"], v.get("confidence"))
+    return out

@@ -52,6 +52,19 @@ def write_json(res, path, extra=None) -> Path:
     return path
 
 
+def write_segment_diagnoses(diagnoses, out) -> list:
+    """Each diagnosed segment's ``diagnosis.json`` (``{index: content}``, :func:`heavecomp.diagnosis.monitor.
+    diagnose_segments`) as ``out/segment_<index>/diagnosis.json``; returns the paths."""
+    paths = []
+    for i, d in sorted(diagnoses.items()):
+        sub = Path(out) / f"segment_{i}"
+        sub.mkdir(parents=True, exist_ok=True)
+        p = sub / "diagnosis.json"
+        p.write_text(json.dumps(clean(d), indent=2) + "\n", encoding="utf-8")
+        paths.append(p)
+    return paths
+
+
 def report_markdown(res, source="", figure="timeline.png") -> str:
     lines = [f"# Monitor — {source}" if source else "# Monitor", "",
              f"{res.duration / 3600:.2f} h of log, sensors {', '.join(res.sensors)}; statistic blocks of "
@@ -69,10 +82,10 @@ def report_markdown(res, source="", figure="timeline.png") -> str:
               "operating change is one the load balance carries (the mean pressure moves with the WOB, "
               "A Δp = -ΔW); a WOB that moves alone is a misreading (`sensors`).", "", "## Segments", ""]
     hdr = ["start [s]", "end [s]", "WOB set-point [kN]", "static stroke [m]", "static pressure [MPa]"] + \
-          [f"{c} gap/noise [-]" for c in COMPONENTS]
+          [f"{c} gap/noise [-]" for c in COMPONENTS] + ["verdict"]
     rows = [[f"{s['start']:.0f}", f"{s['end']:.0f}", f"{s['operating_point']['wob_setpoint'] * 1e-3:.1f}",
              f"{s['operating_point']['static_stroke']:.3f}", f"{s['operating_point']['static_pressure'] * 1e-6:.3f}"]
-            + [f"{s['gap_to_noise'][c]:.2f}" for c in COMPONENTS] for s in res.segments]
+            + [f"{s['gap_to_noise'][c]:.2f}" for c in COMPONENTS] + [_verdict(s)] for s in res.segments]
     lines += [md_table(hdr, rows), "",
               "gap/noise: per component, sqrt(1 + gap) over the segment: the rms of its residual parts over their "
               "equations' noise, less the noise's own share (1.00: at the noise). Residual units: "
@@ -80,6 +93,15 @@ def report_markdown(res, source="", figure="timeline.png") -> str:
               "Method: component residuals (equation error) in windows, a two-sided CUSUM per component on the "
               "log of its block statistic (docs/monitoring.md)."]
     return "\n".join(lines) + "\n"
+
+
+def _verdict(segment) -> str:
+    v = segment.get("verdict")
+    if not v:
+        return "-"
+    if v["effect"] == "not_diagnosed":
+        return f"not diagnosed ({v['reason']})"
+    return f"{v['effect']} ({v.get('confidence')}; {v.get('component') or '-'})"
 
 
 def write_report(res, out, *, source="", extra=None) -> Path:
