@@ -19,6 +19,15 @@ class InputError(ValueError):
     value for it (``"t=ms"``).  The command line turns them into its own flag, when the command
     has one: ``duration must be ...`` becomes ``--duration must be ...``, and a hint such as
     ``; use --units t=ms`` is added (:func:`heavecomp.cli.message`).
+
+    Parameters
+    ----------
+    *args : str
+        The message (one line), as for ``ValueError``.
+    option : str or tuple of str or None
+        The library argument(s) that carry the bad value or would fix it.
+    example : str or None
+        A value for ``option`` that the hint shows.
     """
 
     def __init__(self, *args, option: str | tuple[str, ...] | None = None, example: str | None = None):
@@ -36,6 +45,14 @@ class DataError(InputError):
 
 
 def did_you_mean(word: str, choices) -> str:
-    """Return ``" (did you mean 'x'?)"`` for the closest match, or ``""``."""
+    """Return ``" (did you mean 'x'?)"`` for the closest match, or ``""``.
+
+    Parameters
+    ----------
+    word : str
+        The unknown name as given (converted with ``str``).
+    choices : iterable
+        The known names.
+    """
     close = difflib.get_close_matches(str(word), [str(c) for c in choices], n=1, cutoff=0.6)
     return f" (did you mean '{close[0]}'?)" if close else ""

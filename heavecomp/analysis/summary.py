@@ -15,6 +15,19 @@ def analyse(params, *, n_points: int = 1000, omega_min: float = 1e-3, omega_max:
             sliding_velocity: float | None = None) -> dict:
     """Everything ``heavecomp analyse`` reports for one parameter set (no files).
 
+    Parameters
+    ----------
+    params : CMCParams
+        The parameter set (:class:`heavecomp.params.CMCParams`).
+    n_points : int
+        Number of frequencies of the grid (:func:`~heavecomp.analysis.frequency.frequency_grid`).
+    omega_min : float [rad/s]
+        Lowest frequency.
+    omega_max : float [rad/s], optional
+        Highest frequency; default 10 x the fastest pole.
+    sliding_velocity : float [m/s], optional
+        Also linearise about sliding at this velocity (friction models other than ``none``).
+
     Returns
     -------
     dict

@@ -29,6 +29,7 @@ from heavecomp.params.core import choice, from_table, q, read_text, text
 from heavecomp.params import dumps, from_dict, SETS
 from heavecomp.params import load as load_params
 from heavecomp.params.cmc import TABLES
+from heavecomp.effects.spec import plant_effects
 
 DEFAULT_FILE = Path(__file__).with_name("default_campaign.toml")
 REGIMES = ("none", "stribeck", "rotating_eq6", "rotating_eq7")
@@ -191,7 +192,12 @@ class Campaign:
             path = Path(self.base_dir) / path
         if not path.is_file():
             raise ParameterError(f"campaign.base: not a named set ({', '.join(SETS)}) nor a file: {b}")
-        return load_params(path)
+        params = load_params(path)
+        if plant_effects(params):  # checked strictly; the batch stepper is the nominal CMC's: refuse, never ignore
+            raise ParameterError(f"campaign.base: {path.name} has plant effects in [[effects]] "
+                                 f"({', '.join(n for n, _ in params.effects)}); the campaign's batch stepper runs the "
+                                 "nominal CMC only: simulate such a model with `simulate`")
+        return params
 
     def params_for(self, run: Run, base=None):
         """CMC parameters of one run: base + variant overrides + regime + JONSWAP heave."""
@@ -324,7 +330,21 @@ def _parse_outputs(t):
 
 
 def loads(text_: str, *, base_dir=None, source: str = "<string>") -> Campaign:
-    """Parse campaign TOML text (see module docstring); raises ParameterError."""
+    """Parse campaign TOML text (see module docstring); raises ParameterError.
+
+    Parameters
+    ----------
+    text_ : str
+        The campaign TOML.
+    base_dir : str or os.PathLike or None
+        Folder that relative paths in the text (the base parameter file) are resolved from.
+    source : str
+        Name of the text in messages (its file).
+
+    Returns
+    -------
+    Campaign
+    """
     try:
         data = tomllib.loads(text_)
     except tomllib.TOMLDecodeError as exc:
@@ -361,7 +381,22 @@ def loads(text_: str, *, base_dir=None, source: str = "<string>") -> Campaign:
 
 
 def load(path) -> Campaign:
-    """Read and validate a campaign TOML file."""
+    """Read and validate a campaign TOML file.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The campaign file; relative paths inside it are resolved from its folder.
+
+    Returns
+    -------
+    Campaign
+
+    Raises
+    ------
+    heavecomp.errors.ParameterError
+        A missing or unreadable file, or an invalid campaign.
+    """
     path = Path(path)
     raw = read_text(path, "campaign file")
     return loads(raw, base_dir=path.resolve().parent, source=str(path))

@@ -34,7 +34,7 @@ from heavecomp.controllers import ControllerConfig, Measurement, make
 from heavecomp.errors import InputError
 from heavecomp.params.budget import check_run_size
 from heavecomp.params.cmc import active
-from heavecomp.effects.registry import resolve
+from heavecomp.effects.spec import effects_for
 from heavecomp.plants.cmc import eigen_rate, plant_vectors
 from heavecomp.simulate import excitation
 from heavecomp.simulate.core import CSV_COLUMNS, SimulationResult, default_dt, plant_stepper
@@ -107,7 +107,7 @@ def _percentile_ms(x, q):
 
 def simulate_closed_loop(params, controller="passive", duration: float = 120.0, *, dt: float | None = None,
                          heave=None, noise: Noise | None = Noise(), preview: str = "predicted",
-                         stats_start: float | None = None, progress=None, effects=(), **options) -> ClosedLoopResult:
+                         stats_start: float | None = None, progress=None, effects=None, **options) -> ClosedLoopResult:
     """Simulate the CMC with an active cylinder under ``controller``.
 
     Parameters
@@ -128,7 +128,8 @@ def simulate_closed_loop(params, controller="passive", duration: float = 120.0, 
         ``perfect``: it is given the true future heave (an upper bound).
     effects : sequence, optional
         Effects at the true plant's hooks (:mod:`heavecomp.effects`; the controller knows
-        them only if it was built with them).
+        them only if it was built with them).  None: the plant effects of ``params``' ``[[effects]]``
+        (a named controller is built with them too).
     options
         :class:`~heavecomp.controllers.ControllerConfig` overrides (when
         ``controller`` is a name).
@@ -176,7 +177,7 @@ def simulate_closed_loop(params, controller="passive", duration: float = 120.0, 
         t_in, z_in = heave
         hs = excitation.from_series(t_in, z_in, n_ctrl * Tc + horizon_t, sp, src="heave")
     plant = plant_vectors(params)  # the one params -> vectors conversion
-    advance, state, smooth = plant_stepper(plant, resolve(effects))
+    advance, state, smooth = plant_stepper(plant, effects_for(params, effects))
     rng = np.random.default_rng(noise.seed if noise else 0)
     sig = np.array([noise.stroke, noise.pressure, noise.wob, noise.heave]) if noise else np.zeros(4)
 

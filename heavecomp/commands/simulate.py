@@ -32,7 +32,7 @@ def run(args) -> int:
     from pathlib import Path
 
     from heavecomp.commands._progress import Progress
-    from heavecomp.params import load
+    from heavecomp.effects.spec import load  # the file with its [[effects]] checked
     from heavecomp.report.background import BackgroundFigure
     from heavecomp.report.simulation import write_outputs
     from heavecomp.simulate import simulate

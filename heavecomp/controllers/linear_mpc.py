@@ -38,14 +38,19 @@ class LinearMPC(PredictiveController):
 
     Parameters
     ----------
-    params, config, effects
-        As :class:`~heavecomp.controllers.predictive.PredictiveController` (``effects``: what its model knows).
+    params : heavecomp.params.CMCParams
+        The plant's parameters (the model uses :func:`~heavecomp.controllers.model.controller_params`
+        of them).
+    config : ControllerConfig or None
+        Horizon, weights, limits; None: ``ControllerConfig.from_params(params)``.
+    effects : sequence
+        Effects its model knows, as :class:`~heavecomp.controllers.predictive.PredictiveController`.
     """
 
     name = "linear-mpc"
     log_name = "linear MPC"
 
-    def __init__(self, params, config=None, effects=()):
+    def __init__(self, params, config=None, effects=None):
         import osqp
         import scipy.sparse as sp
 

@@ -28,6 +28,7 @@ import math
 
 import numpy as np
 
+from heavecomp.effects.spec import correct, reading_effects
 from heavecomp.errors import DataError
 from heavecomp.simulate.excitation import HeaveSamples
 from heavecomp.io.series import MAX_DT_S, gaps
@@ -119,9 +120,12 @@ def load_run(path, params=None, *, columns=None, units=None) -> MeasuredRun:
     s = read_series(path, REQUIRED, optional=ANGLES, columns=cols, units=uns, what="measured run")
     data = dict(s.columns)
     t = data.pop("t")
+    fixes = reading_effects(params) if params is not None else []
+    if fixes:  # [[effects]] sensor effects: the log is read as the rig truly moved (docs/contracts/parameter-file.md)
+        data, notes = correct(fixes, t, data)
     run = check_run(t, data, params=params, source=s.source, rows=s.rows)
     run.warnings[:0] = s.warnings
-    run.measurement = s.measurement
+    run.measurement = dict(s.measurement or {}, corrections=notes) if fixes else s.measurement
     return run
 
 

@@ -12,7 +12,8 @@ from typing import Callable
 import numpy as np
 
 from heavecomp.effects.compose import composition_for
-from heavecomp.effects.registry import resolve, split_effects
+from heavecomp.effects.registry import split_effects
+from heavecomp.effects.spec import effects_for
 from heavecomp.errors import InputError
 from heavecomp.params.budget import check_run_size
 from heavecomp.plants.cmc import eigen_rate, plant_vectors
@@ -195,7 +196,7 @@ class SimulationResult:
 
 def simulate(params, duration: float, *, dt: float | None = None, rate: float = 20.0, heave=None,
              progress: Callable[[float], None] | None = None, stats_start: float | None = None,
-             u_active: float = 0.0, effects=()) -> SimulationResult:
+             u_active: float = 0.0, effects=None) -> SimulationResult:
     """Simulate the CMC from rest at the operating point with exact stick-slip.
 
     Parameters
@@ -219,7 +220,8 @@ def simulate(params, duration: float, *, dt: float | None = None, rate: float = 
     effects : sequence, optional
         Effects at the plant's hooks (:mod:`heavecomp.effects`): instances
         (``FlowLoss(resistance=2e5)``), registered names (default parameters) or
-        ``(name, {parameter: value})`` pairs.  None: the nominal CMC (the ahead-of-time stepper).
+        ``(name, {parameter: value})`` pairs.  None: the plant effects of ``params``' ``[[effects]]``
+        (none: the nominal CMC, the ahead-of-time stepper; :func:`heavecomp.effects.spec.effects_for`).
         A heave effect (``heave_reference``) changes the heave the plant sees (the recorded
         ``heave`` stays the measured one); a channel effect (``sensor_gain``, ``sensor_offset``,
         ``sensor_delay``, each with its ``channel``) changes the recorded channel.
@@ -248,7 +250,7 @@ def simulate(params, duration: float, *, dt: float | None = None, rate: float = 
     else:
         t_in, z_in = heave
         hs = excitation.from_series(t_in, z_in, n_steps * h, sp, src="heave")
-    plant_fx, heave_fx, sensor_fx = split_effects(resolve(effects))
+    plant_fx, heave_fx, sensor_fx = split_effects(effects_for(params, effects))
     measured = hs
     for e in heave_fx:  # the heave the plant sees is not the measured one
         hs = e.transform(hs)
