@@ -58,7 +58,25 @@ def long_log(changes, *, seed=0, duration=3600.0, rate=10.0, sea="jonswap", para
     """A generated log with ``changes`` = [(t [s], label), ...] (labels :data:`LABELS`).
 
     Returns a :class:`heavecomp.benchmark.TestRun`; ``truth["changes"]`` lists each change's
-    ``t``, ``label``, ``component``, parameters and its own gap per channel (over the noise floor)."""
+    ``t``, ``label``, ``component``, parameters and its own gap per channel (over the noise floor).
+
+    Parameters
+    ----------
+    changes : list of (float, str)
+        (time [s, log time], label of :data:`LABELS`) of each change.
+    seed : int
+        Seeds the sea, the changes' draws and sizes, and the noise.
+    duration : float [s]
+        Length of the log.
+    rate : float [Hz]
+        Logging rate.
+    sea : str
+        Kind of sea (:func:`heavecomp.benchmark.make_sea`).
+    params : str
+        Nominal parameter set (:func:`heavecomp.benchmark.parameter_sets`).
+    size : float [-]
+        Each effect's own largest channel gap over the noise floor, alone over the whole log.
+    """
     rng = np.random.default_rng(seed)
     nominal = parameter_sets()[params]
     changes = [(float(tc) + LEAD, label) for tc, label in changes]  # on the simulation's clock

@@ -6,6 +6,13 @@ import argparse
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
+    """The ``monitor`` subcommand's arguments.
+
+    Parameters
+    ----------
+    p : argparse.ArgumentParser
+        The ``monitor`` subcommand's parser.
+    """
     p.add_argument("run", metavar="LOG", help="measured log: columns t, heave, stroke, pressure, wob; CSV (any "
                    "delimiter, decimal comma, .gz/.bz2/.xz/.zip), Parquet or .mat (docs/contracts/measured-run.md)")
     p.add_argument("--columns", default=None, metavar="t=NAME,...",
@@ -23,6 +30,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run(args) -> int:
+    """Monitor the log (and with ``--diagnose`` diagnose its segments); returns the exit code.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed arguments of :func:`add_arguments`.
+    """
     import sys
     import time
     from pathlib import Path

@@ -174,7 +174,13 @@ def _block_means(y, edges):
 
 def robust_sigma(x) -> float:
     """Block-to-block noise of a series: 1.4826 MAD of its first differences / sqrt 2 (a step is
-    one outlier among the differences, not a spread) [unit of x]."""
+    one outlier among the differences, not a spread) [unit of x].
+
+    Parameters
+    ----------
+    x : array
+        A block series [any unit].
+    """
     d = np.diff(np.asarray(x, float))
     d = d[np.isfinite(d)]
     if d.size < 4:
@@ -192,7 +198,25 @@ def cusum(u, learn=LEARN, drift=DRIFT, threshold=THRESHOLD, start=0, window=WIND
     deviation is clipped at +-``clip`` sigmas (a robust CUSUM: one stick-slip burst in one block
     cannot raise an alarm alone; a lasting shift still adds every block).
 
-    Returns (alarm block, column, onset block, mean shift between onset and alarm [sigmas]) or None."""
+    Returns (alarm block, column, onset block, mean shift between onset and alarm [sigmas]) or None.
+
+    Parameters
+    ----------
+    u : array (blocks,) or (blocks, series)
+        Standardised series [block sigmas]; NaN blocks skipped.
+    learn : int
+        Finite blocks before any alarm [-].
+    drift : float [sigmas]
+        Allowance k.
+    threshold : float [sigmas]
+        Decision threshold h.
+    start : int
+        First block of the stretch.
+    window : int
+        Blocks of the reference before the change-point estimate.
+    clip : float [sigmas]
+        Largest deviation one block adds.
+    """
     u = np.asarray(u, float)
     if u.ndim == 1:
         u = u[:, None]
@@ -242,7 +266,23 @@ def _sensors(run) -> list:
 def operating_changes(op, block_t, block, params, *, threshold=THRESHOLD_OP, learn=LEARN):
     """Changes of the block-mean WOB; each classified by the load balance (module docstring).
 
-    Returns (list of change dicts, list of operating boundaries as block indices)."""
+    Returns (list of change dicts, list of operating boundaries as block indices).
+
+    Parameters
+    ----------
+    op : dict
+        Block means per channel (``wob``, ``pressure``, ...) [SI].
+    block_t : array [s]
+        Start of every block.
+    block : float [s]
+        Block length.
+    params : CMCParams
+        Nominal parameters (the cylinder area of the load balance).
+    threshold : float [sigmas]
+        CUSUM threshold of the block-mean WOB.
+    learn : int
+        Blocks learnt before any alarm.
+    """
     w, p = op["wob"], op["pressure"]
     sw = robust_sigma(w)
     out, bounds = [], []
@@ -355,7 +395,28 @@ def coefficient_features() -> dict:
 def component_blocks(run, params, edges, op_bounds, op, noise, *, block=BLOCK, chunk=CHUNK, pad=PAD,
                      progress=None) -> BlockSums:
     """Block sums of the equation residuals and their component parts (pass 2), chunk by chunk, each
-    operating segment with its own operating point."""
+    operating segment with its own operating point.
+
+    Parameters
+    ----------
+    run : MeasuredRun
+    params : CMCParams
+        Nominal parameters.
+    edges : array of int
+        Sample index where each block starts, and the end.
+    op_bounds : list of int
+        Blocks where an operating change begins.
+    op : dict
+        Block means per channel [SI].
+    noise : dict
+        Channel -> noise sigma [SI].
+    block : float [s]
+    chunk : float [s]
+        Component-residual window.
+    pad : float [s]
+        Extra samples on each side of a chunk.
+    progress : callable (fraction, message), optional
+    """
     nb = edges.size - 1
     t = run.t
     sums = None
@@ -472,7 +533,12 @@ def columns(sums):
 
     One column per equation (its mean square, :func:`_standardised`; component None: named from its
     parts) and one per (equation, feature) block coefficient (:func:`coefficient_features`; the
-    component whose law the feature belongs to)."""
+    component whose law the feature belongs to).
+
+    Parameters
+    ----------
+    sums : BlockSums
+    """
     names, comps, eqs, cols = [], [], [], []
     for e in sums.eq:
         names.append(e), comps.append(None), eqs.append(e), cols.append(_standardised(sums.z_eq(e)))
@@ -522,7 +588,21 @@ def _attribute_change(sums, names, comps, eqs, u, j, onset, alarm, start):
 
 def component_changes(sums, block_t, block, op_bounds, *, threshold=THRESHOLD, learn=LEARN):
     """CUSUM changes of the equation statistics and block coefficients (pass 3), named by
-    :func:`_attribute_change`, restarting at every operating boundary and after every alarm."""
+    :func:`_attribute_change`, restarting at every operating boundary and after every alarm.
+
+    Parameters
+    ----------
+    sums : BlockSums
+    block_t : array [s]
+        Start of every block.
+    block : float [s]
+    op_bounds : list of int
+        Blocks where an operating change begins.
+    threshold : float [sigmas]
+        CUSUM threshold.
+    learn : int
+        Blocks learnt at a stretch's start.
+    """
     names, comps, eqs, u = columns(sums)
     out = []
     nb = u.shape[0]
@@ -545,7 +625,15 @@ def component_changes(sums, block_t, block, op_bounds, *, threshold=THRESHOLD, l
 def absorbed(effect, op_changes) -> bool:
     """An effect alarm that an operating change explains: it falls between :data:`OP_SLACK` before the
     operating change's onset and its alarm (the new set-point reached the residuals before the
-    block-mean WOB had moved enough)."""
+    block-mean WOB had moved enough).
+
+    Parameters
+    ----------
+    effect : dict
+        An effect change.
+    op_changes : list of dict
+        The operating changes.
+    """
     return any(o["kind"] == "operating" and o["onset"] - OP_SLACK <= effect["t"] <= o["t"] + OP_SLACK
                and effect["onset"] <= o["t"] for o in op_changes)
 
@@ -565,7 +653,20 @@ def _segment_gap(sums, a, b) -> dict:
 
 def segments(changes, block_t, block, op, sums, duration) -> list:
     """The stationary stretches between changes (boundaries at the changes' onsets), each with its
-    operating point (medians of the block means) and gap_to_noise."""
+    operating point (medians of the block means) and gap_to_noise.
+
+    Parameters
+    ----------
+    changes : list of dict
+        Every change.
+    block_t : array [s]
+    block : float [s]
+    op : dict
+        Block means per channel [SI].
+    sums : BlockSums
+    duration : float [s]
+        Length of the log.
+    """
     cuts = sorted({c["onset"] for c in changes})
     bounds = [0.0] + [c for c in cuts if 0.0 < c < duration] + [duration]
     out = []
@@ -587,6 +688,12 @@ def monitor(run, params, *, block=BLOCK, chunk=CHUNK, threshold=THRESHOLD, thres
 
     Parameters
     ----------
+    run : MeasuredRun
+        The log.
+    params : CMCParams
+        The nominal parameters.
+    learn : int
+        Blocks learnt before any alarm (:data:`LEARN`).
     block : float [s]
         Statistic block (:data:`BLOCK`).
     chunk : float [s]
@@ -628,13 +735,28 @@ DIAGNOSE_MIN = 120.0  #: a segment shorter than this is not diagnosed (a fitted 
 def carries_gap(segment, changes) -> bool:
     """A segment carries a gap when it starts at an effect change (the monitor saw the gap appear or
     change there).  The first segment is the log's reference stretch: its gap, if any, is the one
-    ``heavecomp diagnose`` of the log's start finds."""
+    ``heavecomp diagnose`` of the log's start finds.
+
+    Parameters
+    ----------
+    segment : dict
+        A segment of :func:`segments`.
+    changes : list of dict
+        Every change.
+    """
     return any(c["kind"] == "effect" and math.isclose(c["onset"], segment["start"], abs_tol=1e-6) for c in changes)
 
 
 def segment_run(run, start, end) -> MeasuredRun:
     """The part of ``run`` from ``start`` to ``end`` [s, log time] as a run of its own, its clock restarted
-    at 0 (the diagnosis estimates the state it starts from, as for any log that starts mid-operation)."""
+    at 0 (the diagnosis estimates the state it starts from, as for any log that starts mid-operation).
+
+    Parameters
+    ----------
+    run : MeasuredRun
+    start, end : float [s]
+        The part to slice, in log time.
+    """
     k = (run.t >= start) & (run.t <= end)
     t = run.t[k]
     return MeasuredRun(t - t[0], {c: y[k] for c, y in run.columns.items()},
@@ -648,6 +770,22 @@ def diagnose_segments(result, run, params, *, candidates=None, n_jobs=1, span=DI
     Adds ``verdict`` (``effect``, ``confidence``, ``component``, ``shrink``, ``span`` [s, log time]) to
     each diagnosed segment of ``result.segments``, and ``verdict = {"effect": "not_diagnosed",
     "reason": ...}`` to a segment that carries a gap but is shorter than :data:`DIAGNOSE_MIN`.
+
+    Parameters
+    ----------
+    result : MonitorResult
+        What :func:`monitor` found; its segments gain ``verdict``.
+    run : MeasuredRun
+        The log it ran on.
+    params : CMCParams
+        The nominal parameters.
+    candidates : sequence of str, optional
+        Effect names (default: every candidate).
+    n_jobs : int
+        Candidates fitted concurrently.
+    span : float [s]
+        Longest part of a segment diagnosed.
+    progress : callable (fraction, message), optional
 
     Returns
     -------

@@ -100,7 +100,13 @@ HOOK_RESIDUALS = {h: _parts_of(c) + tuple(f"replay/{y}" for y in OUTPUTS)
 
 def channel_residuals(channel) -> tuple:
     """Residual parts a misreading of ``channel`` enters: every equation that reads it (in the part
-    :data:`CHANNEL_PART` names, else the equation's own) and its replay (the heave: every replay)."""
+    :data:`CHANNEL_PART` names, else the equation's own) and its replay (the heave: every replay).
+
+    Parameters
+    ----------
+    channel : str
+        A measured channel (:data:`CHANNELS`).
+    """
     eqs = [e for e, chs in equation_channels().items() if channel in chs]
     part = CHANNEL_PART.get(channel)
     parts = tuple(f"{e}/{part or OWN[e]}" for e in eqs)
@@ -141,7 +147,13 @@ class _Trace(dict):
 def dependence(name) -> frozenset:
     """The signals a candidate's term is a function of in its equation residual, traced from its
     equation-error form (:meth:`Effect.features` on probe signals; ``y``, the channel's own reading,
-    is returned as ``y``).  Empty when the effect has no equation-error form."""
+    is returned as ``y``).  Empty when the effect has no equation-error form.
+
+    Parameters
+    ----------
+    name : str
+        A candidate effect name (:data:`heavecomp.effects.candidates.CANDIDATES`).
+    """
     import numpy as np
 
     cls = _candidate_classes()[name]
@@ -160,7 +172,15 @@ def dependence(name) -> frozenset:
 
 def expand(candidates, sensors) -> list:
     """Candidate names with channel effects expanded to ``name:channel`` for each channel in
-    ``sensors`` (a name already of that form is kept when its channel is present)."""
+    ``sensors`` (a name already of that form is kept when its channel is present).
+
+    Parameters
+    ----------
+    candidates : iterable of str
+        Effect names, a channel effect optionally as ``name:channel``.
+    sensors : iterable of str
+        Channels the log has.
+    """
     lib = _candidate_classes()
     out = []
     for c in candidates:
@@ -182,7 +202,13 @@ def expand(candidates, sensors) -> list:
 
 
 def entries(candidate) -> tuple:
-    """Residual parts a candidate (``name`` or ``name:channel``) enters, whatever the sensors."""
+    """Residual parts a candidate (``name`` or ``name:channel``) enters, whatever the sensors.
+
+    Parameters
+    ----------
+    candidate : str
+        ``name`` or ``name:channel``.
+    """
     base, _, ch = candidate.partition(":")
     cls = _candidate_classes()[base]
     if cls.hook == "channel":
@@ -191,7 +217,13 @@ def entries(candidate) -> tuple:
 
 
 def check_sensors(sensors) -> tuple:
-    """The sensor set in contract order; InputError naming an unknown channel or a missing heave."""
+    """The sensor set in contract order; InputError naming an unknown channel or a missing heave.
+
+    Parameters
+    ----------
+    sensors : iterable of str
+        Channels the log has (:data:`CHANNELS`).
+    """
     sensors = tuple(sensors)
     for s in sensors:
         if s not in CHANNELS:
@@ -202,14 +234,30 @@ def check_sensors(sensors) -> tuple:
 
 
 def computable(sensors) -> tuple:
-    """Residual parts computable from ``sensors``."""
+    """Residual parts computable from ``sensors``.
+
+    Parameters
+    ----------
+    sensors : iterable of str
+        Channels the log has (:data:`CHANNELS`; ``heave`` required).
+    """
     have = set(check_sensors(sensors))
     return tuple(r for r, need in residuals().items() if set(need) <= have)
 
 
 def signature(candidate, sensors, level="structural") -> frozenset:
     """The candidate's fault signature over the computable residuals: residual names, or at
-    ``level="shape"`` (residual, signals) pairs for the equation residuals."""
+    ``level="shape"`` (residual, signals) pairs for the equation residuals.
+
+    Parameters
+    ----------
+    candidate : str
+        ``name`` or ``name:channel``.
+    sensors : iterable of str
+        Channels the log has.
+    level : {"structural", "shape"}
+        Residual parts only, or also the signals the term is a function of.
+    """
     if level not in LEVELS:
         raise InputError(f"unknown isolability level {level!r}; levels: {', '.join(LEVELS)}")
     comp = set(computable(sensors))
@@ -254,7 +302,15 @@ def isolability(sensors, candidates=None, level="structural") -> dict:
 def group_of(effect, iso) -> list:
     """The group of ``effect`` in an :func:`isolability` answer: ``[effect]`` when it is isolable, the
     members it cannot be told from otherwise, ``[]`` when the sensor set cannot detect it.  A channel
-    effect given without its channel (``sensor_gain``) matches every ``sensor_gain:*`` group."""
+    effect given without its channel (``sensor_gain``) matches every ``sensor_gain:*`` group.
+
+    Parameters
+    ----------
+    effect : str
+        An effect name, or ``name:channel``.
+    iso : dict
+        An :func:`isolability` answer.
+    """
     for g in iso["groups"]:
         if effect in g or any(m.partition(":")[0] == effect and ":" not in effect for m in g):
             return list(g)
@@ -262,7 +318,15 @@ def group_of(effect, iso) -> list:
 
 
 def signature_matrix(sensors, candidates=None) -> tuple:
-    """(residual names, {candidate: [0/1 per residual]}) over the computable residuals."""
+    """(residual names, {candidate: [0/1 per residual]}) over the computable residuals.
+
+    Parameters
+    ----------
+    sensors : iterable of str
+        Channels the log has.
+    candidates : iterable of str, optional
+        Effect names (default: every candidate of the gap diagnosis).
+    """
     sensors = check_sensors(sensors)
     res = computable(sensors)
     cands = expand(default_candidates() if candidates is None else candidates, sensors)
@@ -270,7 +334,13 @@ def signature_matrix(sensors, candidates=None) -> tuple:
 
 
 def markdown(level_notes=True) -> str:
-    """The isolability tables of every sensor set of :data:`SENSOR_SETS` (docs/monitoring.md)."""
+    """The isolability tables of every sensor set of :data:`SENSOR_SETS` (docs/monitoring.md).
+
+    Parameters
+    ----------
+    level_notes : bool
+        Add the shape-level notes under each table.
+    """
     lines = []
     for s in SENSOR_SETS:
         st, sh = isolability(s), isolability(s, level="shape")

@@ -17,7 +17,14 @@ from heavecomp.report.scenario import md_table
 def timeline_figure(res, *, title=""):
     """One row per component: the block statistic as rms over noise (sqrt of the block's mean square
     of the component's parts over the noise variance) against time, on a log scale; the block-mean
-    WOB on top; effect changes as solid red lines, operating changes dashed."""
+    WOB on top; effect changes as solid red lines, operating changes dashed.
+
+    Parameters
+    ----------
+    res : heavecomp.diagnosis.monitor.MonitorResult
+    title : str
+        Figure title (default: a description of the rows).
+    """
     plt = _plt()
     rows = 1 + len(COMPONENTS)
     fig, axes = plt.subplots(rows, 1, figsize=(11, 1.5 * rows + 1), sharex=True)
@@ -45,6 +52,16 @@ def timeline_figure(res, *, title=""):
 
 
 def write_json(res, path, extra=None) -> Path:
+    """Write ``monitor.json`` (:meth:`heavecomp.diagnosis.monitor.MonitorResult.to_json`, plus ``extra``).
+
+    Parameters
+    ----------
+    res : heavecomp.diagnosis.monitor.MonitorResult
+    path : str or Path
+        The ``monitor.json`` to write.
+    extra : dict, optional
+        Keys added at the top level (e.g. ``measurement``).
+    """
     d = res.to_json()
     d.update(extra or {})
     path = Path(path)
@@ -54,7 +71,15 @@ def write_json(res, path, extra=None) -> Path:
 
 def write_segment_diagnoses(diagnoses, out) -> list:
     """Each diagnosed segment's ``diagnosis.json`` (``{index: content}``, :func:`heavecomp.diagnosis.monitor.
-    diagnose_segments`) as ``out/segment_<index>/diagnosis.json``; returns the paths."""
+    diagnose_segments`) as ``out/segment_<index>/diagnosis.json``; returns the paths.
+
+    Parameters
+    ----------
+    diagnoses : dict
+        Segment index -> ``diagnosis.json`` content.
+    out : str or Path
+        Output folder.
+    """
     paths = []
     for i, d in sorted(diagnoses.items()):
         sub = Path(out) / f"segment_{i}"
@@ -66,6 +91,16 @@ def write_segment_diagnoses(diagnoses, out) -> list:
 
 
 def report_markdown(res, source="", figure="timeline.png") -> str:
+    """The monitor's ``report.md``: the changes, the segments (with their verdicts) and the method.
+
+    Parameters
+    ----------
+    res : heavecomp.diagnosis.monitor.MonitorResult
+    source : str
+        Name of the log, for the title.
+    figure : str
+        File name of the timeline figure, relative to the report.
+    """
     lines = [f"# Monitor — {source}" if source else "# Monitor", "",
              f"{res.duration / 3600:.2f} h of log, sensors {', '.join(res.sensors)}; statistic blocks of "
              f"{res.block:g} s. {sum(c['kind'] == 'effect' for c in res.changes)} effect change(s), "
@@ -106,7 +141,18 @@ def _verdict(segment) -> str:
 
 def write_report(res, out, *, source="", extra=None) -> Path:
     """``monitor.json``, ``timeline.png`` and ``report.md`` in ``out`` (the HTML comes with the provenance
-    stamp, :func:`heavecomp.report.provenance.finish`)."""
+    stamp, :func:`heavecomp.report.provenance.finish`).
+
+    Parameters
+    ----------
+    res : heavecomp.diagnosis.monitor.MonitorResult
+    out : str or Path
+        Output folder.
+    source : str
+        Name of the log, for the title.
+    extra : dict, optional
+        Keys added to ``monitor.json``.
+    """
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     write_json(res, out / "monitor.json", extra)
