@@ -28,6 +28,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "params": ("heavecomp.commands.params", "write or check a parameter file (built-in sets: paper_a, ...)"),
     "analyse": ("heavecomp.commands.analyse", "linear analysis: k_eff_dc, natural frequencies, heave -> WOB frequency response"),
     "diagnose": ("heavecomp.commands.diagnose", "sim-to-real gap diagnosis of a measured run (which unmodelled effect)"),
+    "monitor": ("heavecomp.commands.monitor", "monitor a long log: when and where the sim-to-real gap appears or changes"),
     "campaign": ("heavecomp.commands.campaign", "run a sea-state campaign: WOB exceedance over a scatter diagram"),
     "stickslip": ("heavecomp.commands.stickslip", "paper B pneumatic cylinder: stick-slip analysis, simulation, map"),
     "identify": ("heavecomp.commands.identify", "identify from measured data: EMPS axis (+ residual diagnosis) or seal friction vs pressure"),
