@@ -45,13 +45,13 @@ def run(args) -> int:
     from heavecomp.diagnosis.data import load_run
     from heavecomp.errors import InputError
     from heavecomp.io.series import check_spec, parse_mapping
-    from heavecomp.params import load
+    from heavecomp.effects.spec import load  # the file with its [[effects]] checked
     from heavecomp.report.monitor import write_report, write_segment_diagnoses
     from heavecomp.report.provenance import finish
 
     columns, units = check_spec(parse_mapping(args.columns, "--columns"), parse_mapping(args.units, "--units"),
                                 "cli")
-    params = load(args.params)
+    params = load(args.params, heave_file=False)  # the log carries the heave: an unused heave file may be absent
     block = M.BLOCK if args.block is None else args.block
     if not block > 0:
         raise InputError(f"--block must be > 0 s, got {args.block}")
@@ -71,7 +71,7 @@ def run(args) -> int:
     diagnoses = M.diagnose_segments(res, run_, params, n_jobs=args.jobs, progress=progress) if args.diagnose else {}
     write_report(res, args.out, source=run_.source, extra={"measurement": run_.measurement} if run_.measurement else None)
     write_segment_diagnoses(diagnoses, args.out)
-    finish(args.out, params=params, json_files=("monitor.json",), measured_run=str(Path(args.run).resolve()))
+    finish(args.out, params=params, json_files=("monitor.json",), heave_used=False, measured_run=str(Path(args.run).resolve()))
     eff = [c for c in res.changes if c["kind"] == "effect"]
     ops = [c for c in res.changes if c["kind"] == "operating"]
     print(f"{len(eff)} effect change(s), {len(ops)} operating change(s), {len(res.segments)} segment(s)"
