@@ -41,7 +41,19 @@ def _copy(cols):
 
 
 def frozen(t, cols, channel, start):
-    """``channel`` holds its value at ``start`` [s] to the end of the run."""
+    """``channel`` holds its value at ``start`` [s] to the end of the run.
+
+    Parameters
+    ----------
+    t : numpy.ndarray [s]
+        Time of each sample.
+    cols : dict of str to numpy.ndarray
+        The run's columns by contract name, SI units; not modified (the result is a copy).
+    channel : str
+        Name of the corrupted column (a key of ``cols``).
+    start : float [s]
+        Time from the run's first sample at which the channel freezes.
+    """
     out = _copy(cols)
     i = int(np.searchsorted(t, t[0] + start))
     out[channel][i:] = out[channel][i]
@@ -52,7 +64,21 @@ def frozen(t, cols, channel, start):
 
 
 def spike(t, cols, channel, index, value):
-    """Sample ``index`` of ``channel`` replaced by ``value``."""
+    """Sample ``index`` of ``channel`` replaced by ``value``.
+
+    Parameters
+    ----------
+    t : numpy.ndarray [s]
+        Time of each sample.
+    cols : dict of str to numpy.ndarray
+        The run's columns by contract name, SI units; not modified (the result is a copy).
+    channel : str
+        Name of the corrupted column (a key of ``cols``).
+    index : int
+        Row of the replaced sample.
+    value : float [unit of the column, SI]
+        The wild value written there.
+    """
     out = _copy(cols)
     out[channel][index] = value
     return np.array(t, dtype=float), out, {"class": "spike", "column": channel, "row": int(index), "value": float(value),
@@ -60,7 +86,17 @@ def spike(t, cols, channel, index, value):
 
 
 def time_scale(t, cols, factor):
-    """The time column multiplied by ``factor`` (every sample kept)."""
+    """The time column multiplied by ``factor`` (every sample kept).
+
+    Parameters
+    ----------
+    t : numpy.ndarray [s]
+        Time of each sample.
+    cols : dict of str to numpy.ndarray
+        The run's columns by contract name, SI units; not modified (the result is a copy).
+    factor : float [-]
+        Scale of the elapsed time (0.5 halves it, 2 doubles it).
+    """
     t = np.asarray(t, dtype=float)
     return t[0] + (t - t[0]) * factor, _copy(cols), {"class": "time_scale", "column": "t", "factor": float(factor),
                                                      "expect": "refuse_or_low"}
@@ -68,7 +104,19 @@ def time_scale(t, cols, factor):
 
 def clock_skew(t, cols, channel, lag):
     """``channel`` read ``lag`` [s] late (its clock behind: y(t) is the value at t - lag); the ends where one
-    side has no data are cut."""
+    side has no data are cut.
+
+    Parameters
+    ----------
+    t : numpy.ndarray [s]
+        Time of each sample.
+    cols : dict of str to numpy.ndarray
+        The run's columns by contract name, SI units; not modified (the result is a copy).
+    channel : str
+        Name of the corrupted column (a key of ``cols``).
+    lag : float [s]
+        How late the channel is read; negative reads it early.
+    """
     t = np.asarray(t, dtype=float)
     out = _copy(cols)
     shifted = np.interp(t - lag, t, out[channel])
@@ -79,14 +127,34 @@ def clock_skew(t, cols, channel, lag):
 
 
 def torn_cell(value, keep):
-    """The text of ``value`` cut after ``keep`` characters (as a file cut mid-write): a number again."""
+    """The text of ``value`` cut after ``keep`` characters (as a file cut mid-write): a number again.
+
+    Parameters
+    ----------
+    value : float [any]
+        The intact number.
+    keep : int
+        Characters of its ``repr`` kept (at least one, never the whole text).
+    """
     s = repr(float(value))
     cut = s[:max(1, min(keep, len(s) - 1))].rstrip(".eE+-")
     return float(cut) if cut not in ("", "-") else 0.0
 
 
 def torn(t, cols, channel, keep):
-    """The last value of ``channel`` cut to its first ``keep`` characters (the last row torn)."""
+    """The last value of ``channel`` cut to its first ``keep`` characters (the last row torn).
+
+    Parameters
+    ----------
+    t : numpy.ndarray [s]
+        Time of each sample.
+    cols : dict of str to numpy.ndarray
+        The run's columns by contract name, SI units; not modified (the result is a copy).
+    channel : str
+        Name of the corrupted column (a key of ``cols``).
+    keep : int
+        Characters kept of the last value's text (:func:`torn_cell`).
+    """
     out = _copy(cols)
     was = float(out[channel][-1])
     out[channel][-1] = torn_cell(was, keep)
@@ -97,7 +165,21 @@ def torn(t, cols, channel, keep):
 
 
 def non_finite(t, cols, channel, index, value=math.inf):
-    """Sample ``index`` of ``channel`` non-finite (``1e400`` reads as inf)."""
+    """Sample ``index`` of ``channel`` non-finite (``1e400`` reads as inf).
+
+    Parameters
+    ----------
+    t : numpy.ndarray [s]
+        Time of each sample.
+    cols : dict of str to numpy.ndarray
+        The run's columns by contract name, SI units; not modified (the result is a copy).
+    channel : str
+        Name of the corrupted column (a key of ``cols``).
+    index : int
+        Row of the replaced sample.
+    value : float
+        The non-finite value written there (default ``inf``).
+    """
     out = _copy(cols)
     out[channel][index] = value
     return np.array(t, dtype=float), out, {"class": "non_finite", "column": channel, "row": int(index),
@@ -105,7 +187,21 @@ def non_finite(t, cols, channel, index, value=math.inf):
 
 
 def scaled(t, cols, channel, factor, cls="setpoint"):
-    """``channel`` multiplied by ``factor`` (a unit declared wrongly: kN as tonnes is x9.81)."""
+    """``channel`` multiplied by ``factor`` (a unit declared wrongly: kN as tonnes is x9.81).
+
+    Parameters
+    ----------
+    t : numpy.ndarray [s]
+        Time of each sample.
+    cols : dict of str to numpy.ndarray
+        The run's columns by contract name, SI units; not modified (the result is a copy).
+    channel : str
+        Name of the corrupted column (a key of ``cols``).
+    factor : float [-]
+        Multiplier of the column.
+    cls : str
+        Class named in the description (``"setpoint"`` or ``"magnitude"``).
+    """
     out = _copy(cols)
     out[channel] = out[channel] * factor
     return np.array(t, dtype=float), out, {"class": cls, "column": channel, "factor": float(factor),
@@ -113,7 +209,21 @@ def scaled(t, cols, channel, factor, cls="setpoint"):
 
 
 def offset(t, cols, channel, value, cls="magnitude"):
-    """``value`` added to ``channel`` (e.g. a pressure that reads below vacuum)."""
+    """``value`` added to ``channel`` (e.g. a pressure that reads below vacuum).
+
+    Parameters
+    ----------
+    t : numpy.ndarray [s]
+        Time of each sample.
+    cols : dict of str to numpy.ndarray
+        The run's columns by contract name, SI units; not modified (the result is a copy).
+    channel : str
+        Name of the corrupted column (a key of ``cols``).
+    value : float [unit of the column, SI]
+        Added to every sample (e.g. [Pa] for the pressure).
+    cls : str
+        Class named in the description.
+    """
     out = _copy(cols)
     out[channel] = out[channel] + value
     return np.array(t, dtype=float), out, {"class": cls, "column": channel, "offset": float(value),
@@ -125,6 +235,19 @@ def corrupt(kind, t, cols, rng, params):
     clearly corrupt, not borderline (the borderline is the quality checks' business).
 
     Returns ``(t, columns, description)``; ``description["expect"]`` is the honest answer (module table).
+
+    Parameters
+    ----------
+    kind : str
+        Corruption class, one of :data:`CLASSES`.
+    t : numpy.ndarray [s]
+        Time of each sample.
+    cols : dict of str to numpy.ndarray
+        The run's columns by contract name, SI units; not modified (the result is a copy).
+    rng : numpy.random.Generator
+        Draws the channel and the size.
+    params : heavecomp.params.CMCParams
+        The rig's parameters (the pressure offset of ``magnitude`` goes below vacuum from its ``p0`` [Pa]).
     """
     t = np.asarray(t, dtype=float)
     n = t.size

@@ -211,7 +211,15 @@ def calibrate(nominal, diagnosis: dict) -> Calibrated:
 
 
 def to_toml(cal: Calibrated, source: str = "") -> str:
-    """The calibrated parameter file's text (round-trips through :func:`heavecomp.params.loads`)."""
+    """The calibrated parameter file's text (round-trips through :func:`heavecomp.params.loads`).
+
+    Parameters
+    ----------
+    cal : Calibrated
+        The calibrated model (:func:`calibrate`).
+    source : str
+        The measured log's name, for the header comment (empty: not named).
+    """
     header = "\n".join(["calibrated model written by heavecomp diagnose"
                         + (f" from {source}" if source else ""), *cal.why,
                         f"held-out shrink the diagnosis reported for it: {cal.expected_shrink:.3f}"])
@@ -219,7 +227,19 @@ def to_toml(cal: Calibrated, source: str = "") -> str:
 
 
 def write(nominal, diagnosis: dict, out_dir, source: str = "") -> Calibrated:
-    """Write ``out_dir/calibrated.toml`` and return the :class:`Calibrated` model."""
+    """Write ``out_dir/calibrated.toml`` and return the :class:`Calibrated` model.
+
+    Parameters
+    ----------
+    nominal : CMCParams
+        The parameter set the diagnosis was run against.
+    diagnosis : dict
+        ``diagnosis.json`` content (:func:`calibrate`).
+    out_dir : str or Path
+        Existing run folder the file is written into.
+    source : str
+        The measured log's name, for the header comment (empty: not named).
+    """
     from pathlib import Path
 
     try:
@@ -284,7 +304,17 @@ class FileEffectsDiagnoser(GapDiagnoser):
 
 def diagnoser(params, *args, **kw) -> GapDiagnoser:
     """The gap diagnoser of ``params``: :class:`FileEffectsDiagnoser` when its ``[[effects]]`` has plant
-    effects, else :class:`GapDiagnoser`."""
+    effects, else :class:`GapDiagnoser`.
+
+    Parameters
+    ----------
+    params : CMCParams
+        The nominal parameters (with their ``[[effects]]``).
+    *args : tuple
+        Passed on to the diagnoser's constructor (:class:`GapDiagnoser`'s arguments).
+    **kw : dict
+        Passed on likewise (keyword arguments such as ``split``, ``n_jobs``).
+    """
     return (FileEffectsDiagnoser if plant_effects(params) else GapDiagnoser)(params, *args, **kw)
 
 
@@ -306,6 +336,20 @@ def replay_shrink(path, calibrated, nominal, diagnosis: dict, *, columns=None, u
     recorded* (the calibrated prediction read back through the sensor effects), on the diagnosis'
     held-out part (``split.validate``) of the channel its shrink is on (``verdict.shrink_channel``):
     shrink = 1 - rms_after / rms_before.
+
+    Parameters
+    ----------
+    path : str or Path, or pandas.DataFrame
+        The measured log, as :func:`heavecomp.diagnosis.data.load_run` takes it.
+    calibrated : CMCParams
+        The calibrated model (e.g. ``calibrated.toml`` loaded).
+    nominal : CMCParams
+        The parameter set the diagnosis was run against.
+    diagnosis : dict
+        ``diagnosis.json`` content: ``verdict`` (``shrink_channel``, ``shrink``), ``split.validate`` [s],
+        ``calibrated.expected_shrink``.
+    columns, units : dict, optional
+        Contract name -> source column / unit, as :func:`~heavecomp.diagnosis.data.load_run` takes them.
 
     Returns
     -------

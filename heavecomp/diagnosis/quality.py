@@ -139,7 +139,15 @@ def _uniform(t, y):
 
 
 def mean_period(t, z) -> float:
-    """Spectral mean period T_m01 = m0 / m1 [s] of a heave (the band 0.02-1 Hz, Welch spectrum)."""
+    """Spectral mean period T_m01 = m0 / m1 [s] of a heave (the band 0.02-1 Hz, Welch spectrum).
+
+    Parameters
+    ----------
+    t : numpy.ndarray [s]
+        Time of each sample (not necessarily uniform; resampled to the median step).
+    z : numpy.ndarray [m]
+        Heave at ``t``; NaN where missing.
+    """
     from scipy.signal import welch
 
     tu, zu = _uniform(t, z)
@@ -161,6 +169,13 @@ def spikes(y, last=True):
     sampled at >= 6 samples per period of the rig's fastest mode (0.44 / 1.8 Hz for paper A, 10 Hz
     logs and up) moves a lone sample off that median by at most (1 - cos(2 pi / 6)) = 1/2 of its own
     amplitude, a quarter of the range at most for a mode as large as the whole channel.
+
+    Parameters
+    ----------
+    y : array_like [unit of the channel]
+        One channel's samples; NaN where missing (not tested).
+    last : bool
+        Also test whether the last sample is a torn row.
     """
     y = np.asarray(y, dtype=float)
     ok = np.isfinite(y)
@@ -189,7 +204,15 @@ def spikes(y, last=True):
 
 
 def frozen_runs(y, min_len):
-    """(start, stop) index pairs of stretches where ``y`` repeats one value exactly for >= ``min_len`` samples."""
+    """(start, stop) index pairs of stretches where ``y`` repeats one value exactly for >= ``min_len`` samples.
+
+    Parameters
+    ----------
+    y : array_like [unit of the channel]
+        One channel's samples.
+    min_len : int
+        Fewest samples of a repeated value that count as frozen.
+    """
     y = np.asarray(y, dtype=float)
     same = np.concatenate([[False], (np.diff(y) == 0.0) & np.isfinite(y[1:])])
     out = []
@@ -376,7 +399,15 @@ def assess(run, params=None, *, rows=None) -> Quality:
 
 def cleaned(run, q: Quality):
     """The run with ``q``'s exclusions as dropouts (NaN), its torn last row dropped, ``q``'s warnings
-    appended and ``run.quality = q`` (a new :class:`MeasuredRun`; ``run`` is unchanged)."""
+    appended and ``run.quality = q`` (a new :class:`MeasuredRun`; ``run`` is unchanged).
+
+    Parameters
+    ----------
+    run : MeasuredRun
+        The checked run.
+    q : Quality
+        What :func:`assess` found in it.
+    """
     cols = {k: np.array(v, dtype=float) for k, v in run.columns.items()}
     for c, idx in q.exclude.items():
         cols[c][idx] = np.nan
@@ -388,7 +419,17 @@ def cleaned(run, q: Quality):
 
 
 def checked(run, params=None, *, rows=None):
-    """:func:`assess` then :func:`cleaned`: the run :func:`heavecomp.diagnosis.data.load_run` returns."""
+    """:func:`assess` then :func:`cleaned`: the run :func:`heavecomp.diagnosis.data.load_run` returns.
+
+    Parameters
+    ----------
+    run : MeasuredRun
+        As :func:`heavecomp.diagnosis.data.check_run` returns it.
+    params : CMCParams, optional
+        The nominal parameters (:func:`assess`).
+    rows : array of int, optional
+        File line of each sample, for messages (:func:`assess`).
+    """
     return cleaned(run, assess(run, params, rows=rows))
 
 
@@ -397,6 +438,13 @@ def apply_quality(verdict: dict, quality) -> dict:
 
     A capped verdict says so: ``verdict["data_quality"]`` lists the problems' kinds and columns and
     ``confidence_capped_from`` the confidence it had.  ``quality`` None or without a cap: unchanged.
+
+    Parameters
+    ----------
+    verdict : dict
+        The diagnosis verdict (``confidence`` among :data:`CONFIDENCE`).
+    quality : Quality or None
+        The run's quality (``run.quality``); None: no cap.
     """
     cap = getattr(quality, "confidence_cap", None)
     if cap is None:

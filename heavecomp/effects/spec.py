@@ -46,7 +46,17 @@ def classes() -> dict:
 def build(name: str, values: dict, where: str = "effects") -> Effect:
     """One effect instance from a file entry, checked strictly (see the module docstring).
 
-    ``where`` prefixes the messages (``effects[0]``)."""
+    ``where`` prefixes the messages (``effects[0]``).
+
+    Parameters
+    ----------
+    name : str
+        The effect's name (a key of :func:`classes`).
+    values : dict
+        Its parameters from the file (SI), with ``channel`` for a channel effect.
+    where : str
+        Prefix of the error messages (the entry's place in the file).
+    """
     lib = classes()
     if name not in lib:
         raise ParameterError(f"{where}.name = {name!r}: unknown effect{did_you_mean(name, lib)}; known: "
@@ -88,7 +98,13 @@ def build(name: str, values: dict, where: str = "effects") -> Effect:
 
 
 def check(params) -> list:
-    """The effect instances of ``params.effects`` (a file's ``[[effects]]``), checked strictly."""
+    """The effect instances of ``params.effects`` (a file's ``[[effects]]``), checked strictly.
+
+    Parameters
+    ----------
+    params : CMCParams
+        Parameters whose ``effects`` (the file's ``[[effects]]`` specs) are read.
+    """
     return [build(name, values, f"effects[{i}]") for i, (name, values) in enumerate(getattr(params, "effects", ()))]
 
 
@@ -113,20 +129,40 @@ def load(path, *, heave_file=True):
 
 
 def plant_effects(params) -> list:
-    """The plant effects of ``params``' ``[[effects]]`` (the terms at the plant's hooks), checked."""
+    """The plant effects of ``params``' ``[[effects]]`` (the terms at the plant's hooks), checked.
+
+    Parameters
+    ----------
+    params : CMCParams
+        Parameters whose ``effects`` (the file's ``[[effects]]`` specs) are read.
+    """
     return [e for e in check(params) if e.kind == "plant"]
 
 
 def reading_effects(params) -> list:
     """The reading effects of ``params``' ``[[effects]]``: how the sensors misread (channel effects and
-    ``heave_reference``), checked; :func:`correct` undoes them on a log."""
+    ``heave_reference``), checked; :func:`correct` undoes them on a log.
+
+    Parameters
+    ----------
+    params : CMCParams
+        Parameters whose ``effects`` (the file's ``[[effects]]`` specs) are read.
+    """
     return [e for e in check(params) if e.kind in ("output", "heave")]
 
 
 def effects_for(params, effects=None) -> list:
     """The effect instances a model of ``params`` runs with: ``effects`` when given (instances, names or
     ``(name, values)`` pairs, :func:`heavecomp.effects.registry.resolve`), else the plant effects of the
-    file's ``[[effects]]`` (its reading effects correct a log, not the plant: :func:`correct`)."""
+    file's ``[[effects]]`` (its reading effects correct a log, not the plant: :func:`correct`).
+
+    Parameters
+    ----------
+    params : CMCParams
+        Parameters whose ``effects`` (the file's ``[[effects]]`` specs) are read.
+    effects : sequence, optional
+        Effects to run instead: instances, names or ``(name, values)`` pairs; None: the file's plant effects.
+    """
     return plant_effects(params) if effects is None else resolve(effects)
 
 
@@ -152,6 +188,15 @@ def correct(effects, t, columns: dict) -> tuple[dict, list]:
     the channel back; its last t_d seconds become NaN, a dropout); ``heave_reference`` replaces the
     measured heave by the heave the compensator sees (``seen``, less the lever arm times the logged
     ``pitch`` when there is one).  Plant effects are ignored.
+
+    Parameters
+    ----------
+    effects : sequence of Effect
+        Effect instances (e.g. :func:`reading_effects`); plant effects among them are ignored.
+    t : array_like [s]
+        Time of each sample.
+    columns : dict of str to array_like
+        The measured channels by contract name (SI); not modified.
 
     Returns
     -------
@@ -182,7 +227,13 @@ def correct(effects, t, columns: dict) -> tuple[dict, list]:
 
 
 def to_spec(effect: Effect) -> tuple:
-    """``(name, {parameter: value})`` of an instance (with its ``channel``), for a parameter file."""
+    """``(name, {parameter: value})`` of an instance (with its ``channel``), for a parameter file.
+
+    Parameters
+    ----------
+    effect : Effect
+        The instance to write.
+    """
     vals = {k: float(v) for k, v in effect.values.items()}
     if isinstance(effect, ChannelEffect):
         vals = {"channel": effect.channel, **vals}
@@ -190,5 +241,11 @@ def to_spec(effect: Effect) -> tuple:
 
 
 def field_units(name: str) -> dict:
-    """Parameter -> unit of the effect ``name`` (for comments and reports)."""
+    """Parameter -> unit of the effect ``name`` (for comments and reports).
+
+    Parameters
+    ----------
+    name : str
+        The effect's name (a key of :func:`classes`).
+    """
     return {f.name: f.metadata.get("unit", "") for f in dataclasses.fields(classes()[name].Params)}

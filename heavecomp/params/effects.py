@@ -42,6 +42,11 @@ def parse(value: Any) -> tuple:
     Raises :class:`ParameterError` (one line naming ``effects[i]`` and the key) for a value that is
     not an array of tables, an entry without a string ``name``, or a value that is neither a finite
     number nor a string.
+
+    Parameters
+    ----------
+    value : Any
+        The parsed TOML value of the ``effects`` key.
     """
     if isinstance(value, Mapping):
         raise ParameterError("effects: expected an array of tables [[effects]] (one per effect), got a table "
@@ -79,12 +84,24 @@ def parse(value: Any) -> tuple:
 
 
 def to_tables(specs) -> list[dict]:
-    """``[{name: ..., key: value}, ...]`` of raw specs (for TOML output and ``to_dict``)."""
+    """``[{name: ..., key: value}, ...]`` of raw specs (for TOML output and ``to_dict``).
+
+    Parameters
+    ----------
+    specs : sequence of (str, dict)
+        Raw ``(name, {key: value})`` specs, as :func:`parse` returns them.
+    """
     return [{NAME: name, **dict(values)} for name, values in specs]
 
 
 def dump(specs) -> str:
-    """TOML text of the ``[[effects]]`` array (empty string for no effects)."""
+    """TOML text of the ``[[effects]]`` array (empty string for no effects).
+
+    Parameters
+    ----------
+    specs : sequence of (str, dict)
+        Raw ``(name, {key: value})`` specs, as :func:`parse` returns them.
+    """
     out = []
     for table in to_tables(specs):
         body = dump_toml({"effects": table}).split("\n", 1)[1]  # the keys, without the [effects] header

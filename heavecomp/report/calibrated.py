@@ -24,7 +24,19 @@ def _value(name: str, key: str, value) -> str:
 
 def what_next(cal: Calibrated, out_dir, *, run_path: str = "LOG", params_path: str = "NOMINAL.toml") -> list[str]:
     """Markdown lines of the "What next" section: what to change (the parameter, the effect, or
-    nothing), the calibrated file, and the exact commands that use it."""
+    nothing), the calibrated file, and the exact commands that use it.
+
+    Parameters
+    ----------
+    cal : Calibrated
+        The calibrated model (:func:`heavecomp.diagnosis.calibrate.calibrate`).
+    out_dir : str or Path
+        The run folder holding ``calibrated.toml`` (paths in the commands are under it).
+    run_path : str
+        The measured log as the user named it, for the re-diagnosis command.
+    params_path : str
+        The nominal parameter file as the user named it.
+    """
     out = Path(out_dir)
     f = (out / FILE).as_posix()
     lines = ["", "## What next", ""]
@@ -72,7 +84,19 @@ def what_next(cal: Calibrated, out_dir, *, run_path: str = "LOG", params_path: s
 
 def write_calibrated(params, out_dir, *, run_path: str, params_path: str) -> Calibrated:
     """Write ``out_dir/calibrated.toml`` from ``out_dir/diagnosis.json``, add the ``calibrated`` block to
-    ``diagnosis.json`` and the "What next" section to ``report.md``; returns the :class:`Calibrated`."""
+    ``diagnosis.json`` and the "What next" section to ``report.md``; returns the :class:`Calibrated`.
+
+    Parameters
+    ----------
+    params : CMCParams
+        The nominal parameters the diagnosis was run against.
+    out_dir : str or Path
+        The diagnosis run folder (with ``diagnosis.json``, and ``report.md`` if written).
+    run_path : str
+        The measured log as the user named it (header comment and commands).
+    params_path : str
+        The nominal parameter file as the user named it.
+    """
     out = Path(out_dir)
     jpath = out / "diagnosis.json"
     d = json.loads(jpath.read_text(encoding="utf-8"))
