@@ -41,7 +41,17 @@ def _gb(n: float) -> str:
 
 def step_drivers(params, rate_fn: Callable, *, top: int = 3) -> list[str]:
     """``["friction.stribeck_velocity = 0.0001 m/s", ...]``: the keys the plant rate ``rate_fn(params)`` [1/s]
-    depends on most (elasticity d ln rate / d ln value over a 10 % change, largest first)."""
+    depends on most (elasticity d ln rate / d ln value over a 10 % change, largest first).
+
+    Parameters
+    ----------
+    params : CMCParams
+        The parameter set.
+    rate_fn : callable(params) -> float [1/s]
+        The plant rate the default step is made from.
+    top : int
+        Most keys returned.
+    """
 
     r0 = rate_fn(params)
     found = []
@@ -127,7 +137,17 @@ def check_run_size(params, *, duration: float, h: float, n_steps: int, n_rows: i
 
 def check_default_step(params, h: float, rate_fn: Callable) -> None:
     """Raise :class:`ParameterError` if the default step ``h`` [s] of ``params`` is below :data:`MIN_DEFAULT_STEP`,
-    naming the keys that set it (``heavecomp params`` checks this; no run of useful length would fit)."""
+    naming the keys that set it (``heavecomp params`` checks this; no run of useful length would fit).
+
+    Parameters
+    ----------
+    params : CMCParams
+        The parameter set.
+    h : float [s]
+        Its default step.
+    rate_fn : callable(params) -> float [1/s]
+        The plant rate the default step is made from; used only to name the keys that set it.
+    """
     if h >= MIN_DEFAULT_STEP:
         return
     drivers = step_drivers(params, rate_fn)

@@ -289,7 +289,15 @@ def check_heave_path(heave, base_dir) -> None:
     or an empty file (an empty string is refused by :class:`CMCParams` itself).  A relative path is
     resolved against ``base_dir`` (the parameter file's folder).  :func:`load` calls it: a file's
     heave is checked when the file is read; a set built or changed in code is checked when its heave
-    is read (:func:`heavecomp.simulate.excitation.read_heave_csv`)."""
+    is read (:func:`heavecomp.simulate.excitation.read_heave_csv`).
+
+    Parameters
+    ----------
+    heave : Heave or None
+        The ``[heave]`` table (None or another kind: nothing to check).
+    base_dir : str or Path or None
+        The parameter file's folder; None: a relative path is not checked.
+    """
     if heave is None or heave.kind != "file" or not heave.path.strip():
         return
     path = Path(heave.path)
@@ -318,7 +326,15 @@ OPTIONAL_EXTRA: dict[str, Any] = {}
 
 
 def from_dict(data: Mapping[str, Any], *, base_dir: Path | None = None) -> CMCParams:
-    """Validate a nested mapping (a parsed TOML file) into :class:`CMCParams`."""
+    """Validate a nested mapping (a parsed TOML file) into :class:`CMCParams`.
+
+    Parameters
+    ----------
+    data : Mapping[str, Any]
+        Table name -> table (SI values), ``effects`` -> the ``[[effects]]`` array.
+    base_dir : Path or None
+        Folder relative paths in the file (``heave.path``) are resolved against (the file's folder).
+    """
     data = dict(data)
     fx = effects_table.parse(data.pop("effects")) if "effects" in data else ()
     for tname, value in data.items():
@@ -340,7 +356,17 @@ def from_dict(data: Mapping[str, Any], *, base_dir: Path | None = None) -> CMCPa
 
 
 def loads(text_: str, *, base_dir: Path | None = None, source: str = "<string>") -> CMCParams:
-    """Parse TOML text into :class:`CMCParams`."""
+    """Parse TOML text into :class:`CMCParams`.
+
+    Parameters
+    ----------
+    text_ : str
+        The TOML text.
+    base_dir : Path or None
+        Folder relative paths in the file (``heave.path``) are resolved against (the file's folder).
+    source : str
+        Name of the text in error messages (the file's path).
+    """
     try:
         data = tomllib.loads(text_)
     except (tomllib.TOMLDecodeError, ValueError) as exc:  # ValueError: an integer of > 4300 digits
@@ -376,14 +402,32 @@ def load(path: str | Path, *, heave_file: bool = True) -> CMCParams:
 
 
 def dumps(params: CMCParams, header: str = "") -> str:
-    """TOML text of a parameter set (round-trips through :func:`loads`)."""
+    """TOML text of a parameter set (round-trips through :func:`loads`).
+
+    Parameters
+    ----------
+    params : CMCParams
+        The parameter set.
+    header : str
+        Comment lines put at the top (empty: none).
+    """
     d = params.to_dict()
     fx = d.pop("effects", [])
     return dump_toml(d, header=header) + ("\n" + effects_table.dump(effects_table.parse(fx)) if fx else "")
 
 
 def save(params: CMCParams, path: str | Path, header: str = "") -> Path:
-    """Write a parameter set as TOML."""
+    """Write a parameter set as TOML.
+
+    Parameters
+    ----------
+    params : CMCParams
+        The parameter set.
+    path : str or Path
+        The TOML file written (replaced if it exists).
+    header : str
+        Comment lines put at the top (empty: none).
+    """
     path = Path(path)
     path.write_text(dumps(params, header), encoding="utf-8")
     return path
@@ -416,7 +460,13 @@ OPTIONAL_EXTRA["active"] = lambda table: from_table(Active, table, "active")
 
 
 def active(params: CMCParams) -> Active:
-    """The ``[active]`` table of ``params``, or its documented defaults when absent."""
+    """The ``[active]`` table of ``params``, or its documented defaults when absent.
+
+    Parameters
+    ----------
+    params : CMCParams
+        The parameter set.
+    """
     return params.extra.get("active") or Active()
 
 

@@ -38,6 +38,8 @@ def q(default=_MISSING, unit: str = "-", *, bounds=(-math.inf, math.inf), symbol
         Physically possible range (inclusive unless ``open_low``).
     symbol : str
         Symbol used in the papers (e.g. ``"F_S"``).
+    doc : str
+        One-line meaning of the key, with its default (the documentation rows, :func:`describe`).
     open_low : bool
         Lower bound is exclusive (e.g. masses must be > 0).
     integer : bool
@@ -56,7 +58,17 @@ def q(default=_MISSING, unit: str = "-", *, bounds=(-math.inf, math.inf), symbol
 
 
 def choice(options, default=_MISSING, *, doc: str = ""):
-    """A string parameter restricted to ``options``."""
+    """A string parameter restricted to ``options``.
+
+    Parameters
+    ----------
+    options : iterable of str
+        The allowed values.
+    default : str, optional
+        Documented default; omit for a required key.
+    doc : str
+        One-line meaning of the key (the documentation rows, :func:`describe`).
+    """
     meta = dict(kind="choice", options=tuple(options), doc=doc, unit="", symbol="")
     if default is _MISSING:
         return dataclasses.field(metadata=meta)
@@ -64,7 +76,15 @@ def choice(options, default=_MISSING, *, doc: str = ""):
 
 
 def text(default=_MISSING, *, doc: str = ""):
-    """A free string parameter (e.g. a file path)."""
+    """A free string parameter (e.g. a file path).
+
+    Parameters
+    ----------
+    default : str, optional
+        Documented default; omit for a required key.
+    doc : str
+        One-line meaning of the key (the documentation rows, :func:`describe`).
+    """
     meta = dict(kind="text", doc=doc, unit="", symbol="")
     if default is _MISSING:
         return dataclasses.field(metadata=meta)
@@ -76,7 +96,15 @@ def _fmt(x) -> str:
 
 
 def unit_hint(meta: Mapping[str, Any], value: float) -> str:
-    """``"; is it in kN? (SI: N)"`` for a value outside the bounds on a side with a likely unit."""
+    """``"; is it in kN? (SI: N)"`` for a value outside the bounds on a side with a likely unit.
+
+    Parameters
+    ----------
+    meta : Mapping[str, Any]
+        A numeric field's metadata (:func:`q`: ``bounds``, ``unit``, ``unit_low``, ``unit_high``).
+    value : float [the field's SI unit]
+        The value outside the bounds.
+    """
     lo, hi = meta["bounds"]
     unit = meta.get("unit", "")
     likely = meta.get("unit_low") if 0 < value <= lo else meta.get("unit_high") if value > hi else ""
@@ -88,7 +116,17 @@ def unit_hint(meta: Mapping[str, Any], value: float) -> str:
 
 
 def check_value(name: str, f: dataclasses.Field, value: Any) -> Any:
-    """Validate one value against its field metadata; return the normalised value."""
+    """Validate one value against its field metadata; return the normalised value.
+
+    Parameters
+    ----------
+    name : str
+        The key as the message names it (``table.key``).
+    f : dataclasses.Field
+        Its field, with the metadata of :func:`q`, :func:`choice` or :func:`text`.
+    value : Any
+        The value read from the file.
+    """
     meta = f.metadata
     kind = meta.get("kind")
     if kind == "number":
@@ -130,6 +168,17 @@ def from_table(cls, table: Mapping[str, Any] | None, prefix: str, *, required: s
     ``required`` overrides which keys must be present (default: every field
     without a default).  Keys of ``cls`` that are not in ``required`` and have no
     default are filled with ``None`` (the caller documents when that is allowed).
+
+    Parameters
+    ----------
+    cls : type
+        A parameter table's dataclass (fields made by :func:`q`, :func:`choice`, :func:`text`).
+    table : Mapping[str, Any] or None
+        The TOML table (SI values); None: an empty table.
+    prefix : str
+        The table's name, prefixed to the keys in messages.
+    required : set of str, optional
+        Keys that must be present.
     """
     table = dict(table or {})
     fields = {f.name: f for f in dataclasses.fields(cls)}
@@ -154,12 +203,24 @@ def from_table(cls, table: Mapping[str, Any] | None, prefix: str, *, required: s
 
 
 def to_table(obj) -> dict[str, Any]:
-    """Dataclass -> plain dict (``None`` values dropped), for TOML output."""
+    """Dataclass -> plain dict (``None`` values dropped), for TOML output.
+
+    Parameters
+    ----------
+    obj : dataclass instance
+        A parameter table.
+    """
     return {f.name: getattr(obj, f.name) for f in dataclasses.fields(obj) if getattr(obj, f.name) is not None}
 
 
 def describe(cls) -> list[tuple[str, str, str, str, str]]:
-    """(key, unit, symbol, default, doc) rows for documentation."""
+    """(key, unit, symbol, default, doc) rows for documentation.
+
+    Parameters
+    ----------
+    cls : type
+        A parameter table's dataclass (fields made by :func:`q`, :func:`choice`, :func:`text`).
+    """
     rows = []
     for f in dataclasses.fields(cls):
         m = f.metadata
@@ -169,7 +230,15 @@ def describe(cls) -> list[tuple[str, str, str, str, str]]:
 
 
 def bounds_rows(cls, prefix: str) -> list[str]:
-    """Markdown rows ``| key | unit | plausible range | why |`` of a parameter table's numeric fields (docs)."""
+    """Markdown rows ``| key | unit | plausible range | why |`` of a parameter table's numeric fields (docs).
+
+    Parameters
+    ----------
+    cls : type
+        A parameter table's dataclass (fields made by :func:`q`, :func:`choice`, :func:`text`).
+    prefix : str
+        The table's name, prefixed to the keys (empty: bare keys).
+    """
     rows = []
     for f in dataclasses.fields(cls):
         m = f.metadata
@@ -184,7 +253,15 @@ def bounds_rows(cls, prefix: str) -> list[str]:
 
 def read_text(path, what: str = "parameter file") -> str:
     """A user's text file (UTF-8, a UTF-8 byte-order mark is dropped), or a one-line
-    :class:`ParameterError` naming it and, for other encodings, where and what they are."""
+    :class:`ParameterError` naming it and, for other encodings, where and what they are.
+
+    Parameters
+    ----------
+    path : str or Path
+        The file.
+    what : str
+        What the file is, for messages (e.g. ``"parameter file"``).
+    """
     from pathlib import Path
 
     path = Path(path)
@@ -209,7 +286,17 @@ def read_text(path, what: str = "parameter file") -> str:
 
 def toml_error_message(text_: str, exc: Exception, source: str) -> str:
     """One line for a TOML syntax error: the file, the key (``table.key``) on the offending line, the parser's
-    message and, for ``0,72``, the hint that TOML numbers use a decimal point."""
+    message and, for ``0,72``, the hint that TOML numbers use a decimal point.
+
+    Parameters
+    ----------
+    text_ : str
+        The TOML text that failed to parse.
+    exc : Exception
+        The parser's error (``tomllib.TOMLDecodeError`` or ``ValueError``).
+    source : str
+        Name of the text in the message (the file's path).
+    """
     import re
 
     msg = str(exc)
@@ -236,7 +323,15 @@ def toml_error_message(text_: str, exc: Exception, source: str) -> str:
 
 
 def dump_toml(tables: Mapping[str, Mapping[str, Any]], header: str = "") -> str:
-    """Write nested ``{table: {key: value}}`` as TOML (numbers, strings, bools)."""
+    """Write nested ``{table: {key: value}}`` as TOML (numbers, strings, bools).
+
+    Parameters
+    ----------
+    tables : Mapping[str, Mapping[str, Any]]
+        Table name -> key -> value (SI).
+    header : str
+        Comment lines put at the top (empty: none).
+    """
     out = [f"# {line}" if line else "#" for line in header.splitlines()] if header else []
     for tname, table in tables.items():
         if out:

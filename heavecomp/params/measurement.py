@@ -31,7 +31,13 @@ class Measurement:
 
 
 def from_table(table) -> Measurement:
-    """Validate a ``[measurement]`` table; one-line ParameterError naming the key."""
+    """Validate a ``[measurement]`` table; one-line ParameterError naming the key.
+
+    Parameters
+    ----------
+    table : Mapping[str, Any]
+        The parsed ``[measurement]`` table: ``columns`` and ``units`` inline tables.
+    """
 
     for k in table:
         if k not in KEYS:
@@ -48,5 +54,11 @@ def from_table(table) -> Measurement:
 
 
 def to_table(m: Measurement) -> dict:
-    """The TOML table of ``m`` (only non-empty keys)."""
+    """The TOML table of ``m`` (only non-empty keys).
+
+    Parameters
+    ----------
+    m : Measurement
+        The validated table.
+    """
     return {k: dict(getattr(m, k)) for k in KEYS if getattr(m, k)}

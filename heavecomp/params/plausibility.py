@@ -84,7 +84,13 @@ def _g(x: float) -> str:
 
 
 def check(p) -> None:
-    """Raise :class:`ParameterError` for the first implausible relation between keys of ``p`` (a CMCParams)."""
+    """Raise :class:`ParameterError` for the first implausible relation between keys of ``p`` (a CMCParams).
+
+    Parameters
+    ----------
+    p : CMCParams
+        A parameter set whose tables passed their own key checks (SI values).
+    """
     c, f, ds, fo, op = p.compensator, p.friction, p.drill_string, p.formation, p.operating_point
     mb_g = ds.lower_mass * G
     if op.wob_setpoint >= mb_g:
@@ -161,7 +167,13 @@ def check(p) -> None:
 
 
 def natural_frequencies(p) -> tuple[np.ndarray, np.ndarray]:
-    """Undamped natural frequencies [Hz] of the frictionless two-mass rig and the mode shapes (columns)."""
+    """Undamped natural frequencies [Hz] of the frictionless two-mass rig and the mode shapes (columns).
+
+    Parameters
+    ----------
+    p : CMCParams
+        The parameter set (masses [kg], stiffnesses [N/m]).
+    """
     c, ds, fo = p.compensator, p.drill_string, p.formation
     K = np.array([[c.gas_stiffness + ds.stiffness, -ds.stiffness], [-ds.stiffness, ds.stiffness + fo.stiffness]])
     m = np.array([c.moving_mass, ds.lower_mass])
