@@ -42,8 +42,6 @@ PACKAGE = ROOT / "heavecomp"
 PENDING = {
     "heavecomp/closed_loop/design.py",
     "heavecomp/closed_loop/loop.py",
-    "heavecomp/commands/diagnose.py",
-    "heavecomp/commands/simulate.py",
     "heavecomp/controllers/registry.py",
     "heavecomp/diagnosis/components.py",
     "heavecomp/diagnosis/data.py",
@@ -57,7 +55,6 @@ PENDING = {
     "heavecomp/effects/features.py",
     "heavecomp/effects/model.py",
     "heavecomp/effects/registry.py",
-    "heavecomp/io/series.py",
     "heavecomp/report/diagnosis.py",
     "heavecomp/simulate/core.py",
     "heavecomp/simulate/excitation.py",

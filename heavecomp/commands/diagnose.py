@@ -10,6 +10,13 @@ MIN_DURATION = 60.0
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
+    """Add the arguments of ``heavecomp diagnose`` to its parser.
+
+    Parameters
+    ----------
+    p : argparse.ArgumentParser
+        The sub-command's parser (:func:`heavecomp.cli.build_parser`).
+    """
     p.add_argument("run", metavar="RUN", help="measured run: columns t, heave, stroke, pressure, wob; CSV (any "
                    "delimiter, decimal comma, .gz/.bz2/.xz/.zip), Parquet or .mat (docs/contracts/measured-run.md)")
     p.add_argument("--columns", default=None, metavar="t=NAME,...",
@@ -30,6 +37,26 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run(args) -> int:
+    """Run ``heavecomp diagnose``: the measured run read and checked against the nominal parameter
+    file, the gap diagnosed (:func:`heavecomp.diagnosis.calibrate.diagnoser`), ``diagnosis.json``,
+    ``report.md`` and ``calibrated.toml`` written to ``--out`` and the verdict printed on one line.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The arguments of :func:`add_arguments`; while it runs ``args.out`` is the staging folder and
+        ``args.out_final`` the folder the user named.
+
+    Returns
+    -------
+    int
+        Exit code (0).
+
+    Raises
+    ------
+    heavecomp.errors.InputError
+        Bad input (the CLI prints one line and exits 2).
+    """
     import sys
     import time
     from pathlib import Path

@@ -6,6 +6,13 @@ import argparse
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
+    """Add the arguments of ``heavecomp simulate`` to its parser.
+
+    Parameters
+    ----------
+    p : argparse.ArgumentParser
+        The sub-command's parser (:func:`heavecomp.cli.build_parser`).
+    """
     p.add_argument("params", metavar="PARAMS.toml", help="CMC parameter file (contract: docs/contracts/parameter-file.md)")
     p.add_argument("--duration", type=float, required=True, metavar="S", help="simulated time [s]")
     p.add_argument("--out", required=True, metavar="DIR", help="output folder")
@@ -29,6 +36,26 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run(args) -> int:
+    """Run ``heavecomp simulate``: the parameter file simulated for ``--duration`` [s] (passive, or with
+    the active controller of ``--controller`` in the loop), ``timeseries.csv``, ``metrics.json`` and the
+    WOB figure written to ``--out`` and the WOB summary printed on one line.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The arguments of :func:`add_arguments`; while it runs ``args.out`` is the staging folder and
+        ``args.out_final`` the folder the user named.
+
+    Returns
+    -------
+    int
+        Exit code (0).
+
+    Raises
+    ------
+    heavecomp.errors.InputError
+        Bad input (the CLI prints one line and exits 2).
+    """
     from pathlib import Path
 
     from heavecomp.commands._progress import Progress

@@ -101,13 +101,29 @@ class Series:
 
 
 def short(path, limit=80) -> str:
-    """A path for a one-line message: long ones cut in the middle."""
+    """A path for a one-line message: long ones cut in the middle.
+
+    Parameters
+    ----------
+    path : str or Path
+        The path.
+    limit : int
+        Most characters kept.
+    """
     s = str(path)
     return s if len(s) <= limit else s[: limit // 2 - 2] + "..." + s[-(limit // 2 - 1):]
 
 
 def parse_mapping(text, option="--columns") -> dict:
-    """``"t=Time,heave=MRU_heave"`` -> ``{"t": "Time", "heave": "MRU_heave"}`` (one-line errors)."""
+    """``"t=Time,heave=MRU_heave"`` -> ``{"t": "Time", "heave": "MRU_heave"}`` (one-line errors).
+
+    Parameters
+    ----------
+    text : str or None
+        Comma-separated ``NAME=VALUE`` pairs; None: an empty mapping.
+    option : str
+        Where the text came from, named at the start of error messages.
+    """
     out = {}
     if text is None:
         return out
@@ -128,6 +144,15 @@ def check_spec(columns: dict | None, units: dict | None, where: str) -> tuple[di
 
     Keys must be contract names; units must be known and of the contract name's kind.
     ``where`` is ``"cli"`` (messages name ``--units t``) or a table name (``measurement.units.t``).
+
+    Parameters
+    ----------
+    columns : dict or None
+        Contract name -> source column header.
+    units : dict or None
+        Contract name -> unit of its source column (a key of :data:`UNITS`).
+    where : str
+        ``"cli"`` or the table's name, for messages.
     """
 
     columns, units = dict(columns or {}), dict(units or {})
@@ -238,6 +263,11 @@ def read_text(path) -> tuple[str, list]:
 
     Returns ``(text, warnings)``; a missing, unreadable, binary or corrupt file is a one-line
     :class:`DataError` (never a ``UnicodeDecodeError``).
+
+    Parameters
+    ----------
+    path : str or Path
+        The file.
     """
     path = Path(path)
     src = short(path)
@@ -288,7 +318,13 @@ _UNIT_RE = re.compile(r"^(.*?)\s*[\[(]\s*([^\])]*)\s*[\])]\s*$")
 
 
 def split_header(name: str) -> tuple[str, str | None]:
-    """``"Time [ms]"`` -> ``("time", "ms")``; ``"WOB_kN"`` -> ``("wob", "kN")``; ``"Heave"`` -> ``("heave", None)``."""
+    """``"Time [ms]"`` -> ``("time", "ms")``; ``"WOB_kN"`` -> ``("wob", "kN")``; ``"Heave"`` -> ``("heave", None)``.
+
+    Parameters
+    ----------
+    name : str
+        A column header as written in the file.
+    """
     raw = " ".join(str(name).replace("\ufeff", "").split())
     m = _UNIT_RE.match(raw)
     base, unit = (m.group(1), m.group(2).strip()) if m else (raw, None)
@@ -623,7 +659,17 @@ def _check_time_unit(t, declared: bool, src: str, header) -> None:
 
 
 def gaps(t, max_gap: float, factor: float = 3.0):
-    """Indices i where ``t[i+1] - t[i]`` exceeds both ``factor`` median intervals and ``max_gap`` [s]."""
+    """Indices i where ``t[i+1] - t[i]`` exceeds both ``factor`` median intervals and ``max_gap`` [s].
+
+    Parameters
+    ----------
+    t : numpy.ndarray [s]
+        Sample times, increasing.
+    max_gap : float [s]
+        Smallest interval that counts as a gap.
+    factor : float [-]
+        Smallest interval that counts as a gap, in median intervals.
+    """
     d = np.diff(t)
     if d.size == 0:
         return np.array([], dtype=int)
