@@ -114,7 +114,7 @@ def short(path, limit=80) -> str:
     return s if len(s) <= limit else s[: limit // 2 - 2] + "..." + s[-(limit // 2 - 1):]
 
 
-def parse_mapping(text, option="--columns") -> dict:
+def parse_mapping(text, option="mapping") -> dict:
     """``"t=Time,heave=MRU_heave"`` -> ``{"t": "Time", "heave": "MRU_heave"}`` (one-line errors).
 
     Parameters
@@ -122,7 +122,8 @@ def parse_mapping(text, option="--columns") -> dict:
     text : str or None
         Comma-separated ``NAME=VALUE`` pairs; None: an empty mapping.
     option : str
-        Where the text came from, named at the start of error messages.
+        Where the text came from, named at the start of error messages (the commands pass their
+        flag, e.g. ``"--columns"``; the library names no flag of its own).
     """
     out = {}
     if text is None:
