@@ -32,6 +32,7 @@ import numpy as np
 from heavecomp.data import WAVERIDER
 from heavecomp.diagnosis.data import check_run, heave_samples, MeasuredRun
 from heavecomp.diagnosis.estimator import GapDiagnoser
+from heavecomp.diagnosis.stepper import CHANNELS as SC, replay_dt, run_fx
 from heavecomp.params import paper_a
 from heavecomp.simulate import excitation
 from heavecomp.diagnosis.truth import (COMPONENT, first_order_lag, heave_lever_arm, heave_mru, OUT_OF_LIBRARY,
@@ -183,8 +184,6 @@ class _Sea:
     OUT = ("stroke", "pressure", "wob")
 
     def __init__(self, nominal, rng, duration, rate, sea=None, noise=1.0):
-        from heavecomp.diagnosis.stepper import replay_dt
-
         self.nominal = nominal
         self.noise = {c: noise * v for c, v in NOISE.items()}
         self.h = h = replay_dt(nominal, rate)
@@ -203,7 +202,6 @@ class _Sea:
         self.heave_noise = rng.normal(0.0, self.noise["heave"], self.t.size)
         self.mask = self.t >= min(30.0, 0.1 * duration)  # the diagnosis' default settling window
         self.floor = self._floor()
-        from heavecomp.diagnosis.stepper import CHANNELS as SC
 
         stuck = grid[:, SC.index("stuck")] > 0.5
         edges = np.diff(np.r_[0, stuck.astype(int), 0])
@@ -214,8 +212,6 @@ class _Sea:
     def sim(self, parts, hs=None, grid=False):
         """Clean channels of the truth model with the effects ``[(name, truth effects, extra), ...]``
         (extra: ``("lag", channel, tau)``, ``("params", changes)``, ``("out", law, kwargs, heave?)``)."""
-        from heavecomp.diagnosis.stepper import CHANNELS as SC, run_fx
-
         effects = []
         prm = self.nominal
         post = []
