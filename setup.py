@@ -74,10 +74,15 @@ def warm_cache():
     folder is set when heavecomp's kernels are imported)."""
     env = dict(os.environ)
     env["PYTHONPATH"] = os.pathsep.join([str(HERE)] + [p for p in env.get("PYTHONPATH", "").split(os.pathsep) if p])
-    t0 = time.perf_counter()
+    import resource
+
+    t0, r0 = time.perf_counter(), resource.getrusage(resource.RUSAGE_CHILDREN)
     try:
         subprocess.run([sys.executable, "-c", WARM], cwd=str(HERE), env=env, check=True)
-        print(f"heavecomp: numba's cache warmed in {time.perf_counter() - t0:.0f} s", file=sys.stderr)
+        r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+        cpu = r1.ru_utime - r0.ru_utime + r1.ru_stime - r0.ru_stime
+        print(f"heavecomp: numba's cache warmed in {time.perf_counter() - t0:.0f} s ({cpu:.0f} s of CPU)",
+              file=sys.stderr)
     except Exception as exc:  # noqa: BLE001 - the first run compiles instead
         print(f"heavecomp: numba's cache not warmed ({type(exc).__name__}: {exc}); "
               "the first run compiles the stepper", file=sys.stderr)

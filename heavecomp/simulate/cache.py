@@ -54,6 +54,11 @@ def base_dir() -> Path:
     return Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "heavecomp"
 
 
+def where() -> Path:
+    """Where compiled kernels are kept now: ``NUMBA_CACHE_DIR`` when the user set it, else :func:`base_dir`."""
+    return Path(os.environ.get("NUMBA_CACHE_DIR") or base_dir())
+
+
 def _file_digest(rel: str) -> bytes:
     return hashlib.sha256((ROOT / rel).read_bytes()).digest()
 

@@ -97,9 +97,12 @@ def _jit_kernel(comp):
         return fn
     with _COMPILE_LOCK:  # the diagnosis' threads: one compile, one notice
         if fn not in _READY:
-            what = ("the stick-slip stepper" if comp is None or not comp.classes
-                    else f"the stick-slip stepper with {len(comp.classes)} effect{'s' * (len(comp.classes) > 1)}")
-            with compiling(what):
+            n = 0 if comp is None else len(comp.classes)
+            what = "the stick-slip stepper" + (f" with {n} effect{'s' * (n > 1)}" if n else "")
+            # loading from the cache can take seconds on a busy machine: no notice then (a late one if
+            # the cache turns out not to hold this signature after all)
+            with compiling(what, notice_after=20.0 if _in_cache(fn) else 1.0,
+                           estimate_s=COMPILE_S + COMPILE_S_PER_EFFECT * n):
                 _ensure_compiled(fn, comp)
             _READY.add(fn)
     return fn
@@ -159,11 +162,26 @@ def _signature(comp=None):
     return tuple(numba.typeof(a) for a in args)
 
 
+def _in_cache(fn) -> bool:
+    """True when numba's cache holds a fresh entry of ``fn`` (same numba, same source; read from
+    numba's cache index: a private interface, so any surprise answers False)."""
+    try:
+        return bool(fn._cache._cache_file._load_index())  # noqa: SLF001
+    except Exception:  # noqa: BLE001
+        return False
+
+
 def _ensure_compiled(fn, comp=None) -> None:
     """Compile (or load from numba's cache) ``fn`` for the canonical argument types."""
     sig = _signature(comp)
     if sig not in fn.overloads:
         fn.compile(sig)
+
+
+#: CPU seconds to compile the nominal stepper, and more per effect of a composition (measured:
+#: 34 s and 73 s for the library's 10 effects, numba 0.68; the notice quotes their sum)
+COMPILE_S = 35
+COMPILE_S_PER_EFFECT = 4
 
 
 class compiling:
@@ -172,11 +190,8 @@ class compiling:
 
     Logged at WARNING on ``heavecomp.simulate.stepper`` (the CLI prints it to stderr)."""
 
-    #: seconds of expected compile time per kernel on a 2-core machine (the notice quotes it)
-    ESTIMATE_S = 60
-
-    def __init__(self, what: str, notice_after: float = 1.0, every: float = 15.0):
-        self.what, self.notice_after, self.every = what, notice_after, every
+    def __init__(self, what: str, notice_after: float = 1.0, every: float = 15.0, estimate_s: float = 60.0):
+        self.what, self.notice_after, self.every, self.estimate_s = what, notice_after, every, estimate_s
         self._done = threading.Event()
         self._thread = None
 
@@ -184,8 +199,8 @@ class compiling:
         t0 = time.monotonic()
         if self._done.wait(self.notice_after):
             return
-        log.warning("heavecomp: compiling %s once (about %d s; kept in %s for the next runs)", self.what,
-                    self.ESTIMATE_S, cache.base_dir())
+        log.warning("heavecomp: compiling %s once (about %d s of CPU; kept in %s for the next runs)", self.what,
+                    self.estimate_s, cache.where())
         while not self._done.wait(self.every):
             log.warning("heavecomp: ... still compiling %s (%.0f s)", self.what, time.monotonic() - t0)
 
