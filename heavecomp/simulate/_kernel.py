@@ -182,7 +182,7 @@ from heavecomp.simulate.layout import (CHANNELS, FX_CHANNELS, NCH, NSTATS, SLIDI
                                       COL_LOWER_VELOCITY, COL_PRESSURE, COL_STROKE, COL_STROKE_VELOCITY,
                                       COL_STUCK, COL_T, COL_TENSION, COL_U_ACTIVE, COL_WOB, STAT_EVENT_CAP_FIRST_T,
                                       STAT_EVENT_CAP_HITS, STAT_N_BREAKAWAY, STAT_N_CONTACT_SWITCH, STAT_N_REVERSAL,
-                                      STAT_N_STICK, STAT_STUCK_TIME)
+                                      STAT_N_STICK, STAT_STUCK_TIME, Plant)
 
 #: the effect parameters of the plain CMC (no effect composed; read-only: for the hook functions'
 #: pins, the stepper takes a writable empty array, :func:`heavecomp.simulate.stepper.plant_args`)
@@ -355,8 +355,8 @@ def advance(state, mode_dir, t0, n_steps, h, plant, drive, out, out_every, out_p
     accumulates STATS.  Releases the GIL (the diagnosis fits in threads).
     """
     X, tau = state_load(state)
-    X, tau, mode, d, pos = _advance(X, tau, int(mode_dir[0]), mode_dir[1], t0, n_steps, h, plant, drive,
-                                    out, out_every, out_pos, stats)
+    X, tau, mode, d, pos = _advance(X, tau, int(mode_dir[0]), mode_dir[1], t0, n_steps, h, own_effects(plant),
+                                    drive, out, out_every, out_pos, stats)
     state_store(state, X, tau)
     mode_dir[0] = mode
     mode_dir[1] = d
@@ -365,6 +365,26 @@ def advance(state, mode_dir, t0, n_steps, h, plant, drive, out, out_every, out_p
 
 #: the name the diagnosis knew the effect-aware stepper by (one stepper now)
 advance_fx = advance
+
+
+@_jit(inline=True)
+def _with_no_effects(plant):
+    """The plant with the effect parameters of no effect as a constant of the compiled code: the
+    nominal stepper reads no EP, and LLVM then drops them (~14 % less time per step than a run-time
+    EP, measured on the 1 h paper-A runs); :func:`kernel_for` binds ``own_effects`` to
+    :func:`_with_its_effects` instead, so the steppers of compositions use the caller's EP."""
+    code, FP, PP, EP, smooth = plant
+    return Plant(code, FP, PP, NO_EFFECTS, smooth)
+
+
+@_jit(inline=True)
+def _with_its_effects(plant):
+    """The plant as given: the effect parameters of a composition's stepper are the caller's."""
+    return plant
+
+
+#: what :func:`advance` makes of the plant's effect parameters (rebound per composition)
+own_effects = _with_no_effects
 
 
 @_jit(inline=True)
@@ -606,6 +626,7 @@ def kernel_for(comp):
     with _LOCK:  # the diagnosis fits in threads: one dispatcher per composition, so one compile
         if comp.key not in _KERNELS:
             env = dict(_hook_env(comp))
+            env["own_effects"] = _with_its_effects
             key = _cache.composition_key(comp)
             for fname in _PER_COMPOSITION:
                 f = globals()[fname]
