@@ -24,7 +24,7 @@ from heavecomp.simulate import simulate
 from heavecomp.plants.cmc import plant_vectors
 from heavecomp.simulate.core import check_events, default_dt
 from heavecomp.simulate.excitation import make_heave
-from heavecomp.simulate.layout import SLIDING, STATS, STUCK
+from heavecomp.simulate.layout import SLIDING, STATS, STUCK, Drive, Plant
 
 # paper-A case with a sine heave whose 5th reversal (t ~ 36 s) leaves the static limit by
 # so little that the motion stops again within 10 ms: inside one 25 ms step
@@ -64,12 +64,12 @@ def test_one_step_from_a_saved_jonswap_state_reverses_then_sticks():
     h = 0.025
     hs = make_heave(p.heave, 3600.0, 0.5 * h)
     pv = plant_vectors(p)
-    state = np.array([-0.4330494954617954, -0.0038108388064242715, 0.020136018167088973, 0.05464465285339529])
+    state = np.array([-0.4330494954617954, -0.0038108388064242715, 0.020136018167088973, 0.05464465285339529, 0.0])
     mode_dir = np.array([float(SLIDING), -1.0])
     stats = np.zeros(len(STATS))
     out = np.zeros((2, K.NCH))
-    K.advance(state, mode_dir, 479.625, 1, h, pv.code, pv.FP, pv.PP, False, 0.0, 0.5 * h,
-              hs.z, hs.dz, hs.ddz, out, 1, 0, stats)
+    K.advance(state, mode_dir, 479.625, 1, h, Plant(pv.code, pv.FP, pv.PP, np.zeros(0), False),
+              Drive(0.0, 0.5 * h, hs.z, hs.dz, hs.ddz), out, 1, 0, stats)
     st = dict(zip(STATS, stats))
     assert st["event_cap_hits"] == 0
     assert (st["n_reversal"], st["n_stick"], st["n_breakaway"]) == (1, 1, 0)

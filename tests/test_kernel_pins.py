@@ -14,6 +14,7 @@ from heavecomp.params import paper_a
 from heavecomp.effects import model as effects_model
 from heavecomp.plants import cmc
 from heavecomp.simulate import _kernel as K
+from heavecomp.simulate.layout import Drive, Plant
 from heavecomp.simulate import simulate
 from heavecomp.simulate.excitation import ramp_factor
 
@@ -84,8 +85,8 @@ def test_kernel_rhs_equals_casadi_model_away_from_zero_velocity(model):
         # held contact state = the clamped law wherever they agree (physics once)
         assert _close(K.lower_accel_contact(s, v, yb, vb, zh, dzh, cm, PP), cmc.lower_accel(s, v, yb, vb, zh, dzh, PP), 1.0)
         X = (s, v, yb, vb)  # the plain CMC's stepper: no effect states
-        EP = K.NO_EFFECTS
-        k = K.rhs(0.0, X, K.SLIDING, float(np.sign(v)), cm, smooth, law.code, law.FP, PP, EP, u, 1.0, Z, DZ, DDZ)
+        plant, drive = Plant(law.code, law.FP, PP, np.zeros(0), smooth), Drive(u, 1.0, Z, DZ, DDZ)
+        k = K.rhs(0.0, X, K.SLIDING, float(np.sign(v)), cm, plant, drive)
         assert k[0] == v and k[2] == vb and len(k) == 4
         assert _close(k[1], xdot[1], 1.0)
         assert _close(k[3], xdot[3], 1.0)
@@ -98,13 +99,13 @@ def test_kernel_rhs_equals_casadi_model_away_from_zero_velocity(model):
         # holding force = M_c dv + F_f (casadi) = kernel's hold
         # the stepper's holding force (at v = 0, where it decides stick or breakaway) = M_c dv of
         # the casadi model at v = 0, whose friction J tanh(0) + K(0) vanishes there
-        hold, pr = K.hold(0.0, X, u, PP, EP, 1.0, Z, DZ, DDZ)
+        hold, pr = K.hold(0.0, X, plant, drive)
         xdot0, y0 = f([s, 0.0, yb, vb], [zh, dzh, ddzh, u])
         assert float(y0[4]) == 0.0
         assert _close(hold, PP[cmc.MC] * float(xdot0[1]), 1e5)
         assert _close(pr, y[2], 1e6)
         # stuck mode: stroke frozen, lower mass as in the model
-        k0 = K.rhs(0.0, X, K.STUCK, 1.0, cm, smooth, law.code, law.FP, PP, EP, u, 1.0, Z, DZ, DDZ)
+        k0 = K.rhs(0.0, X, K.STUCK, 1.0, cm, plant, drive)
         assert k0[0] == 0.0 and k0[1] == 0.0
         assert _close(k0[3], K.lower_accel(s, 0.0, yb, vb, zh, dzh, PP), 1.0)
 

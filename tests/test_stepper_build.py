@@ -7,24 +7,25 @@ import numpy as np
 import pytest
 
 from heavecomp.params import paper_a
-from heavecomp.simulate import core, simulate
+from heavecomp.simulate import simulate
+from heavecomp.simulate import stepper as S
 
 
 @pytest.fixture
 def fresh_stepper(monkeypatch):
-    monkeypatch.setattr(core, "_STEPPER", None)
+    monkeypatch.setattr(S, "_NOMINAL", None)
     yield
-    core._STEPPER = None
+    S._NOMINAL = None
 
 
 def _run(model, monkeypatch, jit):
-    core._STEPPER = None
+    S._NOMINAL = None
     if jit:
         monkeypatch.setenv("HEAVECOMP_JIT", "1")
     else:
         monkeypatch.delenv("HEAVECOMP_JIT", raising=False)
     res = simulate(paper_a(model), 180.0)
-    return res, core.stepper()
+    return res, S.nominal()
 
 
 def test_aot_was_built_and_is_used(fresh_stepper, monkeypatch):
@@ -52,7 +53,7 @@ def test_stale_build_falls_back_to_jit(fresh_stepper, monkeypatch):
 
     monkeypatch.delenv("HEAVECOMP_JIT", raising=False)
     monkeypatch.setattr(layout, "source_hash", lambda: -1)  # as if cmc.py had been edited
-    assert core.stepper() is _kernel.advance
+    assert S.nominal() is _kernel.advance
 
 
 @pytest.mark.parametrize("fork", [True, False])

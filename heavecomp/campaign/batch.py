@@ -2,7 +2,7 @@
 
 :func:`simulate_batch` runs a list of campaign runs through the *same* compiled
 exact stick-slip stepper as :func:`heavecomp.simulate.simulate`
-(:func:`heavecomp.simulate._kernel.advance`), in parallel over runs
+(:func:`heavecomp.simulate.stepper.jit_stepper`), in parallel over runs
 (``numba.prange``), each with its own JONSWAP heave samples
 (:func:`heavecomp.simulate.excitation.jonswap`, identical to the single-run
 path) and a small reusable output buffer of ``BLOCK`` samples.  Nothing of
@@ -32,7 +32,10 @@ import time
 import numba as nb
 import numpy as np
 
-from heavecomp.simulate import _kernel as K, excitation
+from heavecomp.simulate import cache, excitation
+from heavecomp.simulate.layout import (COL_HEAVE, COL_PRESSURE, COL_STROKE, COL_STUCK, COL_T, COL_WOB, NCH, NSTATS,
+                                      STAT_N_BREAKAWAY, STAT_N_REVERSAL, STAT_N_STICK, STUCK, Drive, Plant)
+from heavecomp.simulate.stepper import jit_stepper
 from heavecomp.errors import ParameterError
 from heavecomp.params.budget import HEAVE_BYTES_PER_STEP, MAX_BYTES, check_run_size
 from heavecomp.plants.cmc import eigen_rate, plant_vectors
@@ -48,10 +51,13 @@ ACC = ("n", "sum_dev", "sumsq_dev", "wob_min", "wob_max", "stuck", "stroke_max",
 NACC = len(ACC)
 
 
-@nb.njit(parallel=True, cache=True)
+_advance = jit_stepper()  # the nominal stepper, called from the compiled driver below
+
+
+@cache.jit(("campaign/batch.py",), parallel=True)
 def _batch(codes, FPs, PPs, smooth, hsteps, nsteps, out_every, t_stat, W0, half, Zs, DZs, DDZs,
            kink_step, ddz_left, dev_max, nbins, acc, hist, phist, stats):
-    """Parallel driver: ``prange`` over runs, each stepping ``K.advance`` block by block.
+    """Parallel driver: ``prange`` over runs, each stepping the nominal stepper block by block.
 
     As in :func:`heavecomp.simulate.core.run_kernel`, the steps up to the end of the
     fade-in (``kink_step``, -1 if none) see the left-limit heave acceleration there."""
@@ -61,10 +67,11 @@ def _batch(codes, FPs, PPs, smooth, hsteps, nsteps, out_every, t_stat, W0, half,
         h = hsteps[r]
         oe = out_every[r]
         sp = 0.5 * h
-        out = np.empty((BLOCK + 1, K.NCH))
-        state = np.zeros(4)
-        mode_dir = np.array([float(K.STUCK), 1.0])
-        st = np.zeros(K.NSTATS)
+        out = np.empty((BLOCK + 1, NCH))
+        state = np.zeros(5)  # s, v, y_b, v_b, dwell time (no effect states)
+        mode_dir = np.array([float(STUCK), 1.0])
+        st = np.zeros(NSTATS)
+        plant = Plant(codes[r], FPs[r], PPs[r], np.zeros(0), smooth[r])
         a = acc[r]
         a[3] = np.inf
         a[4] = -np.inf
@@ -86,15 +93,14 @@ def _batch(codes, FPs, PPs, smooth, hsteps, nsteps, out_every, t_stat, W0, half,
                 n = k1 - done
             start = 0 if done == 0 else 1
             if done < k1:
-                pos = K.advance(state, mode_dir, done * h, n, h, codes[r], FPs[r], PPs[r], smooth[r], 0.0, sp,
-                                Zs[r][:2 * k1 + 1].copy(), DZs[r][:2 * k1 + 1].copy(), ddl, out, oe, start, st)
+                drive = Drive(0.0, sp, Zs[r][:2 * k1 + 1].copy(), DZs[r][:2 * k1 + 1].copy(), ddl)
             else:
-                pos = K.advance(state, mode_dir, done * h, n, h, codes[r], FPs[r], PPs[r], smooth[r], 0.0, sp,
-                                Zs[r], DZs[r], DDZs[r], out, oe, start, st)
+                drive = Drive(0.0, sp, Zs[r], DZs[r], DDZs[r])
+            pos = _advance(state, mode_dir, done * h, n, h, plant, drive, out, oe, start, st)
             for j in range(start, pos):
-                if out[j, 0] < t_stat[r] - 1e-12:
+                if out[j, COL_T] < t_stat[r] - 1e-12:
                     continue
-                w = out[j, 4]
+                w = out[j, COL_WOB]
                 d = w - W0[r]
                 a[0] += 1.0
                 a[1] += d
@@ -103,8 +109,8 @@ def _batch(codes, FPs, PPs, smooth, hsteps, nsteps, out_every, t_stat, W0, half,
                     a[3] = w
                 if w > a[4]:
                     a[4] = w
-                a[5] += out[j, 10]
-                s_abs = abs(out[j, 2])
+                a[5] += out[j, COL_STUCK]
+                s_abs = abs(out[j, COL_STROKE])
                 if s_abs > a[6]:
                     a[6] = s_abs
                 outside = 1 if abs(d) > half[r] else 0
@@ -114,10 +120,10 @@ def _batch(codes, FPs, PPs, smooth, hsteps, nsteps, out_every, t_stat, W0, half,
                 prev_out = outside
                 if w <= 0.0:
                     a[10] += 1.0
-                z = out[j, 1]
+                z = out[j, COL_HEAVE]
                 a[11] += z
                 a[12] += z * z
-                p = out[j, 3]
+                p = out[j, COL_PRESSURE]
                 if p < a[13]:
                     a[13] = p
                 if p > a[14]:
@@ -147,8 +153,19 @@ def _batch(codes, FPs, PPs, smooth, hsteps, nsteps, out_every, t_stat, W0, half,
                     peak = abs(d)
                 prev_d = d
             done += n
-        for k in range(4):
+        for k in range(4):  # stuck time and the stick, breakaway, reversal counts
             stats[r, k] = st[k]
+
+
+def compile_batch() -> None:
+    """Compile :func:`_batch` for the argument types :func:`simulate_batch` passes (or load it from
+    numba's cache): a call over no run (``setup.py`` runs it at install)."""
+    i8, f8 = np.int64, np.float64
+    e1 = np.zeros(0)
+    e2 = np.zeros((0, 1))
+    _batch(np.zeros(0, dtype=i8), e2, e2, np.zeros(0, dtype=np.bool_), e1, np.zeros(0, dtype=i8),
+           np.zeros(0, dtype=i8), e1, e1, e1, e2, e2, e2, np.zeros(0, dtype=i8), e1, f8(1.0), 2,
+           np.zeros((0, NACC)), np.zeros((0, 4), dtype=i8), np.zeros((0, 2), dtype=i8), np.zeros((0, 4)))
 
 
 def check_budget(campaign, runs, base=None) -> None:
@@ -376,7 +393,8 @@ def simulate_batch(campaign, runs, *, threads: int | None = None, base=None) -> 
                "frac_outside_band": c["outside"] / cnt, "n_band_exits": int(c["exits"]),
                "liftoff_fraction": c["liftoff"] / cnt, "n_cycles": int(c["cycles"]),
                "heave_hs": 4.0 * math.sqrt(max(c["heave_sumsq"] / cnt - hm * hm, 0.0)),
-               "n_stick": int(stats[i, 1]), "n_breakaway": int(stats[i, 2]), "n_reversal": int(stats[i, 3]),
+               "n_stick": int(stats[i, STAT_N_STICK]), "n_breakaway": int(stats[i, STAT_N_BREAKAWAY]),
+               "n_reversal": int(stats[i, STAT_N_REVERSAL]),
                "batch_wall_s": wall / n}
         for key, value in campaign.variant(run.variant).overrides:
             row[key] = value

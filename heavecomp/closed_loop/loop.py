@@ -1,6 +1,6 @@
 """Closed-loop simulation: the exact stick-slip CMC with an active cylinder and a controller.
 
-The plant is the foundation's compiled stepper (:func:`heavecomp.simulate._kernel.advance`),
+The plant is the foundation's compiled stepper (:mod:`heavecomp.simulate.stepper`),
 called one RK4 step at a time so that the active force can change between
 steps.  Per control interval (``[active].control_rate``, 20 Hz by default):
 
@@ -37,7 +37,10 @@ from heavecomp.params.cmc import active
 from heavecomp.effects.spec import effects_for
 from heavecomp.plants.cmc import eigen_rate, plant_vectors
 from heavecomp.simulate import excitation
-from heavecomp.simulate.core import CSV_COLUMNS, SimulationResult, default_dt, plant_stepper
+from heavecomp.simulate import layout as L
+from heavecomp.simulate.core import CSV_COLUMNS, SimulationResult, default_dt
+from heavecomp.simulate.layout import Drive
+from heavecomp.simulate.stepper import heave_at, plant_stepper
 
 log = logging.getLogger(__name__)
 
@@ -141,7 +144,6 @@ def simulate_closed_loop(params, controller="passive", duration: float = 120.0, 
         ``u_active_max``, ``solve_time_ms_p50``/``_p99``, ``violations_*``,
         ``solver_failures``, ``fallbacks``, ``preview_rmse_m``.
     """
-    from heavecomp.simulate import _kernel as K  # numba-compiled stepper: loaded on first use
 
     if not (duration > 0 and math.isfinite(duration)):
         raise InputError(f"duration must be a positive number of seconds, got {duration}", option="duration")
@@ -162,7 +164,7 @@ def simulate_closed_loop(params, controller="passive", duration: float = 120.0, 
         log.warning("dt = %g s does not divide the control interval %g s; using %g s", dt, Tc, Tc / n_sub)
     h = Tc / n_sub
     n_ctrl = int(math.ceil(duration / Tc - 1e-9))
-    check_run_size(params, duration=duration, h=h, n_steps=n_ctrl * n_sub, n_rows=n_ctrl + 1, n_cols=K.NCH, dt=dt, rate=act.control_rate, rate_fn=eigen_rate)
+    check_run_size(params, duration=duration, h=h, n_steps=n_ctrl * n_sub, n_rows=n_ctrl + 1, n_cols=L.NCH, dt=dt, rate=act.control_rate, rate_fn=eigen_rate)
     sp = 0.5 * h
     # the true future heave is only needed for a perfect preview (a record must then reach past the end)
     horizon_t = (cfg.horizon + 2) * Tc if preview == "perfect" else 0.0
@@ -177,15 +179,15 @@ def simulate_closed_loop(params, controller="passive", duration: float = 120.0, 
         t_in, z_in = heave
         hs = excitation.from_series(t_in, z_in, n_ctrl * Tc + horizon_t, sp, src="heave")
     plant = plant_vectors(params)  # the one params -> vectors conversion
-    advance, state, smooth = plant_stepper(plant, effects_for(params, effects))
+    advance, state, args = plant_stepper(plant, effects_for(params, effects))  # the compiled stepper (loaded on first use)
     rng = np.random.default_rng(noise.seed if noise else 0)
     sig = np.array([noise.stroke, noise.pressure, noise.wob, noise.heave]) if noise else np.zeros(4)
 
-    mode_dir = np.array([float(K.STUCK), 1.0])
-    stats = np.zeros(len(K.STATS))
-    rows = np.empty((n_ctrl + 1, K.NCH))
-    rec = np.empty((1, K.NCH))
-    none_out = np.empty((0, K.NCH))
+    mode_dir = np.array([float(L.STUCK), 1.0])
+    stats = np.zeros(len(L.STATS))
+    rows = np.empty((n_ctrl + 1, L.NCH))
+    rec = np.empty((1, L.NCH))
+    none_out = np.empty((0, L.NCH))
     u = 0.0
     du_step = act.rate_max * h
     du_max = act.rate_max * Tc
@@ -199,8 +201,7 @@ def simulate_closed_loop(params, controller="passive", duration: float = 120.0, 
     t_wall = time.perf_counter()
     for k in range(n_ctrl + 1):
         t = k * Tc
-        advance(state, mode_dir, t, 0, h, plant.code, plant.FP, plant.PP, smooth, u, sp, hs.z, hs.dz, hs.ddz,
-                  rec, 1, 0, stats)
+        advance(state, mode_dir, t, 0, h, args, Drive(u, sp, hs.z, hs.dz, hs.ddz), rec, 1, 0, stats)
         rows[k] = rec[0]
         if k == n_ctrl:
             break
@@ -209,7 +210,7 @@ def simulate_closed_loop(params, controller="passive", duration: float = 120.0, 
         pv = None
         if preview == "perfect":
             tt = t + Tc * np.arange(cfg.horizon + 1)
-            pv = np.array([K.heave_at(ti, sp, hs.z, hs.dz, hs.ddz) for ti in tt])
+            pv = np.array([heave_at(ti, sp, hs.z, hs.dz, hs.ddz) for ti in tt])
         t_step = time.perf_counter()
         try:
             u_cmd = float(ctrl.step(t, meas, pv))
@@ -232,8 +233,7 @@ def simulate_closed_loop(params, controller="passive", duration: float = 120.0, 
             previews.append(lp)
         for j in range(n_sub):
             u = u + min(max(u_cmd - u, -du_step), du_step)
-            advance(state, mode_dir, t + j * h, 1, h, plant.code, plant.FP, plant.PP, smooth, u, sp, hs.z, hs.dz,
-                      hs.ddz, none_out, 1, 0, stats)
+            advance(state, mode_dir, t + j * h, 1, h, args, Drive(u, sp, hs.z, hs.dz, hs.ddz), none_out, 1, 0, stats)
         if progress is not None and k % 200 == 0:
             progress(k / n_ctrl)
     wall = time.perf_counter() - t_wall
@@ -255,23 +255,23 @@ def simulate_closed_loop(params, controller="passive", duration: float = 120.0, 
         "noise": dataclasses.asdict(noise) if noise else None,
         "config": dataclasses.asdict(cfg),
     }
-    control.update(_preview_error(previews, hs, sp, Tc, K))
+    control.update(_preview_error(previews, hs, sp, Tc, heave_at))
     if stats_start is None:
         stats_start = (params.heave.ramp or 0.0) if (heave is None and params.heave is not None) else 0.0
         stats_start = min(stats_start, 0.5 * duration)
-    return ClosedLoopResult(data=rows, params=params, dt=h, stats=dict(zip(K.STATS, stats.tolist())),
+    return ClosedLoopResult(data=rows, params=params, dt=h, stats=dict(zip(L.STATS, stats.tolist())),
                             heave_info=hs.info, wall_time=wall, stats_start=stats_start,
                             controller=name, control=control)
 
 
-def _preview_error(previews, hs, sp, Tc, K) -> dict:
+def _preview_error(previews, hs, sp, Tc, heave_at) -> dict:
     """RMS error of the heave preview at each horizon step, after the first 30 s [m]."""
     errs = []
     for t0, z in previews:
         if t0 < 30.0:
             continue
         tt = t0 + Tc * np.arange(z.size)
-        true = np.array([K.heave_at(ti, sp, hs.z, hs.dz, hs.ddz)[0] for ti in tt])
+        true = np.array([heave_at(ti, sp, hs.z, hs.dz, hs.ddz)[0] for ti in tt])
         errs.append(z - true)
     if not errs:
         return {}

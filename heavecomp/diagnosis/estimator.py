@@ -55,6 +55,7 @@ from heavecomp.errors import InputError
 from heavecomp.estimator import GapEstimator
 from heavecomp.params.budget import MAX_REPLAY_STEPS
 from heavecomp.diagnosis import where as W
+from heavecomp.diagnosis.stepper import CHANNELS as SC, replay_dt, run_segments
 from heavecomp.diagnosis.data import (ANGLES, derivative_zero_phase, HEAVE_CUTOFF, heave_filtered, heave_samples,
                                       MeasuredRun, noise_floor, uniform, zero_phase_lowpass)
 from heavecomp.plants.cmc import D0, KF, plant_vectors
@@ -254,8 +255,6 @@ class GapDiagnoser(GapEstimator):
 
     # ------------------------------------------------------------------ replay
     def _setup(self, run):
-        from heavecomp.diagnosis.stepper import replay_dt
-
         h = replay_dt(self.nominal)
         n_steps = int(math.ceil(run.t[-1] / h - 1e-9))
         if n_steps > MAX_REPLAY_STEPS:  # before any work: the diagnosis replays the log hundreds of times
@@ -324,8 +323,6 @@ class GapDiagnoser(GapEstimator):
         ``[(effect name, values), ...]`` (empty: the nominal model), driven by the replay's heave
         or by ``hs`` (heave samples on the same grid).  A stroke or WOB reading in the configuration
         also moves the start (:meth:`_start_for`)."""
-        from heavecomp.diagnosis.stepper import CHANNELS as SC, run_segments
-
         rp = self._rp
         hs = rp.hs if hs is None else hs
         plant = rp.plant
@@ -526,7 +523,6 @@ class GapDiagnoser(GapEstimator):
         fit leaves the smallest weighted residual wins."""
         from scipy.optimize import minimize_scalar
 
-        from heavecomp.diagnosis.stepper import CHANNELS as SC
 
         (field,) = cls.fields()
         a, b = field.metadata["bounds"]

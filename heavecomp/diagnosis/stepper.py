@@ -1,6 +1,6 @@
 """The diagnosis' effect-aware replay: thin wrappers over the foundation stepper.
 
-The stepper is :func:`heavecomp.simulate._kernel.kernel_for` of an effect composition
+The stepper is :func:`heavecomp.simulate.stepper.kernel_for` of an effect composition
 (:mod:`heavecomp.effects.compose`), the same compiled exact stick-slip RK4 with event location
 that :func:`heavecomp.simulate.simulate` runs (velocity reversal, stick, breakaway, bit lift-off
 and touchdown, the end of the fade-in as a step boundary), with the effects' terms at the
@@ -25,10 +25,10 @@ import time
 import numpy as np
 
 from heavecomp.effects.compose import composition_for
-from heavecomp.simulate import _kernel as K
+from heavecomp.simulate import stepper as S
 from heavecomp.simulate.core import drive
 from heavecomp.simulate.layout import CHANNELS as _SIM_CHANNELS
-from heavecomp.simulate.layout import FX_CHANNELS, NSTATS, SLIDING, STUCK
+from heavecomp.simulate.layout import FX_CHANNELS, NSTATS, SLIDING, STUCK, Drive
 from heavecomp.simulate import excitation
 from heavecomp.effects.registry import resolve
 from heavecomp.plants.cmc import eigen_rate, plant_vectors
@@ -65,17 +65,16 @@ def run_fx(plant, comp, EP, hs, h, n_steps, out_every=1, *, u_active=0.0, progre
     -------
     ndarray (n_out, len(CHANNELS))
     """
-    advance_fx = K.kernel_for(comp)
-    FP, PP, EP = plant.FP, plant.PP, np.asarray(EP, dtype=float)
+    advance = S.kernel_for(comp)
+    args = S.plant_args(plant, EP, smooth_fx(plant, comp, EP))
     out = np.empty((n_steps // out_every + 1, NCH))
-    state = comp.initial_state(FP, PP, EP)
+    state = comp.initial_state(plant.FP, plant.PP, args.EP)
     mode_dir = np.array([float(STUCK), 1.0])
     stats = np.zeros(NSTATS)
-    smooth = smooth_fx(plant, comp, EP)
 
     def step(t0, n, Z, DZ, DDZ, pos):
-        return advance_fx(state, mode_dir, t0, n, h, plant.code, FP, PP, EP, smooth, float(u_active), 0.5 * h,
-                          Z, DZ, DDZ, out, int(out_every), int(pos), stats)
+        return advance(state, mode_dir, t0, n, h, args, Drive(float(u_active), 0.5 * h, Z, DZ, DDZ), out,
+                       int(out_every), int(pos), stats)
 
     pos = drive(step, hs, h, n_steps, out_every, progress=progress, chunk_steps=chunk_steps)
     return out[:pos]
@@ -131,9 +130,10 @@ def run_segments(plant, comp, EP, hs, h, bounds, starts, n_out):
 
     Returns the output rows on the stepper grid (row i at t = i h), shape (n_out, NCH).
     """
-    advance_fx = K.kernel_for(comp)
-    FP, PP, EP = plant.FP, plant.PP, np.asarray(EP, dtype=float)
-    smooth = smooth_fx(plant, comp, EP)
+    advance = S.kernel_for(comp)
+    args = S.plant_args(plant, EP, smooth_fx(plant, comp, EP))
+    FP, PP, EP = plant.FP, plant.PP, args.EP
+    drive_args = Drive(0.0, 0.5 * h, hs.z, hs.dz, hs.ddz)
     stats = np.zeros(NSTATS)
     out = np.zeros((n_out, NCH))  # zeros: the columns of effect states a composition does not have read 0
     prev = None  # where the previous segment ended (slow effect states carry on from there)
@@ -150,7 +150,6 @@ def run_segments(plant, comp, EP, hs, h, bounds, starts, n_out):
                 X0[1] = v
                 mode_dir[:] = (float(SLIDING), 1.0 if v > 0 else -1.0)
             comp.steady_states(X0[1], FP, PP, EP, X0, prev)
-        advance_fx(X0, mode_dir, i0 * h, i1 - i0, h, plant.code, FP, PP, EP, smooth, 0.0, 0.5 * h, hs.z, hs.dz,
-                   hs.ddz, out[i0:], 1, 0, stats)
+        advance(X0, mode_dir, i0 * h, i1 - i0, h, args, drive_args, out[i0:], 1, 0, stats)
         prev = X0
     return out

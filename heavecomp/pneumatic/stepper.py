@@ -26,17 +26,22 @@ import numpy as np
 
 from heavecomp.pneumatic import friction as _fr
 from heavecomp.pneumatic import plant as _pn
+from heavecomp.simulate import cache
 from heavecomp.simulate._kernel import _compile
 
-mixed_shape = _compile(_fr.mixed_shape)
-branch_magnitude = _compile(_fr.branch_magnitude)
-critical_ratio = _compile(_pn.critical_ratio)
-flow_function = _compile(_pn.flow_function)
-orifice_flow = _compile(_pn.orifice_flow)
-chamber_volumes = _compile(_pn.chamber_volumes)
-pressure_rates = _compile(_pn.pressure_rates)
-drive_force = _compile(_pn.drive_force)
-piston_accel = _compile(_pn.piston_accel)
+#: the files this stepper is compiled from (its numba cache folder is keyed to them)
+SOURCES = ("pneumatic/friction.py", "pneumatic/plant.py", "pneumatic/stepper.py")
+_KEY = cache.source_key(SOURCES)
+
+mixed_shape = _compile(_fr.mixed_shape, key=_KEY)
+branch_magnitude = _compile(_fr.branch_magnitude, key=_KEY)
+critical_ratio = _compile(_pn.critical_ratio, key=_KEY)
+flow_function = _compile(_pn.flow_function, key=_KEY)
+orifice_flow = _compile(_pn.orifice_flow, key=_KEY)
+chamber_volumes = _compile(_pn.chamber_volumes, key=_KEY)
+pressure_rates = _compile(_pn.pressure_rates, key=_KEY)
+drive_force = _compile(_pn.drive_force, key=_KEY)
+piston_accel = _compile(_pn.piston_accel, key=_KEY)
 
 STUCK, SLIDING = 0, 1
 CHANNELS = ("t", "position", "velocity", "pressure_a", "pressure_b", "friction", "stuck", "accelerating")
@@ -44,7 +49,7 @@ NCH = len(CHANNELS)
 STATS = ("n_stick", "n_breakaway", "n_reversal", "t_first_breakaway", "t_first_stick", "t_second_breakaway",
          "v_max", "end_of_stroke", "t_final", "stuck_time")
 NST = len(STATS)
-_jit = nb.njit(cache=True)
+_jit = cache.jit(SOURCES)
 
 
 @_jit
@@ -248,7 +253,7 @@ def run(state, t_end, h, PP, FPB, moved, stop_at_stick, out, out_every):
     return pos, stats
 
 
-@nb.njit(parallel=True, cache=True)
+@cache.jit(SOURCES, parallel=True)
 def run_many(states, t_ends, h, PPs, FPBs, moved, stop_at_stick):
     """Run many independent simulations in parallel (numba prange); returns stats (n, NST).
 

@@ -1,21 +1,32 @@
-"""Ahead-of-time build of the stepper (numba.pycc), used by ``setup.py``.
+"""Ahead-of-time build of the nominal stepper (numba.pycc), used by ``setup.py``.
 
 The compiled module ``heavecomp.simulate._cmc_aot`` is the same
-:func:`heavecomp.simulate._kernel.advance` — the same Python source,
-compiled once at install time instead of at the first call of every
-process — so a short ``heavecomp simulate`` does not pay numba's start-up
-(~0.4 s: numba imports scipy.linalg, initialises LLVM and loads its cache).
+:func:`heavecomp.simulate._kernel.advance` — the same Python source, the same signature
+(:func:`heavecomp.simulate.stepper.canonical_args`: the :class:`~heavecomp.simulate.layout.Plant`
+and :class:`~heavecomp.simulate.layout.Drive` tuples), compiled once at install time instead of
+at the first call of every process — so a short ``heavecomp simulate`` does not pay numba's
+start-up (~0.4 s: numba imports scipy.linalg, initialises LLVM and loads its cache).
 It also exports ``source_hash()``, the hash of the source files it was built
-from; :func:`heavecomp.simulate.core.stepper` uses the module only when that
+from; :func:`heavecomp.simulate.stepper.nominal` uses the module only when that
 matches the files on disk, so an edited plant can never run stale code.
+
+``numba.pycc`` is marked for deprecation in numba: the JIT stepper, compiled into numba's cache
+at install (:func:`heavecomp.simulate.stepper.compile_all`), is the first-class path; this build
+only saves the numba import of a short nominal run, and its absence changes no result.
 """
 
 from __future__ import annotations
 
 from heavecomp.simulate.layout import source_hash
+from heavecomp.simulate.stepper import canonical_args
 
-ADVANCE_SIGNATURE = ("i8(f8[::1], f8[::1], f8, i8, f8, i8, f8[::1], f8[::1], b1, f8, f8, "
-                     "f8[::1], f8[::1], f8[::1], f8[:,::1], i8, i8, f8[::1])")
+
+def advance_signature():
+    """numba signature of the exported ``advance`` (the JIT stepper's canonical one)."""
+    import numba
+    from numba import types
+
+    return types.int64(*(numba.typeof(a) for a in canonical_args()))
 
 
 def build_cc(output_dir=None):
@@ -28,7 +39,7 @@ def build_cc(output_dir=None):
     if output_dir is not None:
         cc.output_dir = str(output_dir)
     cc.verbose = False
-    cc.export("advance", ADVANCE_SIGNATURE)(_kernel.advance.py_func)
+    cc.export("advance", advance_signature())(_kernel.advance.py_func)
     ns: dict = {}
     exec(f"def source_hash():\n    return {source_hash()}\n", ns)  # a constant baked into the module
     cc.export("source_hash", "i8()")(ns["source_hash"])

@@ -1,4 +1,5 @@
-"""Compiled exact stick-slip stepper for the CMC (numba).
+"""Compiled exact stick-slip stepper for the CMC (numba): the implementation of
+:mod:`heavecomp.simulate.stepper`, which holds the public entry points (call those).
 
 The physics is not restated here: the equations are the functions of
 :mod:`heavecomp.plants.cmc` and :mod:`heavecomp.friction.laws`, and the effects' methods at
@@ -15,7 +16,10 @@ functions are compiled for the composition of no effect, where the hooks are the
 :func:`advance` (used by :func:`heavecomp.simulate.simulate`, the closed loop, the campaigns,
 and compiled ahead of time).  :func:`kernel_for` compiles the same functions again with the
 hooks of a composition (the library's effects for the diagnosis and ``simulate(effects=...)``,
-the generator's truth laws for the benchmark) and returns its ``advance_fx``.
+the generator's truth laws for the benchmark) and returns its ``advance``.  Every stepper takes
+the plant and what drives it as two tuples (:class:`~heavecomp.simulate.layout.Plant`,
+:class:`~heavecomp.simulate.layout.Drive`) and names its output columns and stats slots by
+the constants of :mod:`heavecomp.simulate.layout`.
 
 Scheme
 ------
@@ -67,70 +71,39 @@ from heavecomp.plants.cmc import MC
 
 
 
-#: the sources compiled code is built from: the packages whose functions numba compiles or
-#: inlines (physics, effects, steppers), the modules holding a jitted stepper, and the constants
-#: they read (``params/cmc.py``: g, p_atm; ``params/budget.py``).  Editing anything else (reports, the diagnosis'
-#: decisions, commands) leaves the compiled kernels valid.
-COMPILED_SOURCES = ("friction", "plants", "effects", "simulate", "pneumatic", "test_rig",
-                    "diagnosis/stepper.py", "campaign/batch.py", "closed_loop/loop.py", "params/cmc.py",
-                    "params/budget.py")
+from heavecomp.simulate import cache as _cache
+
+#: cache key of the nominal stepper (:data:`heavecomp.simulate.layout.KERNEL_SOURCES`); the steppers
+#: of effect compositions are keyed by :func:`heavecomp.simulate.cache.composition_key`
+KERNEL_KEY = _cache.source_key()
 
 
-def _numba_cache_dir():
-    """A numba cache folder keyed to the hash of the sources compiled code is built from.
+def _jit(func=None, *, inline=False, nogil=False):
+    """``njit(cache=True, fastmath=False)`` cached under :data:`KERNEL_KEY` (``inline``: inlined
+    into its callers in numba's IR; ``nogil``: releases the GIL)."""
+    def decorate(f):
+        opts = {"cache": True, "fastmath": False}
+        if inline:
+            opts["inline"] = "always"
+        if nogil:
+            opts["nogil"] = True
+        with _cache.keyed(KERNEL_KEY):
+            return nb.njit(**opts)(f)
 
-    numba invalidates a cached function only when *its own* file changes, but the
-    compiled steppers inline physics from other files (friction/laws.py,
-    plants/cmc.py, ...): after an edit or an upgrade, a stale cache would run old
-    physics.  Keying the whole cache to every file in :data:`COMPILED_SOURCES` makes that
-    impossible, and an edit elsewhere recompiles nothing.
-    ``NUMBA_CACHE_DIR`` set by the user wins.
-    """
-    import hashlib
-    import os
-    from pathlib import Path
-
-    root = Path(__file__).resolve().parents[1]
-    h = hashlib.sha256()
-    files = set()
-    for rel in COMPILED_SOURCES:
-        path = root / rel
-        files.update(path.rglob("*.py") if path.is_dir() else [path])
-    for p in sorted(files):
-        h.update(p.relative_to(root).as_posix().encode())
-        h.update(p.read_bytes())
-    base = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "heavecomp"
-    return base / f"numba-{h.hexdigest()[:16]}"
+    return decorate if func is None else decorate(func)
 
 
-def _use_keyed_cache():
-    import os
-
-    if os.environ.get("NUMBA_CACHE_DIR"):
-        return
-    from numba.core import config
-
-    d = _numba_cache_dir()
-    try:
-        d.mkdir(parents=True, exist_ok=True)
-    except OSError:  # read-only home: numba's default (__pycache__ beside the sources)
-        return
-    config.CACHE_DIR = str(d)
-
-
-_use_keyed_cache()  # before any njit(cache=True) below or in modules that import this one
-_jit = nb.njit(cache=True, fastmath=False)
-_jit_inline = nb.njit(cache=True, fastmath=False, inline="always")
 _ENV: dict = {}
 
 
-def _compile(func, inline=False, env=None, *, cache=True, name=None, nogil=False):
+def _compile(func, inline=False, env=None, *, cache=True, name=None, nogil=False, key=None):
     """njit ``func`` from its own source, with the names it calls bound to the
     already-compiled versions (so the plant modules need not import numba).
     ``inline=True`` inlines it into its callers in numba's IR (no call, no array
     reference counting: LLVM leaves larger functions out of line).  ``env`` (default the
     module's ``_ENV``) receives it under ``name`` (default its own); ``cache=False`` for
-    generated source, which has no file for numba's cache."""
+    generated source, which has no file for numba's cache.  ``key``: the cache key
+    (:mod:`heavecomp.simulate.cache`; default :data:`KERNEL_KEY`)."""
     env = _ENV if env is None else env
     g = dict(func.__globals__)
     g.update(env)
@@ -142,7 +115,8 @@ def _compile(func, inline=False, env=None, *, cache=True, name=None, nogil=False
         opts["inline"] = "always"
     if nogil:
         opts["nogil"] = True
-    jitted = nb.njit(**opts)(clone)
+    with _cache.keyed(KERNEL_KEY if key is None else key):
+        jitted = nb.njit(**opts)(clone)
     env[func.__name__] = jitted
     return jitted
 
@@ -174,12 +148,12 @@ contact_switch = _compile(_cmc.contact_switch)
 # and for the pins (tests/test_kernel_pins.py): numba compiles them on first use only.
 
 
-def _compile_composition(comp, env):
+def _compile_composition(comp, env, key=None):
     """Compile the effects' hook methods and the generated hook functions of ``comp`` into ``env``."""
     for i, c in enumerate(comp.classes):
         for m in c.methods():
             f = getattr(c, m)
-            _compile(f, inline=True, env=env)
+            _compile(f, inline=True, env=env, key=key)
             env[f"E{i}_{m}"] = env.pop(f.__name__)
     for fname in _compose.GENERATED:
         _compile(comp.functions[fname], inline=True, env=env, cache=False)
@@ -203,9 +177,15 @@ state_load = _ENV["state_load"]
 state_store = _ENV["state_store"]
 state_record = _ENV["state_record"]
 
-from heavecomp.simulate.layout import CHANNELS, FX_CHANNELS, NCH, NSTATS, SLIDING, STATS, STUCK  # noqa: E402,F401
+from heavecomp.simulate.layout import (CHANNELS, FX_CHANNELS, NCH, NSTATS, SLIDING, STATS, STUCK,  # noqa: E402,F401
+                                      COL_FRICTION, COL_GAS_PRESSURE, COL_HEAVE, COL_LOWER_DISPLACEMENT,
+                                      COL_LOWER_VELOCITY, COL_PRESSURE, COL_STROKE, COL_STROKE_VELOCITY,
+                                      COL_STUCK, COL_T, COL_TENSION, COL_U_ACTIVE, COL_WOB, STAT_EVENT_CAP_FIRST_T,
+                                      STAT_EVENT_CAP_HITS, STAT_N_BREAKAWAY, STAT_N_CONTACT_SWITCH, STAT_N_REVERSAL,
+                                      STAT_N_STICK, STAT_STUCK_TIME, Plant)
 
-#: the effect parameters of the plain CMC (no effect composed; a constant of the compiled code)
+#: the effect parameters of the plain CMC (no effect composed; read-only: for the hook functions'
+#: pins, the stepper takes a writable empty array, :func:`heavecomp.simulate.stepper.plant_args`)
 NO_EFFECTS = np.zeros(0)
 NO_EFFECTS.setflags(write=False)
 
@@ -258,14 +238,18 @@ def heave_at(t, sp, Z, DZ, DDZ):
     return z, dz, ddz
 
 
-@_jit_inline
-def rhs(t, X, mode, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ):
+@_jit(inline=True)
+def rhs(t, X, mode, d, cm, plant, drive):
     """Time derivatives of ``X = (s, v, yb, vb, effect states...)`` in the given mode.
 
     The plant is the composition's ``plant_fx`` (:mod:`heavecomp.effects.compose`: the CMC of
     :mod:`heavecomp.plants.cmc` with the effects' hook terms; X[4:] are the effects' states, as
     many as the composition has); the contact state ``cm`` is held, the stroke frozen while stuck.
+    ``plant`` and ``drive`` are the stepper's :class:`~heavecomp.simulate.layout.Plant` and
+    :class:`~heavecomp.simulate.layout.Drive`.
     """
+    code, FP, PP, EP, smooth = plant
+    u, sp, Z, DZ, DDZ = drive
     s, v, yb, vb = X[0], X[1], X[2], X[3]
     if mode == STUCK:
         v = 0.0
@@ -281,18 +265,20 @@ def rhs(t, X, mode, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ):
 
 
 @_jit
-def rk4(t, h, X, mode, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ):
-    k1 = rhs(t, X, mode, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ)
+def rk4(t, h, X, mode, d, cm, plant, drive):
+    k1 = rhs(t, X, mode, d, cm, plant, drive)
     h2 = 0.5 * h
-    k2 = rhs(t + h2, state_axpy(X, h2, k1), mode, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ)
-    k3 = rhs(t + h2, state_axpy(X, h2, k2), mode, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ)
-    k4 = rhs(t + h, state_axpy(X, h, k3), mode, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ)
+    k2 = rhs(t + h2, state_axpy(X, h2, k1), mode, d, cm, plant, drive)
+    k3 = rhs(t + h2, state_axpy(X, h2, k2), mode, d, cm, plant, drive)
+    k4 = rhs(t + h, state_axpy(X, h, k3), mode, d, cm, plant, drive)
     return state_rk4(X, h / 6.0, k1, k2, k3, k4)
 
 
 @_jit
-def hold(t, X, u, PP, EP, sp, Z, DZ, DDZ):
+def hold(t, X, plant, drive):
     """(holding force, cylinder pressure) at v = 0: while stuck the friction is the holding force."""
+    code, FP, PP, EP, smooth = plant
+    u, sp, Z, DZ, DDZ = drive
     zh, dzh, ddzh = heave_at(t, sp, Z, DZ, DDZ)
     p, T, F, dvb = plant_fx(X[0], 0.0, X[2], X[3], X, zh, dzh, ddzh, u, 1.0, PP, EP)
     return F, p
@@ -353,56 +339,74 @@ def _rest_root(a0, v1, a1, H):
     return min(max(th, 0.0), 1.0) * H
 
 
-@_jit
-def advance(state, mode_dir, t0, n_steps, h, code, FP, PP, smooth, u, sp, Z, DZ, DDZ,
-            out, out_every, out_pos, stats):
+@_jit(nogil=True)
+def advance(state, mode_dir, t0, n_steps, h, plant, drive, out, out_every, out_pos, stats):
     """Advance the CMC ``n_steps`` steps of size ``h`` from ``t0``.
 
-    ``state = [s, v, yb, vb]`` and ``mode_dir = [mode, direction]`` are updated
-    in place.  Every ``out_every`` steps a row of CHANNELS is written to
-    ``out[out_pos]`` (``out_pos`` is returned, advanced); the first row written
-    is the state at ``t0`` when ``out_pos == 0``.  ``stats`` accumulates STATS.
-    This is :func:`advance_fx` with no effect.
-    """
-    X = (state[0], state[1], state[2], state[3])
-    X, tau, mode, d, pos = _advance(X, 0.0, int(mode_dir[0]), mode_dir[1], t0, n_steps, h, code, FP, PP,
-                                    NO_EFFECTS, smooth, u, sp, Z, DZ, DDZ, out, out_every, out_pos, stats)
-    state[0], state[1], state[2], state[3] = X[0], X[1], X[2], X[3]
-    mode_dir[0] = mode
-    mode_dir[1] = d
-    return pos
-
-
-@nb.njit(cache=True, nogil=True)
-def advance_fx(state, mode_dir, t0, n_steps, h, code, FP, PP, EP, smooth, u, sp, Z, DZ, DDZ,
-               out, out_every, out_pos, stats):
-    """:func:`advance` with effects: the stepper of an effect composition (:func:`kernel_for`;
-    this module-level one has none) with effect parameters ``EP`` (:meth:`Composition.ep`).
-
+    ``plant`` is a :class:`~heavecomp.simulate.layout.Plant` (its ``EP`` the effect parameters of
+    this stepper's composition: :meth:`Composition.ep`, empty for this module's stepper, which has
+    no effect), ``drive`` a :class:`~heavecomp.simulate.layout.Drive` (active force, heave samples).
     ``state`` is ``[s, v, yb, vb, effect states..., tau]`` (the composition's effect states, the
-    dwell time at rest: :meth:`Composition.initial_state`); when ``out`` has more than NCH columns
-    the next ones get FX_CHANNELS (the gas pressure, then the effect states as far as there is room).
-    Releases the GIL (the diagnosis fits in threads).
+    dwell time at rest: :meth:`Composition.initial_state`) and ``mode_dir = [mode, direction]``;
+    both are updated in place.  Every ``out_every`` steps a row of CHANNELS is written to
+    ``out[out_pos]`` (``out_pos`` is returned, advanced); the first row written is the state at
+    ``t0`` when ``out_pos == 0``; when ``out`` has more than NCH columns the next ones get
+    FX_CHANNELS (the gas pressure, then the effect states as far as there is room).  ``stats``
+    accumulates STATS.  Releases the GIL (the diagnosis fits in threads).
     """
     X, tau = state_load(state)
-    X, tau, mode, d, pos = _advance(X, tau, int(mode_dir[0]), mode_dir[1], t0, n_steps, h, code, FP, PP,
-                                    EP, smooth, u, sp, Z, DZ, DDZ, out, out_every, out_pos, stats)
+    X, tau, mode, d, pos = _advance(X, tau, int(mode_dir[0]), mode_dir[1], t0, n_steps, h, own_effects(plant),
+                                    drive, out, out_every, out_pos, stats)
     state_store(state, X, tau)
     mode_dir[0] = mode
     mode_dir[1] = d
     return pos
 
 
+#: the name the diagnosis knew the effect-aware stepper by (one stepper now)
+advance_fx = advance
+
+
+@_jit(inline=True)
+def _with_no_effects(plant):
+    """The plant with the effect parameters of no effect as a constant of the compiled code: the
+    nominal stepper reads no EP, and LLVM then drops them (~14 % less time per step than a run-time
+    EP, measured on the 1 h paper-A runs); :func:`kernel_for` binds ``own_effects`` to
+    :func:`_with_its_effects` instead, so the steppers of compositions use the caller's EP."""
+    code, FP, PP, EP, smooth = plant
+    return Plant(code, FP, PP, NO_EFFECTS, smooth)
+
+
+@_jit(inline=True)
+def _with_its_effects(plant):
+    """The plant as given: the effect parameters of a composition's stepper are the caller's."""
+    return plant
+
+
+#: what :func:`advance` makes of the plant's effect parameters (rebound per composition)
+own_effects = _with_no_effects
+
+
+@_jit(inline=True)
+def _accept(X1, tc, left, cut, switched, cm, stats):
+    """Take the tentative step ``X1`` of length ``cut``: ``(X, tc, left, cm)`` after it, the held
+    contact state flipped (and counted) when the step ended at a contact switch."""
+    if switched:
+        stats[STAT_N_CONTACT_SWITCH] += 1.0
+        cm = 1.0 - cm
+    return X1, tc + cut, left - cut, cm
+
+
 @_jit
-def _advance(X, tau, mode, d, t0, n_steps, h, code, FP, PP, EP, smooth, u, sp, Z, DZ, DDZ,
-             out, out_every, out_pos, stats):
+def _advance(X, tau, mode, d, t0, n_steps, h, plant, drive, out, out_every, out_pos, stats):
     """The event-handling stepper; returns ``(X, tau, mode, d, out_pos)`` at ``t0 + n_steps h``."""
+    code, FP, PP, EP, smooth = plant
     cm = 1.0 if contact_switch(X[2], X[3], PP) > 0.0 else 0.0  # bit on the rock (held between events)
     if smooth:
         mode = SLIDING
     pos = out_pos
     if pos == 0 and out.shape[0] > 0:
-        _record(out, pos, t0, X, mode, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ)
+        _record(out, pos, t0, X, mode, d, cm, plant, drive)
         pos += 1
     for i in range(n_steps):
         tc = t0 + i * h
@@ -411,34 +415,29 @@ def _advance(X, tau, mode, d, t0, n_steps, h, code, FP, PP, EP, smooth, u, sp, Z
             # tentative step to the grid, cut at the first contact switch (lift-off/touchdown)
             if mode == STUCK:
                 X = state_rest(X)
-            X1 = rk4(tc, left, X, mode, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ)
+            X1 = rk4(tc, left, X, mode, d, cm, plant, drive)
             cut = left
             switched = False
             if (contact_switch(X1[2], X1[3], PP) > 0.0) != (cm > 0.5):
-                cut = _contact_time(tc, left, X, mode, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ)
-                X1 = rk4(tc, cut, X, mode, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ)
+                cut = _contact_time(tc, left, X, mode, d, cm, plant, drive)
+                X1 = rk4(tc, cut, X, mode, d, cm, plant, drive)
                 switched = True
             if mode == SLIDING:
                 if smooth or X1[1] * d > 0.0:
-                    X = X1
-                    tc += cut
-                    left -= cut
-                    if switched:
-                        stats[5] += 1.0
-                        cm = 1.0 - cm
+                    X, tc, left, cm = _accept(X1, tc, left, cut, switched, cm, stats)
                     if left <= 0.0:
                         break
                     continue
                 # velocity reaches zero before the cut: locate it
-                a0 = rhs(tc, X, SLIDING, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ)[1]
-                a1 = rhs(tc + cut, X1, SLIDING, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ)[1]
+                a0 = rhs(tc, X, SLIDING, d, cm, plant, drive)[1]
+                a1 = rhs(tc + cut, X1, SLIDING, d, cm, plant, drive)[1]
                 tz = _cubic_root(X[1], a0, X1[1], a1, cut)
                 Xt = X1
                 for _n in range(4):
-                    Xt = rk4(tc, tz, X, SLIDING, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ)
+                    Xt = rk4(tc, tz, X, SLIDING, d, cm, plant, drive)
                     if abs(Xt[1]) < 1e-13:
                         break
-                    at = rhs(tc + tz, Xt, SLIDING, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ)[1]
+                    at = rhs(tc + tz, Xt, SLIDING, d, cm, plant, drive)[1]
                     if at == 0.0:
                         break
                     nt = tz - Xt[1] / at
@@ -450,34 +449,29 @@ def _advance(X, tau, mode, d, t0, n_steps, h, code, FP, PP, EP, smooth, u, sp, Z
                 X = state_rest(Xt)
                 tc += tz
                 left -= tz
-                F, p = hold(tc, X, u, PP, EP, sp, Z, DZ, DDZ)
+                F, p = hold(tc, X, plant, drive)
                 if abs(F) <= static_limit_fx(code, p, X[0], 1.0 if F > 0 else -1.0, X, 0.0, FP, EP):
                     mode = STUCK
                     tau = 0.0
-                    stats[1] += 1.0
+                    stats[STAT_N_STICK] += 1.0
                 else:
                     d = 1.0 if F > 0 else -1.0
-                    stats[3] += 1.0
+                    stats[STAT_N_REVERSAL] += 1.0
                 if left <= 0.0:
                     break
             else:  # STUCK
-                F1, p1 = hold(tc + cut, X1, u, PP, EP, sp, Z, DZ, DDZ)
+                F1, p1 = hold(tc + cut, X1, plant, drive)
                 lim1 = static_limit_fx(code, p1, X1[0], 1.0 if F1 > 0 else -1.0, X1, tau + cut, FP, EP)
                 if abs(F1) <= lim1:
-                    stats[0] += cut
+                    stats[STAT_STUCK_TIME] += cut
                     tau += cut
-                    X = X1
-                    tc += cut
-                    left -= cut
-                    if switched:
-                        stats[5] += 1.0
-                        cm = 1.0 - cm
+                    X, tc, left, cm = _accept(X1, tc, left, cut, switched, cm, stats)
                     if left <= 0.0:
                         break
                     continue
                 # breakaway before the cut: bracket [lo, hi] with margin(lo) >= 0 > margin(hi)
                 sg = 1.0 if F1 > 0 else -1.0
-                F0, p0 = hold(tc, X, u, PP, EP, sp, Z, DZ, DDZ)
+                F0, p0 = hold(tc, X, plant, drive)
                 m_lo = static_limit_fx(code, p0, X[0], sg, X, tau, FP, EP) - sg * F0
                 m_hi = lim1 - sg * F1
                 lo, hi = 0.0, cut
@@ -489,8 +483,8 @@ def _advance(X, tau, mode, d, t0, n_steps, h, code, FP, PP, EP, smooth, u, sp, Z
                     tt = lo + (hi - lo) * m_lo / (m_lo - m_hi) if m_lo != m_hi else 0.5 * (lo + hi)
                     if not (lo < tt < hi):
                         tt = 0.5 * (lo + hi)
-                    X2 = rk4(tc, tt, X, STUCK, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ)
-                    F2, p2 = hold(tc + tt, X2, u, PP, EP, sp, Z, DZ, DDZ)
+                    X2 = rk4(tc, tt, X, STUCK, d, cm, plant, drive)
+                    F2, p2 = hold(tc + tt, X2, plant, drive)
                     m = static_limit_fx(code, p2, X2[0], sg, X2, tau + tt, FP, EP) - sg * F2
                     if m >= 0.0:
                         lo, m_lo = tt, m
@@ -507,13 +501,13 @@ def _advance(X, tau, mode, d, t0, n_steps, h, code, FP, PP, EP, smooth, u, sp, Z
                         if m < 0.0:
                             break
                 X = state_rest(Xhi)
-                stats[0] += hi
+                stats[STAT_STUCK_TIME] += hi
                 tc += hi
                 left -= hi
                 tau = 0.0
                 mode = SLIDING
                 d = sg
-                stats[2] += 1.0
+                stats[STAT_N_BREAKAWAY] += 1.0
                 if left <= 0.0:
                     break
         else:
@@ -521,27 +515,28 @@ def _advance(X, tau, mode, d, t0, n_steps, h, code, FP, PP, EP, smooth, u, sp, Z
             # step in the current mode without further event checks, count it and keep
             # the time of the first (STATS "event_cap_hits", "event_cap_first_t")
             if left > 0.0:
-                X = rk4(tc, left, X, mode, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ)
+                X = rk4(tc, left, X, mode, d, cm, plant, drive)
                 if mode == STUCK:
                     X = state_rest(X)
-                    stats[0] += left
+                    stats[STAT_STUCK_TIME] += left
                     tau += left
-                if stats[4] == 0.0:
-                    stats[6] = tc
-                stats[4] += 1.0
+                if stats[STAT_EVENT_CAP_HITS] == 0.0:
+                    stats[STAT_EVENT_CAP_FIRST_T] = tc
+                stats[STAT_EVENT_CAP_HITS] += 1.0
         if (i + 1) % out_every == 0 and pos < out.shape[0]:
-            _record(out, pos, t0 + (i + 1) * h, X, mode, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ)
+            _record(out, pos, t0 + (i + 1) * h, X, mode, d, cm, plant, drive)
             pos += 1
     return X, tau, mode, d, pos
 
 
 @_jit
-def _contact_time(tc, left, X, mode, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ):
+def _contact_time(tc, left, X, mode, d, cm, plant, drive):
     """Time in (0, left] just past the zero of the contact switch (Illinois on RK4 sub-steps
     with the contact state ``cm`` held)."""
+    PP = plant.PP
     g_lo = contact_switch(X[2], X[3], PP)
     c_lo = cm > 0.5
-    X1 = rk4(tc, left, X, mode, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ)
+    X1 = rk4(tc, left, X, mode, d, cm, plant, drive)
     g_hi = contact_switch(X1[2], X1[3], PP)
     lo, hi = 0.0, left
     side = 0
@@ -551,7 +546,7 @@ def _contact_time(tc, left, X, mode, d, cm, smooth, code, FP, PP, EP, u, sp, Z, 
         tt = lo + (hi - lo) * g_lo / (g_lo - g_hi) if g_lo != g_hi else 0.5 * (lo + hi)
         if not (lo < tt < hi):
             tt = 0.5 * (lo + hi)
-        X2 = rk4(tc, tt, X, mode, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ)
+        X2 = rk4(tc, tt, X, mode, d, cm, plant, drive)
         g = contact_switch(X2[2], X2[3], PP)
         if (g > 0.0) == c_lo:
             lo, g_lo = tt, g
@@ -567,7 +562,9 @@ def _contact_time(tc, left, X, mode, d, cm, smooth, code, FP, PP, EP, u, sp, Z, 
 
 
 @_jit
-def _record(out, pos, t, X, mode, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ, DDZ):
+def _record(out, pos, t, X, mode, d, cm, plant, drive):
+    code, FP, PP, EP, smooth = plant
+    u, sp, Z, DZ, DDZ = drive
     s, v, yb, vb = X[0], X[1], X[2], X[3]
     if mode == STUCK:
         v = 0.0
@@ -579,25 +576,25 @@ def _record(out, pos, t, X, mode, d, cm, smooth, code, FP, PP, EP, u, sp, Z, DZ,
         Ff = friction_cont(code, v, p, FP)
     else:
         Ff = sliding_friction_fx(code, d, v, p, s, X, FP, EP)
-    out[pos, 0] = t
-    out[pos, 1] = zh
-    out[pos, 2] = s
-    out[pos, 3] = p
-    out[pos, 4] = wob(yb, vb, PP)
-    out[pos, 5] = v
-    out[pos, 6] = Ff
-    out[pos, 7] = T
-    out[pos, 8] = yb
-    out[pos, 9] = vb
-    out[pos, 10] = 1.0 if mode == STUCK else 0.0
-    out[pos, 11] = u
+    out[pos, COL_T] = t
+    out[pos, COL_HEAVE] = zh
+    out[pos, COL_STROKE] = s
+    out[pos, COL_PRESSURE] = p
+    out[pos, COL_WOB] = wob(yb, vb, PP)
+    out[pos, COL_STROKE_VELOCITY] = v
+    out[pos, COL_FRICTION] = Ff
+    out[pos, COL_TENSION] = T
+    out[pos, COL_LOWER_DISPLACEMENT] = yb
+    out[pos, COL_LOWER_VELOCITY] = vb
+    out[pos, COL_STUCK] = 1.0 if mode == STUCK else 0.0
+    out[pos, COL_U_ACTIVE] = u
     if out.shape[1] > NCH:  # FX_CHANNELS
-        out[pos, NCH] = gas_fx(s, v, X, PP, EP)
-        state_record(out, pos, NCH + 1, X)
+        out[pos, COL_GAS_PRESSURE] = gas_fx(s, v, X, PP, EP)
+        state_record(out, pos, COL_GAS_PRESSURE + 1, X)
 
 
 #: kernel functions that call the hook functions, callees first (cloned per composition)
-_PER_COMPOSITION = ("rhs", "rk4", "hold", "_contact_time", "_record", "_advance", "advance_fx")
+_PER_COMPOSITION = ("rhs", "rk4", "hold", "_contact_time", "_record", "_advance", "advance")
 _KERNELS: dict = {}
 
 
@@ -609,30 +606,33 @@ def _hook_env(comp) -> dict:
     """Names -> compiled functions with the hook functions of ``comp`` (compiled on first call)."""
     if comp.key not in _HOOK_ENVS:
         env = dict(_ENV)
-        _compile_composition(comp, env)
+        _compile_composition(comp, env, key=_cache.composition_key(comp))
         _HOOK_ENVS[comp.key] = env
     return _HOOK_ENVS[comp.key]
 
 
 def kernel_for(comp):
-    """The compiled ``advance_fx`` of an effect composition (:class:`heavecomp.effects.compose.Composition`).
+    """The compiled :func:`advance` of an effect composition (:class:`heavecomp.effects.compose.Composition`).
 
     The stepper's functions that call the plant's hooks are compiled again from their own source,
     with the composition's hook functions (the effects' methods, inlined) bound in their place;
-    numba's disk cache keeps each under a name keyed to the composition's source (about 30 s of
-    CPU to compile once per composition, then loaded in a fraction of a second).  The
-    composition of no effect is this module's :func:`advance_fx`.
+    numba's disk cache keeps each under a name and in a folder keyed to what it is compiled from
+    (:func:`heavecomp.simulate.cache.composition_key`; about 30 s of CPU to compile once per
+    composition, then loaded in a fraction of a second).  The composition of no effect is this
+    module's :func:`advance`.
     """
     if not comp.classes:
-        return advance_fx
+        return advance
     with _LOCK:  # the diagnosis fits in threads: one dispatcher per composition, so one compile
         if comp.key not in _KERNELS:
             env = dict(_hook_env(comp))
+            env["own_effects"] = _with_its_effects
+            key = _cache.composition_key(comp)
             for fname in _PER_COMPOSITION:
                 f = globals()[fname]
-                _compile(f.py_func, inline=fname == "rhs", env=env, name=f"{fname}__fx_{comp.key}",
-                         nogil=fname == "advance_fx")
-            _KERNELS[comp.key] = env["advance_fx"]  # numba compiles it once on the first call (its own lock)
+                _compile(f.py_func, inline=fname == "rhs", env=env, name=f"{fname}__fx_{key[:12]}",
+                         nogil=fname == "advance", key=key)
+            _KERNELS[comp.key] = env["advance"]  # numba compiles it once on the first call (its own lock)
     return _KERNELS[comp.key]
 
 

@@ -11,14 +11,14 @@ from typing import Callable
 
 import numpy as np
 
-from heavecomp.effects.compose import composition_for
 from heavecomp.effects.registry import split_effects
 from heavecomp.effects.spec import effects_for
 from heavecomp.errors import InputError
 from heavecomp.params.budget import check_run_size
 from heavecomp.plants.cmc import eigen_rate, plant_vectors
 from heavecomp.simulate import excitation, layout
-from heavecomp.simulate.layout import CHANNELS, NCH, STATS, STUCK
+from heavecomp.simulate.layout import CHANNELS, NCH, STATS, STUCK, Drive
+from heavecomp.simulate.stepper import heave_at, nominal, plant_stepper  # noqa: F401 (plant_stepper: re-exported)
 
 log = logging.getLogger(__name__)
 
@@ -258,8 +258,6 @@ def simulate(params, duration: float, *, dt: float | None = None, rate: float = 
                         effects=plant_fx)
     data, stats, wall = result
     if heave_fx:  # the recorded heave is the measured one (interpolated as the stepper does)
-        from heavecomp.simulate._kernel import heave_at
-
         data[:, CHANNELS.index("heave")] = [heave_at(ti, measured.spacing, measured.z, measured.dz, measured.ddz)[0]
                                             for ti in data[:, 0]]
     for e in sensor_fx:  # a recorded channel that misreads
@@ -272,46 +270,21 @@ def simulate(params, duration: float, *, dt: float | None = None, rate: float = 
                             wall_time=wall, stats_start=stats_start)
 
 
-def plant_stepper(plant, effects=()):
-    """``(advance, state, smooth)`` for the plant ``plant`` (:func:`heavecomp.plants.cmc.plant_vectors`)
-    with ``effects`` (instances) at its hooks: ``advance`` has the signature of
-    :func:`heavecomp.simulate._kernel.advance` and updates ``state`` in place.
-
-    Without effects it is the nominal stepper (:func:`stepper`: ahead of time when built);
-    with effects the stepper of their composition (:func:`heavecomp.simulate._kernel.kernel_for`),
-    its effect parameters bound.
-    """
-    if not effects:
-        return stepper(), np.zeros(4), bool(not plant.has_stiction)
-    from heavecomp.simulate import _kernel
-
-    comp = composition_for(effects)
-    EP = comp.ep(effects)
-    advance_fx = _kernel.kernel_for(comp)
-
-    def advance(state, mode_dir, t0, n_steps, h, code, FP, PP, smooth, u, sp, Z, DZ, DDZ, out, out_every, out_pos,
-                stats):
-        return advance_fx(state, mode_dir, t0, n_steps, h, code, FP, PP, EP, smooth, u, sp, Z, DZ, DDZ, out,
-                          out_every, out_pos, stats)
-
-    return advance, comp.initial_state(plant.FP, plant.PP, EP), bool(not (plant.has_stiction or comp.adds_stiction(EP)))
-
-
 def run_kernel(plant, hs, h, n_steps, out_every, *, u_active=0.0, progress=None, chunk_steps=200_000, effects=()):
     """Run the compiled stepper from rest (stuck) at the operating point.
 
     ``plant`` is :func:`heavecomp.plants.cmc.plant_vectors`; ``effects`` (instances) act at its
-    hooks (:func:`plant_stepper`).
+    hooks (:func:`heavecomp.simulate.stepper.plant_stepper`).
     """
     n_out = n_steps // out_every + 1
     out = np.empty((n_out, NCH))
     mode_dir = np.array([float(STUCK), 1.0])
     stats = np.zeros(len(STATS))
-    advance, state, smooth = plant_stepper(plant, effects)
+    advance, state, args = plant_stepper(plant, effects)
 
     def step(t0, n, Z, DZ, DDZ, pos):
-        return advance(state, mode_dir, t0, n, h, plant.code, plant.FP, plant.PP, smooth, float(u_active),
-                       0.5 * h, Z, DZ, DDZ, out, int(out_every), int(pos), stats)
+        return advance(state, mode_dir, t0, n, h, args, Drive(float(u_active), 0.5 * h, Z, DZ, DDZ), out,
+                       int(out_every), int(pos), stats)
 
     t0 = time.perf_counter()
     pos = drive(step, hs, h, n_steps, out_every, progress=progress, chunk_steps=chunk_steps)
@@ -398,36 +371,5 @@ def drive(step, hs, h, n_steps, out_every, *, progress=None, chunk_steps=200_000
     return pos
 
 
-_STEPPER = None
-
-
-def stepper():
-    """The compiled ``advance`` of :mod:`heavecomp.simulate._kernel`.
-
-    Uses the ahead-of-time build (``heavecomp.simulate._cmc_aot``, compiled from
-    the same source at install time, see ``setup.py``) when it exists and was
-    built from the current source files (hash check); otherwise the numba JIT
-    (first call of a session loads it from numba's cache, ~0.4 s).  Set
-    ``HEAVECOMP_JIT=1`` to force the JIT.
-    """
-    global _STEPPER
-    if _STEPPER is None:
-        import os
-
-        fn = None
-        if not os.environ.get("HEAVECOMP_JIT"):
-            try:
-                from heavecomp.simulate import _cmc_aot
-
-                if _cmc_aot.source_hash() == layout.source_hash():
-                    fn = _cmc_aot.advance
-                else:
-                    log.info("ahead-of-time stepper is stale (source changed since install); using the JIT")
-            except ImportError:
-                pass
-        if fn is None:
-            from heavecomp.simulate import _kernel
-
-            fn = _kernel.advance
-        _STEPPER = fn
-    return _STEPPER
+#: the nominal stepper (ahead of time when built, else the JIT): :func:`heavecomp.simulate.stepper.nominal`
+stepper = nominal

@@ -1,0 +1,234 @@
+"""The compiled exact stick-slip stepper of the CMC: its public entry points.
+
+:mod:`heavecomp.simulate._kernel` is the implementation (numba, imported on first use);
+this module is what the simulator, the closed loop, the campaigns and the diagnosis call.
+
+One call signature serves every stepper::
+
+    out_pos = advance(state, mode_dir, t0, n_steps, h, plant, drive, out, out_every, out_pos, stats)
+
+- ``plant``: :class:`Plant` ``(code, FP, PP, EP, smooth)``, the plant with the effect parameters
+  of the stepper's composition (:func:`plant_args`);
+- ``drive``: :class:`Drive` ``(u, sp, Z, DZ, DDZ)``, the active force [N] and the heave samples
+  (z, dz, ddz) spaced ``sp`` = h/2 [s];
+- ``state`` = ``[s, v, y_b, v_b, effect states..., tau]`` and ``mode_dir`` = ``[mode, direction]``
+  (updated in place); ``out`` gets a row of :data:`CHANNELS` every ``out_every`` steps from row
+  ``out_pos`` on (returned, advanced); ``stats`` accumulates :data:`STATS`.
+
+Entry points: :func:`nominal` (the stepper of the plain CMC: ahead of time when built, else the
+JIT), :func:`kernel_for` (the stepper of an effect composition), :func:`plant_stepper` (either,
+for a plant and its effects, with its initial state and :class:`Plant`), :func:`heave_at`.
+:func:`compile_all` compiles every stepper the commands use (``setup.py`` runs it at install, so
+the first run loads machine code instead of compiling it).  Every call with the argument types of
+:func:`canonical_args` uses the one compiled signature.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import threading
+import time
+
+import numpy as np
+
+from heavecomp.effects.compose import composition, composition_for, library_composition
+from heavecomp.simulate import cache, layout
+from heavecomp.simulate.layout import CHANNELS, NCH, NSTATS, STATS, STUCK, Drive, Plant
+
+__all__ = ["Plant", "Drive", "CHANNELS", "STATS", "NCH", "NSTATS", "plant_args", "nominal", "kernel_for",
+           "plant_stepper", "jit_stepper", "heave_at", "compile_all", "compiling"]
+
+log = logging.getLogger(__name__)
+
+
+def plant_args(plant, EP=None, smooth=None) -> Plant:
+    """The stepper's :class:`Plant` of ``plant`` (:func:`heavecomp.plants.cmc.plant_vectors`).
+
+    ``EP``: effect parameters of the stepper's composition (default none: the nominal stepper);
+    ``smooth``: default True when the friction law has no part that jumps with sign(v)."""
+    EP = np.zeros(0) if EP is None else np.ascontiguousarray(EP, dtype=float)
+    if smooth is None:
+        smooth = not plant.has_stiction
+    return Plant(int(plant.code), plant.FP, plant.PP, EP, bool(smooth))
+
+
+_NOMINAL = None
+
+
+def nominal():
+    """The compiled stepper of the plain CMC (no effect).
+
+    The ahead-of-time build (``heavecomp.simulate._cmc_aot``, compiled from the same source at
+    install time, see ``setup.py``) when it exists and was built from the current source files
+    (hash check), so a short run does not import numba; otherwise the numba JIT
+    (:func:`heavecomp.simulate._kernel.advance`).  ``HEAVECOMP_JIT=1`` forces the JIT.
+    """
+    global _NOMINAL
+    if _NOMINAL is None:
+        fn = None
+        if not os.environ.get("HEAVECOMP_JIT"):
+            try:
+                from heavecomp.simulate import _cmc_aot
+
+                if _cmc_aot.source_hash() == layout.source_hash():
+                    fn = _cmc_aot.advance
+                else:
+                    log.info("ahead-of-time stepper is stale (source changed since install); using the JIT")
+            except ImportError:
+                pass
+        if fn is None:
+            fn = _jit_kernel(None)
+        _NOMINAL = fn
+    return _NOMINAL
+
+
+_READY: set = set()
+_COMPILE_LOCK = threading.Lock()
+
+
+def _jit_kernel(comp):
+    """The JIT stepper of ``comp`` (None: the nominal one), compiled for the canonical signature
+    (or loaded from numba's cache) on first use, with a notice when that takes a while."""
+    from heavecomp.simulate import _kernel
+
+    fn = _kernel.advance if comp is None else _kernel.kernel_for(comp)
+    if fn in _READY:
+        return fn
+    with _COMPILE_LOCK:  # the diagnosis' threads: one compile, one notice
+        if fn not in _READY:
+            n = 0 if comp is None else len(comp.classes)
+            what = "the stick-slip stepper" + (f" with {n} effect{'s' * (n > 1)}" if n else "")
+            # loading from the cache can take seconds on a busy machine: no notice then (a late one if
+            # the cache turns out not to hold this signature after all)
+            with compiling(what, notice_after=20.0 if _in_cache(fn) else 1.0,
+                           estimate_s=COMPILE_S + COMPILE_S_PER_EFFECT * n):
+                _ensure_compiled(fn, comp)
+            _READY.add(fn)
+    return fn
+
+
+def kernel_for(comp):
+    """The compiled stepper of an effect composition (:class:`heavecomp.effects.compose.Composition`;
+    the composition of no effect: the JIT nominal stepper), compiled (or loaded from the cache) now."""
+    return _jit_kernel(comp)
+
+
+def plant_stepper(plant, effects=()):
+    """``(advance, state, plant)`` for ``plant`` (:func:`heavecomp.plants.cmc.plant_vectors`) with
+    ``effects`` (instances) at its hooks: the stepper, its initial state at rest at the operating
+    point and its :class:`Plant` (effect parameters bound).
+
+    Without effects the nominal stepper (:func:`nominal`), with effects the stepper of their
+    composition (:func:`heavecomp.effects.compose.composition_for`)."""
+    if not effects:
+        return nominal(), composition(()).initial_state(plant.FP, plant.PP, np.zeros(0)), plant_args(plant)
+    comp = composition_for(effects)
+    EP = comp.ep(effects)
+    args = plant_args(plant, EP, not (plant.has_stiction or comp.adds_stiction(EP)))
+    return kernel_for(comp), comp.initial_state(plant.FP, plant.PP, EP), args
+
+
+def jit_stepper():
+    """The JIT nominal stepper itself (a numba dispatcher), for compiled drivers that call it from
+    their own compiled code (the campaign's batch); Python callers use :func:`nominal`."""
+    from heavecomp.simulate import _kernel
+
+    return _kernel.advance
+
+
+def heave_at(t, sp, Z, DZ, DDZ):
+    """(z, dz, ddz) of the heave samples at time ``t`` [s] as the stepper interpolates them (quintic Hermite)."""
+    from heavecomp.simulate import _kernel
+
+    return _kernel.heave_at(t, sp, Z, DZ, DDZ)
+
+
+# ---------------------------------------------------------------------------- compile once
+def canonical_args(n_eff_states: int = 0, n_ep: int = 0, n_cols: int = NCH):
+    """Arguments of the canonical types of the stepper's signature (a call of no step)."""
+    state = np.zeros(4 + n_eff_states + 1)
+    mode_dir = np.array([float(STUCK), 1.0])
+    z = np.zeros(8)
+    plant = Plant(0, np.zeros(6), np.zeros(6), np.zeros(n_ep), False)
+    drive = Drive(0.0, 0.005, z, z.copy(), z.copy())
+    return state, mode_dir, 0.0, 0, 0.01, plant, drive, np.zeros((0, n_cols)), 1, 0, np.zeros(NSTATS)
+
+
+def _signature(comp=None):
+    import numba
+
+    args = canonical_args() if comp is None else canonical_args(comp.n_states, comp.n_ep)
+    return tuple(numba.typeof(a) for a in args)
+
+
+def _in_cache(fn) -> bool:
+    """True when numba's cache holds a fresh entry of ``fn`` (same numba, same source; read from
+    numba's cache index: a private interface, so any surprise answers False)."""
+    try:
+        return bool(fn._cache._cache_file._load_index())  # noqa: SLF001
+    except Exception:  # noqa: BLE001
+        return False
+
+
+def _ensure_compiled(fn, comp=None) -> None:
+    """Compile (or load from numba's cache) ``fn`` for the canonical argument types."""
+    sig = _signature(comp)
+    if sig not in fn.overloads:
+        fn.compile(sig)
+
+
+#: CPU seconds to compile the nominal stepper, and more per effect of a composition (measured:
+#: 34 s and 73 s for the library's 10 effects, numba 0.68; the notice quotes their sum)
+COMPILE_S = 35
+COMPILE_S_PER_EFFECT = 4
+
+
+class compiling:
+    """Context manager: when what it wraps runs longer than ``notice_after`` seconds (a compile,
+    not a load from the cache), log one line saying so, then a heartbeat every ``every`` seconds.
+
+    Logged at WARNING on ``heavecomp.simulate.stepper`` (the CLI prints it to stderr)."""
+
+    def __init__(self, what: str, notice_after: float = 1.0, every: float = 15.0, estimate_s: float = 60.0):
+        self.what, self.notice_after, self.every, self.estimate_s = what, notice_after, every, estimate_s
+        self._done = threading.Event()
+        self._thread = None
+
+    def _watch(self):
+        t0 = time.monotonic()
+        if self._done.wait(self.notice_after):
+            return
+        log.warning("heavecomp: compiling %s once (about %d s of CPU; kept in %s for the next runs)", self.what,
+                    self.estimate_s, cache.where())
+        while not self._done.wait(self.every):
+            log.warning("heavecomp: ... still compiling %s (%.0f s)", self.what, time.monotonic() - t0)
+
+    def __enter__(self):
+        self._thread = threading.Thread(target=self._watch, name="heavecomp-compile-notice", daemon=True)
+        self._thread.start()
+        return self
+
+    def __exit__(self, *exc):
+        self._done.set()
+        self._thread.join()
+        return False
+
+
+def compile_all(progress=None) -> list[str]:
+    """Compile the steppers the commands use into numba's cache (``setup.py`` runs it at install,
+    with the campaign's batch: :func:`heavecomp.campaign.batch.compile_batch`).
+
+    The nominal stepper (simulate, closed loop), :func:`heave_at` and the stepper of the library's
+    effect composition (``simulate(effects=...)``, the diagnosis).  Returns the names compiled;
+    ``progress(name)`` is called before each."""
+    from heavecomp.simulate import _kernel
+
+    steps = [("nominal stepper", lambda: _jit_kernel(None)),
+             ("heave interpolation", lambda: _kernel.heave_at(0.0, 0.005, np.zeros(8), np.zeros(8), np.zeros(8))),
+             ("library effects stepper", lambda: _jit_kernel(library_composition()))]
+    for name, step in steps:
+        if progress is not None:
+            progress(name)
+        step()
+    return [name for name, _ in steps]
