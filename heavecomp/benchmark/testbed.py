@@ -10,6 +10,7 @@ import numpy as np
 from heavecomp.benchmark.sea import make_sea
 from heavecomp.benchmark.truth import truth_composition
 from heavecomp.diagnosis.data import heave_samples, MeasuredRun
+from heavecomp.diagnosis.stepper import CHANNELS as SC, replay_dt, run_fx
 from heavecomp.plants.cmc import plant_vectors
 
 NOISE = {"heave": 0.002, "stroke": 0.002, "pressure": 2e3, "wob": 400.0}  #: 1-sigma sensor noise [SI]
@@ -39,8 +40,6 @@ class Testbed:
     OUT = OUT
 
     def __init__(self, nominal, rng, duration, rate, sea, noise):
-        from heavecomp.diagnosis.stepper import CHANNELS as SC, replay_dt
-
         self.nominal = nominal
         self.noise = {c: noise * v for c, v in NOISE.items()}
         self.h = h = replay_dt(nominal, rate)
@@ -68,8 +67,6 @@ class Testbed:
             Time [s], channel -> array [SI] (``heave`` and :data:`OUT`, plus what an output law adds),
             and the stepper's full output grid.
         """
-        from heavecomp.diagnosis.stepper import CHANNELS as SC, run_fx
-
         effects = []
         prm = self.nominal
         post = []

@@ -39,6 +39,7 @@ import numpy as np
 
 from heavecomp.diagnosis.estimator import CH, GapDiagnoser
 from heavecomp.diagnosis.data import load_run
+from heavecomp.diagnosis.stepper import CHANNELS as SC, run_segments
 from heavecomp.effects.candidates import MISMATCH_KEYS, ParameterMismatch, get
 from heavecomp.effects.compose import composition_for
 from heavecomp.effects.discovered_term import COMPONENT as DISCOVERED_COMPONENT
@@ -266,8 +267,6 @@ class FileEffectsDiagnoser(GapDiagnoser):
         file_fx = plant_effects(self.nominal)
         if not file_fx:
             return super().simulate(config, t_end, hs)
-        from heavecomp.diagnosis.stepper import CHANNELS as SC, run_segments
-
         rp = self._rp
         hs = rp.hs if hs is None else hs
         plant = rp.plant
