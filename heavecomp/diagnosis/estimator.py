@@ -55,6 +55,7 @@ from heavecomp.errors import InputError
 from heavecomp.estimator import GapEstimator
 from heavecomp.params.budget import MAX_REPLAY_STEPS
 from heavecomp.diagnosis import where as W
+from heavecomp.diagnosis.policy import VerdictPolicy
 from heavecomp.diagnosis.data import (ANGLES, derivative_zero_phase, HEAVE_CUTOFF, heave_filtered, heave_samples,
                                       MeasuredRun, noise_floor, uniform, zero_phase_lowpass)
 from heavecomp.plants.cmc import D0, KF, plant_vectors
@@ -78,30 +79,9 @@ class Replay:
     plant: object  # PlantVectors of the nominal parameters
 
 
-PRESCREEN_GAP = 1.0  #: a component gap (noise variances above noise and floor) at or below which its candidates are not replayed
-#: a component with less than this share of the equation-error gap shows only what the others leak into it
-PRESCREEN_SHARE = 0.02
-#: Gauss-Newton steps of a stroke or WOB reading through the replay it starts (GapDiagnoser._refine_reading)
-START_ITERATIONS = 2
-#: span of the fit part [s] on which the coarse start grid of a candidate is scored
-GRID_SPAN = 150.0
-#: points of the scan of a channel delay over its bounds (then refined by a bounded scalar search)
-DELAY_SCAN = 61
-#: a component holding this share of the gap (``where.components``) gets its best candidate tried as a second effect
-SECOND_SHARE = 0.1
-DISCOVER_SHRINK = 0.5  #: an open-search term this good on its held-out component residual turns inconclusive into discovered
 #: component of each parameter table of parameter_mismatch
 TABLE_COMPONENT = {"compensator": "gas_spring", "friction": "friction", "drill_string": "string_formation",
                    "formation": "string_formation"}
-#: a best candidate whose held-out prediction shrinks the gap's rms by this share rules out `none`
-NONE_PREDICTED = 0.5
-#: heave-noise draws whose replays test a candidate's explained share (median of their explained shares):
-#: one draw can flip an early stick event (tuning seed 20001: dwell stiction explained 0.99 on the
-#: replay, 0.02 on the first draw, 0.98-0.99 on five others)
-PERTURBED_DRAWS = 3
-#: share of ``max_nfev`` a joint second-effect fit gets (it starts from the candidate's own fit)
-JOINT_NFEV = 0.5
-BOUND_TOL = 0.01  #: a fitted parameter within this share of its search range from a bound is "at the bound"
 
 
 @functools.cache
@@ -114,7 +94,7 @@ def _least_squares_has_workers() -> bool:
     return "workers" in inspect.signature(least_squares).parameters
 
 
-def at_bounds(name, values, tol=BOUND_TOL) -> list:
+def at_bounds(name, values, tol=VerdictPolicy.bound_tol) -> list:
     """Fitted parameters of candidate ``name`` that sit at a bound of their search range
     (within ``tol`` of the range, on the fit's own scale: log where the candidate fits in log);
     not those whose bounds are the ends of their physical range (``cls.limits``: a share of 0 or 1).
@@ -222,7 +202,7 @@ class GapDiagnoser(GapEstimator):
     def __init__(self, nominal, candidates=None, *, split=0.67, settle=None, penalty=0.03, min_explained=0.5,
                  none_ratio=1.2, max_nfev=40, decimate=2, n_jobs=2, progress=None, second=4, segment=None,
                  reinit=1.5, stuck_speed=2e-3, grid=7, input_draws=8, none_tail=2.0, none_explained=0.25, scan=6,
-                 prescreen_gap=PRESCREEN_GAP, discover_shrink=DISCOVER_SHRINK):
+                 prescreen_gap=1.0, discover_shrink=0.5, policy=None):
         self.nominal = nominal
         names = list(CANDIDATES) if candidates is None else list(candidates)
         for n in names:
@@ -250,6 +230,16 @@ class GapDiagnoser(GapEstimator):
         self.none_explained = none_explained
         self.prescreen_gap = prescreen_gap
         self.discover_shrink = discover_shrink
+        self.policy = policy
+
+    #: settings that override the policy's fields of the same name
+    POLICY_SETTINGS = ("penalty", "min_explained", "none_ratio", "none_tail", "none_explained", "prescreen_gap",
+                       "discover_shrink")
+
+    def verdict_policy(self) -> VerdictPolicy:
+        """The thresholds this diagnoser decides with: ``policy`` (default :class:`VerdictPolicy`) with
+        the settings of :attr:`POLICY_SETTINGS` written in."""
+        return dataclasses.replace(self.policy or VerdictPolicy(), **{k: getattr(self, k) for k in self.POLICY_SETTINGS})
 
     # ------------------------------------------------------------------ replay
     def _setup(self, run):
@@ -411,10 +401,11 @@ class GapDiagnoser(GapEstimator):
         e_c = (mse_b - mse_a) / max(mse_b - sigma_c^2, 0.1 mse_b), averaged with weights
         g_c = max(mse_b / sigma_c^2 - 1, 0) (the channel with the largest gap over its noise counts most)."""
         num = den = 0.0
+        floor_share = self.verdict_policy().gap_floor_share
         for c in CH:
             f2 = max(self.noise_floor_[c] ** 2, 1e-30)
             g = max(mse_b[c] / f2 - 1.0, 0.0)
-            e = (mse_b[c] - mse_a[c]) / max(mse_b[c] - f2, 0.1 * mse_b[c], 1e-300)
+            e = (mse_b[c] - mse_a[c]) / max(mse_b[c] - f2, floor_share * mse_b[c], 1e-300)
             num += g * e
             den += g
         return num / den if den > 0 else 0.0
@@ -477,8 +468,9 @@ class GapDiagnoser(GapEstimator):
             # scored on the first GRID_SPAN seconds of the fit part (it only picks the start)
             k = x0.size
             # a joint fit starts from the candidate's own fit, next to its optimum: half the budget
-            budget = max(1, int(JOINT_NFEV * self.max_nfev)) if fixed else self.max_nfev
-            t_grid = min(t_end, self.split_["settle"] + GRID_SPAN)
+            P = self.verdict_policy()
+            budget = max(1, int(P.joint_nfev * self.max_nfev)) if fixed else self.max_nfev
+            t_grid = min(t_end, self.split_["settle"] + P.grid_span)
             x_ee = self._equation_error_start(name, cls) if start is None else None
             if x_ee is not None:
                 # the component residual's fit (blind to stick timing) as a start, where it fixes every
@@ -532,20 +524,21 @@ class GapDiagnoser(GapEstimator):
         base = self.simulate(list(fixed), t_end)
         grid = base["_grid"]
         best = None
+        n_scan = self.verdict_policy().delay_scan
         for c in CH:
             def obj(x, c=c):
                 pred = dict(base)
                 pred[c] = cls.apply(base["t"], grid[:, 0], grid[:, SC.index(c)], x)
                 r = self._resid_vec(pred)
                 return float(r @ r)
-            xs = np.linspace(a, b, DELAY_SCAN)
+            xs = np.linspace(a, b, n_scan)
             k = int(np.argmin([obj(x) for x in xs]))
             r = minimize_scalar(obj, bounds=(xs[max(k - 1, 0)], xs[min(k + 1, xs.size - 1)]), method="bounded",
                                 options={"xatol": 1e-4})
             if best is None or r.fun < best[0]:
                 best = (r.fun, c, float(r.x))
         return {"values": {"channel": best[1], field.name: best[2]}, "sigma": {field.name: math.nan},
-                "nfev": DELAY_SCAN * len(CH), "cost": best[0]}
+                "nfev": n_scan * len(CH), "cost": best[0]}
 
     def _least_squares(self, fun, x0, lo, hi, budget=None):
         """Bounded least squares on the decimated fit residual (``max_nfev`` evaluations)."""
@@ -668,7 +661,7 @@ class GapDiagnoser(GapEstimator):
         coef = np.array(got[2], dtype=float)
         r = resid(coef)
         best = (float(r @ r), coef.copy())
-        for _ in range(START_ITERATIONS):
+        for _ in range(self.verdict_policy().start_iterations):
             J = np.empty((r.size, idx.size))
             for j, i in enumerate(idx):
                 step = 1e-3 * (scale if abs(coef[i]) < 1e-12 or names[i] == "offset" else abs(coef[i]))
@@ -825,6 +818,7 @@ class GapDiagnoser(GapEstimator):
             for n in names:
                 finish(n, fit_and_replay(n))
         rows = []
+        P = self.verdict_policy()
         for n in names:
             fitted, pred, pred_pert = results[n]
             mse_a = self._mse(pred, self._valmask)
@@ -835,7 +829,7 @@ class GapDiagnoser(GapEstimator):
             expl = min(expl_plain, expl_pert)
             if not math.isfinite(expl):  # the fitted model diverged on held-out data
                 log.warning("diagnose: %s diverged on the held-out data", n)
-                expl = -10.0
+                expl = P.diverged_explained
             k = fitted.get("n_params", self._candidate(n).n_params())  # optional parameters held at null are not counted
             rows.append({"effect": n, "parameters": self._public(n, fitted["values"]),
                          "uncertainty": fitted["sigma"],
@@ -845,7 +839,7 @@ class GapDiagnoser(GapEstimator):
                                           "shrink": 1.0 - math.sqrt(mse_a[c] / mse_b[c]) if mse_b[c] > 0 else 0.0}
                                       for c in CH},
                          "explained": float(expl), "explained_replay": float(expl_plain),
-                         "explained_perturbed_heave": float(expl_pert), "n_params": k, "score": float(expl - self.penalty * k),
+                         "explained_perturbed_heave": float(expl_pert), "n_params": k, "score": float(expl - P.penalty * k),
                          "fit_wall_time": fitted["wall_time"], "_values": fitted["values"], "_pred": pred})
         rows.sort(key=lambda r: -r["score"])
         self._report(0.9, "verdict")
@@ -870,6 +864,7 @@ class GapDiagnoser(GapEstimator):
         return dict(values)
 
     def _verdict(self, rows, J_b, J_n):
+        P = self.verdict_policy()
         best = rows[0]
         gap_ratio = max(self.gap_["channels"][c]["rms_validate"] / max(self.noise_floor_[c], 1e-30) for c in CH)
         runner = rows[1] if len(rows) > 1 else None
@@ -882,7 +877,7 @@ class GapDiagnoser(GapEstimator):
         # lagging stroke sensor): wob's held-out gap over its floor is under half the largest channel's
         # (wob can sit at 1.2-1.7x its floor from stick-event noise alone); then on that channel
         ratio = {c: self.gap_["channels"][c]["rms_validate"] / max(self.noise_floor_[c], 1e-30) for c in CH}
-        ch = "wob" if ratio["wob"] >= 0.5 * max(ratio.values()) else max(CH, key=ratio.get)
+        ch = "wob" if ratio["wob"] >= P.shrink_channel_ratio * max(ratio.values()) else max(CH, key=ratio.get)
         # `none`: the held-out gap is no larger than measurement noise plus what the heave noise alone
         # makes of the replay (its envelope over independent draws: stick-event flips are rare but large)
         input_ratio = max(self.gap_["channels"][c]["rms_validate"] / max(self.input_envelope_[c], 1e-30) for c in CH)
@@ -895,37 +890,37 @@ class GapDiagnoser(GapEstimator):
         # on a soft formation the replay's sensitivity to the heave pre-filter is as large as the gap,
         # and a string damping of 4.5 x the output noise read `none`; its fitted candidate cut the held-out
         # WOB gap from 2.3 kN to 0.6 kN)
-        predicts = best["channels"][ch]["shrink"] >= NONE_PREDICTED and best["explained_perturbed_heave"] >= self.min_explained
+        predicts = best["channels"][ch]["shrink"] >= P.none_predicted and best["explained_perturbed_heave"] >= P.min_explained
         v["predicted_shrink"] = best["channels"][ch]["shrink"]
-        if (input_ratio <= self.none_ratio or (input_ratio <= self.none_tail and best["explained"] < self.none_explained)) \
+        if (input_ratio <= P.none_ratio or (input_ratio <= P.none_tail and best["explained"] < P.none_explained)) \
                 and not predicts:
             # between none_ratio and none_tail x the envelope: a gap that no candidate (not even the
             # six-parameter refit) explains a quarter of is read as the tail of the stick-event noise
-            tail = input_ratio > self.none_ratio
+            tail = input_ratio > P.none_ratio
             v.update(effect="none", parameters={}, shrink=0.0, uncertainty={},
-                     confidence="low" if tail else ("high" if gap_ratio <= 0.5 * (1 + self.none_ratio) else "medium"),
+                     confidence="low" if tail else ("high" if gap_ratio <= P.none_high * (1 + P.none_ratio) else "medium"),
                      note=(f"held-out gap {input_ratio:.2f} x the input-noise envelope and no candidate explains "
-                           f"{100 * self.none_explained:.0f} % of it" if tail else
-                           f"held-out gap within {self.none_ratio:g} x the noise floor (or the envelope of the "
+                           f"{100 * P.none_explained:.0f} % of it" if tail else
+                           f"held-out gap within {P.none_ratio:g} x the noise floor (or the envelope of the "
                            "replay's response to the heave noise) on every channel"))
             self.verdict_ = v
             return
-        if best["explained"] < self.min_explained:
+        if best["explained"] < P.min_explained:
             # two comparable effects: neither explains enough alone; the best with a second one may
             second = None
             if self.second:
                 second = self._second(rows)
                 v["second_candidates"] = self._second_candidates()
-            if second is not None and second["explained_joint"] >= self.min_explained:
-                v.update(second_effect=second, confidence="medium" if second["explained_joint"] >= 0.6 and margin >= 0.03
+            if second is not None and second["explained_joint"] >= P.min_explained:
+                v.update(second_effect=second, confidence="medium" if second["explained_joint"] >= P.medium_explained and margin >= P.medium_margin
                          and survives else "low", note=f"{best['effect']} explains {100 * best['explained']:.0f} % alone, "
                                           f"{100 * second['explained_joint']:.0f} % with {second['effect']}")
                 self.verdict_ = v
                 return
             pre = self.prescreen_.get(best["effect"], {})
             ee = pre.get("equation_error")
-            if (ee and ee["shrink"] >= self.discover_shrink and best["explained"] >= self.none_explained
-                    and self.where_["components"].get(pre.get("component"), 0.0) >= 0.5):
+            if (ee and ee["shrink"] >= P.discover_shrink and best["explained"] >= P.none_explained
+                    and self.where_["components"].get(pre.get("component"), 0.0) >= P.confirm_share):
                 # the replay drifts on stick-event timing (spent scoring seed 70008: an asymmetry of 0.18
                 # held out 0.45, of 0.20 0.89, on the same fit cost); the candidate's own equation, fitted
                 # on its component's residual (blind to stick timing), shrinks that residual held out as
@@ -941,22 +936,22 @@ class GapDiagnoser(GapEstimator):
                           "held-out gap above noise", best_candidate=best["effect"])
             self.verdict_ = v
             return
-        if best["explained"] >= 0.8 and margin >= 0.1 and survives:
+        if best["explained"] >= P.high_explained and margin >= P.high_margin and survives:
             v["confidence"] = "high"
-        elif best["explained"] >= 0.6 and margin >= 0.03 and survives:
+        elif best["explained"] >= P.medium_explained and margin >= P.medium_margin and survives:
             v["confidence"] = "medium"
         if not survives:
             v["note"] = (f"margin to {runner['effect']} ({margin:.3f}) within the spread a heave-noise redraw makes "
                          f"of the explained shares ({spread:.3f}): confidence low")
-        if input_ratio <= self.none_tail and v["confidence"] != "low":
+        if input_ratio <= P.none_tail and v["confidence"] != "low":
             # the stick-event-noise tail: runs with no effect reach 1.0-1.7 x their input-noise envelope,
             # and there a candidate can fit most of that noise (tuning set: a no-effect run read as a
             # 3.5 mm stroke offset, high) -- a named verdict there is never confident
             v["confidence"] = "low"
             v["note"] = (f"held-out gap only {input_ratio:.2f} x the input-noise envelope (runs without any effect "
-                         f"reach up to {self.none_tail:g} x): confidence low")
+                         f"reach up to {P.none_tail:g} x): confidence low")
         # second effect: joint fit of the best with the runners-up
-        if self.second and best["explained"] < 0.95:
+        if self.second and best["explained"] < P.second_below:
             v["second_effect"] = self._second(rows)
             v["second_candidates"] = self._second_candidates()
         self.verdict_ = v
@@ -977,6 +972,7 @@ class GapDiagnoser(GapEstimator):
         gap, shares = cr.gap(), self.where_["components"]
         fm, vm = self._fitmask & cr.mask, self._valmask & cr.mask
         out = {}
+        P = self.verdict_policy()
         for n in names:
             t0 = time.perf_counter()
             cls = get(n)
@@ -985,7 +981,7 @@ class GapDiagnoser(GapEstimator):
             if comp in cr.residual:
                 ranked = EE.rank_effects(cr.residual[comp], cr.signals_for(comp), [cls], fm, vm, component=comp)
                 ee = ranked[0] if ranked else None
-            small = gap.get(comp, 0.0) <= self.prescreen_gap or shares.get(comp, 0.0) < PRESCREEN_SHARE
+            small = gap.get(comp, 0.0) <= P.prescreen_gap or shares.get(comp, 0.0) < P.prescreen_share
             quiet = comp in CR.SCREENED and cls.screened and small and (ee is None or ee["shrink"] < EE.MIN_SHRINK)
             replay = not (cls.kind == "plant" and quiet)
             out[n] = {"component": comp, "component_gap": float(gap.get(comp, math.nan)), "replay": replay,
@@ -1001,7 +997,7 @@ class GapDiagnoser(GapEstimator):
         pre = self.prescreen_[name]
         rms = math.sqrt(mse_b["wob"])
         return {"effect": name, "parameters": {}, "rms_before": rms, "rms_after": rms, "shrink": 0.0,
-                "score": -self.penalty * self._candidate(name).n_params(), "explained": 0.0,
+                "score": -self.verdict_policy().penalty * self._candidate(name).n_params(), "explained": 0.0,
                 "n_params": self._candidate(name).n_params(),
                 "at_bound": [], "fit_wall_time": pre["wall_time"],
                 "skipped": f"pre-screen: its component {pre['component']} shows no gap of its own "
@@ -1023,6 +1019,7 @@ class GapDiagnoser(GapEstimator):
         shrinks its held-out component residual by >= ``discover_shrink``; otherwise the term is
         attached as a suggestion."""
         v = self.verdict_
+        P = self.verdict_policy()
         shares = self.where_["components"]
         eff = v["effect"]
         if eff == "none":
@@ -1033,14 +1030,14 @@ class GapDiagnoser(GapEstimator):
             # better than the equation-error shares (tuning set: gas heat transfer at 0.49 explained read
             # as flow_line from the shares, since both are ~v in the gas law's residual)
             best_comp = self._candidate_component(rows[0])
-            if rows[0]["effect"] == "parameter_mismatch" and self._refit_disagrees(best_comp, shares, largest):
+            if rows[0]["effect"] == "parameter_mismatch" and self._refit_disagrees(best_comp, shares, largest, P):
                 best_comp = largest  # the refit stands in (below): spent scoring seed 90028, a line inertance
-            v["component"] = (best_comp if rows[0]["explained"] >= self.none_explained and best_comp else
+            v["component"] = (best_comp if rows[0]["explained"] >= P.none_explained and best_comp else
                               largest or best_comp)
         else:
             v["component"] = self._candidate_component(rows[0])
         if eff == "parameter_mismatch":
-            if self._refit_disagrees(v["component"], shares, largest):
+            if self._refit_disagrees(v["component"], shares, largest, P):
                 # the six-parameter refit can bend any gap into the nominal's parameters; when the
                 # parameter it moved most is of a component where the equation error sees (almost) no
                 # gap, while another holds most of it, the two readings disagree: the gap lives where the
@@ -1055,7 +1052,7 @@ class GapDiagnoser(GapEstimator):
                     f"{100 * shares[largest]:.0f} % of the equation-error gap lies in {largest}; the refit "
                     "may stand in for an unmodelled effect there -- confidence low")
             self._stationarity(v)
-        if rows[0]["explained"] >= self.min_explained:
+        if rows[0]["explained"] >= P.min_explained:
             return
         found = self._discover()
         if found is None:
@@ -1063,17 +1060,17 @@ class GapDiagnoser(GapEstimator):
         v["discovered"] = found
         if eff == "inconclusive" and found["component"] == "sensors":
             v["component"] = "sensors"  # one channel misreads: seen in every equation that reads it
-        if eff == "inconclusive" and found["shrink"] >= self.discover_shrink:
+        if eff == "inconclusive" and found["shrink"] >= P.discover_shrink:
             v.update(effect="discovered", component=found["component"], confidence="low",
                      note=f"no named effect explains half the gap (best {rows[0]['effect']}: "
                           f"{100 * rows[0]['explained']:.0f} %); the open search's term {found['term']} shrinks the "
                           f"held-out {found['component']} residual by {100 * found['shrink']:.0f} %")
 
     @staticmethod
-    def _refit_disagrees(moved, shares, largest) -> bool:
+    def _refit_disagrees(moved, shares, largest, P) -> bool:
         """The parameter_mismatch refit moved a parameter of component ``moved`` most, where the equation
         error sees under :data:`SECOND_SHARE` of the gap, while ``largest`` holds at least half of it."""
-        return bool(largest) and shares[largest] >= 0.5 and shares.get(moved, 0.0) < SECOND_SHARE
+        return bool(largest) and shares[largest] >= P.refit_share and shares.get(moved, 0.0) < P.second_share
 
     def _stationarity(self, v):
         """A parameter mismatch is a *constant* error of the nominal's parameters: its component's
@@ -1082,7 +1079,9 @@ class GapDiagnoser(GapEstimator):
         refit averages a time-varying effect (tuning seed 20020, scoring seed 70029: a seal that warms
         and loses a third of its friction over the first minutes, read as lower friction parameters
         with high confidence): confidence low, ``verdict.stationarity`` and a warning say which moved."""
-        st = self.components_.stationarity(v["component"], mask=self._fitmask | self._valmask)
+        P = self.verdict_policy()
+        st = self.components_.stationarity(v["component"], mask=self._fitmask | self._valmask,
+                                           drift_sigmas=P.drift_sigmas, drift_share=P.drift_share)
         if st is None:
             return
         v["stationarity"] = st
@@ -1120,7 +1119,7 @@ class GapDiagnoser(GapEstimator):
             return self.discovered_
         gap = cr.gap()
         best = None
-        for c in sorted((c for c in COMPONENTS if gap[c] > 0), key=lambda c: -gap[c])[:3]:
+        for c in sorted((c for c in COMPONENTS if gap[c] > 0), key=lambda c: -gap[c])[:self.verdict_policy().discover_components]:
             d = EE.open_search(cr.residual[c], cr.signals_for(c), fm, vm, component=c)
             if d is not None and (best is None or d["shrink"] > best["shrink"]):
                 best = dict(d, unit=CR.UNITS[c])
@@ -1134,7 +1133,7 @@ class GapDiagnoser(GapEstimator):
         ``at_bound``; a named verdict with a parameter there drops to confidence ``low``, says so in
         ``warnings`` and lists them in ``verdict.at_bound``."""
         for r in rows:
-            r["at_bound"] = at_bounds(r["effect"], r["_values"])
+            r["at_bound"] = at_bounds(r["effect"], r["_values"], tol=self.verdict_policy().bound_tol)
         v = self.verdict_
         if v["effect"] in ("none", "inconclusive") or v["effect"] != rows[0]["effect"]:
             return
@@ -1165,6 +1164,7 @@ class GapDiagnoser(GapEstimator):
         component that holds a real share of the equation-error gap is tried (the components see a
         second effect without replaying it).  Default 4 + those: the joint fits were half of the
         diagnosis' time with every runner-up tried (bench_600s)."""
+        P = self.verdict_policy()
         best = rows[0]
         fixed = [(best["effect"], best["_values"])]
         best_output = get(best["effect"]).kind == "output"
@@ -1175,7 +1175,7 @@ class GapDiagnoser(GapEstimator):
         have = {self._candidate_component(best)} | {self._candidate_component(r) for r in partners}
         for r in allowed[self.second:]:
             comp = self._candidate_component(r)
-            if comp not in have and shares.get(comp, 0.0) >= SECOND_SHARE:
+            if comp not in have and shares.get(comp, 0.0) >= P.second_share:
                 partners.append(r)
                 have.add(comp)
 
@@ -1197,9 +1197,9 @@ class GapDiagnoser(GapEstimator):
         for r, (fitted, pred, expl) in zip(partners, results):
             if not math.isfinite(expl):
                 continue
-            gain = expl - best["explained"] - self.penalty * fitted.get("n_params", self._candidate(r["effect"]).n_params())
+            gain = expl - best["explained"] - P.penalty * fitted.get("n_params", self._candidate(r["effect"]).n_params())
             self.second_tried_.append({"effect": r["effect"], "explained_joint": float(expl), "added_explained": float(gain)})
-            if gain > 0.1 and (out is None or gain > out["added_explained"]):
+            if gain > P.second_gain and (out is None or gain > out["added_explained"]):
                 mse_a = self._mse(pred, self._valmask)
                 out = {"effect": r["effect"], "parameters": self._public(r["effect"], fitted["values"]),
                        "added_explained": float(gain), "explained_joint": float(expl),
@@ -1239,12 +1239,13 @@ class GapDiagnoser(GapEstimator):
             return {c: float(np.mean((a[c][m] - nom[c][m]) ** 2)) for c in CH}
 
         draws = [perturbed() for _ in range(self.input_draws)]  # the noise drawn in order, replayed concurrently
-        self._hs_pert = draws[:PERTURBED_DRAWS]
+        n_pert = self.verdict_policy().perturbed_draws
+        self._hs_pert = draws[:n_pert]
         # sensitivity to the heave pre-processing: cut-off 1.5 x higher
-        cut = heave_samples(run, self._rp.h, self._rp.n_steps, cutoff=1.5 * HEAVE_CUTOFF,
+        cut = heave_samples(run, self._rp.h, self._rp.n_steps, cutoff=self.verdict_policy().floor_cutoff_ratio * HEAVE_CUTOFF,
                             reference=self._rp.hs.info["reference_m"])
         alt, *others, alt2 = self._map(lambda hs: self.simulate([], hs=hs), draws + [cut])
-        self._mse_b_pert = [self._mse(a, val) for a in ([alt] + others)[:PERTURBED_DRAWS]]
+        self._mse_b_pert = [self._mse(a, val) for a in ([alt] + others)[:n_pert]]
         env = ms(alt, val)
         for o in others:
             other = ms(o, val)
