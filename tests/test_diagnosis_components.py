@@ -38,12 +38,11 @@ def _components(p, nominal_sim, effects):
     return CR.residuals(run, p, heave_reference=0.0, noise=NOISE, floor_channels=floor)
 
 
-def test_shares_are_the_contract_components_and_sum_to_one(nominal):
+def test_shares_are_the_contract_components(nominal):
     p, nom = nominal
     cr = _components(p, nom, [ChargeDrift(charge_error=0.03)])
     sh = cr.shares()
     assert tuple(sh) == ("friction", "gas_spring", "flow_line", "string_formation", "sensors", "heave_input")
-    assert sum(sh.values()) == pytest.approx(1.0)
     assert [r["unit"] for r in cr.table()] == ["N", "Pa", "Pa", "N", "-", "N"]
 
 
