@@ -1,5 +1,6 @@
-"""The diagnosis as parts (issue 20 item 1): one frozen verdict policy whose every field is documented
-and evidenced, and the verdict decided under it."""
+"""The diagnosis as parts (issue 20 items 1 and 4): one frozen verdict policy whose every field is
+documented and evidenced, the verdict decided under it, and effects fitted by
+name from their fit spec."""
 
 import ast
 import dataclasses
@@ -12,6 +13,8 @@ from heavecomp.diagnosis import GapDiagnoser
 from heavecomp.diagnosis.fitting import CandidateFit
 from heavecomp.diagnosis.policy import VerdictPolicy
 from heavecomp.diagnosis.verdict import Evidence, decide
+from heavecomp.effects.registry import library
+from heavecomp.errors import ParameterError
 from heavecomp.params import paper_a
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -50,3 +53,12 @@ def test_the_settings_write_into_the_policy_and_a_policy_changes_the_verdict():
 def _fit(name, explained):
     return CandidateFit(name, {}, {}, {c: {"rms_before": 1.0, "rms_after": 0.5, "shrink": 0.5} for c in CH},
                         explained, explained, explained, 1, explained - 0.03, 0.0, {})
+
+
+def test_any_registered_effect_is_a_candidate_by_name():
+    """``charge_drift`` is registered but no default candidate: it is accepted by name; an unknown
+    name is refused in one line naming the known ones."""
+    assert "charge_drift" in library() and not library()["charge_drift"].fit.candidate
+    assert GapDiagnoser(paper_a("stribeck"), ["charge_drift", "flow_loss"]).candidates == ["charge_drift", "flow_loss"]
+    with pytest.raises(ParameterError, match="charge_drift"):
+        GapDiagnoser(paper_a("stribeck"), ["charge_drfit"])

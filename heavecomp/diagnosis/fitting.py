@@ -115,7 +115,7 @@ def public(nominal, name, values) -> dict:
 def at_bounds(name, values, tol=VerdictPolicy.bound_tol) -> list:
     """Fitted parameters of candidate ``name`` that sit at a bound of their search range
     (within ``tol`` of the range, on the fit's own scale: log where the candidate fits in log);
-    not those whose bounds are the ends of their physical range (``cls.limits``: a share of 0 or 1).
+    not those whose bounds are the ends of their physical range (``cls.fit.limits``: a share of 0 or 1).
 
     Returns a list of {parameter, value, side ("lower" | "upper"), bound}.
     """
@@ -124,9 +124,9 @@ def at_bounds(name, values, tol=VerdictPolicy.bound_tol) -> list:
     out = []
     for f, a, b in zip(cls.fields(), lo, hi):
         v = values.get(f.name)
-        if not isinstance(v, (int, float)) or not math.isfinite(v) or f.name in cls.limits:
+        if not isinstance(v, (int, float)) or not math.isfinite(v) or f.name in cls.fit.limits:
             continue
-        x = math.log(v) if f.name in cls.log and v > 0 else v
+        x = math.log(v) if f.name in cls.fit.log and v > 0 else v
         span = tol * (b - a)
         side = "upper" if x >= b - span else "lower" if x <= a + span else None
         if side:
@@ -196,7 +196,7 @@ def fit(ctx, name, start=None, fixed=(), *, search=Search(), hint=None) -> Fit:
     start ``hint``, a fit vector) with the strategy its kind asks for."""
     cls = candidate_class(ctx, name)
     t0 = time.perf_counter()
-    if cls.kind == "output" and getattr(cls, "linear", False):
+    if cls.kind == "output" and cls.fit.linear:
         out = fit_linear_output(ctx, cls, fixed)
     elif cls.kind == "output":
         out = fit_delay_output(ctx, cls, fixed)
@@ -280,7 +280,7 @@ def least_squares(fun, x0, lo, hi, budget, n_jobs=1):
 
 
 def rescan(cls, fun, r, lo, hi, nominal, search=Search()):
-    """Second start for the parameters whose cost is rugged (``cls.rugged``, e.g. the static
+    """Second start for the parameters whose cost is rugged (``cls.fit.rugged``, e.g. the static
     friction force: stick-slip timing makes the cost jump, so a local fit from the nominal can
     settle in a side minimum).  Each such parameter is scanned over its search box (``scan``
     points, 10-90 % of the range, the others at the fit, clipped ones as the model uses them:
@@ -289,7 +289,7 @@ def rescan(cls, fun, r, lo, hi, nominal, search=Search()):
     data play no part in the choice).  At most ``scan`` evaluations + one more fit per parameter."""
     best, nfev = r, int(r.nfev)
     names = [f.name for f in cls.fields()]
-    for p in getattr(cls, "rugged", ()):
+    for p in cls.fit.rugged:
         i = names.index(p)
         x = best.x
         if hasattr(cls, "effective"):  # the fitted model with its clips written in (same cost)
@@ -352,7 +352,7 @@ def sigma(cls, r) -> dict:
     except np.linalg.LinAlgError:
         sx = np.full(k, math.nan)
     vals = cls.from_x(r.x)
-    return {f.name: float(abs(vals[f.name]) * s if f.name in cls.log else s) for f, s in zip(cls.fields(), sx)}
+    return {f.name: float(abs(vals[f.name]) * s if f.name in cls.fit.log else s) for f, s in zip(cls.fields(), sx)}
 
 
 # ------------------------------------------------------------------ channel readings
@@ -399,7 +399,7 @@ def fit_linear_output(ctx, cls, fixed=()) -> Fit:
     t_end = ctx.split["fit"][1]
     base0 = ctx.simulate(list(fixed), t_end)
     names = [f.name for f in cls.fields()]
-    used = np.array([n not in cls.optional for n in names])
+    used = np.array([n not in cls.fit.optional for n in names])
     best = None
     for c in CH:
         got = _fit_channel(ctx, cls, base0, c, used)

@@ -113,7 +113,7 @@ class Replay:
         mean shift no reading of the channel can undo.  Delays and channels the start does not read keep
         the run's start.  Cached per configuration."""
         fixes = [(get(n), v) for n, v in readings
-                 if getattr(get(n), "linear", False) and v.get("channel") in ("stroke", "wob")]
+                 if get(n).fit.linear and v.get("channel") in ("stroke", "wob")]
         if not fixes:
             return 0.0, self.starts
         key = tuple((cls.name, tuple(sorted(v.items()))) for cls, v in fixes)

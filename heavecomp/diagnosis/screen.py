@@ -33,7 +33,7 @@ def prescreen(cr, shares, fitmask, valmask, names, policy) -> dict:
     and whether it is replayed: a plant candidate whose component shows no gap
     (<= ``prescreen_gap``, or under ``prescreen_share`` of the whole gap: what a large gap elsewhere
     leaks into it; only components in :data:`heavecomp.diagnosis.components.SCREENED` and candidates
-    their residual sees, ``Effect.screened``) and whose equation-error columns shrink nothing held out
+    their residual sees, ``Effect.fit.screened``) and whose equation-error columns shrink nothing held out
     (< :data:`heavecomp.diagnosis.equation_error.MIN_SHRINK`) is not.  Output and nominal candidates
     (a channel delay, the six-parameter refit) are always replayed, and so is every candidate when
     none would be.  ``shares``: the equation-error shares of the gap (``where.components``)."""
@@ -49,7 +49,7 @@ def prescreen(cr, shares, fitmask, valmask, names, policy) -> dict:
             ranked = EE.rank_effects(cr.residual[comp], cr.signals_for(comp), [cls], fm, vm, component=comp)
             ee = ranked[0] if ranked else None
         small = gap.get(comp, 0.0) <= policy.prescreen_gap or shares.get(comp, 0.0) < policy.prescreen_share
-        quiet = comp in CR.SCREENED and cls.screened and small and (ee is None or ee["shrink"] < EE.MIN_SHRINK)
+        quiet = comp in CR.SCREENED and cls.fit.screened and small and (ee is None or ee["shrink"] < EE.MIN_SHRINK)
         replay = not (cls.kind == "plant" and quiet)
         out[n] = {"component": comp, "component_gap": float(gap.get(comp, math.nan)), "replay": replay,
                   "equation_error": ee, "wall_time": time.perf_counter() - t0}
