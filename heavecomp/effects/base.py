@@ -248,7 +248,11 @@ class Effect:
 
 def _mirror_fit(cls) -> None:
     """The fields of ``cls.fit`` as class attributes of the same names (``feature_shape`` only when
-    set: readers test for it)."""
+    set: readers test for it).  A class written with the loose attributes instead (``feature_grid =
+    ...`` on the class, no ``fit`` of its own) gets them as its ``fit``."""
+    loose = {f.name: cls.__dict__[f.name] for f in dataclasses.fields(FitSpec) if f.name in cls.__dict__}
+    if loose and "fit" not in cls.__dict__:
+        cls.fit = dataclasses.replace(cls.fit, **loose)
     for f in dataclasses.fields(FitSpec):
         value = getattr(cls.fit, f.name)
         if f.name == "feature_shape" and value is None:
