@@ -50,9 +50,16 @@ CATEGORIES = ("named", "none", "near_noise", "out_of_library", "two_effects")
 
 
 def frozen_settings(nominal) -> dict:
-    """The diagnoser's default settings (``get_params()``) that decide a verdict, JSON-ready."""
+    """The diagnoser's default settings (``get_params()``) that decide a verdict, JSON-ready (its
+    ``policy`` is hashed field by field: :func:`frozen_digest`)."""
     p = GapDiagnoser(nominal).get_params()
-    return {k: (list(v) if isinstance(v, tuple) else v) for k, v in p.items() if k not in NOT_FROZEN}
+    return {k: (list(v) if isinstance(v, tuple) else v) for k, v in p.items() if k not in NOT_FROZEN + ("policy",)}
+
+
+def frozen_digest(nominal, settings: dict) -> str:
+    """The hash of the settings plus every field of the verdict policy the diagnoser decides with
+    (``GapDiagnoser.verdict_policy()``): a threshold changed anywhere changes it."""
+    return settings_hash({**settings, "policy": GapDiagnoser(nominal).verdict_policy().to_json()})
 
 
 def settings_hash(settings: dict) -> str:
@@ -295,8 +302,9 @@ def main(argv=None) -> int:
         args.out = args.out / args.which
         args.out.mkdir(parents=True, exist_ok=True)
     cases = validation_cases(args.which, quick=args.quick)
-    settings = frozen_settings(parameter_sets()["paper_a"])
-    digest = settings_hash(settings)
+    nominal = parameter_sets()["paper_a"]
+    settings = frozen_settings(nominal)
+    digest = frozen_digest(nominal, settings)
     ok, note = _settings_check(args.which, digest)
     if not ok and not args.allow_unfrozen:
         print(f"diagnosis_validation: {note} (--allow-unfrozen scores anyway, flagged)", file=sys.stderr)

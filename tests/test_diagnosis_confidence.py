@@ -1,29 +1,30 @@
 """Confidence that means something (issue 12 item 6): a medium or high verdict only when the margin
 to the runner-up survives the replay's own input-noise spread (how far each candidate's explained
-share moves when the heave is redrawn within its noise)."""
+share moves when the heave is redrawn within its noise).  The verdict is a pure function of the
+scored fits (:func:`heavecomp.diagnosis.verdict.decide`): these tests feed it fits directly."""
 
 import pytest
 
-from heavecomp.diagnosis import GapDiagnoser
-from heavecomp.params import paper_a
+from heavecomp.diagnosis.fitting import CandidateFit
+from heavecomp.diagnosis.policy import VerdictPolicy
+from heavecomp.diagnosis.verdict import Evidence, decide
 
 CH = ("wob", "stroke", "pressure")
+COMPS = ("friction", "gas_spring", "flow_line", "string_formation", "sensors", "heave_input")
+POLICY = VerdictPolicy()
 
 
-def _row(name, plain, perturbed, k=1, penalty=0.03):
+def _row(name, plain, perturbed, k=1, penalty=0.03, shrink=0.5, values=None):
     expl = min(plain, perturbed)
-    return {"effect": name, "parameters": {}, "uncertainty": {}, "explained": expl, "explained_replay": plain,
-            "explained_perturbed_heave": perturbed, "n_params": k, "score": expl - penalty * k,
-            "channels": {c: {"shrink": 0.5} for c in CH}}
+    return CandidateFit(name, {}, {}, {c: {"rms_before": 1.0, "rms_after": 1.0 - shrink, "shrink": shrink} for c in CH},
+                        expl, plain, perturbed, k, expl - penalty * k, 0.0, values or {})
 
 
-def _verdict(rows):
-    d = GapDiagnoser(paper_a("stribeck"), second=0)
-    d.gap_ = {"channels": {c: {"rms_validate": 10.0} for c in CH}}
-    d.noise_floor_ = {c: 1.0 for c in CH}
-    d.input_envelope_ = {c: 1.0 for c in CH}  # gap 10x the envelope: not `none`
-    d._verdict(rows, 100.0, 1.0)
-    return d.verdict_
+def _decide(rows, gap=10.0, evidence=None):
+    """The verdict on ``rows`` with every channel's held-out rms ``gap`` x its noise floor and envelope."""
+    ones = {c: 1.0 for c in CH}
+    ev = evidence or Evidence({c: 0.0 for c in COMPS})
+    return decide(rows, {c: {"rms_validate": gap} for c in CH}, ones, ones, POLICY, ev)
 
 
 @pytest.mark.parametrize("runner_plain, confidence", [(0.70, "high"), (1.00, "low")])
@@ -31,7 +32,7 @@ def test_margin_must_survive_the_input_noise_spread(runner_plain, confidence):
     """Best explains 0.90 (0.91 on the redrawn heave); the runner-up 0.70 on the redrawn heave. With
     its replay at 0.70 too the spread is ~0.01 and the 0.20 margin holds (high); with its replay at
     1.00 the redraw moved it by 0.30, more than the margin: the ranking is within the noise (low)."""
-    v = _verdict([_row("flow_loss", 0.90, 0.91), _row("gas_heat_transfer", runner_plain, 0.70)])
+    v = _decide([_row("flow_loss", 0.90, 0.91), _row("gas_heat_transfer", runner_plain, 0.70)]).body
     assert v["effect"] == "flow_loss"
     assert v["margin"] == pytest.approx(0.20)
     assert v["confidence"] == confidence
@@ -42,32 +43,27 @@ def test_a_gap_in_the_stick_event_noise_tail_is_never_confident():
     stick-event noise alone: a candidate explaining 96 % of such a gap is named, but with low
     confidence (the same rows at 10 x the envelope read high)."""
     rows = [_row("sensor_offset", 0.98, 0.96, k=2), _row("sensor_gain", 0.02, 0.02)]
-    d = GapDiagnoser(paper_a("stribeck"), second=0)
-    d.gap_ = {"channels": {c: {"rms_validate": 1.6} for c in CH}}
-    d.noise_floor_ = {c: 1.0 for c in CH}
-    d.input_envelope_ = {c: 1.0 for c in CH}
-    d._verdict(rows, 100.0, 1.0)
-    assert d.verdict_["effect"] == "sensor_offset" and d.verdict_["confidence"] == "low"
-    assert _verdict(rows)["confidence"] == "high"
+    v = _decide(rows, gap=1.6)
+    assert v.effect == "sensor_offset" and v.confidence == "low"
+    assert _decide(rows).confidence == "high"
 
 
 @pytest.mark.parametrize("held_out_shrink, effect", [(0.74, "string_damping"), (0.2, "none")])
 def test_a_gap_a_candidate_predicts_on_held_out_data_is_not_noise(held_out_shrink, effect):
     """A held-out gap within the input-noise envelope reads `none`, unless the best candidate, fitted on
-    the fit part only, predicts it: noise on held-out samples cannot be predicted.  Scoring seed 70005
-    (a string damping on a soft formation, whose replay's sensitivity to the heave pre-filter is as
-    large as the gap) had its fitted candidate cut the held-out WOB rms by 74 %; a no-effect run's best
-    candidate shrinks little.  Named, the verdict stays low: the gap is within the envelope."""
-    row = _row("string_damping", 1.87, 1.87)
-    row["channels"] = {c: {"shrink": held_out_shrink} for c in CH}
-    d = GapDiagnoser(paper_a("stribeck"), second=0)
-    d.gap_ = {"channels": {c: {"rms_validate": 1.0} for c in CH}}
-    d.noise_floor_ = {c: 1.0 for c in CH}
-    d.input_envelope_ = {c: 1.0 for c in CH}
-    d._verdict([row, _row("friction_lag", 0.88, 0.88, k=2)], 100.0, 1.0)
-    assert d.verdict_["effect"] == effect
+    the fit part only, predicts it: noise on held-out samples cannot be predicted.  A string damping on
+    a soft formation, whose replay's sensitivity to the heave pre-filter is as large as the gap, had its
+    fitted candidate cut the held-out WOB rms by 74 %; a no-effect run's best candidate shrinks little.
+    Named, the verdict stays low: the gap is within the envelope."""
+    row = _row("string_damping", 1.87, 1.87, shrink=held_out_shrink)
+    v = _decide([row, _row("friction_lag", 0.88, 0.88, k=2)], gap=1.0)
+    assert v.effect == effect
     if effect != "none":
-        assert d.verdict_["confidence"] == "low"
+        assert v.confidence == "low"
+
+
+MISMATCH = {"gas_stiffness": 1.0, "static_force": 1.1, "coulomb_force": 1.05, "viscous_coefficient": 0.9,
+            "drill_string_stiffness": 1.2, "formation_stiffness": 0.4}
 
 
 @pytest.mark.parametrize("largest, component, confidence", [("string_formation", "string_formation", "high"),
@@ -75,27 +71,16 @@ def test_a_gap_a_candidate_predicts_on_held_out_data_is_not_noise(held_out_shrin
                                                              ("gas_spring+string", "string_formation", "high")])
 def test_a_refit_that_moves_another_component_than_the_equation_error_is_not_confident(largest, component,
                                                                                          confidence):
-    """parameter_mismatch moved the formation stiffness most (x 0.4).  Where the equation error also puts
-    the gap in the string and formation, the two readings agree and the verdict keeps its confidence;
-    where it puts 99 % of it in the line (scoring seed 70028: a line inertance), the refit is a stand-in:
-    the component is the equation error's and the confidence low, with a warning.  A mismatch in two
-    components (tuning seed 20007: gas and string stiffness, 58 % and 42 % of the gap) agrees in both."""
-    import numpy as np
-    from heavecomp.diagnosis.components import ComponentResiduals
-
-    d = GapDiagnoser(paper_a("stribeck"), second=0)
-    comps = ("friction", "gas_spring", "flow_line", "string_formation", "sensors", "heave_input")
+    """parameter_mismatch moved the formation stiffness most (x 0.4), and its replay alone reads high.
+    Where the equation error also puts the gap in the string and formation, the two readings agree and
+    the verdict keeps its confidence; where it puts 99 % of it in the line (a line inertance), the refit
+    is a stand-in: the component is the equation error's and the confidence low, with a warning.  A
+    mismatch in two components (gas and string stiffness, 58 % and 42 % of the gap) agrees in both."""
     split = {"gas_spring": 0.58, "string_formation": 0.42} if largest == "gas_spring+string" else {largest: 0.99}
-    d.where_ = {"components": {c: split.get(c, 0.002) for c in comps}}
-    d.components_ = ComponentResiduals(np.zeros(1), {}, {}, {}, {}, {}, np.ones(1, bool))
-    d._fitmask = d._valmask = np.ones(1, bool)
-    d.warnings_ = []
-    d.verdict_ = {"effect": "parameter_mismatch", "confidence": "high"}
-    values = {"gas_stiffness": 1.0, "static_force": 1.1, "coulomb_force": 1.05, "viscous_coefficient": 0.9,
-              "drill_string_stiffness": 1.2, "formation_stiffness": 0.4}
-    d._component_verdict([{"effect": "parameter_mismatch", "explained": 0.74, "_values": values}])
-    assert d.verdict_["component"] == component and d.verdict_["confidence"] == confidence
-    assert bool(d.warnings_) == (confidence == "low")
+    rows = [_row("parameter_mismatch", 0.9, 0.9, k=6, values=MISMATCH), _row("flow_loss", 0.3, 0.3)]
+    v = _decide(rows, evidence=Evidence({c: split.get(c, 0.002) for c in COMPS}))
+    assert v.body["component"] == component and v.confidence == confidence
+    assert bool(v.warnings) == (confidence == "low")
 
 
 @pytest.mark.parametrize("ee_shrink, share, effect", [(0.70, 1.0, "asymmetric_friction"), (0.20, 1.0, "inconclusive"),
@@ -105,32 +90,34 @@ def test_a_replay_short_of_half_is_named_when_its_equation_error_confirms(ee_shr
     on stick timing).  Its own equation, fitted on its component's residual, shrinks that residual held
     out by 70 % in the component holding the gap: named, low.  A weak equation-error fit, or a component
     that holds only 30 % of the gap, leaves it inconclusive."""
-    d = GapDiagnoser(paper_a("stribeck"), second=0)
-    d.gap_ = {"channels": {c: {"rms_validate": 10.0} for c in CH}}
-    d.noise_floor_ = {c: 1.0 for c in CH}
-    d.input_envelope_ = {c: 1.0 for c in CH}
-    d.prescreen_ = {"asymmetric_friction": {"component": "friction", "equation_error": {"shrink": ee_shrink}}}
-    d.where_ = {"components": {"friction": share, "string_formation": 1.0 - share}}
-    d._verdict([_row("asymmetric_friction", 0.45, 0.52, k=2), _row("sensor_offset", 0.19, 0.19, k=2)], 100.0, 1.0)
-    assert d.verdict_["effect"] == effect and d.verdict_["confidence"] == "low"
+    pre = {"asymmetric_friction": {"component": "friction", "equation_error": {"shrink": ee_shrink}}}
+    shares = {c: {"friction": share, "string_formation": 1.0 - share}.get(c, 0.0) for c in COMPS}
+    v = _decide([_row("asymmetric_friction", 0.45, 0.52, k=2), _row("sensor_offset", 0.19, 0.19, k=2)],
+                evidence=Evidence(shares, pre))
+    assert v.effect == effect and v.confidence == "low"
 
 
 def test_an_inconclusive_refit_takes_the_equation_errors_component_when_they_disagree():
     """Inconclusive, the best candidate parameter_mismatch (48 %) moved a friction parameter most while
-    the equation error puts 99 % of the gap in the line (spent scoring seed 90028, a line inertance):
-    the verdict's component is the line's, not friction."""
-    import numpy as np
-    from heavecomp.diagnosis.components import ComponentResiduals
-
-    d = GapDiagnoser(paper_a("stribeck"), second=0)
-    comps = ("friction", "gas_spring", "flow_line", "string_formation", "sensors", "heave_input")
-    d.where_ = {"components": {c: (0.99 if c == "flow_line" else 0.002) for c in comps}}
-    d.components_ = ComponentResiduals(np.zeros(1), {}, {}, {}, {}, {}, np.ones(1, bool))
-    d._fitmask = d._valmask = np.ones(1, bool)
-    d.warnings_, d.discovered_ = [], None
-    d._discover = lambda: None
-    d.verdict_ = {"effect": "inconclusive", "confidence": "low"}
+    the equation error puts 99 % of the gap in the line (a line inertance): the verdict's component is
+    the line's, not friction."""
     values = {"gas_stiffness": 1.0, "static_force": 1.0, "coulomb_force": 1.0, "viscous_coefficient": 0.35,
               "drill_string_stiffness": 1.1, "formation_stiffness": 1.0}
-    d._component_verdict([{"effect": "parameter_mismatch", "explained": 0.48, "_values": values}])
-    assert d.verdict_["component"] == "flow_line"
+    rows = [_row("parameter_mismatch", 0.48, 0.48, k=6, values=values), _row("flow_loss", 0.2, 0.2)]
+    v = _decide(rows, evidence=Evidence({c: (0.99 if c == "flow_line" else 0.002) for c in COMPS}))
+    assert v.effect == "inconclusive"
+    assert v.body["component"] == "flow_line"
+
+
+def test_a_drifting_component_lowers_a_parameter_mismatch():
+    """A parameter mismatch is a constant error: when its component's residual changes its coefficients
+    over the run (a seal that warms), the verdict drops to low and a warning names what moved; a
+    stationary residual keeps the confidence."""
+    rows = [_row("parameter_mismatch", 0.9, 0.9, k=6, values=MISMATCH), _row("flow_loss", 0.3, 0.3)]
+    shares = {c: (0.99 if c == "string_formation" else 0.002) for c in COMPS}
+    st = {"windows": [[0, 1], [1, 2]], "drifting": ["rel"],
+          "coefficients": [{"feature": "rel", "unit": "N/m", "value": [1.0, 2.0], "stderr": [0.1, 0.1]}]}
+    drifting = _decide(rows, evidence=Evidence(shares, stationarity=lambda c: st))
+    steady = _decide(rows, evidence=Evidence(shares, stationarity=lambda c: dict(st, drifting=[])))
+    assert drifting.confidence == "low" and "rel: 1 to 2 N/m" in drifting.warnings[0]
+    assert steady.confidence == "high" and steady.body["stationarity"]["drifting"] == []

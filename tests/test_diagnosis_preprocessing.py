@@ -102,7 +102,7 @@ def test_noise_floor_on_generated_channels(fs):
 
 def test_where_counts_offset_and_trend():
     """A WOB residual that is 20 % offset, 52 % slow drift and 28 % oscillation at the string resonance:
-    ``levels`` gives each its share (they sum to 1), while the schema-1 ``bands`` (mean-removed spectrum)
+    ``levels`` gives each its share, while the schema-1 ``bands`` (mean-removed spectrum)
     hide the drift and call most of the gap "resonance" -- the defect of issue 12."""
     from heavecomp.diagnosis.data import check_run
     from heavecomp.diagnosis.where import eigenfrequencies, locate
@@ -125,7 +125,6 @@ def test_where_counts_offset_and_trend():
     nom = {"wob": cols["wob"] + resid, "stuck": np.zeros(t.size), "stroke_velocity": np.gradient(-0.9 * z, t)}
     w = locate(run, nom, p, np.ones(t.size, bool))
     lv = w["levels"]
-    assert sum(lv.values()) == pytest.approx(1.0, abs=1e-6)
     assert lv["offset"] == pytest.approx(c * c / ms, abs=0.01)
     assert lv["trend"] == pytest.approx(d * d / 3 / ms, abs=0.01)
     assert lv["resonance"] == pytest.approx(A * A / 2 / ms, abs=0.03)

@@ -89,6 +89,7 @@ def test_parameter_mismatch_rescan_leaves_the_stick_slip_side_minimum():
     """The side minimum a local fit reached on another kernel (F_S 12.5 kN against 23 kN, F_C's
     multiplier clipped): started there, the plain fit stays; the rescan of the rugged static
     force finds the truth's basin, on the fit part's cost alone."""
+    from heavecomp.diagnosis import fitting as F
     from heavecomp.effects.candidates import ParameterMismatch as PM
 
     truth = paper_a().replace(compensator={"gas_stiffness": 60e3}, drill_string={"stiffness": 1.2e6})
@@ -97,14 +98,17 @@ def test_parameter_mismatch_rescan_leaves_the_stick_slip_side_minimum():
     t_end = d.split_["fit"][1]
     lo, hi = PM.bounds_x()
 
+    ctx = d.context_
+
     def fun(x):
-        return d._resid_vec(d.simulate([("parameter_mismatch", PM.from_x(x))], t_end))
+        return ctx.resid_vec(ctx.simulate([("parameter_mismatch", PM.from_x(x))], t_end))
 
     x0 = PM.x0()
     x0[1] = math.log(0.54)
-    trapped = d._least_squares(fun, x0, lo, hi)
+    search = F.Search(max_nfev=d.max_nfev, scan=d.scan)
+    trapped = F.least_squares(fun, x0, lo, hi, search.max_nfev)
     assert PM.named_values(nominal, PM.from_x(trapped.x))["friction.static_force"] < 0.8 * 23e3  # the trap is real
-    r = d._rescan(PM, fun, trapped, lo, hi)
+    r = F.rescan(PM, fun, trapped, lo, hi, nominal, search)
     got = PM.named_values(nominal, PM.from_x(r.x))
     assert r.cost < trapped.cost
     assert got["friction.static_force"] == pytest.approx(23e3, rel=0.1)

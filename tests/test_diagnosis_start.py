@@ -13,6 +13,7 @@ import pytest
 
 from heavecomp.diagnosis import start as S
 from heavecomp.diagnosis.data import check_run, heave_filtered
+from heavecomp.diagnosis import replay as R
 from heavecomp.diagnosis.estimator import GapDiagnoser
 from heavecomp.diagnosis.stepper import CHANNELS as SC, replay_dt, run_fx
 from heavecomp.effects.compose import composition
@@ -50,9 +51,8 @@ def test_a_run_from_rest_is_estimated_at_rest():
     assert st.at_rest and st.stuck
     assert abs(st.stroke) < 1e-3 and st.stroke_velocity == 0.0
     assert abs(st.heave_reference) < 1e-3  # the truth's operating point belongs to heave 0
-    d = GapDiagnoser(p, ["flow_loss"], second=0, n_jobs=1)
-    d._setup(run)
-    assert d.start_warnings_ == []
+    rp = R.build(run, p)
+    assert R.start_warnings(rp.initial, p) == []
 
 
 @pytest.mark.parametrize("t0", [37.0, 60.0, 83.3])
@@ -82,16 +82,15 @@ def test_cut_run_is_replayed_like_the_whole_run_and_warned(t0):
     cut = _crop(p, t, meas, t0)
     reps = {}
     for name, run in (("full", full), ("cut", cut)):
-        d = GapDiagnoser(p, ["flow_loss"], second=0, n_jobs=1)
-        d._rp = d._setup(run)
-        reps[name] = (run, d.simulate([]), d)
-    run_c, nom_c, d_c = reps["cut"]
+        rp = R.build(run, p)
+        reps[name] = (run, rp.simulate([]), rp)
+    run_c, nom_c, rp_c = reps["cut"]
     _, nom_f, _ = reps["full"]
     m = run_c.t >= 30.0
     for c, sigma in (("stroke", NOISE["stroke"]), ("wob", NOISE["wob"]), ("pressure", NOISE["pressure"])):
         other = np.interp(run_c.t[m] + t0, full.t, nom_f[c])
         assert np.sqrt(np.mean((nom_c[c][m] - other) ** 2)) < 0.5 * sigma, c
-    assert any("does not start at rest" in w for w in d_c.start_warnings_)
+    assert any("does not start at rest" in w for w in R.start_warnings(rp_c.initial, p))
 
 
 @pytest.mark.slow

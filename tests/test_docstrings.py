@@ -46,7 +46,7 @@ PENDING = {
     "heavecomp/diagnosis/components.py",
     "heavecomp/diagnosis/data.py",
     "heavecomp/diagnosis/equation_error.py",
-    "heavecomp/diagnosis/estimator.py",
+
     "heavecomp/diagnosis/stepper.py",
     "heavecomp/diagnosis/where.py",
     "heavecomp/effects/base.py",

@@ -5,10 +5,16 @@
 >>> d = GapDiagnoser(nominal, split=0.67).fit(run)               # doctest: +SKIP
 >>> d.verdict_, d.candidates_, d.where_, d.to_json()             # doctest: +SKIP
 
+Parts: :mod:`~heavecomp.diagnosis.replay` (the run prepared once), :mod:`~heavecomp.diagnosis.fitting`
+(the fitting strategies), :mod:`~heavecomp.diagnosis.screen` (equation error: pre-screen, open search),
+:mod:`~heavecomp.diagnosis.joint` (a second effect), :mod:`~heavecomp.diagnosis.verdict` (the pure
+verdict) and :mod:`~heavecomp.diagnosis.policy` (every threshold).
+
 Heavy modules (numba, scipy) load on first use.
 """
 
 from heavecomp.diagnosis.data import MeasuredRun, check_run, load_run
 from heavecomp.diagnosis.estimator import GapDiagnoser
+from heavecomp.diagnosis.policy import VerdictPolicy
 
-__all__ = ["GapDiagnoser", "load_run", "check_run", "MeasuredRun"]
+__all__ = ["GapDiagnoser", "VerdictPolicy", "load_run", "check_run", "MeasuredRun"]

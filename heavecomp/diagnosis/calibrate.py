@@ -23,31 +23,28 @@ a sensor effect (``sensor_gain``,   an ``[[effects]]`` entry that corrects how a
 A second effect the diagnosis named (``verdict.second_effect``) is added the same way.
 
 :func:`replay_shrink` checks the calibrated model: it replays the log with it (the diagnosis' own
-replay, :class:`FileEffectsDiagnoser`) and measures the held-out shrink the diagnosis reported.
-:class:`FileEffectsDiagnoser` is the gap diagnosis with the parameter file's plant effects in every
-replay (the nominal replay and every candidate's), so ``diagnose LOG --params calibrated.toml``
-diagnoses what is left after the calibration.
+replay, :class:`heavecomp.diagnosis.replay.Replay`) and measures the held-out shrink the diagnosis
+reported.  The diagnosis replays the parameter file's plant effects in every replay (the nominal
+replay and every candidate's), so ``diagnose LOG --params calibrated.toml`` diagnoses what is left
+after the calibration.
 """
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from heavecomp.diagnosis.estimator import CH, GapDiagnoser
+from heavecomp.diagnosis.estimator import GapDiagnoser
 from heavecomp.diagnosis.data import load_run
-from heavecomp.diagnosis.stepper import CHANNELS as SC, run_segments
-from heavecomp.effects.candidates import MISMATCH_KEYS, ParameterMismatch, get
-from heavecomp.effects.compose import composition_for
+from heavecomp.diagnosis import replay as R
+from heavecomp.effects.candidates import MISMATCH_KEYS
 from heavecomp.effects.discovered_term import COMPONENT as DISCOVERED_COMPONENT
 from heavecomp.effects.discovered_term import FEATURES as DISCOVERED_FEATURES
-from heavecomp.effects.spec import build, classes, plant_effects, reading_effects
+from heavecomp.effects.spec import build, classes, reading_effects
 from heavecomp.errors import InputError
 from heavecomp.params import dumps
-from heavecomp.plants.cmc import plant_vectors
 
 #: file name of the calibrated model in the diagnosis folder
 FILE = "calibrated.toml"
@@ -254,56 +251,9 @@ def write(nominal, diagnosis: dict, out_dir, source: str = "") -> Calibrated:
 
 
 # ------------------------------------------------------------------------------------ replay
-class FileEffectsDiagnoser(GapDiagnoser):
-    """The gap diagnosis of a parameter file that carries plant effects (``[[effects]]``): every replay
-    (the nominal one and each candidate's) runs the file's plant effects at their hooks, a candidate of
-    the same effect refits it.  Without plant effects it is :class:`GapDiagnoser` exactly.
-
-    (A stand-in until the estimator takes the file's effects itself: the replay below is
-    :meth:`GapDiagnoser.simulate` with the file's effects put before the configuration's.)
-    """
-
-    def simulate(self, config, t_end=None, hs=None):
-        file_fx = plant_effects(self.nominal)
-        if not file_fx:
-            return super().simulate(config, t_end, hs)
-        rp = self._rp
-        hs = rp.hs if hs is None else hs
-        plant = rp.plant
-        effects, sensors = list(file_fx), []
-        shift, starts = self._start_for([(n, v) for n, v in config if get(n).kind == "output"])
-        if shift:
-            hs = dataclasses.replace(hs, z=hs.z + shift)
-        for name, values in config:
-            cls = get(name)
-            if cls.kind == "plant":
-                effects = [e for e in effects if e.name != name] + [cls(**values)]
-            elif cls.kind == "nominal":
-                plant = plant_vectors(ParameterMismatch.apply(self.nominal, values))
-            elif cls.kind == "heave":
-                hs = cls(**values).transform(hs)
-            else:
-                sensors.append(cls(**values))
-        comp = composition_for(effects)
-        n = rp.n_steps if t_end is None else min(rp.n_steps, int(math.ceil(t_end / rp.h)) + 2)
-        out = run_segments(plant, comp, comp.ep(effects), hs, rp.h, rp.bounds, starts, n + 1)
-        tg = out[:, 0]
-        t = rp.t if t_end is None else rp.t[rp.t <= tg[-1]]
-        res = {c: np.interp(t, tg, out[:, SC.index(c)]) for c in CH + ("stroke_velocity", "stuck")}
-        done = set()
-        for e in sensors:
-            c = e.channel
-            if c in CH:
-                res[c] = e.measure(t, t, res[c]) if c in done else e.measure(t, tg, out[:, SC.index(c)])
-                done.add(c)
-        res["t"] = t
-        res["_grid"] = out
-        return res
-
-
 def diagnoser(params, *args, **kw) -> GapDiagnoser:
-    """The gap diagnoser of ``params``: :class:`FileEffectsDiagnoser` when its ``[[effects]]`` has plant
-    effects, else :class:`GapDiagnoser`.
+    """The gap diagnoser of ``params`` (:class:`GapDiagnoser`: its replays run the file's plant effects,
+    ``[[effects]]``, at their hooks; a candidate of the same effect refits it).
 
     Parameters
     ----------
@@ -314,16 +264,15 @@ def diagnoser(params, *args, **kw) -> GapDiagnoser:
     **kw : dict
         Passed on likewise (keyword arguments such as ``split``, ``n_jobs``).
     """
-    return (FileEffectsDiagnoser if plant_effects(params) else GapDiagnoser)(params, *args, **kw)
+    return GapDiagnoser(params, *args, **kw)
 
 
 def _replay(params, run):
     """The diagnosis' replay of ``run`` (a :class:`~heavecomp.diagnosis.data.MeasuredRun`) with the model
     ``params`` (its plant effects included): channel -> array at the run's times."""
-    d = diagnoser(params)
-    d._run, d._starts = run, {}
-    d._rp = d._setup(run)  # the replay's grid, heave and start estimated from the log, as in fit()
-    return d.simulate([])
+    d = diagnoser(params)  # its settings: the replay's grid, heave and start estimated from the log, as in fit()
+    rp = R.build(run, params, stuck_speed=d.stuck_speed, segment=d.segment, reinit=d.reinit, noise=R.output_noise(run))
+    return rp.simulate([])
 
 
 def replay_shrink(path, calibrated, nominal, diagnosis: dict, *, columns=None, units=None) -> dict:
@@ -379,4 +328,4 @@ def replay_shrink(path, calibrated, nominal, diagnosis: dict, *, columns=None, u
             "agreement": agree}
 
 
-__all__ = ["Calibrated", "FileEffectsDiagnoser", "calibrate", "diagnoser", "replay_shrink", "to_toml", "write"]
+__all__ = ["Calibrated", "calibrate", "diagnoser", "replay_shrink", "to_toml", "write"]

@@ -58,6 +58,7 @@ import numpy as np
 
 from heavecomp.diagnosis import equation_error as EE
 from heavecomp.diagnosis.data import ANGLES, fill_gaps, lowpass_zero_phase, noise_floor
+from heavecomp.diagnosis.policy import VerdictPolicy
 from heavecomp.effects.base import COMPONENTS
 from heavecomp.effects.features import rest_durations
 from heavecomp.friction.laws import friction_cont, friction_jump
@@ -146,9 +147,6 @@ STRUCTURE = {"friction": ("sign_v", "v"), "gas_spring": ("const", "x"), "string_
 #: unit of a structure coefficient: the residual's unit (:data:`UNITS`) followed by this
 PER_FEATURE = {"sign_v": "", "const": "", "v": " s/m", "vrel": " s/m", "x": "/m", "rel": "/m"}
 WINDOWS = 4  #: time windows of the stationarity test
-#: a coefficient moving across the windows by this many standard errors (of the difference of two
-#: windows) and by this share of its mean magnitude is not constant; fixed a priori, not tuned
-DRIFT_SIGMAS, DRIFT_SHARE = 4.0, 0.25
 
 
 def _column(sig, name):
@@ -234,14 +232,15 @@ class ComponentResiduals:
             sig["x"], sig["v"] = sig["rel"], sig["vrel"]
         return sig
 
-    def stationarity(self, component, mask=None, windows=WINDOWS) -> dict:
+    def stationarity(self, component, mask=None, windows=WINDOWS, *, drift_sigmas=VerdictPolicy.drift_sigmas,
+                     drift_share=VerdictPolicy.drift_share) -> dict:
         """Does the component's residual keep its shape over the run?  Its least-squares coefficients on
         the component's nominal structure (:data:`STRUCTURE`: a wrong constant parameter of the nominal
         law) in ``windows`` equal time windows, with standard errors for the residual's correlation
         (about 2 x :data:`CUTOFF` independent samples per second).
 
-        Returns {windows [s], drifting: the features whose coefficient moves by >= :data:`DRIFT_SIGMAS`
-        standard errors and >= :data:`DRIFT_SHARE` of its mean magnitude between two windows,
+        Returns {windows [s], drifting: the features whose coefficient moves by >=  ``drift_sigmas``
+        standard errors and >= ``drift_share`` of its mean magnitude between two windows,
         coefficients: per feature {feature, unit, value (per window), stderr (per window)}}; None when
         the component has no structure listed or too few samples."""
         feats = STRUCTURE.get(component)
@@ -275,7 +274,7 @@ class ComponentResiduals:
             i, k = int(np.argmax(C[:, j])), int(np.argmin(C[:, j]))
             move = C[i, j] - C[k, j]
             se = math.hypot(E[i, j], E[k, j])
-            if move >= DRIFT_SIGMAS * se and move >= DRIFT_SHARE * abs(float(np.mean(C[:, j]))):
+            if move >= drift_sigmas * se and move >= drift_share * abs(float(np.mean(C[:, j]))):
                 drifting.append(f)
         return {"windows": spans, "drifting": drifting,
                 "coefficients": [{"feature": f, "unit": UNITS[component] + PER_FEATURE[f], "value": C[:, j].tolist(),

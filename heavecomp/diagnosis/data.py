@@ -335,16 +335,17 @@ def heave_filtered(run: MeasuredRun, cutoff=HEAVE_CUTOFF):
     return CubicSpline(tu, zero_phase_lowpass(zu, tu[1] - tu[0], cutoff))
 
 
-def heave_samples(run: MeasuredRun, h: float, n_steps: int, cutoff=HEAVE_CUTOFF, reference=None):
+def heave_samples(run: MeasuredRun, h: float, n_steps: int, cutoff=HEAVE_CUTOFF, reference=None, spline=None):
     """Heave input for the replay: :func:`heave_filtered` minus the operating point's heave
     reference, z_h, dz_h, ddz_h on the stepper grid (h/2).
 
     ``reference`` [m]: the heave the operating point belongs to (estimated by
     :func:`heavecomp.diagnosis.start.estimate` for a log that starts anywhere); default the first
     filtered sample (cmc-reference.md: a run that starts at rest at the operating point).
+    ``spline``: the run's :func:`heave_filtered` at ``cutoff`` when already made (it is not made again).
     """
 
-    cs = heave_filtered(run, cutoff)
+    cs = heave_filtered(run, cutoff) if spline is None else spline
     ref = float(cs(run.t[0])) if reference is None else float(reference)
     sp = 0.5 * h
     tg = np.minimum(np.arange(2 * n_steps + 2) * sp, run.t[-1])

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from heavecomp.effects.base import Effect
+from heavecomp.effects.base import Effect, FitSpec
 from heavecomp.effects.features import need
 from heavecomp.friction.laws import VS
 from heavecomp.params.core import q
@@ -32,10 +32,14 @@ class AsymmetricFriction(Effect):
     """
 
     name = "asymmetric_friction"
-    candidate = True
+    fit = FitSpec(
+        candidate=True,
+        # a breakaway share of 0 or 1 is a physical answer (the search bounds are its range)
+        limits=("breakaway",),
+        # units of the feature coefficients [SI]
+        feature_units={"asymmetric_friction": "N", "asymmetric_pressure_friction": "N/Pa", "asymmetric_viscous": "N s/m"},
+    )
     hook = "seal_friction"
-    #: a breakaway share of 0 or 1 is a physical answer (the search bounds are its range)
-    limits = ("breakaway",)
 
     @dataclass(frozen=True)
     class Params:
@@ -43,9 +47,6 @@ class AsymmetricFriction(Effect):
                              doc="relative friction excess extending (+) over retracting (-): J (1 + a sign(v))")
         breakaway: float = q(1.0, "-", bounds=(0.0, 1.0), symbol="b",
                              doc="share of the asymmetry the static limit carries (0: symmetric breakaway)")
-
-    #: units of the feature coefficients [SI]
-    feature_units = {"asymmetric_friction": "N", "asymmetric_pressure_friction": "N/Pa", "asymmetric_viscous": "N s/m"}
 
     @classmethod
     def features(cls, sig, shape=None):

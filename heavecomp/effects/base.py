@@ -62,16 +62,51 @@ METHODS = ("gas", "line", "string", "jump", "static", "rates")
 SENSOR_CHANNELS = ("wob", "stroke", "pressure", "heave")
 
 
+@dataclasses.dataclass(frozen=True)
+class FitSpec:
+    """How the gap diagnosis fits an effect: everything on an effect class that is not its physics
+    (``fit = FitSpec(...)`` on the class; every field has a default)."""
+
+    candidate: bool = False
+    """The gap diagnosis fits it by default (the contract's effects, ``diagnosis-contract.md``)."""
+    log: tuple = ()
+    """Parameters fitted on a log scale."""
+    feature_grid: tuple = ()
+    """Values of one nonlinear shape parameter searched by the equation-error fit (empty: none)."""
+    feature_shape: tuple | None = None
+    """(name, unit) of that shape parameter (None: the effect has none)."""
+    feature_units: dict = dataclasses.field(default_factory=dict)
+    """Units of the equation-error coefficients (``features``) by column name."""
+    screened: bool = True
+    """Its component's equation residual sees the effect wherever it acts (the gap diagnosis may then
+    skip its replay when that component shows no gap); False where the residual is blind to it (e.g. a
+    breakaway force, a damping below the balance's noise)."""
+    optional: tuple = ()
+    """Parameters fitted only when they pay (held at their null value otherwise, and then not counted
+    in the parsimony penalty); empty: every parameter is always fitted."""
+    limits: tuple = ()
+    """Parameters whose search bounds are the ends of their physical range (e.g. a share in [0, 1]): a
+    fit at such a bound is an answer, not a sign that the effect stands in for another."""
+    rugged: tuple = ()
+    """Parameters whose fit cost is rugged (stick-slip timing jumps with them): the diagnosis rescans
+    them over their search box for a second start."""
+    linear: bool = False
+    """A channel reading affine in its parameters (fitted by linear least squares)."""
+
+
 class Effect:
-    """Base class of an effect (a submodel at one of the plant's hooks).
+    """Base class of an effect (a submodel at one of the plant's hooks): its physics, plus how the gap
+    diagnosis fits it (``fit``, a :class:`FitSpec`).
 
     Class attributes: ``name`` (the contract name), ``hook`` (a key of :data:`HOOKS`),
     ``Params`` (frozen dataclass), ``states`` (names of extra states), ``adds_stiction``
     (adds friction that jumps with sign(v): the stepper must treat even a smooth law as
     stick-slip), ``kind`` (``"plant"``: terms at kernel hooks; ``"output"``: acts on a
-    measured channel; ``"nominal"``: refits nominal parameters), ``log`` (parameters fitted on
-    a log scale), ``candidate`` (the gap diagnosis fits it by default: the contract's effects,
-    ``diagnosis-contract.md``).  An instance carries parameter values: ``FlowLoss(resistance=2e5)``.
+    measured channel; ``"nominal"``: refits nominal parameters), ``fit`` (log-scaled parameters,
+    ``candidate``: fitted by default, equation-error grid and units, ...).  The fields of ``fit`` are
+    mirrored as read-only class attributes of the same names (``cls.log``, ``cls.feature_grid``, ...)
+    for older readers; set them on ``fit``.  An instance carries parameter values:
+    ``FlowLoss(resistance=2e5)``.
     """
 
     name: str = ""
@@ -80,22 +115,13 @@ class Effect:
     states: tuple = ()
     adds_stiction: bool = False
     kind: str = "plant"
-    log: tuple = ()
-    candidate: bool = False
-    #: values of one nonlinear shape parameter searched by the equation-error fit (empty: none)
-    feature_grid: tuple = ()
-    #: its component's equation residual sees the effect wherever it acts (the gap diagnosis may
-    #: then skip its replay when that component shows no gap); False where the residual is blind
-    #: to it (e.g. a breakaway force, a damping below the balance's noise)
-    screened: bool = True
-    #: parameters the gap diagnosis fits only when they pay (held at their null value otherwise, and
-    #: then not counted in the parsimony penalty); empty: every parameter is always fitted
-    optional: tuple = ()
-    #: parameters whose search bounds are the ends of their physical range (e.g. a share in [0, 1]):
-    #: a fit at such a bound is an answer, not a sign that the effect stands in for another
-    limits: tuple = ()
+    fit: FitSpec = FitSpec()
     # hook methods (staticmethods in subclasses); None: the effect does not act there
     gas = line = string = jump = static = rates = initial = steady = None
+
+    def __init_subclass__(cls, **kw):
+        super().__init_subclass__(**kw)
+        _mirror_fit(cls)
 
     @classmethod
     def component(cls) -> str:
@@ -194,9 +220,9 @@ class Effect:
         """The fit's start: the defaults, a ``limits`` parameter at a bound moved 1e-9 inside (the
         fitters clip their start into the open box the same way)."""
         x = cls.to_x({f.name: f.default for f in cls.fields()})
-        if cls.limits:
+        if cls.fit.limits:
             lo, hi = cls.bounds_x()
-            at = np.array([f.name in cls.limits for f in cls.fields()])
+            at = np.array([f.name in cls.fit.limits for f in cls.fields()])
             x = np.where(at, np.clip(x, lo + 1e-9, hi - 1e-9), x)
         return x
 
@@ -205,7 +231,7 @@ class Effect:
         lo, hi = [], []
         for f in cls.fields():
             a, b = f.metadata["bounds"]
-            if f.name in cls.log:
+            if f.name in cls.fit.log:
                 a, b = np.log(a), np.log(b)
             lo.append(a)
             hi.append(b)
@@ -213,11 +239,28 @@ class Effect:
 
     @classmethod
     def to_x(cls, values: dict) -> np.ndarray:
-        return np.array([np.log(values[f.name]) if f.name in cls.log else values[f.name] for f in cls.fields()])
+        return np.array([np.log(values[f.name]) if f.name in cls.fit.log else values[f.name] for f in cls.fields()])
 
     @classmethod
     def from_x(cls, x) -> dict:
-        return {f.name: float(np.exp(xi) if f.name in cls.log else xi) for f, xi in zip(cls.fields(), x)}
+        return {f.name: float(np.exp(xi) if f.name in cls.fit.log else xi) for f, xi in zip(cls.fields(), x)}
+
+
+def _mirror_fit(cls) -> None:
+    """The fields of ``cls.fit`` as class attributes of the same names (``feature_shape`` only when
+    set: readers test for it).  A class written with the loose attributes instead (``feature_grid =
+    ...`` on the class, no ``fit`` of its own) gets them as its ``fit``."""
+    loose = {f.name: cls.__dict__[f.name] for f in dataclasses.fields(FitSpec) if f.name in cls.__dict__}
+    if loose and "fit" not in cls.__dict__:
+        cls.fit = dataclasses.replace(cls.fit, **loose)
+    for f in dataclasses.fields(FitSpec):
+        value = getattr(cls.fit, f.name)
+        if f.name == "feature_shape" and value is None:
+            continue
+        setattr(cls, f.name, value)
+
+
+_mirror_fit(Effect)
 
 
 class ChannelEffect(Effect):
@@ -229,8 +272,6 @@ class ChannelEffect(Effect):
     hook = "channel"
     kind = "output"
     apply = None
-    #: the reading is affine in the parameters (the diagnosis fits them by linear least squares)
-    linear = False
 
     def __init__(self, channel: str = "wob", **values):
         if channel not in SENSOR_CHANNELS:

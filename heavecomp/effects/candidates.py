@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from heavecomp.effects.base import Effect
+from heavecomp.effects.base import Effect, FitSpec
 from heavecomp.effects.features import need
 from heavecomp.friction.laws import stribeck_excess
 from heavecomp.errors import ParameterError, did_you_mean
@@ -51,17 +51,19 @@ class ParameterMismatch(Effect):
     hook = "nominal"
     Params = MismatchParams
     kind = "nominal"
-    log = tuple(f.name for f in dataclasses.fields(MismatchParams))
-    #: multipliers whose fit cost is rugged (stick-slip timing jumps with the breakaway force): the
-    #: diagnosis scans them over their search box for a second start (GapDiagnoser._rescan)
-    rugged = ("static_force",)
-    #: Stribeck velocities v_S [m/s] searched by the equation-error fit
-    feature_grid = tuple(np.geomspace(1e-3, 0.1, 13))
-    #: name and unit of the equation-error shape parameter
-    feature_shape = ("friction.stribeck_velocity", "m/s")
-    #: units of the feature coefficients [SI]
-    feature_units = {"friction.coulomb_force": "N", "friction.viscous_coefficient": "N s/m",
-                     "friction.static_force": "N", "friction.stribeck_velocity": "m/s"}
+    fit = FitSpec(
+        log=tuple(f.name for f in dataclasses.fields(MismatchParams)),
+        # multipliers whose fit cost is rugged (stick-slip timing jumps with the breakaway force): the
+        # diagnosis scans them over their search box for a second start (heavecomp.diagnosis.fitting.rescan)
+        rugged=("static_force",),
+        # Stribeck velocities v_S [m/s] searched by the equation-error fit
+        feature_grid=tuple(np.geomspace(1e-3, 0.1, 13)),
+        # name and unit of the equation-error shape parameter
+        feature_shape=("friction.stribeck_velocity", "m/s"),
+        # units of the feature coefficients [SI]
+        feature_units={"friction.coulomb_force": "N", "friction.viscous_coefficient": "N s/m",
+                       "friction.static_force": "N", "friction.stribeck_velocity": "m/s"},
+    )
 
     @classmethod
     def features(cls, sig, shape=None):
@@ -122,8 +124,7 @@ class ParameterMismatch(Effect):
 
 
 def _candidates() -> dict:
-
-    return {**{n: c for n, c in library().items() if c.candidate}, ParameterMismatch.name: ParameterMismatch}
+    return {**{n: c for n, c in library().items() if c.fit.candidate}, ParameterMismatch.name: ParameterMismatch}
 
 
 #: every candidate the diagnosis fits: the registered effects marked ``candidate`` plus ``parameter_mismatch``
@@ -132,9 +133,11 @@ EFFECT_NAMES = tuple(CANDIDATES)
 
 
 def get(name: str) -> type:
-    """The candidate class for a contract effect name (ParameterError naming the known ones)."""
+    """The class of an effect the diagnosis can fit, by name: a candidate, or any other registered effect
+    (:mod:`heavecomp.effects.registry`, e.g. ``charge_drift``); ParameterError naming the known ones."""
+    known = {**CANDIDATES, **library()}
     try:
-        return CANDIDATES[name]
+        return known[name]
     except KeyError:
-        raise ParameterError(f"unknown effect {name!r}{did_you_mean(name, CANDIDATES)}; known: "
-                             f"{', '.join(CANDIDATES)}") from None
+        raise ParameterError(f"unknown effect {name!r}{did_you_mean(name, known)}; known: "
+                             f"{', '.join(known)}") from None

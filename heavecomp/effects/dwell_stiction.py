@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from heavecomp.effects.base import Effect
+from heavecomp.effects.base import Effect, FitSpec
 from heavecomp.effects.features import breakaway_dwell, need
 from heavecomp.params.core import q
 
@@ -21,18 +21,20 @@ class DwellStiction(Effect):
     """
 
     name = "dwell_stiction"
-    candidate = True
+    fit = FitSpec(
+        candidate=True,
+        # the top-mass balance is blind at breakaway (the static force is whatever holds the piston)
+        screened=False,
+        log=("gain",),
+        # exponents beta [-] searched by the equation-error fit
+        feature_grid=(0.25, 0.5, 0.75, 1.0),
+        # name and unit of the equation-error shape parameter
+        feature_shape=("exponent", "-"),
+        # units of the feature coefficients [SI]
+        feature_units={"breakaway_excess": "N/s^beta", "exponent": "-"},
+    )
     hook = "seal_friction"
     adds_stiction = True
-    #: the top-mass balance is blind at breakaway (the static force is whatever holds the piston)
-    screened = False
-    log = ("gain",)
-    #: exponents beta [-] searched by the equation-error fit
-    feature_grid = (0.25, 0.5, 0.75, 1.0)
-    #: name and unit of the equation-error shape parameter
-    feature_shape = ("exponent", "-")
-    #: units of the feature coefficients [SI]
-    feature_units = {"breakaway_excess": "N/s^beta", "exponent": "-"}
     #: how long after a breakaway the excess static friction is counted [s] (equation error only)
     breakaway_window = 0.05
 

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from heavecomp.effects.base import Effect
+from heavecomp.effects.base import Effect, FitSpec
 from heavecomp.params.core import q
 
 
@@ -17,12 +17,14 @@ class FlowLoss(Effect):
     """
 
     name = "flow_loss"
-    candidate = True
+    fit = FitSpec(
+        candidate=True,
+        log=("resistance",),
+        # units of the equation-error coefficients (``features``)
+        feature_units={"flow_loss": "Pa s/m"},
+    )
     hook = "line"
-    log = ("resistance",)
 
-    #: units of the equation-error coefficients (``features``)
-    feature_units = {"flow_loss": "Pa s/m"}
     @dataclass(frozen=True)
     class Params:
         resistance: float = q(3e4, "Pa s/m", bounds=(10.0, 1e7), symbol="R",

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from heavecomp.effects.base import Effect
+from heavecomp.effects.base import Effect, FitSpec
 from heavecomp.effects.features import first_order_lag, need
 from heavecomp.friction.laws import FC, FS, STRIBECK, VS, stribeck_excess
 from heavecomp.params.core import q
@@ -25,19 +25,21 @@ class FrictionLag(Effect):
     """
 
     name = "friction_lag"
-    candidate = True
+    fit = FitSpec(
+        candidate=True,
+        # the top-mass balance is blind where the lag acts, at reversals (a lag of 6.5 x its floor on the
+        # WOB left the friction residual no gap at all: docs/diagnosis.md, the verdict policy)
+        screened=False,
+        log=("lag_time", "drop_time"),
+        # lag times T [s] searched by the equation-error fit
+        feature_grid=tuple(np.geomspace(1e-3, 0.2, 12)),
+        # name and unit of the equation-error shape parameter
+        feature_shape=("lag_time", "s"),
+        # units of the feature coefficients [SI]
+        feature_units={"lag_force": "N", "lag_time": "s"},
+    )
     hook = "seal_friction"
-    #: the top-mass balance is blind where the lag acts, at reversals (tuning seed 20000: a lag of 6.5 x its
-    #: floor on the WOB left the friction residual no gap at all)
-    screened = False
     states = ("E",)
-    log = ("lag_time", "drop_time")
-    #: lag times T [s] searched by the equation-error fit
-    feature_grid = tuple(np.geomspace(1e-3, 0.2, 12))
-    #: name and unit of the equation-error shape parameter
-    feature_shape = ("lag_time", "s")
-    #: units of the feature coefficients [SI]
-    feature_units = {"lag_force": "N", "lag_time": "s"}
 
     @dataclass(frozen=True)
     class Params:

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from heavecomp.effects.base import Effect
+from heavecomp.effects.base import Effect, FitSpec
 from heavecomp.params.core import q
 from heavecomp.plants.cmc import A, N, P0ABS, PATM, V0
 
@@ -28,13 +28,17 @@ class GasHeatTransfer(Effect):
     """
 
     name = "gas_heat_transfer"
-    candidate = True
+    fit = FitSpec(
+        candidate=True,
+        log=("loss_coefficient", "warming", "warming_time"),
+        # units of the equation-error coefficients (``features``)
+        feature_units={"index": "-", "loss": "Pa s/m", "warming": "s^2/m^2"},
+        # warming time constants T_w [s] searched by the equation-error fit
+        feature_grid=(60.0, 300.0, 1200.0),
+    )
     hook = "gas_spring"
     states = ("warming",)
-    log = ("loss_coefficient", "warming", "warming_time")
 
-    #: units of the equation-error coefficients (``features``)
-    feature_units = {"index": "-", "loss": "Pa s/m", "warming": "s^2/m^2"}
     @dataclass(frozen=True)
     class Params:
         effective_index: float = q(1.2, "-", bounds=(1.0, 1.67), symbol="n_eff", doc="effective polytropic index")
@@ -44,9 +48,6 @@ class GasHeatTransfer(Effect):
                            doc="steady relative temperature rise of the gas per squared stroke velocity")
         warming_time: float = q(300.0, "s", bounds=(10.0, 5000.0), symbol="T_w",
                                 doc="time constant of the gas's warming (heat capacity over heat loss to the vessel)")
-
-    #: warming time constants T_w [s] searched by the equation-error fit
-    feature_grid = (60.0, 300.0, 1200.0)
 
     @classmethod
     def features(cls, sig, shape=None):

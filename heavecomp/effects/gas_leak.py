@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from heavecomp.effects.base import Effect
+from heavecomp.effects.base import Effect, FitSpec
 from heavecomp.params.core import q
 from heavecomp.plants.cmc import PATM
 
@@ -25,12 +25,14 @@ class GasLeak(Effect):
     """
 
     name = "gas_leak"
-    candidate = True
+    fit = FitSpec(
+        candidate=True,
+        # units of the equation-error coefficients (``features``)
+        feature_units={"gas_leak": "1/s"},
+    )
     hook = "gas_spring"
     states = ("charge_change",)
 
-    #: units of the equation-error coefficients (``features``)
-    feature_units = {"gas_leak": "1/s"}
     @dataclass(frozen=True)
     class Params:
         leak_rate: float = q(-2e-5, "1/s", bounds=(-1e-3, 1e-3), symbol="r",

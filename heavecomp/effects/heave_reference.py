@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from heavecomp.effects.base import HeaveEffect
+from heavecomp.effects.base import HeaveEffect, FitSpec
 from heavecomp.errors import ParameterError
 from heavecomp.params.core import q
 
@@ -37,10 +37,14 @@ class HeaveReference(HeaveEffect):
     """
 
     name = "heave_reference"
-    candidate = True
+    fit = FitSpec(
+        candidate=True,
+        # units of the equation-error coefficients (``features``)
+        feature_units={"gain": "-", "delay": "-", "lever_arm": "m"},
+        # delays t_d [s] searched by the equation-error fit
+        feature_grid=(-1.0, -0.5, -0.2, -0.1, 0.0, 0.1, 0.2, 0.5),
+    )
 
-    #: units of the equation-error coefficients (``features``)
-    feature_units = {"gain": "-", "delay": "-", "lever_arm": "m"}
     angle_params = ("lever_arm",)
     @dataclass(frozen=True)
     class Params:
@@ -51,9 +55,6 @@ class HeaveReference(HeaveEffect):
         lever_arm: float = q(0.0, "m", bounds=(-30.0, 30.0), symbol="L",
                              doc="lever arm from the compensator to where the heave is measured, times the "
                                  "logged angle: z_meas = z_crown + L sin(pitch); 0 without an angle column")
-
-    #: delays t_d [s] searched by the equation-error fit
-    feature_grid = (-1.0, -0.5, -0.2, -0.1, 0.0, 0.1, 0.2, 0.5)
 
     @classmethod
     def features(cls, sig, shape=None):
@@ -66,7 +67,7 @@ class HeaveReference(HeaveEffect):
         t, z = np.asarray(sig["t"], dtype=float), np.asarray(sig["heave"], dtype=float)
         d = cls.Params().delay if shape is None else float(shape)
         cols = {"gain": z, "delay": cls.seen(t, z, 1.0, d) - z}
-        if "pitch" in sig and "lever_arm" in cls.feature_units:
+        if "pitch" in sig and "lever_arm" in cls.fit.feature_units:
             cols["lever_arm"] = -np.sin(np.asarray(sig["pitch"], dtype=float))
         return cols
 
@@ -108,8 +109,7 @@ class HeaveReferenceNoAngle(HeaveReference):
     """``heave_reference`` on a run without an angle column: the same map with the lever arm fixed at 0
     (two parameters, g and t_d; not registered: :meth:`HeaveReference.for_input` picks it)."""
 
-    feature_units = {"gain": "-", "delay": "-"}
-    candidate = False
+    fit = dataclasses.replace(HeaveReference.fit, candidate=False, feature_units={"gain": "-", "delay": "-"})
 
     Params = dataclasses.make_dataclass(
         "Params", [(f.name, f.type, dataclasses.field(default=f.default, metadata=f.metadata))

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from heavecomp.effects.base import Effect
+from heavecomp.effects.base import Effect, FitSpec
 from heavecomp.effects.features import need
 from heavecomp.params.core import q
 
@@ -28,23 +28,24 @@ class PositionFriction(Effect):
     """
 
     name = "position_friction"
-    candidate = True
+    fit = FitSpec(
+        candidate=True,
+        log=("extra_force",),
+        # bands searched by the equation-error fit: (centre, width) as shares of the travelled span
+        feature_grid=tuple((c, w) for w in (0.1, 0.2, 0.4) for c in np.arange(0.1, 0.95, 0.1).round(2)),
+        # name and unit of the equation-error shape parameter
+        feature_shape=("band_centre_width", "share of the travelled span"),
+        # units of the feature coefficients [SI]
+        feature_units={"position_friction": "N", "band_centre_width": "share of the travelled span"},
+    )
     hook = "seal_friction"
     adds_stiction = True
-    log = ("extra_force",)
 
     @dataclass(frozen=True)
     class Params:
         extra_force: float = q(3e3, "N", bounds=(10.0, 1e5), symbol="dF", doc="friction added inside the band")
         centre: float = q(0.0, "m", bounds=(-2.0, 2.0), symbol="s_c", doc="stroke at the centre of the band")
         width: float = q(0.3, "m", bounds=(0.02, 3.0), symbol="w", doc="width of the band along the stroke")
-
-    #: bands searched by the equation-error fit: (centre, width) as shares of the travelled span
-    feature_grid = tuple((c, w) for w in (0.1, 0.2, 0.4) for c in np.arange(0.1, 0.95, 0.1).round(2))
-    #: name and unit of the equation-error shape parameter
-    feature_shape = ("band_centre_width", "share of the travelled span")
-    #: units of the feature coefficients [SI]
-    feature_units = {"position_friction": "N", "band_centre_width": "share of the travelled span"}
 
     @classmethod
     def features(cls, sig, shape=None):

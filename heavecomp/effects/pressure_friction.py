@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from heavecomp.effects.base import Effect
+from heavecomp.effects.base import Effect, FitSpec
 from heavecomp.effects.features import need
 from heavecomp.params.core import q
 
@@ -15,12 +15,14 @@ class PressureFriction(Effect):
     """J += dC_p |p|: more of paper A eq. 4's C_p term (the seal is energised by the pressure)."""
 
     name = "pressure_friction"
-    candidate = True
+    fit = FitSpec(
+        candidate=True,
+        log=("extra_pressure_coefficient",),
+        # units of the feature coefficients [SI]
+        feature_units={"pressure_friction": "N/Pa"},
+    )
     hook = "seal_friction"
     adds_stiction = True
-    log = ("extra_pressure_coefficient",)
-    #: units of the feature coefficients [SI]
-    feature_units = {"pressure_friction": "N/Pa"}
 
     @dataclass(frozen=True)
     class Params:

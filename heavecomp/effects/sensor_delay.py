@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from heavecomp.effects.base import ChannelEffect
+from heavecomp.effects.base import ChannelEffect, FitSpec
 from heavecomp.params.core import q
 
 
@@ -15,16 +15,17 @@ class SensorDelay(ChannelEffect):
     pressure).  Acts on the recorded channel, outside the stepper."""
 
     name = "sensor_delay"
-    candidate = True
+    fit = FitSpec(
+        candidate=True,
+        # units of the equation-error coefficients (``features``)
+        feature_units={"sensor_delay": "-"},
+        # delays t_d [s] searched by the equation-error fit
+        feature_grid=(0.05, 0.1, 0.2, 0.5, 1.0, 2.0),
+    )
 
-    #: units of the equation-error coefficients (``features``)
-    feature_units = {"sensor_delay": "-"}
     @dataclass(frozen=True)
     class Params:
         delay: float = q(0.2, "s", bounds=(0.0, 3.0), symbol="t_d", doc="transport delay of the lagging channel")
-
-    #: delays t_d [s] searched by the equation-error fit
-    feature_grid = (0.05, 0.1, 0.2, 0.5, 1.0, 2.0)
 
     @classmethod
     def features(cls, sig, shape=None):

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from heavecomp.effects.base import ChannelEffect
+from heavecomp.effects.base import ChannelEffect, FitSpec
 from heavecomp.params.core import q
 
 
@@ -18,11 +18,13 @@ class SensorGain(ChannelEffect):
     """
 
     name = "sensor_gain"
-    candidate = True
-    linear = True
+    fit = FitSpec(
+        candidate=True,
+        linear=True,
+        # units of the equation-error coefficients (``features``)
+        feature_units={"sensor_gain": "-"},
+    )
 
-    #: units of the equation-error coefficients (``features``)
-    feature_units = {"sensor_gain": "-"}
     @dataclass(frozen=True)
     class Params:
         factor: float = q(1.0, "-", bounds=(-2.0, 2.0), symbol="g",

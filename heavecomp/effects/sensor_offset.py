@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from heavecomp.effects.base import ChannelEffect
+from heavecomp.effects.base import ChannelEffect, FitSpec
 from heavecomp.params.core import q
 
 
@@ -18,14 +18,16 @@ class SensorOffset(ChannelEffect):
     """
 
     name = "sensor_offset"
-    candidate = True
-    linear = True
-    #: fitted only when it pays (the diagnosis then counts it in the parsimony penalty): most offsets
-    #: are constant (absolute vs gauge pressure, a zero set elsewhere)
-    optional = ("drift",)
+    fit = FitSpec(
+        candidate=True,
+        linear=True,
+        # fitted only when it pays (the diagnosis then counts it in the parsimony penalty): most offsets
+        # are constant (absolute vs gauge pressure, a zero set elsewhere)
+        optional=("drift",),
+        # units of the equation-error coefficients (``features``)
+        feature_units={"offset": "unit of the channel", "drift": "unit of the channel/s"},
+    )
 
-    #: units of the equation-error coefficients (``features``)
-    feature_units = {"offset": "unit of the channel", "drift": "unit of the channel/s"}
     @dataclass(frozen=True)
     class Params:
         offset: float = q(0.0, "unit of the channel (N, m or Pa)", bounds=(-1e7, 1e7), symbol="o",

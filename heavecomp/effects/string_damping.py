@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from heavecomp.effects.base import Effect
+from heavecomp.effects.base import Effect, FitSpec
 from heavecomp.params.core import q
 
 
@@ -14,15 +14,17 @@ class StringDamping(Effect):
     """A linear dashpot c (dz_h + v - v_b) added to the drill-string tension."""
 
     name = "string_damping"
-    candidate = True
+    fit = FitSpec(
+        candidate=True,
+        # the lower-mass balance missed a string damping whose WOB gap was 3.3x its noise (tuning set):
+        # its residual is too noisy to rule it out
+        screened=False,
+        log=("damping",),
+        # units of the equation-error coefficients (``features``)
+        feature_units={"string_damping": "N s/m"},
+    )
     hook = "string"
-    #: the lower-mass balance missed a string damping whose WOB gap was 3.3x its noise (tuning set):
-    #: its residual is too noisy to rule it out
-    screened = False
-    log = ("damping",)
 
-    #: units of the equation-error coefficients (``features``)
-    feature_units = {"string_damping": "N s/m"}
     @dataclass(frozen=True)
     class Params:
         damping: float = q(3e4, "N s/m", bounds=(10.0, 2e6), symbol="c", doc="extra drill-string damping")

@@ -1,0 +1,484 @@
+"""Fitting strategies: each ``(context, effect, start) -> Fit`` on the fit part of a prepared run.
+
+A strategy reads the frozen :class:`~heavecomp.diagnosis.replay.ReplayContext` and fits one candidate
+effect class (optionally jointly after ``fixed`` configurations already fitted):
+
+- :func:`fit_replayed` -- a plant or nominal candidate through the replay: a coarse start grid
+  (<= 2 parameters) or the equation-error start, then Nelder-Mead (<= 2 parameters: stick-slip costs are
+  piecewise smooth) or bounded least squares with a rescan of the rugged parameters;
+- :func:`fit_linear_output` -- a channel reading affine in its parameters (sensor_gain, sensor_offset):
+  linear least squares per channel, refined through the replay on stroke and WOB;
+- :func:`fit_delay_output` -- a channel delay (sensor_delay): a scan refined by a bounded scalar search.
+
+:func:`fit` picks the strategy; :func:`score` turns a fit into a :class:`CandidateFit`, its held-out
+record (the rows of ``diagnosis.json``'s ``candidates``).
+"""
+
+from __future__ import annotations
+
+import concurrent.futures as cf
+import dataclasses
+import functools
+import logging
+import math
+import time
+import types
+
+import numpy as np
+
+from heavecomp.diagnosis import equation_error as EE
+from heavecomp.diagnosis.policy import VerdictPolicy
+from heavecomp.diagnosis.replay import CH
+from heavecomp.diagnosis.stepper import CHANNELS as SC
+from heavecomp.effects.candidates import MISMATCH_KEYS, ParameterMismatch, get
+
+log = logging.getLogger(__name__)
+
+
+@dataclasses.dataclass(frozen=True)
+class Search:
+    """How hard a strategy searches: ``max_nfev`` model evaluations per candidate, ``grid`` points per
+    axis of the coarse start grid, ``scan`` points of the rescan of each rugged parameter, ``n_jobs``
+    threads for the least-squares Jacobian."""
+
+    max_nfev: int = 40
+    grid: int = 7
+    scan: int = 6
+    n_jobs: int = 1
+
+
+@dataclasses.dataclass(frozen=True)
+class Fit:
+    """One candidate fitted on the fit part: parameter ``values`` [SI], their 1-sigma ``sigma``,
+    model evaluations ``nfev``, fit cost (weighted sum of squares), wall time [s] and, where optional
+    parameters were held at null, the parameters used (``n_params``; None: all)."""
+
+    values: dict
+    sigma: dict
+    nfev: int
+    cost: float
+    wall_time: float = 0.0
+    n_params: int | None = None
+
+
+@dataclasses.dataclass(frozen=True)
+class CandidateFit:
+    """A fitted candidate scored on the held-out part (a row of ``candidates``).
+
+    ``channels`` {channel: {rms_before, rms_after, shrink}} [SI, -]; ``explained`` the smaller of
+    ``explained_replay`` and ``explained_perturbed`` (the heave-noise draws' median); ``score`` =
+    explained - penalty x ``n_params``; ``values`` the fit's parameters, ``parameters`` as reported
+    (parameter_mismatch: named nominal values); ``pred`` the held-out replay; ``at_bound`` the
+    parameters at a search bound."""
+
+    effect: str
+    parameters: dict
+    uncertainty: dict
+    channels: dict
+    explained: float
+    explained_replay: float
+    explained_perturbed: float
+    n_params: int
+    score: float
+    fit_wall_time: float
+    values: dict
+    pred: dict = dataclasses.field(repr=False, compare=False, default=None)
+    at_bound: tuple = ()
+
+    @property
+    def rms_before(self) -> float:
+        return self.channels["wob"]["rms_before"]
+
+    @property
+    def rms_after(self) -> float:
+        return self.channels["wob"]["rms_after"]
+
+    @property
+    def shrink(self) -> float:
+        return self.channels["wob"]["shrink"]
+
+    def to_json(self) -> dict:
+        """The ``candidates`` row (contract fields first)."""
+        return {"effect": self.effect, "parameters": self.parameters, "uncertainty": self.uncertainty,
+                "rms_before": self.rms_before, "rms_after": self.rms_after, "shrink": self.shrink,
+                "channels": self.channels, "explained": self.explained, "explained_replay": self.explained_replay,
+                "explained_perturbed_heave": self.explained_perturbed, "n_params": self.n_params,
+                "score": self.score, "fit_wall_time": self.fit_wall_time, "at_bound": list(self.at_bound)}
+
+
+def public(nominal, name, values) -> dict:
+    """A candidate's parameters as reported (parameter_mismatch: the nominal's values it stands for)."""
+    if name == "parameter_mismatch":
+        return ParameterMismatch.named_values(nominal, values)
+    return dict(values)
+
+
+def at_bounds(name, values, tol=VerdictPolicy.bound_tol) -> list:
+    """Fitted parameters of candidate ``name`` that sit at a bound of their search range
+    (within ``tol`` of the range, on the fit's own scale: log where the candidate fits in log);
+    not those whose bounds are the ends of their physical range (``cls.fit.limits``: a share of 0 or 1).
+
+    Returns a list of {parameter, value, side ("lower" | "upper"), bound}.
+    """
+    cls = get(name)
+    lo, hi = cls.bounds_x()
+    out = []
+    for f, a, b in zip(cls.fields(), lo, hi):
+        v = values.get(f.name)
+        if not isinstance(v, (int, float)) or not math.isfinite(v) or f.name in cls.fit.limits:
+            continue
+        x = math.log(v) if f.name in cls.fit.log and v > 0 else v
+        span = tol * (b - a)
+        side = "upper" if x >= b - span else "lower" if x <= a + span else None
+        if side:
+            out.append({"parameter": f.name, "value": float(v), "side": side,
+                        "bound": float(f.metadata["bounds"][1 if side == "upper" else 0]), "unit": f.metadata["unit"]})
+    if cls is ParameterMismatch:  # the names the verdict's parameters use ("table.key"), values as multipliers
+        names = {f.name: key for f, (key, _, _) in zip(cls.fields(), MISMATCH_KEYS)}
+        for o in out:
+            o["parameter"] = names.get(o["parameter"], o["parameter"])
+    return out
+
+
+def channel_scores(mse_b, mse_a) -> dict:
+    """Held-out rms before and after, and shrink, per channel."""
+    return {c: {"rms_before": math.sqrt(mse_b[c]), "rms_after": math.sqrt(mse_a[c]),
+                "shrink": 1.0 - math.sqrt(mse_a[c] / mse_b[c]) if mse_b[c] > 0 else 0.0} for c in CH}
+
+
+def score(ctx, name, fitted: Fit, pred, pred_pert) -> CandidateFit:
+    """The held-out record of candidate ``name`` fitted as ``fitted``, from its replay ``pred`` and its
+    replays on the heave-noise draws ``pred_pert``."""
+    P = ctx.policy
+    mse_a = ctx.mse(pred, ctx.valmask)
+    expl_plain = ctx.explained(ctx.mse_before, mse_a)
+    # robustness: the same comparison with the heave-perturbed replay; a gain that comes
+    # from lucky stick-event timing does not survive it, a real effect does
+    expl_pert = ctx.explained_perturbed(pred_pert)
+    expl = min(expl_plain, expl_pert)
+    if not math.isfinite(expl):  # the fitted model diverged on held-out data
+        log.warning("diagnose: %s diverged on the held-out data", name)
+        expl = P.diverged_explained
+    k = n_params(ctx, name, fitted)  # optional parameters held at null are not counted
+    return CandidateFit(name, public(ctx.replay.nominal, name, fitted.values), fitted.sigma,
+                        channel_scores(ctx.mse_before, mse_a), float(expl), float(expl_plain), float(expl_pert), k,
+                        float(expl - P.penalty * k), fitted.wall_time, fitted.values, pred,
+                        tuple(at_bounds(name, fitted.values, tol=P.bound_tol)))
+
+
+def candidate_class(ctx, name) -> type:
+    """The class fitted for candidate ``name`` on this run (``Effect.for_input``: heave_reference
+    without a logged angle fits g and t_d only)."""
+    return get(name).for_input(ctx.replay.hs)
+
+
+def n_params(ctx, name, fitted: Fit) -> int:
+    """Parameters a fit used (optional ones held at null are not counted)."""
+    return candidate_class(ctx, name).n_params() if fitted.n_params is None else fitted.n_params
+
+
+def fit_cost(ctx, name) -> float:
+    """Rough wall time of fitting candidate ``name`` alone (relative; bench_600s): the thread pool
+    starts the costliest first so that no long fit is left running alone at the end.  A plant effect
+    replays on the library stepper (~1.5x the plain one) ~40 times (grid + Nelder-Mead), weighted
+    2.7 per replay (the order bench_600s was measured with; 1.5 measured the same under load); the
+    six-parameter refit ~100 times on the plain stepper (least squares + rescan); an output
+    candidate a few times.  The order changes no result (every fit is independent)."""
+    cls = candidate_class(ctx, name)
+    if cls.kind == "output":
+        return 1.0
+    per_replay = 2.7 if cls.kind == "plant" else 1.0
+    return per_replay * (40.0 if cls.n_params() <= 2 else 100.0)
+
+
+def fit(ctx, name, start=None, fixed=(), *, search=Search(), hint=None) -> Fit:
+    """Fit candidate ``name`` (optionally jointly after the ``fixed`` configurations) on the fit part,
+    from ``start`` (parameter values; None: the default start, the coarse grid and the equation-error
+    start ``hint``, a fit vector) with the strategy its kind asks for."""
+    cls = candidate_class(ctx, name)
+    t0 = time.perf_counter()
+    if cls.kind == "output" and cls.fit.linear:
+        out = fit_linear_output(ctx, cls, fixed)
+    elif cls.kind == "output":
+        out = fit_delay_output(ctx, cls, fixed)
+    else:
+        out = fit_replayed(ctx, cls, start, fixed, search=search, hint=hint)
+    return dataclasses.replace(out, wall_time=time.perf_counter() - t0)
+
+
+# ------------------------------------------------------------------ through the replay
+def fit_replayed(ctx, cls, start=None, fixed=(), *, search=Search(), hint=None) -> Fit:
+    """A plant or nominal candidate fitted through the replay (see the module docstring)."""
+    P = ctx.policy
+    t_end = ctx.split["fit"][1]
+    x0 = cls.to_x(start) if start else cls.x0()
+    lo, hi = cls.bounds_x()
+    x0 = np.clip(x0, lo + 1e-9, hi - 1e-9)
+    seen = {}  # residual by (span, parameter vector): e.g. Nelder-Mead's optimum is evaluated again for its Jacobian
+
+    def fun(x, t_stop=t_end):
+        key = (t_stop, np.asarray(x, dtype=float).tobytes())
+        if key not in seen:
+            seen[key] = ctx.resid_vec(ctx.simulate(list(fixed) + [(cls.name, cls.from_x(x))], t_stop))
+        return seen[key].copy()
+
+    # a joint fit starts from the candidate's own fit, next to its optimum: a share of the budget
+    budget = max(1, int(P.joint_nfev * search.max_nfev)) if fixed else search.max_nfev
+    if start is None:
+        x0 = _start(cls, fun, x0, lo, hi, min(t_end, ctx.split["settle"] + P.grid_span), search.grid, hint)
+    if x0.size <= 2:
+        r = nelder_mead(fun, x0, lo, hi, budget)
+    else:
+        r = least_squares(fun, x0, lo, hi, budget, search.n_jobs)
+        if start is None:
+            r = rescan(cls, fun, r, lo, hi, ctx.replay.nominal, search)
+    return Fit(cls.from_x(r.x), sigma(cls, r), int(r.nfev), float(2 * r.cost))
+
+
+def _start(cls, fun, x0, lo, hi, t_grid, grid, hint):
+    """The start of a fit: the equation-error start ``hint`` when it costs less on the first
+    ``t_grid`` s than the default; with <= 2 parameters the best point of a coarse grid (stick-slip
+    makes the cost rough) when it costs less still (the grid only picks the start)."""
+    if hint is not None:
+        # the component residual's fit (blind to stick timing) as a start, where it fixes every
+        # parameter and its cost on the grid span is lower
+        x_ee = np.clip(hint, lo + 1e-9, hi - 1e-9)
+        if float(np.sum(fun(x_ee, t_grid) ** 2)) < float(np.sum(fun(x0, t_grid) ** 2)):
+            x0 = x_ee
+    k = x0.size
+    if k <= 2:
+        axes = [np.linspace(lo[i] + 0.1 * (hi[i] - lo[i]), hi[i] - 0.1 * (hi[i] - lo[i]),
+                            grid if k == 1 else max(3, (grid + 3) // 2)) for i in range(k)]
+        pts = np.array(np.meshgrid(*axes)).reshape(k, -1).T
+        costs = [float(np.sum(fun(x, t_grid) ** 2)) for x in pts]
+        c0 = float(np.sum(fun(x0, t_grid) ** 2))
+        if min(costs) < c0:
+            x0 = pts[int(np.argmin(costs))]
+    return x0
+
+
+@functools.cache
+def _least_squares_has_workers() -> bool:
+    """Whether scipy's least_squares takes ``workers`` (scipy >= 1.16; read once)."""
+    import inspect
+
+    from scipy.optimize import least_squares as ls
+
+    return "workers" in inspect.signature(ls).parameters
+
+
+def least_squares(fun, x0, lo, hi, budget, n_jobs=1):
+    """Bounded least squares on the decimated fit residual (``budget`` evaluations)."""
+    from scipy.optimize import least_squares as ls
+
+    opts = dict(bounds=(lo, hi), diff_step=0.03, max_nfev=budget, x_scale=1.0, xtol=1e-3, ftol=1e-4, gtol=1e-6)
+    if n_jobs > 1 and _least_squares_has_workers():  # scipy >= 1.16
+        # the finite-difference Jacobian's replays (one per parameter) on n_jobs threads: the same
+        # points and differences as the serial one, so the same fit
+        with cf.ThreadPoolExecutor(n_jobs) as ex:
+            return ls(fun, x0, workers=ex.map, **opts)
+    return ls(fun, x0, **opts)
+
+
+def rescan(cls, fun, r, lo, hi, nominal, search=Search()):
+    """Second start for the parameters whose cost is rugged (``cls.fit.rugged``, e.g. the static
+    friction force: stick-slip timing makes the cost jump, so a local fit from the nominal can
+    settle in a side minimum).  Each such parameter is scanned over its search box (``scan``
+    points, 10-90 % of the range, the others at the fit, clipped ones as the model uses them:
+    ``cls.effective``); when the best scanned point costs less
+    than the fit, the fit restarts from it; the lower fit cost wins (fit part only: the held-out
+    data play no part in the choice).  At most ``scan`` evaluations + one more fit per parameter."""
+    best, nfev = r, int(r.nfev)
+    names = [f.name for f in cls.fields()]
+    for p in cls.fit.rugged:
+        i = names.index(p)
+        x = best.x
+        if hasattr(cls, "effective"):  # the fitted model with its clips written in (same cost)
+            x = np.clip(cls.to_x(cls.effective(nominal, cls.from_x(x))), lo, hi)
+        axis = np.linspace(lo[i] + 0.1 * (hi[i] - lo[i]), hi[i] - 0.1 * (hi[i] - lo[i]), search.scan)
+        pts = np.repeat(x[None, :], axis.size, axis=0)
+        pts[:, i] = axis
+        costs = [float(np.sum(fun(x) ** 2)) for x in pts]
+        nfev += axis.size
+        j = int(np.argmin(costs))
+        if costs[j] >= 2 * best.cost:  # least squares' cost is half the sum of squares
+            continue
+        r2 = least_squares(fun, pts[j], lo, hi, search.max_nfev, search.n_jobs)
+        nfev += int(r2.nfev)
+        log.debug("diagnose: %s rescan of %s: fit cost %.4g -> %.4g", cls.name, p, 2 * best.cost, 2 * r2.cost)
+        if r2.cost < best.cost:
+            best = r2
+    best.nfev = nfev
+    return best
+
+
+def nelder_mead(fun, x0, lo, hi, budget):
+    """Derivative-free refinement (Nelder-Mead on the clipped parameters; stick-slip costs are
+    piecewise smooth, so finite-difference gradients mislead), then a forward-difference
+    Jacobian at the optimum for the uncertainty.  Returns an object like least_squares'."""
+    from scipy.optimize import minimize
+
+    def cost(x):
+        r = fun(np.clip(x, lo, hi))
+        return float(r @ r)
+
+    step = 0.08 * (hi - lo)
+    simplex = np.vstack([x0] + [x0 + np.where(np.arange(x0.size) == i, np.where(x0 + step <= hi, step, -step), 0.0)
+                                for i in range(x0.size)])
+    res = minimize(cost, x0, method="Nelder-Mead",
+                   options={"initial_simplex": simplex, "maxfev": budget, "xatol": 1e-3, "fatol": 1e-4})
+    x = np.clip(res.x, lo, hi)
+    f0 = fun(x)
+    J = np.empty((f0.size, x.size))
+    for i in range(x.size):
+        dx = 0.02 * (hi[i] - lo[i]) * (1 if x[i] + 0.02 * (hi[i] - lo[i]) <= hi[i] else -1)
+        xi = x.copy()
+        xi[i] += dx
+        J[:, i] = (fun(xi) - f0) / dx
+    return types.SimpleNamespace(x=x, fun=f0, jac=J, nfev=int(res.nfev) + x.size + 1, cost=0.5 * float(f0 @ f0))
+
+
+def sigma(cls, r) -> dict:
+    """1-sigma of the fitted parameters from the Jacobian, inflated for correlated residuals."""
+    J = r.jac
+    m, k = J.shape
+    res = r.fun
+    s2 = float(res @ res) / max(m - k, 1)
+    rho = float(np.corrcoef(res[:-1], res[1:])[0, 1]) if m > 3 and np.std(res) > 0 else 0.0
+    rho = min(max(rho, 0.0), 0.99)
+    infl = (1 + rho) / (1 - rho)
+    try:
+        cov = np.linalg.pinv(J.T @ J) * s2 * infl
+        sx = np.sqrt(np.maximum(np.diag(cov), 0.0))
+    except np.linalg.LinAlgError:
+        sx = np.full(k, math.nan)
+    vals = cls.from_x(r.x)
+    return {f.name: float(abs(vals[f.name]) * s if f.name in cls.fit.log else s) for f, s in zip(cls.fields(), sx)}
+
+
+# ------------------------------------------------------------------ channel readings
+def fit_delay_output(ctx, cls, fixed=()) -> Fit:
+    """A channel effect with one nonlinear parameter (sensor_delay): per channel, a scan of the
+    parameter over its bounds (``delay_scan`` points of the policy) refined by a bounded scalar search,
+    the channel reading made by the effect's own ``apply`` from the replay's grid (no re-simulation);
+    the channel whose fit leaves the smallest weighted residual wins."""
+    from scipy.optimize import minimize_scalar
+
+    (field,) = cls.fields()
+    a, b = field.metadata["bounds"]
+    base = ctx.simulate(list(fixed), ctx.split["fit"][1])
+    grid = base["_grid"]
+    best = None
+    n_scan = ctx.policy.delay_scan
+    for c in CH:
+        def obj(x, c=c):
+            pred = dict(base)
+            pred[c] = cls.apply(base["t"], grid[:, 0], grid[:, SC.index(c)], x)
+            r = ctx.resid_vec(pred)
+            return float(r @ r)
+        xs = np.linspace(a, b, n_scan)
+        k = int(np.argmin([obj(x) for x in xs]))
+        r = minimize_scalar(obj, bounds=(xs[max(k - 1, 0)], xs[min(k + 1, xs.size - 1)]), method="bounded",
+                            options={"xatol": 1e-4})
+        if best is None or r.fun < best[0]:
+            best = (r.fun, c, float(r.x))
+    return Fit({"channel": best[1], field.name: best[2]}, {field.name: math.nan}, n_scan * len(CH), best[0])
+
+
+def fit_linear_output(ctx, cls, fixed=()) -> Fit:
+    """A channel effect whose reading is affine in its parameters (``linear``: sensor_gain,
+    sensor_offset): per channel, linear least squares of the measured channel on the columns
+    the effect's own ``apply`` makes of the replay (no re-simulation, :func:`_fit_channel`); the
+    channel whose fit leaves the smallest weighted residual wins.  Parameters are clipped to their
+    bounds.  The effect's ``optional`` parameters (a drift) are fitted only when they shrink the
+    channel's fit residual by at least :data:`heavecomp.diagnosis.equation_error.MIN_SHRINK`;
+    ``n_params`` counts the parameters used.  On stroke and WOB, which also set the replay's start
+    (:meth:`~heavecomp.diagnosis.replay.Replay.start_for`), the fit is refined through the replay
+    (:func:`_refine_reading`)."""
+    t_end = ctx.split["fit"][1]
+    base0 = ctx.simulate(list(fixed), t_end)
+    names = [f.name for f in cls.fields()]
+    used = np.array([n not in cls.fit.optional for n in names])
+    best = None
+    for c in CH:
+        got = _fit_channel(ctx, cls, base0, c, used)
+        if c in ("stroke", "wob"):  # they also set the replay's start: Gauss-Newton on every channel
+            got = _refine_reading(ctx, cls, fixed, t_end, c, got, used)
+        if best is None or got[0] < best[0]:
+            best = got
+    cost, c, coef, sig, k_used = best
+    values = {"channel": c, **{n: float(v) for n, v in zip(names, coef)}}
+    return Fit(values, {n: float(s) for n, s in zip(names, sig)}, 1, cost, n_params=k_used)
+
+
+def _fit_channel(ctx, cls, base, c, used):
+    """Linear least squares of channel ``c``'s reading on the replay ``base``: (weighted residual of
+    all channels, channel, coefficients, their 1-sigma, parameters used)."""
+    names = [f.name for f in cls.fields()]
+    lo, hi = cls.bounds_x()  # a reading is affine in its parameters: none is fitted in log
+    t = base["t"]
+    m = ctx.fitmask[: t.size]
+    y = ctx.y[c][: t.size]
+    ok = m & np.isfinite(y)
+    zero = np.zeros(len(names))
+    a0 = cls.apply(t, t, base[c], *zero)
+    X = np.column_stack([cls.apply(t, t, base[c], *np.eye(len(names))[i]) - a0 for i in range(len(names))])
+    Xo, yo = X[ok], (y - a0)[ok]
+
+    def lsq(cols):
+        coef = np.zeros(len(names))
+        coef[cols], *_ = np.linalg.lstsq(Xo[:, cols], yo, rcond=None)
+        coef = np.clip(coef, lo, hi)
+        return coef, yo - Xo @ coef
+
+    coef, r = lsq(used)
+    if not used.all():  # the optional parameters only when they shrink the fit residual >= MIN_SHRINK
+        coef_f, r_f = lsq(np.ones(len(names), bool))
+        if 1.0 - math.sqrt(float(r_f @ r_f) / max(float(r @ r), 1e-300)) >= EE.MIN_SHRINK:
+            coef, r = coef_f, r_f
+    k_used = int(np.count_nonzero(used | (coef != 0.0)))
+    pred = dict(base)
+    pred[c] = a0 + X @ coef
+    rv = ctx.resid_vec(pred)
+    dof = max(int(ok.sum()) - k_used, 1)
+    try:
+        cov = np.linalg.pinv(Xo.T @ Xo) * float(r @ r) / dof
+        sig = np.sqrt(np.maximum(np.diag(cov), 0.0))
+    except np.linalg.LinAlgError:
+        sig = np.full(len(names), math.nan)
+    return float(rv @ rv), c, coef, sig, k_used
+
+
+def _refine_reading(ctx, cls, fixed, t_end, c, got, used):
+    """A stroke or WOB reading also sets the replay's start and heave reference
+    (:meth:`~heavecomp.diagnosis.replay.Replay.start_for`), so a misreading there shows in every channel
+    (a stroke read 3 cm off: the pressure and WOB of the gas law and the string), not in the channel
+    itself, which the start follows.  From the channel's linear fit ``got``, ``start_iterations``
+    Gauss-Newton steps on the weighted fit residual of all channels (finite differences through the
+    replay; the parameters used by the linear fit only); the better of the two is kept."""
+    names = [f.name for f in cls.fields()]
+    lo, hi = cls.bounds_x()
+    idx = np.flatnonzero(used | (got[2] != 0.0))
+    scale = float(np.nanstd(ctx.y[c][ctx.fitmask])) or 1.0
+
+    def resid(coef):
+        vals = {"channel": c, **{n: float(v) for n, v in zip(names, coef)}}
+        return ctx.resid_vec(ctx.simulate(list(fixed) + [(cls.name, vals)], t_end))
+
+    coef = np.array(got[2], dtype=float)
+    r = resid(coef)
+    best = (float(r @ r), coef.copy())
+    for _ in range(ctx.policy.start_iterations):
+        J = np.empty((r.size, idx.size))
+        for j, i in enumerate(idx):
+            step = 1e-3 * (scale if abs(coef[i]) < 1e-12 or names[i] == "offset" else abs(coef[i]))
+            x = coef.copy()
+            x[i] += step
+            J[:, j] = (resid(x) - r) / step
+        coef[idx] = np.clip(coef[idx] - np.linalg.lstsq(J, r, rcond=None)[0], lo[idx], hi[idx])
+        r = resid(coef)
+        if float(r @ r) < best[0]:
+            best = (float(r @ r), coef.copy())
+    if best[0] >= got[0]:
+        return got
+    return (best[0], c, best[1], got[3], got[4])

@@ -1,0 +1,137 @@
+"""The verdict policy: every threshold the gap diagnosis decides with, in one frozen object.
+
+>>> from heavecomp.diagnosis.policy import VerdictPolicy
+>>> VerdictPolicy().none_ratio
+1.2
+>>> VerdictPolicy(none_ratio=1.5).none_ratio      # a variant: a new frozen object
+1.5
+
+Each field's docstring says what it guards against; the evidence for its value (the runs that set
+it) is the table "The verdict policy" in ``docs/diagnosis.md``.  The tuning report
+(``scenarios/diagnosis_validation.py``) hashes every field, so a threshold cannot change unseen.
+Seven fields are also :class:`heavecomp.diagnosis.GapDiagnoser` settings (``penalty``,
+``min_explained``, ``none_ratio``, ``none_tail``, ``none_explained``, ``prescreen_gap``,
+``discover_shrink``): those settings override the policy's fields
+(:meth:`~heavecomp.diagnosis.GapDiagnoser.verdict_policy`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+
+@dataclasses.dataclass(frozen=True)
+class VerdictPolicy:
+    """The thresholds of the gap diagnosis (see the module docstring).  Shares and ratios are [-]."""
+
+    # ---------------------------------------------------------------- scoring a candidate
+    penalty: float = 0.03
+    """Parsimony penalty per fitted parameter on the explained share: guards against a candidate
+    with more parameters winning by fitting noise."""
+    perturbed_draws: int = 3
+    """Heave-noise draws whose replays test a candidate's explained share (their median counts):
+    guards against a gain that only lucky stick-event timing makes (one draw alone can flip an early
+    stick event)."""
+    gap_floor_share: float = 0.1
+    """Smallest denominator of a channel's explained share, as a share of its held-out mean square:
+    guards against dividing by a gap that sits at the noise floor."""
+    diverged_explained: float = -10.0
+    """Explained share given to a candidate whose held-out replay diverged: ranks it last."""
+    bound_tol: float = 0.01
+    """A fitted parameter within this share of its search range from a bound is "at the bound":
+    the fit wanted to go further, so the candidate may stand in for another effect."""
+
+    floor_cutoff_ratio: float = 1.5
+    """The replay's sensitivity to the heave pre-filter (part of the noise floor) is measured with the
+    cut-off raised by this factor: guards against reading the pre-filter's own effect as a gap."""
+
+    # ---------------------------------------------------------------- none
+    none_ratio: float = 1.2
+    """``none`` when every channel's held-out rms is within this factor of its input-noise
+    envelope: guards against naming an effect for a gap that noise alone makes."""
+    none_high: float = 0.5
+    """A ``none`` verdict is high (else medium) when the gap over the noise floor is at most
+    ``none_high * (1 + none_ratio)``: guards against a confident ``none`` at the edge."""
+    none_tail: float = 2.0
+    """Up to this factor of the envelope a gap no candidate explains ``none_explained`` of is
+    ``none`` (low), and a named verdict is never confident: runs with no effect reach it from
+    stick-event noise alone."""
+    none_explained: float = 0.25
+    """Explained share below which a gap in the stick-event-noise tail is read as noise; also the
+    least a best candidate must explain to name the component of an inconclusive verdict, or to be
+    confirmed by its equation error."""
+    none_predicted: float = 0.5
+    """A best candidate whose held-out prediction shrinks the gap's rms by this share rules out
+    ``none``: held-out noise cannot be predicted, so the noise-floor estimate hides a real gap."""
+    shrink_channel_ratio: float = 0.5
+    """The verdict's shrink is on wob unless wob's held-out gap over its floor is under this share
+    of the largest channel's: guards against reporting the shrink of a channel the gap is not in."""
+
+    # ---------------------------------------------------------------- naming and confidence
+    min_explained: float = 0.5
+    """Below this explained share of the held-out gap the verdict is ``inconclusive`` (alone and
+    jointly with a second candidate): guards against naming the best of a bad lot."""
+    high_explained: float = 0.8
+    """Explained share for confidence ``high`` (with ``high_margin``)."""
+    high_margin: float = 0.1
+    """Score margin to the runner-up for confidence ``high``: guards against a confident verdict
+    between two candidates that explain the gap alike."""
+    medium_explained: float = 0.6
+    """Explained share for confidence ``medium`` (with ``medium_margin``), also of a joint fit."""
+    medium_margin: float = 0.03
+    """Score margin to the runner-up for confidence ``medium``."""
+
+    # ---------------------------------------------------------------- a second effect
+    second_below: float = 0.95
+    """A named best candidate that explains less than this is fitted jointly with runners-up:
+    guards against missing a second, weaker effect."""
+    second_gain: float = 0.1
+    """Explained share a joint partner must add (after its parsimony penalty) to be named the
+    ``second_effect``: guards against a partner that only fits the remainder's noise."""
+    second_share: float = 0.1
+    """A component holding this share of the equation-error gap gets its best candidate tried as a
+    second effect; below it a component counts as holding no gap of its own (refit check)."""
+
+    # ---------------------------------------------------------------- equation error
+    prescreen_gap: float = 1.0
+    """A component gap (noise variances above noise and floor) at or below which its screened
+    candidates are not replayed: guards against spending replays where no gap is."""
+    prescreen_share: float = 0.02
+    """A component with less than this share of the equation-error gap shows only what the others
+    leak into it (its screened candidates are not replayed)."""
+    confirm_share: float = 0.5
+    """Share of the equation-error gap the best candidate's component must hold for its own
+    equation-error fit to name it (low) when its replay explains under ``min_explained``."""
+    discover_shrink: float = 0.5
+    """Held-out shrink of a component residual by the open search's term (or the best candidate's
+    equation-error fit) that turns ``inconclusive`` into ``discovered`` (or a low named verdict)."""
+    discover_components: int = 3
+    """Components (largest gap first) the open search looks in when no named effect explains the gap."""
+    refit_share: float = 0.5
+    """A parameter_mismatch whose most-moved parameter's component holds under ``second_share``
+    while another holds this share of the equation-error gap is a stand-in: confidence low, the
+    component the equation error's."""
+    drift_sigmas: float = 4.0
+    """A component residual's coefficient that moves by this many standard errors between two time
+    windows drifts (with ``drift_share``): a parameter_mismatch verdict there drops to low."""
+    drift_share: float = 0.25
+    """... and by this share of its mean magnitude: guards against reading a time-varying effect
+    as a constant parameter error."""
+
+    # ---------------------------------------------------------------- search budget
+    joint_nfev: float = 0.5
+    """Share of ``max_nfev`` a joint second-effect fit gets (it starts from the candidate's own fit)."""
+    grid_span: float = 150.0
+    """Span of the fit part [s] on which the coarse start grid of a candidate is scored."""
+    delay_scan: int = 61
+    """Points of the scan of a channel delay over its bounds (then refined by a bounded scalar search)."""
+    start_iterations: int = 2
+    """Gauss-Newton steps of a stroke or WOB reading through the replay it starts."""
+
+    def to_json(self) -> dict:
+        """Every field by name (JSON-ready): what the tuning report hashes."""
+        return dataclasses.asdict(self)
+
+
+#: the default policy
+DEFAULT = VerdictPolicy()

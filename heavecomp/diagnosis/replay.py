@@ -1,0 +1,397 @@
+"""The replay of a measured run, prepared once: grid, filtered heave, start, noise floors, masks.
+
+:func:`prepare` reads the run once -- the heave gap-filled, made uniform and low-passed into one spline
+(:func:`heavecomp.diagnosis.data.heave_filtered`), the output noise of every channel
+(:func:`heavecomp.diagnosis.data.noise_floor`), the initial state
+(:func:`heavecomp.diagnosis.start.estimate`), the heave samples on the stepper grid -- replays the
+nominal model, measures what the heave noise alone makes of that replay, and returns a frozen
+:class:`ReplayContext`: the masks of the fit and held-out parts, the channel weights, the noise floors
+and the nominal prediction.  Fitting strategies (:mod:`heavecomp.diagnosis.fitting`) and the verdict
+(:mod:`heavecomp.diagnosis.verdict`) only read it.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures as cf
+import dataclasses
+import math
+
+import numpy as np
+
+from heavecomp.diagnosis import start as S
+from heavecomp.diagnosis.data import (ANGLES, HEAVE_CUTOFF, MeasuredRun, derivative_zero_phase, heave_filtered,
+                                      heave_samples, noise_floor, uniform, zero_phase_lowpass)
+from heavecomp.diagnosis.policy import VerdictPolicy
+from heavecomp.effects.candidates import ParameterMismatch, get
+from heavecomp.diagnosis.stepper import CHANNELS as SC, replay_dt, run_segments
+from heavecomp.effects.compose import composition, composition_for, library_composition
+from heavecomp.effects.spec import plant_effects
+from heavecomp.errors import InputError
+from heavecomp.params.budget import MAX_REPLAY_STEPS
+from heavecomp.plants.cmc import D0, KF, plant_vectors
+
+#: the measured channels a replay is compared on (wob first: the primary channel)
+CH = ("wob", "stroke", "pressure")
+#: seed of the heave-noise draws of the input-noise envelope (the same draws on every run)
+NOISE_SEED = 12345
+
+
+@dataclasses.dataclass(frozen=True)
+class Replay:
+    """Everything needed to re-simulate a run quickly: the stepper grid (step ``h`` [s], ``n_steps``),
+    the heave samples ``hs``, the nominal ``plant`` vectors, the segments (``bounds``, ``starts``) and
+    the samples left out after each restart (``reinit``), the heave ``spline`` and the ``initial``
+    state the first segment starts from."""
+
+    run: MeasuredRun
+    nominal: object
+    h: float
+    n_steps: int
+    hs: object
+    plant: object
+    bounds: list
+    starts: list
+    reinit: np.ndarray
+    spline: object
+    initial: S.InitialState
+    stuck_speed: float
+    #: segment starts per stroke/WOB reading (:meth:`start_for`), filled as configurations ask
+    cache: dict = dataclasses.field(default_factory=dict, compare=False, repr=False)
+
+    @property
+    def t(self) -> np.ndarray:
+        return self.run.t
+
+    def simulate(self, config, t_end=None, hs=None) -> dict:
+        """Model channels at the run's times (up to ``t_end`` [s]) for a configuration
+        ``[(effect name, values), ...]`` (empty: the nominal model), driven by the replay's heave or by
+        ``hs`` (heave samples on the same grid).  A stroke or WOB reading in the configuration also
+        moves the start (:meth:`start_for`).  Returns {channel: array, ``stroke_velocity``, ``stuck``,
+        ``t``, ``_grid`` (the stepper's output)}."""
+        hs = self.hs if hs is None else hs
+        plant = self.plant
+        # the parameter file's own plant effects ([[effects]], e.g. a calibrated model) are part of the
+        # model in every replay; a candidate of the same effect refits it
+        file_fx = plant_effects(self.nominal)
+        effects, sensors = list(file_fx), []
+        # a channel that misreads also misled the start estimate: start from its true reading
+        shift, starts = self.start_for([(n, v) for n, v in config if get(n).kind == "output"])
+        if shift:
+            hs = dataclasses.replace(hs, z=hs.z + shift)
+        for name, values in config:
+            cls = get(name)
+            if cls.kind == "plant":
+                effects = [e for e in effects if e.name != name] + [cls(**values)]
+            elif cls.kind == "nominal":
+                plant = plant_vectors(ParameterMismatch.apply(self.nominal, values))
+            elif cls.kind == "heave":  # the heave the plant sees (heave_reference)
+                hs = cls(**values).transform(hs)
+            else:  # a channel that misreads (sensor_delay, sensor_gain, sensor_offset)
+                sensors.append(cls(**values))
+        # no plant effect on: the plain stepper (the composition of none), bit for bit the library's
+        # stepper with every effect off and ~1.5x faster (it integrates no effect states, calls no hooks)
+        comp = (composition_for(effects) if file_fx else library_composition() if effects else composition(()))
+        EP = comp.ep(effects)
+        n = self.n_steps if t_end is None else min(self.n_steps, int(math.ceil(t_end / self.h)) + 2)
+        out = run_segments(plant, comp, EP, hs, self.h, self.bounds, starts, n + 1)
+        tg = out[:, 0]
+        t = self.t if t_end is None else self.t[self.t <= tg[-1]]
+        res = {c: np.interp(t, tg, out[:, SC.index(c)]) for c in CH + ("stroke_velocity", "stuck")}
+        done = set()
+        for e in sensors:  # the first on a channel reads the model's grid, the next ones its reading
+            c = e.channel
+            if c in CH:
+                res[c] = e.measure(t, t, res[c]) if c in done else e.measure(t, tg, out[:, SC.index(c)])
+                done.add(c)
+        res["t"] = t
+        res["_grid"] = out
+        return res
+
+    def start_for(self, readings):
+        """Shift of the heave reference [m] and segment starts for a configuration whose ``readings``
+        (output candidates, ``[(name, values)]``) misread stroke or WOB: the initial state and the heave
+        reference are estimated from what those channels truly read (the measured channel through the
+        inverse of the effect's affine reading ``apply``), not from the misread one -- a stroke read 4 cm
+        off, or a WOB zero that is off, otherwise starts the replay 4 cm off and leaves a transient and a
+        mean shift no reading of the channel can undo.  Delays and channels the start does not read keep
+        the run's start.  Cached per configuration."""
+        fixes = [(get(n), v) for n, v in readings
+                 if get(n).fit.linear and v.get("channel") in ("stroke", "wob")]
+        if not fixes:
+            return 0.0, self.starts
+        key = tuple((cls.name, tuple(sorted(v.items()))) for cls, v in fixes)
+        if key not in self.cache:
+            run = self.run
+            cols = dict(run.columns)
+            for cls, v in fixes:
+                c, y = v["channel"], cols[v["channel"]]
+                par = [v[f.name] for f in cls.fields()]
+                a0 = cls.apply(run.t, run.t, np.zeros_like(y), *par)
+                a1 = cls.apply(run.t, run.t, np.ones_like(y), *par) - a0
+                cols[c] = (y - a0) / np.where(np.abs(a1) > 1e-9, a1, np.nan)
+            st = S.estimate(MeasuredRun(run.t, cols, run.source), self.nominal, self.spline,
+                            stuck_speed=self.stuck_speed)
+            self.cache[key] = (self.initial.heave_reference - st.heave_reference, [st.start()] + list(self.starts[1:]))
+        return self.cache[key]
+
+
+def output_noise(run) -> dict:
+    """Output-noise standard deviation of every channel [SI] (second-difference estimate)."""
+    return {c: noise_floor(run[c], run.t if not run.uniform else None) for c in CH}
+
+
+def build(run, nominal, *, stuck_speed=S.STUCK_SPEED, segment=None, reinit=1.5, noise=None) -> Replay:
+    """The :class:`Replay` of ``run`` under the ``nominal`` parameters: the stepper grid (refused up front
+    beyond the diagnosis budget), the heave spline (made once), the initial state estimated from the
+    first seconds (:func:`heavecomp.diagnosis.start.estimate`, ``noise``: output noise per channel) and
+    the heave samples from the reference it found; with ``segment`` [s], multiple-shooting segments."""
+    h, n_steps = grid(run, nominal)
+    spline = heave_filtered(run)
+    initial = S.estimate(run, nominal, spline, stuck_speed=stuck_speed, noise=noise)
+    hs = heave_samples(run, h, n_steps, reference=initial.heave_reference, spline=spline)
+    plant = plant_vectors(nominal)
+    bounds, starts, rein = [(0, n_steps)], [initial.start()], np.zeros(run.t.size, bool)
+    if segment:
+        bounds, starts, rein = _segments(run, h, n_steps, plant.PP, segment, reinit, stuck_speed)
+        starts[0] = initial.start()
+    return Replay(run, nominal, h, n_steps, hs, plant, bounds, starts, rein, spline, initial, stuck_speed)
+
+
+def grid(run, nominal) -> tuple:
+    """The replay's step [s] and number of steps; a log over the diagnosis budget is refused (before any
+    work: the diagnosis replays the log hundreds of times)."""
+    h = replay_dt(nominal)
+    n_steps = int(math.ceil(run.t[-1] / h - 1e-9))
+    if n_steps > MAX_REPLAY_STEPS:
+        raise InputError(f"{run.source}: the log is {run.t[-1] / 3600:.3g} h long, {n_steps:.3g} replay steps of "
+                         f"{1e3 * h:.3g} ms, over the diagnosis budget of {MAX_REPLAY_STEPS:.3g} "
+                         f"({MAX_REPLAY_STEPS * h / 3600:.3g} h); diagnose a part of it (e.g. the hour of interest)")
+    return h, n_steps
+
+
+def start_warnings(initial, nominal) -> list:
+    """A warning when the log does not start at rest at the operating point (issue 12: start anywhere)."""
+    st = initial
+    if st.at_rest:
+        return []
+    return [f"the log does not start at rest at the operating point (stroke {st.stroke:+.4f} m, stroke velocity "
+            f"{st.stroke_velocity:+.4f} m/s, WOB {st.wob / 1e3:.1f} kN vs W_0 "
+            f"{nominal.operating_point.wob_setpoint / 1e3:.1f} kN, {'stuck' if st.stuck else 'sliding'}): "
+            f"the replay starts from the state estimated from its first {st.window:g} s (initial_state)"]
+
+
+def _segments(run, h, n_steps, PP, length, reinit_s, stuck_speed):
+    """Multiple shooting: segments of ``length`` s, each started from the measured state (stroke and its
+    zero-phase derivative; lower mass from the low-passed WOB through the formation spring,
+    y_b = delta_0 - W/k_F, v_b = -dW/dt / k_F).  The first ``reinit_s`` s of every restarted segment
+    are left out of the residuals."""
+    t = run.t
+    n_seg = max(1, int(math.floor(t[-1] / length)))
+    bounds, starts = [], []
+    tu, su = uniform(t, run["stroke"])
+    sf = zero_phase_lowpass(su, tu[1] - tu[0], 1.0)
+    vs, _ = derivative_zero_phase(t, run["stroke"], 1.0)
+    wf_u = zero_phase_lowpass(uniform(t, run["wob"])[1], tu[1] - tu[0], 3.0)
+    dw, _ = derivative_zero_phase(t, run["wob"], 3.0)
+    reinit = np.zeros(t.size, bool)
+    for k in range(n_seg):
+        i0 = int(round(k * length / h))
+        i1 = n_steps if k == n_seg - 1 else int(round((k + 1) * length / h))
+        bounds.append((i0, i1))
+        if k == 0:
+            starts.append(None)
+            continue
+        tk = i0 * h
+        s = float(np.interp(tk, tu, sf))
+        v = float(np.interp(tk, t, vs))
+        W = float(np.interp(tk, tu, wf_u))
+        starts.append((s, v, PP[D0] - W / PP[KF], -float(np.interp(tk, t, dw)) / PP[KF], abs(v) < stuck_speed))
+        reinit |= (t >= tk) & (t < tk + reinit_s)
+    return bounds, starts, reinit
+
+
+@dataclasses.dataclass(frozen=True)
+class ReplayContext:
+    """A run prepared for the diagnosis (:func:`prepare`); every fit and the verdict read it.
+
+    ``split`` {fit, validate: [t0, t1], settle} [s]; ``y`` the measured channels; ``fitmask`` /
+    ``valmask`` / ``allmask`` the samples of the fit part, the held-out part and everything after the
+    settling window; ``output_noise``, ``replay_floor`` (what the heave noise and its pre-processing
+    make of the replay), ``noise_floor`` (both) and ``input_envelope`` per channel [SI];
+    ``weights`` 1/rms^2 of the nominal fit-part residual; ``nominal_pred`` the nominal replay,
+    ``mse_before`` its held-out mean squares; ``hs_pert`` the heave-noise draws a candidate's
+    explained share is tested on and ``mse_before_pert`` the nominal's held-out mean squares on them."""
+
+    replay: Replay
+    split: dict
+    y: dict
+    fitmask: np.ndarray
+    valmask: np.ndarray
+    allmask: np.ndarray
+    output_noise: dict
+    heave_noise: float
+    replay_floor: dict
+    noise_floor: dict
+    input_envelope: dict
+    weights: dict
+    nominal_pred: dict
+    mse_before: dict
+    hs_pert: list
+    mse_before_pert: list
+    policy: VerdictPolicy
+    decimate: int = 1
+    n_jobs: int = 1
+
+    @property
+    def run(self):
+        return self.replay.run
+
+    def simulate(self, config, t_end=None, hs=None) -> dict:
+        """:meth:`Replay.simulate`."""
+        return self.replay.simulate(config, t_end, hs)
+
+    def mse(self, pred, mask) -> dict:
+        """Mean square of prediction minus measurement per channel on ``mask`` (finite samples)."""
+        return mse(self.y, pred, mask)
+
+    def explained(self, mse_b, mse_a) -> float:
+        """Explained share of the held-out gap above the noise floor: per channel
+        e_c = (mse_b - mse_a) / max(mse_b - sigma_c^2, ``gap_floor_share`` mse_b), averaged with weights
+        g_c = max(mse_b / sigma_c^2 - 1, 0) (the channel with the largest gap over its noise counts most)."""
+        num = den = 0.0
+        floor_share = self.policy.gap_floor_share
+        for c in CH:
+            f2 = max(self.noise_floor[c] ** 2, 1e-30)
+            g = max(mse_b[c] / f2 - 1.0, 0.0)
+            e = (mse_b[c] - mse_a[c]) / max(mse_b[c] - f2, floor_share * mse_b[c], 1e-300)
+            num += g * e
+            den += g
+        return num / den if den > 0 else 0.0
+
+    def explained_perturbed(self, preds) -> float:
+        """Explained share of the held-out gap by replays driven by the heave redrawn within its noise
+        (``preds``, one per draw of :attr:`hs_pert`), each against the nominal replay with the same
+        draw: the median over the draws [-]."""
+        return float(np.median([self.explained(b, self.mse(a, self.valmask))
+                                for b, a in zip(self.mse_before_pert, preds)]))
+
+    def held_out(self, config) -> tuple:
+        """A configuration's whole replay and its replays on the heave-noise draws :attr:`hs_pert`."""
+        return self.simulate(config), [self.simulate(config, hs=hs) for hs in self.hs_pert]
+
+    def resid_vec(self, pred) -> np.ndarray:
+        """The weighted, decimated fit-part residual of all channels (the fits' objective)."""
+        m = self.fitmask[: pred["wob"].size]
+        parts = []
+        for c in CH:
+            y = self.y[c][: m.size]
+            ok = m & np.isfinite(y)
+            parts.append((pred[c][ok] - y[ok])[:: self.decimate] * math.sqrt(self.weights[c]))
+        r = np.concatenate(parts)
+        bad = ~np.isfinite(r)
+        if bad.any():  # a diverged simulation: a large, finite penalty keeps the optimisers working
+            r[bad] = 1e3
+        return r
+
+    def map(self, fn, items) -> list:
+        """``[fn(x) for x in items]``, on ``n_jobs`` threads (the stepper releases the GIL)."""
+        return parallel_map(fn, items, self.n_jobs)
+
+
+def mse(y, pred, mask) -> dict:
+    """Mean square of ``pred`` minus the measured ``y`` per channel on ``mask`` (finite samples)."""
+    out = {}
+    for c in CH:
+        yc = y[c][: pred[c].size]
+        m = mask[: pred[c].size] & np.isfinite(yc)
+        r = pred[c][m] - yc[m]
+        out[c] = float(np.mean(r * r)) if r.size else math.nan
+    return out
+
+
+def parallel_map(fn, items, n_jobs) -> list:
+    """``[fn(x) for x in items]``, on ``n_jobs`` threads."""
+    if n_jobs > 1 and len(items) > 1:
+        with cf.ThreadPoolExecutor(n_jobs) as ex:
+            return list(ex.map(fn, items))
+    return [fn(x) for x in items]
+
+
+def split_of(run, split, settle) -> dict:
+    """The fit / validate intervals and the settling window [s]; bad settings refused."""
+    T_end = float(run.t[-1])
+    settle = settle if settle is not None else min(30.0, 0.1 * T_end)
+    if not 0 <= settle < 0.5 * T_end:
+        raise InputError(f"--settle {settle:g} s must be >= 0 and shorter than half the run ({T_end:g} s)")
+    t_split = split * T_end
+    return {"fit": [0.0, t_split], "validate": [t_split, T_end], "settle": settle}
+
+
+def prepare(run, nominal, *, split=0.67, settle=None, stuck_speed=S.STUCK_SPEED, segment=None, reinit=1.5,
+            input_draws=8, decimate=1, n_jobs=1, policy=None) -> ReplayContext:
+    """Prepare ``run`` once for the diagnosis (see the module docstring); returns the frozen context.
+
+    Parameters are the :class:`heavecomp.diagnosis.GapDiagnoser` settings of the same names (``split``
+    a fraction of the run, ``settle`` and ``reinit`` [s], ``stuck_speed`` [m/s]); ``policy``: the
+    :class:`~heavecomp.diagnosis.policy.VerdictPolicy` (its heave-noise draws and pre-filter ratio).
+    """
+    policy = policy or VerdictPolicy()
+    sp = split_of(run, split, settle)
+    grid(run, nominal)  # refused before any work
+    noise = output_noise(run)
+    rp = build(run, nominal, stuck_speed=stuck_speed, segment=segment, reinit=reinit, noise=noise)
+    t = run.t
+    keep = ~rp.reinit
+    fitmask = (t >= sp["settle"]) & (t < sp["fit"][1]) & keep
+    valmask = (t >= sp["fit"][1]) & keep
+    allmask = (t >= sp["settle"]) & keep
+    nom = rp.simulate([])
+    fl = _replay_floor(rp, nom, allmask, valmask, input_draws, n_jobs, policy)
+    floor = {c: math.hypot(noise[c], fl["replay_floor"][c]) for c in CH}
+    envelope = {c: max(math.hypot(noise[c], math.sqrt(fl["env_ms"][c])), floor[c]) for c in CH}
+    y = {c: run[c] for c in CH}
+    mse_fit = mse(y, nom, fitmask)
+    weights = {c: 1.0 / max(mse_fit[c], floor[c] ** 2, 1e-30) for c in CH}
+    return ReplayContext(rp, sp, y, fitmask, valmask, allmask, noise, fl["heave_noise"], fl["replay_floor"], floor,
+                         envelope, weights, nom, mse(y, nom, valmask), fl["hs_pert"],
+                         [mse(y, a, valmask) for a in fl["pert_preds"]], policy, max(1, int(decimate)),
+                         max(1, int(n_jobs)))
+
+
+def _replay_floor(rp, nom, mask, val, input_draws, n_jobs, policy) -> dict:
+    """Residual an exact model would still show because the *input* is noisy: the nominal replay
+    repeated with the heave perturbed by white noise of the heave's own noise level (second-difference
+    estimate); rms difference per channel [SI] (``replay_floor``), with the sensitivity to the heave
+    pre-processing (cut-off ``floor_cutoff_ratio`` x higher).
+
+    Also the held-out *envelope* of that residual (``env_ms``, mean squares): with exact stiction one
+    heave-noise draw can flip a stick event and shift a whole stretch of the replay, so the residual
+    from input noise is heavy-tailed and one draw under-estimates what a run with no effect can show.
+    The envelope is the largest held-out mean square over ``input_draws`` independent draws, plus the
+    pre-processing term.  The first ``perturbed_draws`` draws (``hs_pert``) and their nominal replays
+    (``pert_preds``) test the candidates."""
+    run = rp.run
+    sz = noise_floor(run["heave"], run.t if not run.uniform else None)
+    rng = np.random.default_rng(NOISE_SEED)
+    ref = rp.hs.info["reference_m"]
+
+    def perturbed():
+        pert = MeasuredRun(run.t, {**{a: run[a] for a in ANGLES if a in run.columns},
+                                   "heave": run["heave"] + rng.normal(0.0, sz, run.t.size)}, run.source)
+        return heave_samples(pert, rp.h, rp.n_steps, reference=ref)
+
+    def ms(a, m):
+        return {c: float(np.mean((a[c][m] - nom[c][m]) ** 2)) for c in CH}
+
+    draws = [perturbed() for _ in range(max(1, int(input_draws)))]  # the noise drawn in order, replayed concurrently
+    n_pert = policy.perturbed_draws
+    cut = heave_samples(run, rp.h, rp.n_steps, cutoff=policy.floor_cutoff_ratio * HEAVE_CUTOFF, reference=ref)
+    alt, *others, alt2 = parallel_map(lambda hs: rp.simulate([], hs=hs), draws + [cut], n_jobs)
+    env = ms(alt, val)
+    for o in others:
+        other = ms(o, val)
+        env = {c: max(env[c], other[c]) for c in CH}
+    pre = ms(alt2, val)
+    a, b = ms(alt, mask), ms(alt2, mask)
+    return {"heave_noise": sz, "hs_pert": draws[:n_pert], "pert_preds": ([alt] + others)[:n_pert],
+            "env_ms": {c: env[c] + pre[c] for c in CH}, "replay_floor": {c: float(np.sqrt(a[c] + b[c])) for c in CH}}

@@ -1,0 +1,119 @@
+"""The equation error's part in the diagnosis: pre-screen, equation-error starts, the open search.
+
+These read the component residuals (:class:`heavecomp.diagnosis.components.ComponentResiduals`,
+computed from the measured signals, blind to stick-event timing) with the fit / held-out masks of the
+replay context:
+
+- :func:`prescreen` -- which candidates are replayed at all;
+- :func:`equation_error_start` -- a candidate's equation-error fit as a start for its replay fit;
+- :func:`skipped_row` -- the ``candidates`` row of a candidate the pre-screen did not replay;
+- :func:`discover` -- the open search's best term when no named effect explains the gap;
+- :func:`candidate_component` -- the component a fitted candidate lives in.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+from heavecomp.diagnosis import components as CR
+from heavecomp.diagnosis import equation_error as EE
+from heavecomp.effects.base import COMPONENTS
+from heavecomp.effects.candidates import MISMATCH_KEYS, ParameterMismatch, get
+
+#: component of each parameter table of parameter_mismatch
+TABLE_COMPONENT = {"compensator": "gas_spring", "friction": "friction", "drill_string": "string_formation",
+                   "formation": "string_formation"}
+
+
+def prescreen(cr, shares, fitmask, valmask, names, policy) -> dict:
+    """Per candidate: its component, the component's gap over noise and floor
+    (:meth:`~heavecomp.diagnosis.components.ComponentResiduals.gap`), its equation-error fit on the
+    component residual where it has one (:func:`heavecomp.diagnosis.equation_error.rank_effects`),
+    and whether it is replayed: a plant candidate whose component shows no gap
+    (<= ``prescreen_gap``, or under ``prescreen_share`` of the whole gap: what a large gap elsewhere
+    leaks into it; only components in :data:`heavecomp.diagnosis.components.SCREENED` and candidates
+    their residual sees, ``Effect.fit.screened``) and whose equation-error columns shrink nothing held out
+    (< :data:`heavecomp.diagnosis.equation_error.MIN_SHRINK`) is not.  Output and nominal candidates
+    (a channel delay, the six-parameter refit) are always replayed, and so is every candidate when
+    none would be.  ``shares``: the equation-error shares of the gap (``where.components``)."""
+    gap = cr.gap()
+    fm, vm = fitmask & cr.mask, valmask & cr.mask
+    out = {}
+    for n in names:
+        t0 = time.perf_counter()
+        cls = get(n)
+        comp = cls.component() if cls.kind == "plant" else ("sensors" if cls.kind == "output" else "")
+        ee = None
+        if comp in cr.residual:
+            ranked = EE.rank_effects(cr.residual[comp], cr.signals_for(comp), [cls], fm, vm, component=comp)
+            ee = ranked[0] if ranked else None
+        small = gap.get(comp, 0.0) <= policy.prescreen_gap or shares.get(comp, 0.0) < policy.prescreen_share
+        quiet = comp in CR.SCREENED and cls.fit.screened and small and (ee is None or ee["shrink"] < EE.MIN_SHRINK)
+        replay = not (cls.kind == "plant" and quiet)
+        out[n] = {"component": comp, "component_gap": float(gap.get(comp, math.nan)), "replay": replay,
+                  "equation_error": ee, "wall_time": time.perf_counter() - t0}
+    if not any(o["replay"] for o in out.values()):
+        for o in out.values():
+            o["replay"] = True
+    return out
+
+
+def equation_error_start(cr, pre, cls):
+    """The fit vector candidate ``cls``'s equation-error fit (``pre``: its :func:`prescreen` entry)
+    stands for (:meth:`heavecomp.effects.base.Effect.from_equation_error`), or None."""
+    pre = pre or {}
+    ee, comp = pre.get("equation_error"), pre.get("component")
+    if ee is None or comp not in cr.residual:
+        return None
+    values = cls.from_equation_error(ee, cr.signals_for(comp))
+    return cls.to_x(values) if values else None
+
+
+def skipped_row(name, pre, shares, rms_before, n_params, policy) -> dict:
+    """The candidates row of a candidate the pre-screen did not replay (contract fields; its
+    held-out prediction is the nominal's: shrink and explained 0, score the parsimony penalty).
+    ``pre``: its :func:`prescreen` entry; ``rms_before``: the held-out wob rms of the nominal [N]."""
+    return {"effect": name, "parameters": {}, "rms_before": rms_before, "rms_after": rms_before, "shrink": 0.0,
+            "score": -policy.penalty * n_params, "explained": 0.0, "n_params": n_params,
+            "at_bound": [], "fit_wall_time": pre["wall_time"],
+            "skipped": f"pre-screen: its component {pre['component']} shows no gap of its own "
+                       f"(gap {pre['component_gap']:.3g} noise variances, "
+                       f"{100 * shares.get(pre['component'], 0.0):.1f} % of the whole; "
+                       f"equation-error shrink under {EE.MIN_SHRINK:g})",
+            "equation_error": pre["equation_error"]}
+
+
+def moved_most(values) -> str:
+    """Component of the nominal parameter a parameter_mismatch moved most (|log multiplier|)."""
+    names = {f.name: table for f, (_, table, _) in zip(ParameterMismatch.fields(), MISMATCH_KEYS)}
+    k = max(values, key=lambda n: abs(math.log(max(values[n], 1e-12))))
+    return TABLE_COMPONENT.get(names.get(k, ""), "")
+
+
+def candidate_component(effect, values, prescreened) -> str:
+    """The component a fitted candidate lives in (parameter_mismatch: that of the parameter that moved
+    most; ``values`` its fitted parameters, ``prescreened`` the :func:`prescreen` result)."""
+    if effect == "parameter_mismatch":
+        return moved_most(values)
+    return prescreened.get(effect, {}).get("component") or get(effect).component()
+
+
+def discover(cr, fitmask, valmask, policy):
+    """The open search (:func:`heavecomp.diagnosis.equation_error.open_search`) on the components with
+    a gap (the ``discover_components`` largest), the best held-out shrink; None when nothing beats noise.
+    A misreading of one channel consistent across the equations that read it
+    (:func:`heavecomp.diagnosis.components.channel_search`) comes first: a single component's term
+    explains one equation, while the same misreading seen in two is a sensor (a saturating WOB channel
+    read as string_formation before; docs/diagnosis.md)."""
+    fm, vm = fitmask & cr.mask, valmask & cr.mask
+    sensor = CR.channel_search(cr, fm, vm)
+    if sensor is not None:
+        return dict(sensor, unit="noise sigmas")
+    gap = cr.gap()
+    best = None
+    for c in sorted((c for c in COMPONENTS if gap[c] > 0), key=lambda c: -gap[c])[:policy.discover_components]:
+        d = EE.open_search(cr.residual[c], cr.signals_for(c), fm, vm, component=c)
+        if d is not None and (best is None or d["shrink"] > best["shrink"]):
+            best = dict(d, unit=CR.UNITS[c])
+    return best

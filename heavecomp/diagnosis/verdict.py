@@ -1,0 +1,302 @@
+"""The verdict: a pure function of the scored fits, the gap, the noise floors and the policy.
+
+>>> v = decide(fits, gap, floors, envelope, policy, evidence)      # doctest: +SKIP
+>>> v.effect, v.confidence, v.warnings                              # doctest: +SKIP
+
+:func:`decide` reads what the diagnosis measured and never computes a fit: the joint fits of a second
+effect and the open search are evidence the orchestrator gathers first, when :func:`wants_second` and
+:func:`wants_discovery` say the verdict will read them.  Its steps, in order:
+
+1. :func:`assess` -- gap over noise and over the input-noise envelope, margin to the runner-up and
+   whether it survives a heave-noise redraw, the shrink channel, whether the best candidate predicts the
+   held-out gap, and whether the gap is ``none``;
+2. ``none``, else :func:`_short_of_min` (best explained < ``min_explained``: a second effect, the
+   equation error's confirmation, or ``inconclusive``), else :func:`_named` (confidence);
+3. :func:`_at_bound` -- a fitted parameter at its search bound lowers a named verdict's confidence;
+4. :func:`_component` -- ``verdict.component``, the parameter_mismatch checks against the equation error
+   (:func:`_refit_check`, :func:`_stationarity`) and the open search's ``discovered`` term.
+
+Every threshold comes from the :class:`~heavecomp.diagnosis.policy.VerdictPolicy`.  A later cap on the
+confidence (e.g. from log-quality flags) is one more step after :func:`_at_bound`, an isolable group a
+field filled by :func:`_component`, and a ``calibrated`` block a function of the returned
+:class:`Verdict` (see ``docs/diagnosis.md``).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from typing import Callable
+
+from heavecomp.diagnosis.joint import SecondSearch
+from heavecomp.diagnosis.replay import CH
+from heavecomp.diagnosis.screen import candidate_component
+from heavecomp.effects.base import COMPONENTS
+
+CONFIDENCE = ("low", "medium", "high")
+
+
+@dataclasses.dataclass(frozen=True)
+class Evidence:
+    """What the verdict reads besides the fits: the equation-error ``shares`` of the gap
+    (``where.components``), the pre-screen per candidate, the ``second`` effect search (None: not
+    searched), the open search's ``discovered`` term (None: not run or nothing beat noise) and the
+    ``stationarity`` of a component's residual (a query: component -> dict or None)."""
+
+    shares: dict
+    prescreen: dict = dataclasses.field(default_factory=dict)
+    second: SecondSearch | None = None
+    discovered: dict | None = None
+    stationarity: Callable = lambda component: None
+
+
+@dataclasses.dataclass(frozen=True)
+class Assessment:
+    """The numbers a verdict is decided on (:func:`assess`)."""
+
+    gap_ratio: float  #: largest held-out rms over its noise floor [-]
+    input_ratio: float  #: largest held-out rms over its input-noise envelope [-]
+    margin: float  #: best score minus the runner-up's [-]
+    spread: float  #: how far a heave-noise redraw moves the two explained shares [-]
+    survives: bool  #: the margin exceeds the spread
+    channel: str  #: the shrink channel
+    predicts: bool  #: the best candidate predicts the held-out gap (rules out ``none``)
+    is_none: bool  #: the gap is ``none``
+
+
+@dataclasses.dataclass(frozen=True)
+class Verdict:
+    """The verdict: its ``diagnosis.json`` block (``body``: effect, confidence, parameters, shrink, ...)
+    and the ``warnings`` it adds to the diagnosis."""
+
+    body: dict
+    warnings: tuple = ()
+
+    @property
+    def effect(self) -> str:
+        return self.body["effect"]
+
+    @property
+    def confidence(self) -> str:
+        return self.body["confidence"]
+
+    def to_json(self) -> dict:
+        return dict(self.body)
+
+
+def assess(fits, gap, floors, envelope, policy) -> Assessment:
+    """Gap ratios, margin and its input-noise spread, shrink channel and the ``none`` test (see
+    :class:`Assessment`).  ``gap``: per channel {rms_validate} [SI]; ``floors``, ``envelope``: noise
+    floor and input-noise envelope per channel [SI]."""
+    P = policy
+    best = fits[0]
+    runner = fits[1] if len(fits) > 1 else None
+    ratio = {c: gap[c]["rms_validate"] / max(floors[c], 1e-30) for c in CH}
+    margin = best.score - runner.score if runner else 1.0
+    # the margin must survive the replay's own input-noise spread (issue 12 item 6): how far a
+    # candidate's explained share moves when the heave is redrawn within its noise, best and runner-up
+    spread = math.hypot(*(abs(r.explained_replay - r.explained_perturbed) for r in (best, runner or best)))
+    # the shrink is on wob (the primary channel) unless the gap lies elsewhere (e.g. a lagging stroke
+    # sensor): wob's held-out gap over its floor is under a share of the largest channel's
+    ch = "wob" if ratio["wob"] >= P.shrink_channel_ratio * max(ratio.values()) else max(CH, key=ratio.get)
+    # `none`: the held-out gap is no larger than measurement noise plus what the heave noise alone
+    # makes of the replay (its envelope over independent draws: stick-event flips are rare but large)
+    input_ratio = max(gap[c]["rms_validate"] / max(envelope[c], 1e-30) for c in CH)
+    # held-out noise cannot be predicted: a candidate fitted on the fit part that shrinks the held-out
+    # gap's rms on its channel has found something the noise floor estimate hides
+    predicts = best.channels[ch]["shrink"] >= P.none_predicted and best.explained_perturbed >= P.min_explained
+    quiet = input_ratio <= P.none_ratio or (input_ratio <= P.none_tail and best.explained < P.none_explained)
+    return Assessment(max(ratio.values()), input_ratio, margin, spread, margin > spread, ch, predicts,
+                      quiet and not predicts)
+
+
+def wants_second(fits, a: Assessment, policy) -> bool:
+    """Whether the verdict reads a second-effect search (:func:`heavecomp.diagnosis.joint.search`)."""
+    best = fits[0].explained
+    return not a.is_none and (best < policy.min_explained or best < policy.second_below)
+
+
+def wants_discovery(fits, a: Assessment, policy) -> bool:
+    """Whether the verdict reads the open search (:func:`heavecomp.diagnosis.screen.discover`)."""
+    return not a.is_none and fits[0].explained < policy.min_explained
+
+
+def decide(fits, gap, floors, envelope, policy, evidence: Evidence) -> Verdict:
+    """The verdict on ``fits`` (:class:`~heavecomp.diagnosis.fitting.CandidateFit`, best score first);
+    see the module docstring.  Pure: the same arguments give the same verdict."""
+    a = assess(fits, gap, floors, envelope, policy)
+    best = fits[0]
+    v = {"effect": best.effect, "confidence": "low", "parameters": best.parameters,
+         "shrink": best.channels[a.channel]["shrink"], "shrink_channel": a.channel, "uncertainty": best.uncertainty,
+         "explained": best.explained, "gap_to_noise": a.gap_ratio, "gap_to_input_envelope": a.input_ratio,
+         "margin": a.margin, "margin_input_noise": a.spread, "predicted_shrink": best.channels[a.channel]["shrink"]}
+    if a.is_none:
+        return Verdict(_none(v, a, policy))
+    if best.explained < policy.min_explained:
+        v = _short_of_min(v, fits, a, policy, evidence)
+    else:
+        v = _named(v, fits, a, policy, evidence)
+    warnings = []
+    _at_bound(v, fits, warnings)
+    _component(v, fits, policy, evidence, warnings)
+    return Verdict(v, tuple(warnings))
+
+
+def _none(v, a, P) -> dict:
+    """The ``none`` verdict: high within ``none_high * (1 + none_ratio)`` of the noise floor; low in the
+    stick-event-noise tail (between ``none_ratio`` and ``none_tail`` x the envelope, where no candidate
+    explains ``none_explained``)."""
+    tail = a.input_ratio > P.none_ratio
+    v.update(effect="none", parameters={}, shrink=0.0, uncertainty={},
+             confidence="low" if tail else ("high" if a.gap_ratio <= P.none_high * (1 + P.none_ratio) else "medium"),
+             note=(f"held-out gap {a.input_ratio:.2f} x the input-noise envelope and no candidate explains "
+                   f"{100 * P.none_explained:.0f} % of it" if tail else
+                   f"held-out gap within {P.none_ratio:g} x the noise floor (or the envelope of the "
+                   "replay's response to the heave noise) on every channel"))
+    return v
+
+
+def _short_of_min(v, fits, a, P, evidence) -> dict:
+    """The best candidate explains under ``min_explained`` alone: named with a second effect when the
+    pair explains enough; named (low) when its own equation, fitted on its component's residual (blind
+    to stick timing), shrinks that residual held out by ``discover_shrink`` in the component holding
+    ``confirm_share`` of the gap; else ``inconclusive``."""
+    best = fits[0]
+    second = evidence.second.best if evidence.second is not None else None
+    if evidence.second is not None:
+        v["second_candidates"] = evidence.second.candidates()
+    if second is not None and second["explained_joint"] >= P.min_explained:
+        ok = second["explained_joint"] >= P.medium_explained and a.margin >= P.medium_margin and a.survives
+        v.update(second_effect=second, confidence="medium" if ok else "low",
+                 note=f"{best.effect} explains {100 * best.explained:.0f} % alone, "
+                      f"{100 * second['explained_joint']:.0f} % with {second['effect']}")
+        return v
+    pre = evidence.prescreen.get(best.effect, {})
+    ee = pre.get("equation_error")
+    if (ee and ee["shrink"] >= P.discover_shrink and best.explained >= P.none_explained
+            and evidence.shares.get(pre.get("component"), 0.0) >= P.confirm_share):
+        v.update(confidence="low", confirmed_by="equation_error",
+                 note=f"{best.effect} explains {100 * best.explained:.0f} % of the held-out replay gap "
+                      f"and shrinks its held-out {pre['component']} residual by {100 * ee['shrink']:.0f} % "
+                      "(equation error): named with low confidence")
+        return v
+    v.update(effect="inconclusive", confidence="low", parameters={},
+             note=f"best candidate {best.effect} explains only {100 * best.explained:.0f} % of the "
+                  "held-out gap above noise", best_candidate=best.effect)
+    return v
+
+
+def _named(v, fits, a, P, evidence) -> dict:
+    """A named verdict's confidence: high or medium by explained share and margin when the margin
+    survives the heave-noise redraw; never confident in the stick-event-noise tail (<= ``none_tail`` x
+    the envelope, where a candidate can fit most of that noise); the second effect when searched."""
+    best = fits[0]
+    if best.explained >= P.high_explained and a.margin >= P.high_margin and a.survives:
+        v["confidence"] = "high"
+    elif best.explained >= P.medium_explained and a.margin >= P.medium_margin and a.survives:
+        v["confidence"] = "medium"
+    if not a.survives:
+        v["note"] = (f"margin to {fits[1].effect} ({a.margin:.3f}) within the spread a heave-noise redraw makes "
+                     f"of the explained shares ({a.spread:.3f}): confidence low")
+    if a.input_ratio <= P.none_tail and v["confidence"] != "low":
+        v["confidence"] = "low"
+        v["note"] = (f"held-out gap only {a.input_ratio:.2f} x the input-noise envelope (runs without any effect "
+                     f"reach up to {P.none_tail:g} x): confidence low")
+    if evidence.second is not None and best.explained < P.second_below:
+        v["second_effect"] = evidence.second.best
+        v["second_candidates"] = evidence.second.candidates()
+    return v
+
+
+def _at_bound(v, fits, warnings) -> None:
+    """A fitted parameter at its search bound (issue 14.3): the fit wanted to go further than the
+    candidate allows, so the candidate probably stands in for something else (e.g. a heave channel
+    with the wrong sign fitted as a 3 s sensor delay): a named verdict drops to confidence ``low``,
+    says so in ``warnings`` and lists them in ``verdict.at_bound``."""
+    if v["effect"] in ("none", "inconclusive") or v["effect"] != fits[0].effect or not fits[0].at_bound:
+        return
+    hits = list(fits[0].at_bound)
+    v["at_bound"] = hits
+    was = v["confidence"]
+    v["confidence"] = "low"
+    where = ", ".join(f"{h['parameter']} = {h['value']:.4g} at its {h['side']} search bound {h['bound']:.4g}"
+                      for h in hits)
+    warnings.append(f"verdict {v['effect']}: fitted {where}; the effect may stand in for another "
+                    f"(e.g. a channel with the wrong sign or unit) -- confidence lowered from {was} to low")
+
+
+def _component(v, fits, P, evidence, warnings) -> None:
+    """``verdict.component`` (every verdict but ``none``), the parameter_mismatch checks, and the open
+    search's ``discovered`` term when no named effect explains ``min_explained`` of the gap: the verdict
+    becomes ``discovered`` (confidence low) only when an ``inconclusive`` verdict's term shrinks its
+    held-out component residual by >= ``discover_shrink``; otherwise the term is a suggestion."""
+    shares = evidence.shares
+    eff, best = v["effect"], fits[0]
+    largest = max(COMPONENTS, key=lambda c: shares[c]) if any(shares.values()) else ""
+    best_comp = candidate_component(best.effect, best.values, evidence.prescreen)
+    if eff == "inconclusive":
+        # a best candidate that explains a real part of the gap (>= none_explained) knows its component
+        # better than the equation-error shares (both a gas heat transfer and a line loss are ~v in the
+        # gas law's residual)
+        if best.effect == "parameter_mismatch" and _refit_disagrees(best_comp, shares, largest, P):
+            best_comp = largest  # the refit stands in (see _refit_check)
+        v["component"] = best_comp if best.explained >= P.none_explained and best_comp else largest or best_comp
+    else:
+        v["component"] = best_comp
+    if eff == "parameter_mismatch":
+        _refit_check(v, shares, largest, P, warnings)
+        _stationarity(v, evidence, warnings)
+    if best.explained >= P.min_explained or evidence.discovered is None:
+        return
+    found = evidence.discovered
+    v["discovered"] = found
+    if eff == "inconclusive" and found["component"] == "sensors":
+        v["component"] = "sensors"  # one channel misreads: seen in every equation that reads it
+    if eff == "inconclusive" and found["shrink"] >= P.discover_shrink:
+        v.update(effect="discovered", component=found["component"], confidence="low",
+                 note=f"no named effect explains half the gap (best {best.effect}: "
+                      f"{100 * best.explained:.0f} %); the open search's term {found['term']} shrinks the "
+                      f"held-out {found['component']} residual by {100 * found['shrink']:.0f} %")
+
+
+def _refit_disagrees(moved, shares, largest, P) -> bool:
+    """The parameter_mismatch refit moved a parameter of component ``moved`` most, where the equation
+    error sees under ``second_share`` of the gap, while ``largest`` holds ``refit_share`` of it."""
+    return bool(largest) and shares[largest] >= P.refit_share and shares.get(moved, 0.0) < P.second_share
+
+
+def _refit_check(v, shares, largest, P, warnings) -> None:
+    """The six-parameter refit can bend any gap into the nominal's parameters; when the parameter it
+    moved most is of a component where the equation error sees (almost) no gap, while another holds
+    most of it, the two readings disagree: the gap lives where the equations put it, and the refit is a
+    stand-in (confidence low, the component the equation error's).  A mismatch in two components
+    agrees with the equations in both."""
+    if not _refit_disagrees(v["component"], shares, largest, P):
+        return
+    moved = v["component"]
+    v.update(component=largest, confidence="low", refit_component=moved)
+    warnings.append(f"verdict parameter_mismatch: the refit moved a {moved} parameter most, but "
+                    f"{100 * shares[largest]:.0f} % of the equation-error gap lies in {largest}; the refit "
+                    "may stand in for an unmodelled effect there -- confidence low")
+
+
+def _stationarity(v, evidence, warnings) -> None:
+    """A parameter mismatch is a *constant* error of the nominal's parameters: its component's
+    equation residual keeps its coefficients over the run
+    (:meth:`~heavecomp.diagnosis.components.ComponentResiduals.stationarity`).  When they move, the
+    refit averages a time-varying effect (a seal that warms and loses a third of its friction over the
+    first minutes): confidence low, ``verdict.stationarity`` and a warning say which moved."""
+    st = evidence.stationarity(v["component"])
+    if st is None:
+        return
+    v["stationarity"] = st
+    if not st["drifting"]:
+        return
+    was = v["confidence"]
+    v["confidence"] = "low"
+    moved = ", ".join(f"{c['feature']}: {min(c['value']):.4g} to {max(c['value']):.4g} {c['unit']}"
+                      for c in st["coefficients"] if c["feature"] in st["drifting"])
+    warnings.append(f"verdict parameter_mismatch: the {v['component']} residual's coefficients move over "
+                    f"the run ({moved}; {len(st['windows'])} windows), "
+                    f"so the mismatch is not constant; a time-varying effect may be averaged -- "
+                    f"confidence lowered from {was} to low")
