@@ -4,8 +4,9 @@ The plant is the foundation's compiled stepper (:func:`heavecomp.simulate._kerne
 called one RK4 step at a time so that the active force can change between
 steps.  Per control interval (``[active].control_rate``, 20 Hz by default):
 
-1. the rig's measurements (stroke, pressure, WOB, heave; Gaussian noise,
-   seeded) and the actuator's force are handed to ``controller.step``;
+1. the rig's measurements (stroke, pressure, WOB, heave; as the true plant's channel effects
+   read them, e.g. a WOB load cell ``sensor_gain``, plus Gaussian noise, seeded) and the
+   actuator's force are handed to ``controller.step``;
 2. the command, as the controller decided it, is checked against the limits
    (``violations_u_max``: ``|u_cmd| > u_max``; ``violations_rate``: the clipped
    command is further than ``rate_max / control_rate`` from the force the
@@ -31,10 +32,11 @@ from pathlib import Path
 import numpy as np
 
 from heavecomp.controllers import ControllerConfig, Measurement, make
-from heavecomp.errors import InputError
+from heavecomp.controllers.registry import takes_effects
+from heavecomp.errors import InputError, ParameterError
 from heavecomp.params.budget import check_run_size
 from heavecomp.params.cmc import active
-from heavecomp.effects.registry import resolve
+from heavecomp.effects.registry import resolve, split_effects
 from heavecomp.plants.cmc import eigen_rate, plant_vectors
 from heavecomp.simulate import excitation
 from heavecomp.simulate.core import CSV_COLUMNS, SimulationResult, default_dt, plant_stepper
@@ -107,7 +109,8 @@ def _percentile_ms(x, q):
 
 def simulate_closed_loop(params, controller="passive", duration: float = 120.0, *, dt: float | None = None,
                          heave=None, noise: Noise | None = Noise(), preview: str = "predicted",
-                         stats_start: float | None = None, progress=None, effects=(), **options) -> ClosedLoopResult:
+                         stats_start: float | None = None, progress=None, effects=(), controller_effects=None,
+                         **options) -> ClosedLoopResult:
     """Simulate the CMC with an active cylinder under ``controller``.
 
     Parameters
@@ -127,8 +130,16 @@ def simulate_closed_loop(params, controller="passive", duration: float = 120.0, 
         ``predicted``: the controller predicts heave from its measurements (AR);
         ``perfect``: it is given the true future heave (an upper bound).
     effects : sequence, optional
-        Effects at the true plant's hooks (:mod:`heavecomp.effects`; the controller knows
-        them only if it was built with them).
+        The true plant's effects (:mod:`heavecomp.effects`: instances, names or ``(name, values)``):
+        plant effects act at its hooks; a channel effect (``sensor_gain``, ``sensor_offset``,
+        ``sensor_delay``, each with its ``channel``) changes the measurement the controller
+        receives (before the noise).  A heave effect is refused (ParameterError).  The controller
+        knows none of them unless told (``controller_effects``).
+    controller_effects : sequence, optional
+        The effects a named MPC's model knows (:func:`heavecomp.controllers.make`'s ``effects``):
+        its plant effects enter the prediction, its channel effects how it reads the measurement.
+        None: the parameter set's own effects (``params.effects``, where it has them) for a
+        controller with a model, none for ``passive`` and ``pid``.
     options
         :class:`~heavecomp.controllers.ControllerConfig` overrides (when
         ``controller`` is a name).
@@ -147,7 +158,18 @@ def simulate_closed_loop(params, controller="passive", duration: float = 120.0, 
     if preview not in ("predicted", "perfect"):
         raise InputError(f"preview {preview!r}: not one of predicted, perfect")
     act = active(params)
-    ctrl = make(controller, params, **options)
+    plant_fx, heave_fx, sensor_fx = split_effects(resolve(effects))
+    if heave_fx:
+        raise ParameterError(f"effect {heave_fx[0].name}: a heave effect is not modelled in the closed loop "
+                             "(the plant would see another heave than the controller measures)")
+    if controller_effects is None:
+        controller_effects = getattr(params, "effects", ()) if takes_effects(controller) else ()
+    if isinstance(controller, str):
+        ctrl = make(controller, params, effects=controller_effects, **options)
+    else:
+        if controller_effects:
+            raise InputError("controller_effects: only for a named controller; build your controller with its effects")
+        ctrl = make(controller, params, **options)
     name = getattr(ctrl, "name", type(ctrl).__name__)
     cfg = getattr(ctrl, "config", None)
     if not isinstance(cfg, ControllerConfig):  # a user's own controller: the preview horizon of the defaults
@@ -176,7 +198,8 @@ def simulate_closed_loop(params, controller="passive", duration: float = 120.0, 
         t_in, z_in = heave
         hs = excitation.from_series(t_in, z_in, n_ctrl * Tc + horizon_t, sp, src="heave")
     plant = plant_vectors(params)  # the one params -> vectors conversion
-    advance, state, smooth = plant_stepper(plant, resolve(effects))
+    advance, state, smooth = plant_stepper(plant, plant_fx)
+    reads = _channel_readers(sensor_fx, n_ctrl + 1, Tc)
     rng = np.random.default_rng(noise.seed if noise else 0)
     sig = np.array([noise.stroke, noise.pressure, noise.wob, noise.heave]) if noise else np.zeros(4)
 
@@ -203,7 +226,7 @@ def simulate_closed_loop(params, controller="passive", duration: float = 120.0, 
         rows[k] = rec[0]
         if k == n_ctrl:
             break
-        noisy = rec[0, [2, 3, 4, 1]] + sig * rng.standard_normal(4)
+        noisy = reads(k, rec[0, MEASURED]) + sig * rng.standard_normal(4)
         meas = Measurement(t=t, stroke=noisy[0], pressure=noisy[1], wob=noisy[2], heave=noisy[3], u_active=u)
         pv = None
         if preview == "perfect":
@@ -261,6 +284,31 @@ def simulate_closed_loop(params, controller="passive", duration: float = 120.0, 
     return ClosedLoopResult(data=rows, params=params, dt=h, stats=dict(zip(K.STATS, stats.tolist())),
                             heave_info=hs.info, wall_time=wall, stats_start=stats_start,
                             controller=name, control=control)
+
+
+#: kernel columns of the measurements stroke, pressure, wob, heave (the order of :class:`Noise`)
+MEASURED = [2, 3, 4, 1]
+MEASURED_NAMES = ("stroke", "pressure", "wob", "heave")
+
+
+def _channel_readers(sensor_fx, n_rows: int, Tc: float):
+    """``reads(k, y) -> y_meas``: the measurements at control instant ``k`` (time k Tc) as the
+    channel effects ``sensor_fx`` read the true values ``y`` (stroke, pressure, wob, heave).  Each
+    effect reads the history of its channel so far (a delay reads the past), chained in order;
+    the identity without effects."""
+    if not sensor_fx:
+        return lambda k, y: y
+    tg = Tc * np.arange(n_rows)
+    stages = [(e, MEASURED_NAMES.index(e.channel), np.empty(n_rows)) for e in sensor_fx]
+
+    def reads(k, y):
+        out = np.array(y, dtype=float)
+        for e, j, hist in stages:
+            hist[k] = out[j]
+            out[j] = e.measure(tg[k:k + 1], tg[:k + 1], hist[:k + 1])[0]
+        return out
+
+    return reads
 
 
 def _preview_error(previews, hs, sp, Tc, K) -> dict:
