@@ -20,6 +20,7 @@ from heavecomp.errors import InputError, did_you_mean
 from heavecomp.report import invocation
 from heavecomp.commands import _progress
 from heavecomp.report import paths as _output
+from heavecomp.report import output as _staging
 
 #: name -> (module, one-line help).  Order is the order shown by --help.
 COMMANDS: dict[str, tuple[str, str]] = {
@@ -125,13 +126,23 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     try:
         _check_outputs(args)
-        if getattr(args, "quiet", False):
-            return _run_quiet(modules[args.command], args)
-        return int(modules[args.command].run(args) or 0)
+        with _staged(args):
+            rc = _run(modules[args.command], args)
+            if rc:
+                raise _Failed(rc)
+        return rc
+    except _Failed as f:
+        return f.code
     except InputError as exc:
-        msg = str(exc).strip().replace("\n", " ")
-        print(f"heavecomp {args.command}: error: {msg}", file=sys.stderr)
+        print(f"heavecomp {args.command}: error: {message(exc, _leaf_for(parser, args), args)}", file=sys.stderr)
         return 2
+    except OSError as exc:
+        if exc.errno not in _staging.NO_SPACE:
+            raise
+        where = (f"--out {args.out_final}" if getattr(args, "out_final", None)
+                 else f"-o {args.output}" if getattr(args, "output", None) else "output")
+        print(f"heavecomp {args.command}: error: {_staging.no_space_message(exc, where)}", file=sys.stderr)
+        return _staging.EXIT_NO_SPACE
     except KeyboardInterrupt:
         print(f"heavecomp {args.command}: interrupted", file=sys.stderr)
         return 130
@@ -140,6 +151,86 @@ def main(argv: list[str] | None = None) -> int:
 
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
+
+
+#: library option names whose flag is not ``--<name>``
+FLAG_OF = {"out": "--out", "out_dir": "--out", "output": "-o"}
+
+
+def message(exc: InputError, leaf: argparse.ArgumentParser | None = None, args=None) -> str:
+    """The one-line message of ``exc`` as the command line shows it.
+
+    The library names no flag; its ``exc.option`` names the argument (see
+    :class:`heavecomp.errors.InputError`).  When this command has that flag, a message starting with
+    the option's name (``duration must be ...``) or with its value (``/data/run: holds ...``) starts
+    with the flag instead, ``name = `` inside it becomes ``--name = ``, and ``exc.example`` is added
+    as ``; use --units t=ms``.  A flag the command lacks is never suggested.  The staging folder
+    (``.DIR.partial``) is shown as the ``--out`` the user gave."""
+    msg = str(exc).strip().replace("\n", " ")
+    final = getattr(args, "out_final", None) if args is not None else None
+    if final:
+        msg = msg.replace(str(_staging.staging_path(final)), str(final))
+    opt = getattr(exc, "option", None)
+    if not opt:
+        return msg
+    known = leaf._option_string_actions if leaf is not None else {}  # noqa: SLF001
+    pairs = [(n, FLAG_OF.get(n, "--" + n.replace("_", "-"))) for n in ((opt,) if isinstance(opt, str) else opt)]
+    pairs = [(n, f) for n, f in pairs if f in known]
+    if not pairs:
+        return msg
+    placed = False
+    for n, f in pairs:
+        value = final if f == "--out" and final else getattr(args, n, None) if args is not None else None
+        spoken = n.replace("_", " ")  # controller_option: "controller option 'x': ..."
+        if msg.startswith(f"{spoken} ") and not placed:
+            msg, placed = f + msg[len(spoken):], True
+        elif value is not None and str(value) and msg.startswith(str(value)) and not placed:
+            msg, placed = f"{f} {msg}", True
+        if f" {n} = " in msg:
+            msg, placed = msg.replace(f" {n} = ", f" {f} = "), True
+    example = getattr(exc, "example", None)
+    if example:
+        return f"{msg}; use {pairs[0][1]} {example}"
+    if not placed:
+        return f"{msg} ({', '.join(f for _, f in pairs)})"
+    return msg
+
+
+class _Failed(Exception):
+    """A command returned a non-zero code: its staged output is dropped."""
+
+    def __init__(self, code: int):
+        super().__init__(code)
+        self.code = code
+
+
+def _run(module, args) -> int:
+    if getattr(args, "quiet", False):
+        return _run_quiet(module, args)
+    return int(module.run(args) or 0)
+
+
+def _staged(args):
+    """The command writes into a staging folder beside ``--out``, moved into place when it has
+    finished (:mod:`heavecomp.report.output`); ``args.out`` is the staging folder and
+    ``args.out_final`` the folder the user named."""
+    import contextlib
+
+    if not getattr(args, "out", None):
+        return contextlib.nullcontext()
+
+    @contextlib.contextmanager
+    def staged():
+        st = _staging.Staged(args.out, "--out", resumable=args.command == "campaign")
+        args.out_final = args.out
+        with st as work:
+            args.out = str(work)
+            try:
+                yield work
+            finally:
+                args.out = args.out_final
+
+    return staged()
 
 
 def _check_outputs(args) -> None:

@@ -34,6 +34,15 @@ def sample_rate(t, *, name: str = "t", rtol: float = 1e-3) -> float:
 
     Raises DataError (naming the column) when ``t`` is not strictly increasing or
     not uniform within ``rtol``.
+
+    Parameters
+    ----------
+    t : array [s]
+        Time column, strictly increasing and uniform.
+    name : str
+        Column name for the error messages.
+    rtol : float
+        Largest deviation of a step from the median step, relative [-].
     """
     t = np.asarray(t, dtype=float)
     if t.ndim != 1 or t.size < 3:
@@ -120,6 +129,13 @@ def filtfilt_fir(x, b) -> np.ndarray:
     FIR's steady-state initial condition in closed form (``zi[k] = sum(b[k+1:])``, what
     ``lfilter_zi`` returns) instead of ``lfilter_zi``'s dense solve, cubic in the number of taps
     (0.14 s per call for a 1 Hz filter at 50 Hz; ``tests/test_signals.py`` pins the two equal).
+
+    Parameters
+    ----------
+    x : array
+        Signal, filtered along its last axis.
+    b : array
+        FIR taps (e.g. :func:`design_lowpass`).
     """
     from scipy.signal import lfilter
     from scipy.signal._arraytools import odd_ext
@@ -142,6 +158,17 @@ def zero_phase_lowpass(x, fs: float, cutoff: float, numtaps: int | None = None) 
 
     The signal must be longer than 3 filter lengths (``filtfilt`` padding);
     otherwise InputError.
+
+    Parameters
+    ----------
+    x : array
+        Signal sampled at ``fs``, filtered along its last axis.
+    fs : float [Hz]
+        Sampling rate.
+    cutoff : float [Hz]
+        -6 dB frequency of one pass (:func:`design_lowpass`).
+    numtaps : int, optional
+        Odd tap count; default ~ 3.3 fs/cutoff.
     """
     x = np.asarray(x, dtype=float)
     b = design_lowpass(fs, cutoff, numtaps)
@@ -194,6 +221,13 @@ def differentiate(t, x, cutoff: float, *, order: int = 2, numtaps: int | None = 
     t : array [s], uniformly sampled
     x : array
     cutoff : float [Hz]
+        -6 dB frequency of one pass of the FIR low-pass (:func:`design_lowpass`).
+    order : int
+        Number of derivatives, 1 or 2.
+    numtaps : int, optional
+        Odd tap count; default ~ 3.3 fs/cutoff.
+    name : str
+        Column name of ``x`` for the error messages.
     """
     fs = sample_rate(t)
     x = np.asarray(x, dtype=float)
@@ -220,7 +254,8 @@ def friction_from_motion(t, x, drive_force, mass: float, cutoff: float, *, numta
     x : array [m]  displacement (e.g. encoder)
     drive_force : array [N]  pressure force, e.g. ``A (P_a - P_b)``
     mass : float [kg]
-    cutoff : float [Hz]
+    cutoff : float [Hz]  -6 dB frequency of one pass of the FIR low-pass
+    numtaps : int, optional  odd tap count; default ~ 3.3 fs/cutoff
 
     Returns
     -------

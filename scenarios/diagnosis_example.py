@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from heavecomp.diagnosis.data import load_run
 from heavecomp.diagnosis.estimator import GapDiagnoser
-from heavecomp.diagnosis.generator import generate
+from heavecomp.benchmark import benchmark_case, generate
 from heavecomp.report.diagnosis import write_report
 from heavecomp.params import dumps
 from heavecomp.report.provenance import annotate_json, stamp
@@ -18,7 +18,7 @@ from heavecomp.report.scenario import parse_args, run, write_metrics
 
 
 def build(quick: bool = False, out=None):
-    tr = generate("string_damping", seed=2024, duration=120.0 if quick else 600.0, param_set="paper_a")
+    tr = generate(benchmark_case("string_damping", seed=2024, duration=120.0 if quick else 600.0, param_set="paper_a"))
     csv = tr.to_csv(out / "run.csv")
     (out / "nominal.toml").write_text(dumps(tr.nominal, header="nominal parameters given to the diagnosis"))
     d = GapDiagnoser(tr.nominal).fit(load_run(csv, tr.nominal))

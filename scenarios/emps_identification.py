@@ -16,7 +16,7 @@ from heavecomp.report import identification as plots
 from heavecomp.identification.study import emps_study
 from heavecomp.plants.axis import load_emps
 from heavecomp.report.figures import save
-from heavecomp.report.scenario import md_table, parse_args, run, write_metrics, write_report
+from heavecomp.report.scenario import parse_args, run, write_metrics, write_report
 
 DATA = EMPS
 
@@ -56,13 +56,11 @@ def main(argv=None) -> int:
                                  diag.where_, diag.where_after_), args.out / "residual_map.png", dpi=90)
     save(plots.emps_cutoff_sensitivity(res["sensitivity"]), args.out / "cutoff_sensitivity.png", dpi=90)
     write_metrics(args.out, m)
-    pub, got, se = m["published"], m["identified_whole_record"], m["stderr_whole_record"]
     w, sel = m["where"], m["selection"]
     write_report(args.out, "EMPS: inverse-model identification and residual diagnosis", [
         __doc__,
         f"Settings: {m['settings']}",
-        md_table(["parameter", "published", "identified (whole record)", "std. error", "deviation [%]"],
-                 [(k, pub[k], got[k], se[k], 100 * m["relative_error"][k]) for k in pub], fmt="{:.4g}"),
+        plots.emps_parameter_table(m),
         "![cut-off](cutoff_sensitivity.png)",
         f"Held-out rms residual of the model fitted on t < {m['split']['fit'][1]:g} s: "
         f"{m['baseline_fit_part']['rms_validate']:.3f} N. Share of squared residual: "
@@ -72,12 +70,8 @@ def main(argv=None) -> int:
         "Candidates: the effect library's classes (the same the CMC diagnosis fits), through their "
         "equation-error features; an effect without a form on this plant (no pressure, no gas, ...) "
         "is left out.",
-        md_table(["candidate", "component", "k", "held-out rms [N]", "shrink", "score (BIC-like)"],
-                 [(c["effect"], c["component"], c["n_parameters"], c["rms_after"], c["shrink"], c["score"])
-                  for c in m["candidates"]], fmt="{:.3f}"),
-        "Candidate parameters (fitted on the fit part, SI):\n\n" + md_table(
-            ["candidate", "parameters"],
-            [(c["effect"], plots.parameters_text(c["parameters"], c["units"])) for c in m["candidates"]]),
+        plots.candidates_table(m),
+        "Candidate parameters (fitted on the fit part, SI):\n\n" + plots.candidate_parameters_table(m),
         "Forward selection (each step chosen by the BIC of the fit part, its shrink measured on the "
         "held-out part): "
         + "; ".join(f"{' + '.join(s['effects'])}: shrink {s['shrink']:.3f}" for s in sel),

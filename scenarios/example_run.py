@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from heavecomp.data import EXAMPLE_PARAMS, EXAMPLE_RUN, WAVERIDER
-from heavecomp.diagnosis.generator import NOISE
+from heavecomp.benchmark import NOISE
 from heavecomp.params import dumps, paper_a
 from heavecomp.simulate import simulate
 from heavecomp.report.scenario import run

@@ -55,11 +55,7 @@ def main(argv=None) -> int:
                  [(k, f["dp_bar"], f"{f['strokes_positive']}/{f['strokes_negative']}", f["friction_positive_N"],
                    f["friction_negative_N"], f"{f['speed_positive_mm_s']:.1f}/{f['speed_negative_mm_s']:.1f}")
                   for k, f in m["files"].items()]),
-        md_table(["fit", "F_C [N]", "C_p [N/bar]", "LS std. err. [N/bar]", "bootstrap std [N/bar]",
-                  "95 % interval [N/bar]", "rms [N]", "strokes"],
-                 [(k, f["F_C"], f["C_p_N_per_bar"], f["C_p_se_N_per_bar"], f["C_p_boot_N_per_bar"] or "-",
-                   "{:.3f} .. {:.3f}".format(*(x * 1e5 for x in f["C_p_ci95"])) if f["C_p_ci95"] else "-",
-                   f["rms"], f["n_strokes"]) for k, f in m["fits"].items()], fmt="{:.3f}"),
+        plots.seal_fits_table(m),
         "`file_means`: one point per file, (mean F_f+ - mean F_f-)/2 against dp (2 degrees of freedom); its "
         "standard error includes the file-to-file scatter (sessions differ) that a bootstrap within files "
         "cannot see. The stroke speed also differs by direction and pressure (table above), so a velocity "

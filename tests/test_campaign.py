@@ -184,7 +184,7 @@ def test_unreachable_scheduler_is_one_line_error(tiny, tmp_path, monkeypatch):
 
     monkeypatch.setattr(execute, "CONNECT_TIMEOUT", "2s")
 
-    with pytest.raises(InputError, match="--scheduler tcp://127.0.0.1:1: cannot connect"):
+    with pytest.raises(InputError, match="scheduler tcp://127.0.0.1:1: cannot connect"):
         run_campaign(tiny, tmp_path, scheduler="tcp://127.0.0.1:1", limit=1)
 
 
@@ -348,7 +348,9 @@ def test_cli_killed_mid_campaign_resumes(tmp_path):
     out = tmp_path / "o"
     cmd = [sys.executable, "-m", "heavecomp.cli", "campaign", str(camp), "--out", str(out), "--workers", "1"]
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
-    table = out / "runs.csv"
+    from heavecomp.report.output import staging_path
+
+    table = staging_path(out) / "runs.csv"  # a running campaign writes beside --out (issue 21.3)
     t0 = time.time()
     while time.time() - t0 < 60:
         if table.is_file() and table.read_text().count("\n") >= 2:
@@ -359,8 +361,11 @@ def test_cli_killed_mid_campaign_resumes(tmp_path):
     assert proc.returncode == -signal.SIGKILL
     done = table.read_text().count("\n") - 1
     assert 1 <= done < n
+    assert not out.exists()  # a killed campaign leaves no folder that reads as a result
     r = subprocess.run(cmd, capture_output=True, text=True)
     assert r.returncode == 0, r.stderr
+    assert not table.exists()
+    table = out / "runs.csv"
     first = r.stdout.splitlines()[0]
     resumed = int(first.split(" resumed")[0].split()[-1])
     assert resumed >= done and first.startswith(f"{n - resumed} runs simulated")

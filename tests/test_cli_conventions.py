@@ -39,6 +39,13 @@ def test_every_command_has_quiet():
     assert len(leaves) >= len(COMMANDS)  # identify has two leaves
     for p in leaves:
         assert "--quiet" in p._option_string_actions, p.prog
+        assert "-q" in p._option_string_actions, p.prog  # diagnose defined --quiet alone (issue 21.6)
+
+
+def test_diagnose_takes_dash_q():
+    parser, _ = build_parser("diagnose")
+    args = parser.parse_args(["diagnose", "run.csv", "--params", "p.toml", "--out", "o", "-q"])
+    assert args.quiet is True
 
 
 def test_quiet_silences_summary_but_not_errors(paper_a_toml, tmp_path):

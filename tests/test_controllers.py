@@ -35,7 +35,7 @@ def test_active_table_bad_values_name_the_key(table, msg):
 def test_unknown_controller_and_option_are_input_errors():
     from heavecomp.controllers import make
 
-    with pytest.raises(InputError, match="--controller 'lqr': not one of passive, pid, linear-mpc, nonlinear-mpc"):
+    with pytest.raises(InputError, match="controller 'lqr': not one of passive, pid, linear-mpc, nonlinear-mpc"):
         make("lqr", paper_a())
     with pytest.raises(InputError, match="controller option 'horizn': unknown .*'horizon'"):
         make("pid", paper_a(), horizn=5)

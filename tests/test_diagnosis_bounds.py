@@ -6,7 +6,7 @@ stuck at its 3 s search limit: the candidate stood in for a defect it cannot des
 import pytest
 
 from heavecomp.diagnosis.estimator import GapDiagnoser, at_bounds
-from heavecomp.diagnosis.generator import generate
+from heavecomp.benchmark import benchmark_case, generate
 
 
 def test_at_bounds_reads_the_candidates_own_search_range():
@@ -36,7 +36,7 @@ def test_sign_flipped_heave_is_named_or_not_confident():
     confidence high (wrong channel).  Now heave_reference may flip the sign and names it."""
     from heavecomp.diagnosis.data import check_run
 
-    tr = generate("none", seed=2, duration=300.0)
+    tr = generate(benchmark_case("none", seed=2, duration=300.0))
     cols = dict(tr.columns)
     cols["heave"] = -cols["heave"]
     d = GapDiagnoser(tr.nominal).fit(check_run(tr.t, cols, params=tr.nominal))

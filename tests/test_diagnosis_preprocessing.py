@@ -93,9 +93,9 @@ def test_noise_floor_holds_from_10_to_100_hz(fs, sigma):
 def test_noise_floor_on_generated_channels(fs):
     """On a generated run (stick-slip stroke, WOB with its resonance) each channel's estimate is within
     10 % of the noise the generator added."""
-    from heavecomp.diagnosis.generator import NOISE, generate
+    from heavecomp.benchmark import benchmark_case, generate, NOISE
 
-    tr = generate("none", seed=7, duration=120.0, rate=fs)
+    tr = generate(benchmark_case("none", seed=7, duration=120.0, rate=fs))
     for c in ("heave", "stroke", "pressure", "wob"):
         assert D.noise_floor(tr.columns[c]) == pytest.approx(NOISE[c], rel=0.1), c
 

@@ -9,13 +9,13 @@ best candidate skipped the joint fit altogether, and a best under 50 % was `inco
 import pytest
 
 from heavecomp.diagnosis.estimator import GapDiagnoser
-from heavecomp.diagnosis.generator import generate
+from heavecomp.benchmark import benchmark_case, generate
 
 CANDIDATES = ["sensor_delay", "flow_loss", "string_damping", "gas_heat_transfer"]
 
 
 def _diagnose(effects, seed):
-    tr = generate(effects, seed=seed, duration=120.0)
+    tr = generate(benchmark_case(effects, seed=seed, duration=120.0))
     return tr, GapDiagnoser(tr.nominal, candidates=CANDIDATES).fit(tr.to_run())
 
 

@@ -98,9 +98,9 @@ def test_cut_run_is_replayed_like_the_whole_run_and_warned(t0):
 def test_cropping_keeps_the_verdict():
     """The issue's case: a withheld dwell stiction; cutting the first 60 s must not change the verdict, and
     the cut run is warned about and reports the state it started from."""
-    from heavecomp.diagnosis.generator import generate
+    from heavecomp.benchmark import benchmark_case, generate
 
-    tr = generate("dwell_stiction", seed=1002, duration=200.0)
+    tr = generate(benchmark_case("dwell_stiction", seed=1002, duration=200.0))
     verdicts = {}
     for t0 in (0.0, 60.0):
         run = _crop(tr.nominal, tr.t, tr.columns, t0)

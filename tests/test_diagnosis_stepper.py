@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from heavecomp.diagnosis.stepper import CHANNELS, replay_dt, simulate_fx
-from heavecomp.diagnosis.truth import TruthDwell, TruthOrifice, TruthThermalGas, truth_composition
+from heavecomp.benchmark.truth import TruthDwell, TruthOrifice, TruthThermalGas, truth_composition
 from heavecomp.effects.registry import effect_class
 from heavecomp.params import paper_a
 from heavecomp.simulate import simulate

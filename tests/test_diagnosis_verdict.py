@@ -1,4 +1,4 @@
-"""Verdicts end to end: the quick withheld-effect benchmark (the generator's run_benchmark; the tuning
+"""Verdicts end to end: the quick withheld-effect benchmark (the benchmark's run_benchmark; the tuning
 and scoring sets of scenarios/diagnosis_validation.py are the full benchmark), the CLI on a generated run with
 dropouts and jittered sampling, and the Python API's contract fields."""
 
@@ -15,7 +15,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 @pytest.mark.slow
 def test_withheld_effects_quick(tmp_path):
-    from heavecomp.diagnosis.generator import run_benchmark
+    from heavecomp.benchmark.run import run_benchmark
 
     rows, summary = run_benchmark(quick=True)
     m = {"runs": rows, "summary": summary}
@@ -48,10 +48,10 @@ def test_withheld_effects_quick(tmp_path):
 
 @pytest.mark.slow
 def test_cli_diagnose_contract_json(tmp_path):
-    from heavecomp.diagnosis.generator import generate
+    from heavecomp.benchmark import benchmark_case, corrupt, generate
     from heavecomp.params import dumps
 
-    tr = generate("sensor_delay", seed=5, duration=90.0, jitter=True, dropouts=True)
+    tr = corrupt(generate(benchmark_case("sensor_delay", seed=5, duration=90.0)), jitter=True, dropouts=True)
     f = tr.to_csv(tmp_path / "run.csv")
     toml = tmp_path / "nom.toml"
     toml.write_text(dumps(tr.nominal))

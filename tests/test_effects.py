@@ -6,7 +6,7 @@ import dataclasses
 import numpy as np
 import pytest
 
-from heavecomp.diagnosis import truth as TR
+from heavecomp.benchmark import truth as TR
 from heavecomp.effects import CANDIDATES, EFFECT_NAMES, get
 from heavecomp.effects.compose import composition
 from heavecomp.errors import ParameterError

@@ -1,5 +1,5 @@
 """heave_reference's lever arm: a heave measured at a lever arm L times a logged pitch angle
-(z_meas = z_crown + L sin(pitch), the validation's truth law :func:`heavecomp.diagnosis.truth.heave_lever_arm`)
+(z_meas = z_crown + L sin(pitch), the validation's truth law :func:`heavecomp.benchmark.truth.heave_reference.heave_lever_arm`)
 is mapped back to the crown's heave, fitted by the diagnosis, refused where no angle exists, and a bad
 pitch column is one line (exit 2)."""
 
@@ -7,7 +7,7 @@ pitch column is one line (exit 2)."""
 import numpy as np
 import pytest
 
-from heavecomp.diagnosis import truth as T
+from heavecomp.benchmark.truth import heave_reference as T
 from heavecomp.diagnosis.data import heave_samples, load_run, MeasuredRun
 from heavecomp.effects.heave_reference import HeaveReference
 from heavecomp.errors import DataError, ParameterError
@@ -107,9 +107,9 @@ CANDIDATES = ["heave_reference", "string_damping", "sensor_gain", "sensor_delay"
 
 @pytest.fixture(scope="module")
 def lever_case():
-    from heavecomp.diagnosis.generator import generate_case
+    from heavecomp.benchmark import Case, generate
 
-    return generate_case(CASE)
+    return generate(Case(**CASE))
 
 
 @pytest.mark.slow

@@ -146,7 +146,7 @@ def test_effect_plant_without_effects_is_the_cmc_bit_for_bit(model):
 def test_compiled_effect_hooks_equal_python_originals():
     """The kernel's compiled hook functions of the library (every effect on) and of the generator's
     truth laws evaluate the same generated source as the numpy functions."""
-    from heavecomp.diagnosis.truth import TRUTH, truth_composition
+    from heavecomp.benchmark.truth import TRUTH, truth_composition
     from heavecomp.effects.compose import library_composition
     from heavecomp.effects.registry import library
 

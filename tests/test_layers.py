@@ -1,7 +1,7 @@
 """Layers that hold (issue 11 item 4), read from the import graph of the package's source.
 
 params -> physics (friction, plants, effects) -> stepper (simulate) -> controllers ->
-closed loop -> analysis / diagnosis / campaign / identification -> report -> commands.
+closed loop -> analysis / diagnosis / campaign / identification / benchmark -> report -> commands.
 A module may import its own layer or a lower one, never a higher one; no two modules
 import each other, directly or round a cycle; the package's own imports sit at module top,
 except imports of modules that load a heavy third-party library (numba, casadi, ...) at
@@ -38,6 +38,7 @@ LAYER_OF = {
     "heavecomp.diagnosis": "analysis",
     "heavecomp.campaign": "analysis",
     "heavecomp.identification": "analysis",
+    "heavecomp.benchmark": "analysis",        # the withheld-effect benchmark: checks diagnosis, beside it
     "heavecomp.estimator": "analysis",        # base of the gap diagnosers
     "heavecomp.report": "report",
     # the wings (paper B's pneumatic cylinder, paper A's rotating-piston rig) keep the same order

@@ -342,14 +342,14 @@ def test_output_budget_names_rate_and_duration():
     from heavecomp.simulate.layout import NCH
 
     rows = MAX_BYTES // (8 * NCH) + 1  # one row more than fits, at the default 25 ms step and 40 Hz output
-    with pytest.raises(ParameterError, match=r"--rate = 40 Hz writes .* rows x \d+ columns"):
+    with pytest.raises(ParameterError, match=r"rate = 40 Hz writes .* rows x \d+ columns"):
         simulate(paper_a(), rows / 40.0, rate=40.0)
 
 
 def test_closed_loop_checks_the_budget_too():
     from heavecomp.closed_loop.loop import simulate_closed_loop
 
-    with pytest.raises(ParameterError, match="--dt = 1e-07 s"):
+    with pytest.raises(ParameterError, match="dt = 1e-07 s"):
         simulate_closed_loop(paper_a(), "pid", 600.0, dt=1e-7)
 
 

@@ -203,3 +203,96 @@ def test_campaign_runs_csv_has_a_unit_per_column(tmp_path):
     u = pd.read_csv(tmp_path / "runs.units.csv", index_col="column", keep_default_na=False)["unit"]
     assert list(u.index) == list(head)
     assert u["wob_std"] == "N" and u["n_stick"] == "count" and u["dev_000"] == "count" and u["hs"] == "m"
+
+
+def test_a_command_that_takes_no_heave_needs_no_heave_file(rig_with_heave_file, tmp_path):
+    """Issue 21.2: the diagnosis (whose heave is the measured run's) and analyse crashed in
+    write_params, after all their work, when [heave] path named a file that was not there."""
+    from heavecomp.errors import ParameterError
+    from heavecomp.params import load
+    from heavecomp.report.provenance import finish
+
+    params = load(rig_with_heave_file)
+    (rig_with_heave_file.parent / "data" / "heave.csv").unlink()
+    out = tmp_path / "diag"
+    finish(out, params=params, json_files=(), heave_used=False)
+    back = load(out / "params.toml")
+    assert back.heave is None and not (out / "heave.csv").exists()  # neither copied nor recorded
+    assert back.compensator == params.compensator
+    with pytest.raises(ParameterError, match=r"^heave.path: .*heave.csv is not a file"):
+        finish(tmp_path / "sim", params=params, json_files=())  # a command that uses the heave: named, one line
+    r = _run("analyse", str(rig_with_heave_file), "--points", "20", "--out", str(tmp_path / "a"), "-q")
+    assert r.returncode == 0, r.stderr
+    assert "[heave]" not in (tmp_path / "a" / "params.toml").read_text()
+
+
+@pytest.mark.slow
+def test_diagnose_with_a_missing_heave_file_in_the_nominal_set(rig_with_heave_file, tmp_path):
+    """The diagnosis takes its heave from the measured run: a nominal [heave] path that does not exist
+    is neither read, copied nor recorded (it crashed in write_params after the whole fit)."""
+    from heavecomp.params import load
+    from heavecomp.simulate import simulate
+
+    res = simulate(load(rig_with_heave_file), 80.0, rate=20.0)
+    res.to_csv(tmp_path / "run.csv")
+    (rig_with_heave_file.parent / "data" / "heave.csv").unlink()
+    out = tmp_path / "d"
+    r = _run("diagnose", str(tmp_path / "run.csv"), "--params", str(rig_with_heave_file), "--out", str(out),
+             "--candidates", "sensor_gain", "-q")
+    assert r.returncode == 0, r.stderr
+    assert json.loads((out / "diagnosis.json").read_text())["verdict"]["effect"]
+    assert "[heave]" not in (out / "params.toml").read_text() and not (out / "heave.csv").exists()
+
+
+def test_a_declared_unit_beats_the_name_lookup():
+    """Issue 21.6: units attached where each value is made -- a stroke offset in m is not given the N
+    that the key name 'offset' has elsewhere (the diagnosis.json defect)."""
+    from heavecomp.report.provenance import declare_units, strip_declared, undeclared, units_of
+
+    guessed, _ = units_of({"stroke": {"offset": 0.01}})
+    assert guessed == {"offset": "N"}  # what the name alone gives: wrong for a stroke
+    r = {"stroke": declare_units({"offset": 0.01, "gain": 1.02}, {"offset": "m", "gain": "-"}),
+         "wob": declare_units({"offset": 250.0}, {"offset": "N"}),
+         "noise": 1.0}
+    declare_units(r, {"window": "s"})
+    r["window"] = [0.0, 30.0]
+    units, missing = units_of(r)
+    assert units["offset"] == "m" and units["wob.offset"] == "N" and units["gain"] == "-" and units["window"] == "s"
+    assert missing == ["noise"] and undeclared(r) == ["noise"]
+    assert "_units" not in json.dumps(strip_declared(r))
+
+
+def test_simulate_metrics_declare_every_unit(paper_a_toml, tmp_path):
+    """metrics.json of simulate cannot name a wrong unit: every number's unit is declared where it is made."""
+    from heavecomp.params import load
+    from heavecomp.report.provenance import finish, undeclared
+    from heavecomp.report.simulation import write_outputs
+    from heavecomp.simulate import simulate
+    from heavecomp.simulate.core import SimulationResult
+
+    params = load(paper_a_toml).replace(heave={"kind": "jonswap", "hs": 2.0, "tp": 10.0, "amplitude": None,
+                                                "period": None})
+    res = simulate(params, 20.0)
+    assert set(res.metrics()) <= set(SimulationResult.METRIC_UNITS)  # a new metric needs its unit
+    m = write_outputs(res, tmp_path)
+    assert undeclared(m) == []
+    finish(tmp_path, params=params, csv_files=("timeseries.csv",))
+    written = json.loads((tmp_path / "metrics.json").read_text())
+    assert "_units" not in json.dumps(written)
+    u = written["units"]
+    assert u["wob_std"] == "N" and u["stroke_max"] == "m" and u["hs"] == "m" and u["repeat_period"] == "s"
+    assert u["n_stick"] == "count" and u["k_eff_eq14"] == "N/m" and u["stats_window"] == "s"
+
+
+def test_campaign_metrics_declare_every_unit():
+    from pathlib import Path
+
+    from heavecomp.report.campaign import summary
+    from heavecomp.report.provenance import undeclared, units_of
+
+    st = json.loads((Path(__file__).resolve().parents[1] / "reports" / "campaign_default" / "statistics.json")
+                    .read_text())
+    m = summary(st)
+    assert undeclared(m) == []
+    units, missing = units_of(m)
+    assert missing == [] and units["band_exits_per_hour"] == "1/h" and units["dev_max_in_exposure"] == "N"

@@ -61,5 +61,5 @@ def test_a_smaller_spike_runs_with_a_warning_naming_its_time(tmp_path, caplog):
 def test_a_step_too_large_for_a_plausible_heave_still_suggests_reducing_dt():
     """The paper-A case at dt = 0.5 s (h lambda ~ 6, beyond RK4's stability) diverges with a
     plain sine heave: then the step is the problem and the message says so."""
-    with pytest.raises(SimulationError, match=r"reduce --dt \(now 0.5 s\)"):
+    with pytest.raises(SimulationError, match=r"reduce the step dt \(now 0.5 s\)"):
         simulate(paper_a("stribeck"), 120.0, dt=0.5)

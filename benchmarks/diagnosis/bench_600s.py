@@ -29,13 +29,13 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
 
     from heavecomp.diagnosis.estimator import GapDiagnoser
-    from heavecomp.diagnosis.generator import generate
+    from heavecomp.benchmark import benchmark_case, generate
     from heavecomp.simulate import simulate
 
-    tr = generate(args.effect, seed=11, duration=args.duration, rate=50.0)
+    tr = generate(benchmark_case(args.effect, seed=11, duration=args.duration, rate=50.0))
     run = tr.to_run()
     simulate(tr.nominal, 10.0, rate=50.0)  # compile / load caches outside the timing
-    GapDiagnoser(tr.nominal, ["flow_loss"], n_jobs=1, second=0).fit(generate("none", duration=30.0).to_run())
+    GapDiagnoser(tr.nominal, ["flow_loss"], n_jobs=1, second=0).fit(generate(benchmark_case("none", duration=30.0)).to_run())
     t0 = time.perf_counter()
     simulate(tr.nominal, args.duration, rate=50.0)
     t_sim = time.perf_counter() - t0

@@ -120,6 +120,8 @@ def describing_response(params, heave_amplitude: float, omega: float, *, n: int 
         Any friction model; ``none`` gives the linear result.
     heave_amplitude : float [m]
     omega : float [rad/s]
+    n : int
+        Samples per period of the describing-function integral (:func:`equivalent_gains`).
 
     Returns
     -------
@@ -168,7 +170,17 @@ def describing_response(params, heave_amplitude: float, omega: float, *, n: int 
 
 
 def first_harmonic(t, x, omega):
-    """Amplitude [x] and phase [deg] of the first harmonic of x(t) (least squares with a mean)."""
+    """Amplitude [x] and phase [deg] of the first harmonic of x(t) (least squares with a mean).
+
+    Parameters
+    ----------
+    t : array [s]
+        Sample times.
+    x : array
+        Signal (any unit; the amplitude is in the same unit).
+    omega : float [rad/s]
+        Angular frequency of the harmonic.
+    """
     M = np.column_stack([np.ones_like(t), np.sin(omega * t), np.cos(omega * t)])
     c = np.linalg.lstsq(M, x, rcond=None)[0]
     return float(np.hypot(c[1], c[2])), float(np.degrees(np.arctan2(c[2], c[1])))
@@ -181,6 +193,21 @@ def simulated_response(params, heave_amplitude: float, period: float, *, settle_
     The heave fades in over two periods (cmc-reference.md), then ``settle_periods``
     periods are dropped and the WOB's first harmonic is fitted over the next
     ``measure_periods`` periods.
+
+    Parameters
+    ----------
+    params : CMCParams
+        The parameter set (:class:`heavecomp.params.CMCParams`). Its heave is replaced by the sine.
+    heave_amplitude : float [m]
+        Amplitude of the sine heave.
+    period : float [s]
+        Period of the sine heave.
+    settle_periods : int
+        Periods dropped after the fade-in.
+    measure_periods : int
+        Periods the first harmonic is fitted over.
+    rate : float [Hz]
+        Output rate of the simulation.
 
     Returns
     -------
@@ -205,6 +232,17 @@ def simulated_response(params, heave_amplitude: float, period: float, *, settle_
 
 def compare_with_simulation(params, amplitudes, periods, **sim_kw) -> list[dict]:
     """Describing-function WOB amplitude vs the simulator's, for a grid of sine heaves.
+
+    Parameters
+    ----------
+    params : CMCParams
+        The parameter set (:class:`heavecomp.params.CMCParams`).
+    amplitudes : sequence of float [m]
+        Heave amplitudes.
+    periods : sequence of float [s]
+        Heave periods.
+    **sim_kw : keyword arguments
+        Passed to :func:`simulated_response` (``settle_periods``, ``measure_periods``, ``rate``).
 
     Returns
     -------
@@ -241,6 +279,8 @@ def describing_transmissibility(params, heave_amplitude: float, omega, *, n: int
     heave_amplitude : float [m]
         Heave amplitude a of the sine the describing function is balanced for.
     omega : array_like [rad/s]
+    n : int
+        Samples per period of the describing-function integral (:func:`equivalent_gains`).
 
     Returns
     -------

@@ -52,7 +52,19 @@ def _siso(sys, output, input_):
 
 
 def frequency_grid(sys=None, n: int = 1000, lo: float = 1e-3, hi: float | None = None) -> np.ndarray:
-    """Log-spaced frequencies [rad/s] from ``lo`` to 10x the fastest pole (or ``hi``)."""
+    """Log-spaced frequencies [rad/s] from ``lo`` to 10x the fastest pole (or ``hi``).
+
+    Parameters
+    ----------
+    sys : control.StateSpace, optional
+        Model whose fastest pole sets the upper end (unused when ``hi`` is given).
+    n : int
+        Number of frequencies.
+    lo : float [rad/s]
+        Lowest frequency.
+    hi : float [rad/s], optional
+        Highest frequency; default 10 x the fastest pole (100 rad/s without ``sys``).
+    """
     if hi is None:
         hi = 10.0 * max(1.0, float(np.max(np.abs(np.linalg.eigvals(sys.A))))) if sys is not None else 100.0
     return np.logspace(np.log10(lo), np.log10(hi), n)
@@ -85,6 +97,14 @@ def effective_stiffness(sys, omega):
 def transmissibility(sys, omega):
     """Transmissibility |WOB/heave| normalised by its DC value: T(omega) = k_eff(omega) / k_eff(0) [-].
 
+    Parameters
+    ----------
+    sys : control.StateSpace
+        Linear CMC model with named signals (:func:`heavecomp.analysis.linear.linearise`).
+        Input ``heave``, output ``wob``.
+    omega : array_like [rad/s]
+        Frequencies.
+
     Returns
     -------
     control.FrequencyResponseData
@@ -100,7 +120,17 @@ def transmissibility(sys, omega):
 
 
 def dc_gain(sys, output="wob", input_="heave") -> float:
-    """Static gain of one channel (solve of -A x = B; no inverse of D-only systems)."""
+    """Static gain of one channel (solve of -A x = B; no inverse of D-only systems).
+
+    Parameters
+    ----------
+    sys : control.StateSpace
+        Linear CMC model with named signals (:func:`heavecomp.analysis.linear.linearise`).
+    output : str
+        Output label (default ``wob`` [N]).
+    input_ : str
+        Input label (default ``heave`` [m]).
+    """
     i, j = _siso(sys, output, input_)
     return float((sys.D[i, j] - sys.C[i] @ np.linalg.solve(sys.A, sys.B[:, j])).real)
 
@@ -112,6 +142,11 @@ def undamped_natural_frequencies(sys) -> np.ndarray:
     :func:`~heavecomp.analysis.linear.linearise` (rows 0 and 2 of A are
     velocity selectors); then ``-A[[1,3]][:, [0,2]] = M^-1 K`` and
     omega_i^2 are its eigenvalues (damping and friction slopes dropped).
+
+    Parameters
+    ----------
+    sys : control.StateSpace or (4, 4) array
+        The model or its A matrix, states ``[q_1, dq_1, q_2, dq_2]`` (:func:`~heavecomp.analysis.linear.linearise`).
     """
     A = np.asarray(sys.A if hasattr(sys, "A") else sys, dtype=float)
     pos, vel = [0, 2], [1, 3]
@@ -126,6 +161,11 @@ def undamped_natural_frequencies(sys) -> np.ndarray:
 
 def modes(sys) -> dict:
     """Natural frequencies and damping ratios from the poles.
+
+    Parameters
+    ----------
+    sys : control.StateSpace
+        Linear CMC model with named signals (:func:`heavecomp.analysis.linear.linearise`).
 
     Returns
     -------
@@ -159,6 +199,14 @@ def modes(sys) -> dict:
 
 def response_table(sys, omega) -> dict[str, np.ndarray]:
     """Columns of ``frequency_response.csv``: heave -> every output, magnitude and phase.
+
+    Parameters
+    ----------
+    sys : control.StateSpace
+        Linear CMC model with named signals (:func:`heavecomp.analysis.linear.linearise`).
+        Input ``heave``, output ``wob`` among others.
+    omega : array_like [rad/s]
+        Frequencies.
 
     Returns
     -------

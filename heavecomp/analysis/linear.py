@@ -44,7 +44,7 @@ from heavecomp.errors import ParameterError
 from heavecomp.friction.laws import FrictionLaw
 from heavecomp.effects.model import casadi_model
 from heavecomp.plants.symbolic import casadi
-from heavecomp.effects.registry import resolve
+from heavecomp.effects.spec import effects_for
 from heavecomp.effects.model import initial_effect_states
 
 log = logging.getLogger(__name__)
@@ -249,10 +249,24 @@ def operating_point(params, *, velocity: float | None = None, eps: float | None 
 
 
 def linearise_details(params, *, friction: str = "none", velocity: float | None = None,
-                      eps: float | None = None, effects=()) -> Linearisation:
+                      eps: float | None = None, effects=None) -> Linearisation:
     """Linearise the CMC; returns the LTI model with the raw jacobians and the state shift.
 
     See :func:`linearise` for the parameters.
+
+    Parameters
+    ----------
+    params : CMCParams
+        The parameter set (:class:`heavecomp.params.CMCParams`).
+    friction : {"none", "viscous", "sliding"}
+        Friction in the linear model (:func:`linearise`).
+    velocity : float [m/s], optional
+        Sliding velocity v0 (``friction="sliding"`` only; non-zero).
+    eps : float [m/s], optional
+        Regularisation width of sign(v) (default |v0|/25).
+    effects : sequence, optional
+        Effects at the plant's hooks (:mod:`heavecomp.effects`: instances, registered names or
+        ``(name, values)``).
     """
     import control as ct
 
@@ -272,7 +286,7 @@ def linearise_details(params, *, friction: str = "none", velocity: float | None 
         raise ParameterError(f"eps = {eps!r}: the friction regularisation width must be > 0 m/s")
 
 
-    effects = resolve(effects)
+    effects = effects_for(params, effects)  # None: the file's [[effects]] (plant)
     op = operating_point(pl, velocity=v0, eps=eps, effects=effects)
     _, _, A, B, C, D = _eval_model(pl, op.x, op.u, eps, effects)
     B0, B1, B2, Bu = B[:, 0], B[:, 1], B[:, 2], B[:, 3]
@@ -311,7 +325,7 @@ def linearise_details(params, *, friction: str = "none", velocity: float | None 
 
 
 def linearise(params, *, friction: str = "none", velocity: float | None = None, eps: float | None = None,
-              effects=()):
+              effects=None):
     """Linearised CMC as a ``control.StateSpace`` with named signals.
 
     Parameters
@@ -330,7 +344,7 @@ def linearise(params, *, friction: str = "none", velocity: float | None = None, 
     effects : sequence, optional
         Effects at the plant's hooks (:mod:`heavecomp.effects`: instances, registered names or
         ``(name, values)``), traced by casadi from the same source the stepper compiles; their
-        states follow the four plant states.
+        states follow the four plant states.  None: the plant effects of ``params``' ``[[effects]]``.
 
     Returns
     -------
@@ -446,7 +460,17 @@ def batch_matrices(*, gas_stiffness, moving_mass, lower_mass, string_stiffness, 
 
 
 def batch_matrices_from_params(params, *, friction_slope=0.0, friction_stiffness=0.0):
-    """:func:`batch_matrices` for one :class:`CMCParams` (frictionless unless a slope is given)."""
+    """:func:`batch_matrices` for one :class:`CMCParams` (frictionless unless a slope is given).
+
+    Parameters
+    ----------
+    params : CMCParams
+        The parameter set (:class:`heavecomp.params.CMCParams`).
+    friction_slope : float [N s/m]
+        Friction slope dF_f/dv on the stroke (0: frictionless).
+    friction_stiffness : float [N/m]
+        Friction stiffness dF_f/ds on the stroke (e.g. the pressure term C_p sign(v0) dp/ds; 0: none).
+    """
     c, ds, fo = params.compensator, params.drill_string, params.formation
     return batch_matrices(gas_stiffness=c.gas_stiffness, moving_mass=c.moving_mass, lower_mass=ds.lower_mass,
                           string_stiffness=ds.stiffness, string_damping=ds.damping,

@@ -86,6 +86,21 @@ def heave_to_output_response(A, B, C, D, omega, output: int = 0):
     """Frequency response heave -> output of a model driven by (z_h, dz_h, ddz_h, u_active).
 
     ``G(jw) = C (jwI - A)^-1 (B_0 + jw B_1 - w^2 B_2) + D_0 + jw D_1 - w^2 D_2`` [output unit per m].
+
+    Parameters
+    ----------
+    A : (n, n) array
+        State matrix.
+    B : (n, 4) array
+        Input matrix, columns (z_h [m], dz_h [m/s], ddz_h [m/s^2], u_active [N]).
+    C : (p, n) array
+        Output matrix.
+    D : (p, 4) array
+        Feedthrough, columns as ``B``.
+    omega : float or array [rad/s]
+        Frequencies.
+    output : int
+        Row of ``C`` (and ``D``) whose response is returned.
     """
     A, B, C, D = (np.asarray(M, dtype=float) for M in (A, B, C, D))
     out = []

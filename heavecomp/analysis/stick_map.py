@@ -25,6 +25,24 @@ def cmc_stick_map(params, amplitudes, periods, models=("stribeck", "rotating_eq6
     has none (paper A: v_t = omega d / 2 ~ 0.05 m/s).
     Returns {model: {"stick_fraction", "n_stick_per_period", "mean_stick_s", "stroke_p2p"}}
     with arrays (len(periods), len(amplitudes)), plus the axes.
+
+    Parameters
+    ----------
+    params : CMCParams
+        The parameter set (:class:`heavecomp.params.CMCParams`). Its heave and friction model
+        are replaced for each cell.
+    amplitudes : sequence of float [m]
+        Heave amplitudes of the sine.
+    periods : sequence of float [s]
+        Heave periods.
+    models : sequence of str
+        Friction models (``stribeck`` eq. 4, ``rotating_eq6``, ``rotating_eq7`` of paper A).
+    n_periods : float
+        Periods simulated after the one-period fade-in [-].
+    rate : float [Hz]
+        Output rate of the simulation.
+    tangential_velocity : float [m/s]
+        v_t of the rotating models when ``params`` has none.
     """
     A, T = np.asarray(amplitudes, float), np.asarray(periods, float)
     out = {"amplitudes": A, "periods": T}
@@ -63,6 +81,15 @@ def cmc_breakout_amplitude(params, period: float, model: str = "stribeck") -> fl
     and formation springs in series, so the holding force changes by ``k_s z_h`` with
     ``1/k_s = 1/k_DS + 1/k_F`` (plus the inertia of the top mass, ``M_c omega^2 z_h``);
     breakout when that exceeds the static limit at the operating pressure.
+
+    Parameters
+    ----------
+    params : CMCParams
+        The parameter set (:class:`heavecomp.params.CMCParams`).
+    period : float [s]
+        Heave period (sets the top mass's inertia term M_c omega^2).
+    model : str
+        Friction model whose static limit at the operating pressure p_0 is used (default ``stribeck``, eq. 4).
     """
     law = FrictionLaw.from_params(params.replace(friction={"model": model}).friction)
     Fs = float(law.static_limit(params.p0))

@@ -12,11 +12,25 @@ from heavecomp.analysis.frequency import dc_gain, frequency_grid, modes, respons
 
 
 def analyse(params, *, n_points: int = 1000, omega_min: float = 1e-3, omega_max: float | None = None,
-            sliding_velocity: float | None = None, effects=()) -> dict:
+            sliding_velocity: float | None = None, effects=None) -> dict:
     """Everything ``heavecomp analyse`` reports for one parameter set (no files).
 
-    ``effects``: effects at the plant's hooks (:mod:`heavecomp.effects`; instances, names or
-    ``(name, values)``), linearised with the plant (:func:`heavecomp.analysis.linear.linearise_details`).
+    Parameters
+    ----------
+    params : CMCParams
+        The parameter set (:class:`heavecomp.params.CMCParams`).
+    n_points : int
+        Number of frequencies of the grid (:func:`~heavecomp.analysis.frequency.frequency_grid`).
+    omega_min : float [rad/s]
+        Lowest frequency.
+    omega_max : float [rad/s], optional
+        Highest frequency; default 10 x the fastest pole.
+    sliding_velocity : float [m/s], optional
+        Also linearise about sliding at this velocity (friction models other than ``none``).
+    effects : sequence, optional
+        Effects at the plant's hooks (:mod:`heavecomp.effects`: instances, names or ``(name, values)``),
+        linearised with the plant (:func:`heavecomp.analysis.linear.linearise_details`); None: the
+        plant effects of ``params``' ``[[effects]]``.
 
     Returns
     -------

@@ -71,13 +71,15 @@ def _check_manifest(campaign, out: Path):
         try:
             old = json.loads(man.read_text())
         except json.JSONDecodeError:
-            raise InputError(f"--out {out}: {MANIFEST} is not valid JSON (remove the folder or choose another --out)") from None
+            raise InputError(f"{out}: {MANIFEST} is not valid JSON (remove the folder or choose another output folder)",
+                             option="out") from None
         if old.get("fingerprint") != fp:
-            raise InputError(f"--out {out}: holds results of a different campaign (fingerprint {old.get('fingerprint')} "
-                             f"!= {fp}); choose another --out")
+            raise InputError(f"{out}: holds results of a different campaign (fingerprint {old.get('fingerprint')} "
+                             f"!= {fp}); choose another output folder", option="out")
         if old.get("physics", physics) != physics:
-            raise InputError(f"--out {out}: holds results of another version of the plant/stepper source "
-                             f"({old.get('physics')} != {physics}); choose another --out or remove the folder")
+            raise InputError(f"{out}: holds results of another version of the plant/stepper source "
+                             f"({old.get('physics')} != {physics}); choose another output folder or remove it",
+                             option="out")
     else:
         out.mkdir(parents=True, exist_ok=True)
         man.write_text(json.dumps({"schema": 1, "campaign": campaign.settings.name, "fingerprint": fp,
@@ -136,7 +138,7 @@ class _Writer:
             self.header = list(rows[0])
         elif set(rows[0]) != set(self.header):
             raise InputError(f"{self.path}: its columns differ from this heavecomp version's table "
-                             "(written by another version?); choose another --out")
+                             "(written by another version?); choose another output folder", option="out")
         with self.path.open("a", newline="") as fh:
             w = csv.DictWriter(fh, fieldnames=self.header, extrasaction="raise")
             if new:
@@ -222,7 +224,7 @@ def run_campaign(campaign, out_dir, *, workers: int | None = None, scheduler: st
     else:
         nw = int(workers) if workers else (os.cpu_count() or 1)
         if nw < 1:
-            raise InputError(f"--workers must be >= 1, got {workers}")
+            raise InputError(f"workers must be >= 1, got {workers}", option="workers")
         nw = min(nw, max(1, len(chunks)))
         if nw == 1:
             executor = "in-process"
@@ -253,7 +255,8 @@ def _run_dask(campaign, chunks, finished, scheduler, client):
     try:
         from dask.distributed import Client, as_completed
     except ImportError:
-        raise InputError("--scheduler needs dask.distributed (pip install 'heavecomp[cluster]')") from None
+        raise InputError("scheduler needs dask.distributed (pip install 'heavecomp[cluster]')",
+                         option="scheduler") from None
     from heavecomp.campaign.batch import run_chunk
 
     own = client is None
@@ -261,7 +264,8 @@ def _run_dask(campaign, chunks, finished, scheduler, client):
         try:
             client = Client(scheduler, timeout=CONNECT_TIMEOUT)
         except (OSError, TimeoutError, ValueError) as exc:
-            raise InputError(f"--scheduler {scheduler}: cannot connect ({type(exc).__name__}: {exc})") from None
+            raise InputError(f"scheduler {scheduler}: cannot connect ({type(exc).__name__}: {exc})",
+                             option="scheduler") from None
     try:
         nw = len(client.scheduler_info().get("workers", {}))
         fc = client.scatter(campaign, broadcast=True)

@@ -29,6 +29,7 @@ from heavecomp.params.core import choice, from_table, q, read_text, text
 from heavecomp.params import dumps, from_dict, SETS
 from heavecomp.params import load as load_params
 from heavecomp.params.cmc import TABLES
+from heavecomp.effects.spec import plant_effects
 
 DEFAULT_FILE = Path(__file__).with_name("default_campaign.toml")
 REGIMES = ("none", "stribeck", "rotating_eq6", "rotating_eq7")
@@ -191,7 +192,12 @@ class Campaign:
             path = Path(self.base_dir) / path
         if not path.is_file():
             raise ParameterError(f"campaign.base: not a named set ({', '.join(SETS)}) nor a file: {b}")
-        return load_params(path)
+        params = load_params(path)
+        if plant_effects(params):  # checked strictly; the batch stepper is the nominal CMC's: refuse, never ignore
+            raise ParameterError(f"campaign.base: {path.name} has plant effects in [[effects]] "
+                                 f"({', '.join(n for n, _ in params.effects)}); the campaign's batch stepper runs the "
+                                 "nominal CMC only: simulate such a model with `simulate`")
+        return params
 
     def params_for(self, run: Run, base=None):
         """CMC parameters of one run: base + variant overrides + regime + JONSWAP heave."""

@@ -16,6 +16,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+from heavecomp.campaign.execute import TABLE, read_table
 from heavecomp.errors import ParameterError
 
 #: columns holding whole numbers (stored as float64 by the CSV reader)
@@ -34,10 +35,26 @@ def _is_hist(name: str) -> bool:
     return name.startswith("dev_") or name.startswith("peak_")
 
 
-def runs_frame(table: dict):
-    """One row per run (scalar columns only), integers as ``int64``, regime/variant as categories."""
+def _table(table) -> dict:
+    """``table`` as read by :func:`heavecomp.campaign.execute.read_table`: a dict of columns passes
+    through; a campaign folder or its ``runs.csv`` is read."""
+    if isinstance(table, dict):
+        return table
+    if isinstance(table, (str, Path)):
+        p = Path(table)
+        return read_table(p / TABLE if p.is_dir() or not p.suffix else p)
+    raise ParameterError(f"campaign table: expected a campaign folder, its runs.csv or read_table()'s dict, "
+                         f"got {type(table).__name__}")
+
+
+def runs_frame(table):
+    """One row per run (scalar columns only), integers as ``int64``, regime/variant as categories.
+
+    ``table``: a campaign folder (``"camp/"``), its ``runs.csv``, or the dict of
+    :func:`heavecomp.campaign.execute.read_table`."""
     import pandas as pd
 
+    table = _table(table)
     data = {}
     for k, v in table.items():
         if _is_hist(k):
@@ -63,10 +80,11 @@ def histograms_frame(table: dict, deviation_max: float, bins: int):
 
     Columns: ``run_id``; ``histogram`` (``"deviation"``: WOB - W_0, ``"cycle_peak"``: max |WOB - W_0|
     between zero up-crossings); ``bin`` (int, -1 = underflow); ``lower_N``, ``upper_N`` (bin edges [N],
-    +-inf for the overflow bins); ``count`` (int64).
+    +-inf for the overflow bins); ``count`` (int64).  ``table`` as for :func:`runs_frame`.
     """
     import pandas as pd
 
+    table = _table(table)
     from heavecomp.campaign.batch import hist_columns
 
     dev_cols, pk_cols = hist_columns(bins)

@@ -32,11 +32,11 @@ from pathlib import Path
 import numpy as np
 
 from heavecomp.controllers import ControllerConfig, Measurement, make
-from heavecomp.controllers.registry import takes_effects
 from heavecomp.errors import InputError, ParameterError
 from heavecomp.params.budget import check_run_size
 from heavecomp.params.cmc import active
-from heavecomp.effects.registry import resolve, split_effects
+from heavecomp.effects.registry import split_effects
+from heavecomp.effects.spec import effects_for
 from heavecomp.plants.cmc import eigen_rate, plant_vectors
 from heavecomp.simulate import excitation
 from heavecomp.simulate.core import CSV_COLUMNS, SimulationResult, default_dt, plant_stepper
@@ -109,7 +109,7 @@ def _percentile_ms(x, q):
 
 def simulate_closed_loop(params, controller="passive", duration: float = 120.0, *, dt: float | None = None,
                          heave=None, noise: Noise | None = Noise(), preview: str = "predicted",
-                         stats_start: float | None = None, progress=None, effects=(), controller_effects=None,
+                         stats_start: float | None = None, progress=None, effects=None, controller_effects=None,
                          **options) -> ClosedLoopResult:
     """Simulate the CMC with an active cylinder under ``controller``.
 
@@ -130,16 +130,16 @@ def simulate_closed_loop(params, controller="passive", duration: float = 120.0, 
         ``predicted``: the controller predicts heave from its measurements (AR);
         ``perfect``: it is given the true future heave (an upper bound).
     effects : sequence, optional
-        The true plant's effects (:mod:`heavecomp.effects`: instances, names or ``(name, values)``):
-        plant effects act at its hooks; a channel effect (``sensor_gain``, ``sensor_offset``,
-        ``sensor_delay``, each with its ``channel``) changes the measurement the controller
-        receives (before the noise).  A heave effect is refused (ParameterError).  The controller
-        knows none of them unless told (``controller_effects``).
+        The true plant's effects (:mod:`heavecomp.effects`: instances, names or ``(name, values)``;
+        None: the plant effects of ``params``' ``[[effects]]``): plant effects act at its hooks; a
+        channel effect (``sensor_gain``, ``sensor_offset``, ``sensor_delay``, each with its
+        ``channel``) changes the measurement the controller receives (before the noise): a sensor
+        fault of the rig.  A heave effect is refused (ParameterError).
     controller_effects : sequence, optional
         The effects a named MPC's model knows (:func:`heavecomp.controllers.make`'s ``effects``):
-        its plant effects enter the prediction, its channel effects how it reads the measurement.
-        None: the parameter set's own effects (``params.effects``, where it has them) for a
-        controller with a model, none for ``passive`` and ``pid``.
+        its plant effects enter the prediction, its channel effects how it reads the measurement
+        (the calibrated correction of a sensor fault).  None: the plant effects of ``params``'
+        ``[[effects]]`` (``passive`` and ``pid`` have no model).
     options
         :class:`~heavecomp.controllers.ControllerConfig` overrides (when
         ``controller`` is a name).
@@ -154,22 +154,15 @@ def simulate_closed_loop(params, controller="passive", duration: float = 120.0, 
     from heavecomp.simulate import _kernel as K  # numba-compiled stepper: loaded on first use
 
     if not (duration > 0 and math.isfinite(duration)):
-        raise InputError(f"--duration must be a positive number of seconds, got {duration}")
+        raise InputError(f"duration must be a positive number of seconds, got {duration}", option="duration")
     if preview not in ("predicted", "perfect"):
         raise InputError(f"preview {preview!r}: not one of predicted, perfect")
     act = active(params)
-    plant_fx, heave_fx, sensor_fx = split_effects(resolve(effects))
+    plant_fx, heave_fx, sensor_fx = split_effects(effects_for(params, effects))
     if heave_fx:
         raise ParameterError(f"effect {heave_fx[0].name}: a heave effect is not modelled in the closed loop "
                              "(the plant would see another heave than the controller measures)")
-    if controller_effects is None:
-        controller_effects = getattr(params, "effects", ()) if takes_effects(controller) else ()
-    if isinstance(controller, str):
-        ctrl = make(controller, params, effects=controller_effects, **options)
-    else:
-        if controller_effects:
-            raise InputError("controller_effects: only for a named controller; build your controller with its effects")
-        ctrl = make(controller, params, **options)
+    ctrl = make(controller, params, effects=controller_effects, **options)
     name = getattr(ctrl, "name", type(ctrl).__name__)
     cfg = getattr(ctrl, "config", None)
     if not isinstance(cfg, ControllerConfig):  # a user's own controller: the preview horizon of the defaults
@@ -177,7 +170,7 @@ def simulate_closed_loop(params, controller="passive", duration: float = 120.0, 
     Tc = 1.0 / act.control_rate
     h = dt if dt is not None else default_dt(params, act.control_rate)
     if not (h > 0 and math.isfinite(h)):
-        raise InputError(f"--dt must be a positive number of seconds, got {dt}")
+        raise InputError(f"dt must be a positive number of seconds, got {dt}", option="dt")
     n_sub = max(1, int(round(Tc / h)))
     if dt is not None and abs(n_sub * dt - Tc) > 1e-9 * Tc:
         log.warning("dt = %g s does not divide the control interval %g s; using %g s", dt, Tc, Tc / n_sub)
@@ -336,6 +329,6 @@ def output_every(rate: float | None, control_rate: float) -> int:
     ratio = control_rate / rate if rate > 0 else math.inf
     every = int(round(ratio)) if math.isfinite(ratio) else 0
     if not (every >= 1 and abs(ratio - every) < 1e-9):
-        raise InputError(f"--rate {rate:g} Hz: a closed-loop run writes at the control rate "
-                         f"[active].control_rate = {control_rate:g} Hz or an integer fraction of it")
+        raise InputError(f"rate {rate:g} Hz: a closed-loop run writes at the control rate "
+                         f"[active].control_rate = {control_rate:g} Hz or an integer fraction of it", option="rate")
     return every

@@ -41,7 +41,7 @@ def run(args) -> int:
     from pathlib import Path
 
     from heavecomp.report.analysis import write_analysis
-    from heavecomp.params import load
+    from heavecomp.effects.spec import load  # the file with its [[effects]] checked
 
     _check(args)
     params = load(args.params)
@@ -49,11 +49,12 @@ def run(args) -> int:
                        omega_min=args.omega_min, omega_max=args.omega_max, sliding_velocity=args.sliding_velocity)
     from heavecomp.report.provenance import finish
 
-    finish(args.out, params=params, json_files=("analysis.json",), csv_files=("frequency_response.csv",))
+    finish(args.out, params=params, json_files=("analysis.json",), heave_used=False, csv_files=("frequency_response.csv",))
     from heavecomp.report.analysis import mode_rows
+    from heavecomp.commands._output import final
 
     modes = "; ".join(f"{n} {w:.3f} rad/s (zeta {z:.4f})"
                       for n, w, f, T, z in mode_rows(s["natural_frequencies"], s["damping_ratios"]))
     print(f"k_eff_dc {s['k_eff_dc'] / 1e3:.3f} kN/m (eq. 14: {s['k_eff_eq14'] / 1e3:.3f}), natural frequencies: "
-          f"{modes} -> {args.out}")
+          f"{modes} -> {final(args)}")
     return 0

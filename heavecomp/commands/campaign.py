@@ -17,6 +17,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 def run(args) -> int:
     import logging
+    from pathlib import Path
+
+    from heavecomp.commands._output import final
     import sys
 
     from heavecomp.campaign import spec
@@ -36,12 +39,12 @@ def run(args) -> int:
     finish(info.out_dir, json_files=("metrics.json", "statistics.json"), params_file="campaign.toml",
            csv_files=("runs.csv",))
     print(f"{info.n_simulated} runs simulated, {info.n_skipped} resumed, {info.wall_time:.1f} s "
-          f"({info.executor}, {info.workers} workers) -> {info.table_path}")
+          f"({info.executor}, {info.workers} workers) -> {Path(final(args)) / info.table_path.name}")
     if st is not None:
         b = st["band_half_width"] / 1e3
         for key, e in st["regime_effect"].items():
             print(f"  {key:28s} long-term time outside +-{b:.0f} kN: {100 * e['frac_outside_band']:6.2f} %   "
                   f"P(leave within {st['exposure']:g} s): {e['p_leave_exposure']:.3f}")
-        print(f"report: {info.out_dir / 'report.md'}")
+        print(f"report: {Path(final(args)) / 'report.md'}")
     sys.stdout.flush()
     return 0

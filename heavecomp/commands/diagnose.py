@@ -26,7 +26,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--settle", type=float, default=None, metavar="S",
                    help="start-up window left out of the residuals [s] (default min(30 s, 10 %% of the run))")
     p.add_argument("--jobs", type=int, default=2, metavar="N", help="candidates fitted concurrently (default 2)")
-    p.add_argument("--quiet", action="store_true", help="no progress output")
+    p.add_argument("-q", "--quiet", action="store_true", help="no progress output")
 
 
 def run(args) -> int:
@@ -35,11 +35,11 @@ def run(args) -> int:
     from pathlib import Path
 
     from heavecomp.diagnosis.data import load_run
-    from heavecomp.diagnosis.estimator import GapDiagnoser
+    from heavecomp.diagnosis.calibrate import diagnoser
     from heavecomp.report.diagnosis import write_report
     from heavecomp.errors import InputError
     from heavecomp.io.series import check_spec, parse_mapping
-    from heavecomp.params import load
+    from heavecomp.effects.spec import load  # the file with its [[effects]] checked
 
     columns, units = check_spec(parse_mapping(args.columns, "--columns"), parse_mapping(args.units, "--units"),
                                 "cli")
@@ -63,17 +63,22 @@ def run(args) -> int:
         if not args.quiet:
             print(f"[{time.perf_counter() - t0:6.1f} s {100 * frac:3.0f} %] {msg}", file=sys.stderr, flush=True)
 
-    d = GapDiagnoser(params, cands, split=args.split, settle=args.settle, n_jobs=args.jobs, progress=progress)
+    d = diagnoser(params, cands, split=args.split, settle=args.settle, n_jobs=args.jobs, progress=progress)
     d.fit(run_)
     write_report(d, args.out, title=f"Sim-to-real gap diagnosis — {run_.source}")
     _record_measurement(Path(args.out) / "diagnosis.json", run_.measurement)
-    from heavecomp.report.provenance import finish
+    from heavecomp.report.calibrated import write_calibrated  # calibrated.toml, its json block, "What next"
 
-    finish(args.out, params=params, json_files=("diagnosis.json",), measured_run=str(Path(args.run).resolve()))
+    cal = write_calibrated(params, args.out, run_path=args.run, params_path=args.params)
+    from heavecomp.report.provenance import finish
+    from heavecomp.commands._output import final
+
+    finish(args.out, params=params, json_files=("diagnosis.json",), heave_used=False, measured_run=str(Path(args.run).resolve()))
     v = d.verdict_
     extra = f", second effect {v['second_effect']['effect']}" if v.get("second_effect") else ""
     print(f"verdict: {v['effect']} (confidence {v['confidence']}), held-out shrink {v['shrink']:.2f} "
-          f"on {v.get('shrink_channel', 'wob')}{extra} -> {args.out}/diagnosis.json")
+          f"on {v.get('shrink_channel', 'wob')}{extra} -> {Path(final(args)) / 'diagnosis.json'}, calibrated model "
+          f"({len(cal.changes)} change{'s' if len(cal.changes) != 1 else ''}) -> {Path(final(args)) / 'calibrated.toml'}")
     return 0
 
 

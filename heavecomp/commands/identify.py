@@ -1,4 +1,7 @@
-"""Identify from measured data: the EMPS axis inverse model (+ residual diagnosis) or seal friction vs pressure."""
+"""Identify from measured data: the EMPS axis inverse model (+ residual diagnosis) or seal friction vs pressure.
+
+Writes DIR/metrics.json, DIR/report.md and report.html (self-contained) and the figures.
+"""
 
 from __future__ import annotations
 
@@ -34,6 +37,8 @@ def run(args) -> int:
     from heavecomp.report.provenance import finish
     from heavecomp.report.scenario import write_metrics
 
+    from heavecomp.commands._output import final
+
     out = Path(args.out)
     if args.kind == "emps":
         from heavecomp.identification.study import emps_study
@@ -55,13 +60,14 @@ def run(args) -> int:
                                      diag.where_, diag.where_after_), out / "residual_map.png", dpi=90)
         save(plots.emps_cutoff_sensitivity(res["sensitivity"]), out / "cutoff_sensitivity.png", dpi=90)
         write_metrics(out, m)
+        plots.emps_report(out, m, Path(args.data).name)
         finish(out, inputs=[str(Path(args.data).resolve())])
         p = m["identified_whole_record"]
         best = m["candidates"][0]
         print(f"M = {p['mass']:.3f} kg, F_v = {p['viscous']:.2f} N s/m, F_c = {p['coulomb']:.3f} N, "
               f"offset = {p['offset']:.3f} N (max deviation from published {100 * m['max_abs_relative_error']:.2f} %); "
               f"held-out residual {m['baseline_fit_part']['rms_validate']:.2f} N rms, best effect {best['effect']} "
-              f"(shrink {best['shrink']:.3f}) -> {out}")
+              f"(shrink {best['shrink']:.3f}) -> {final(args)}")
         return 0
 
     from heavecomp.identification.study import seal_study
@@ -81,7 +87,8 @@ def run(args) -> int:
          dpi=90)
     m = res["metrics"]
     write_metrics(out, m)
+    plots.seal_report(out, m, len(res["fit"].strokes_))
     finish(out, inputs=[str(Path(f).resolve()) for f in args.files])
     print(f"C_p = {m['C_p_N_per_bar']:.3f} +- {m['C_p_uncertainty_N_per_bar']:.3f} N/bar, F_C = {m['F_C_N']:.2f} N "
-          f"over {len(res['fit'].strokes_)} strokes -> {out}")
+          f"over {len(res['fit'].strokes_)} strokes -> {final(args)}")
     return 0

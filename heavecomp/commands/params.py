@@ -17,7 +17,8 @@ def run(args) -> int:
     from pathlib import Path
 
     from heavecomp.errors import ParameterError, did_you_mean
-    from heavecomp.params import SETS, dumps, load
+    from heavecomp.params import SETS, dumps
+    from heavecomp.effects.spec import load  # the file with its [[effects]] checked
 
     if args.source in SETS:
         factory = SETS[args.source]
@@ -43,7 +44,9 @@ def run(args) -> int:
     params = _heave_path_for(params, args.output)
     text = dumps(params, header=header)
     if args.output:
-        Path(args.output).write_text(text, encoding="utf-8")
+        from heavecomp.report.output import write_text_atomic
+
+        write_text_atomic(args.output, text)
     else:
         sys.stdout.write(text)
     return 0

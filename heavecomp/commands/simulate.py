@@ -32,7 +32,7 @@ def run(args) -> int:
     from pathlib import Path
 
     from heavecomp.commands._progress import Progress
-    from heavecomp.params import load
+    from heavecomp.effects.spec import load  # the file with its [[effects]] checked
     from heavecomp.report.background import BackgroundFigure
     from heavecomp.report.simulation import write_outputs
     from heavecomp.simulate import simulate
@@ -40,6 +40,7 @@ def run(args) -> int:
     params = load(args.params)
     if args.friction:
         params = params.replace(friction={"model": args.friction})
+    _need_space(args)
     if args.controller != "passive":
         return _run_closed_loop(args, params, Progress)
     for flag, given in (("--controller-option", args.controller_option), ("--no-noise", args.no_noise),
@@ -59,11 +60,12 @@ def run(args) -> int:
     m = write_outputs(res, args.out, title=f"WOB — {Path(args.params).name}, friction: {params.friction.model}",
                       figure=figure, progress=Progress("writing timeseries.csv") if big else None)
     from heavecomp.report.provenance import finish
+    from heavecomp.commands._output import final
 
     finish(args.out, params=params, csv_files=("timeseries.csv",))
     print(f"WOB mean {m['wob_mean'] / 1e3:.2f} kN, std {m['wob_std'] / 1e3:.2f} kN, "
           f"peak-to-peak {m['wob_p2p'] / 1e3:.2f} kN, stuck {100 * m['stick_fraction']:.1f} % of the time "
-          f"-> {args.out}")
+          f"-> {final(args)}")
     return 0
 
 
@@ -85,9 +87,31 @@ def _run_closed_loop(args, params, Progress) -> int:
     m = write_closed_loop_outputs(res, args.out, title=f"WOB — {Path(args.params).name}, friction: "
                                   f"{params.friction.model}, controller: {args.controller}", rate=args.rate)
     from heavecomp.report.provenance import finish
+    from heavecomp.commands._output import final
 
     finish(args.out, params=params, csv_files=("timeseries.csv",))
     print(f"WOB std {m['wob_std'] / 1e3:.2f} kN, peak-to-peak {m['wob_p2p'] / 1e3:.2f} kN, "
           f"|u_active| max {m['u_active_max'] / 1e3:.1f} kN, solve p50/p99 {m['solve_time_ms_p50']:.2f}/"
-          f"{m['solve_time_ms_p99']:.2f} ms, fallbacks {m['fallbacks']} -> {args.out}")
+          f"{m['solve_time_ms_p99']:.2f} ms, fallbacks {m['fallbacks']} -> {final(args)}")
     return 0
+
+
+#: bytes per value of timeseries.csv, a low estimate (``%.10g`` and a comma take 8-18)
+CSV_BYTES_PER_VALUE = 8
+
+
+def _need_space(args) -> None:
+    """Refuse before the run when timeseries.csv cannot fit on the output's file system."""
+    import math
+
+    from heavecomp.commands._output import final
+    from heavecomp.params.budget import MAX_BYTES
+    from heavecomp.report.output import need_space
+    from heavecomp.simulate.core import CSV_COLUMNS
+
+    if not (math.isfinite(args.duration) and math.isfinite(args.rate)) or args.duration <= 0 or args.rate <= 0:
+        return  # the simulation's own checks name these
+    rows = args.duration * args.rate + 1
+    if 8 * rows * (len(CSV_COLUMNS) + 1) > MAX_BYTES:
+        return  # over the run-size budget: the simulation refuses it, naming --duration and --rate
+    need_space(args.out, rows * (len(CSV_COLUMNS) + 1) * CSV_BYTES_PER_VALUE, "--out", final(args))

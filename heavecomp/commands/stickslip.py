@@ -16,7 +16,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                         "and by simulation; print the agreement")
     p.add_argument("--convention", choices=("paper", "full"), default="paper",
                    help="linearisation: neglect the volume change (paper B) or keep it (full Jacobian)")
-    p.add_argument("--out", default=None, metavar="DIR", help="write metrics.json (and timeseries.csv) here")
+    p.add_argument("--out", default=None, metavar="DIR",
+                   help="write metrics.json, report.md/.html and the figures (simulation.png, critical_curve.png; "
+                        "timeseries.csv with --duration) here")
 
 
 def run(args) -> int:
@@ -44,6 +46,7 @@ def run(args) -> int:
         raise InputError(f"--duration must be a positive number of seconds, got {args.duration}")
     if args.map is not None and not (2 <= args.map <= 200):
         raise InputError(f"--map must be a grid size between 2 and 200, got {args.map}")
+    sim = grid = None
     lin = PL.linearise(p, convention=args.convention)
     Dcr = SS.critical_D(lin.zeta)
     mv = SS.minimum_velocity(p, convention=args.convention, nonlinear=False)
@@ -61,6 +64,7 @@ def run(args) -> int:
         r = PS.simulate(p, args.duration, rate=1000.0)
         m["simulation"] = r["stats"]
         st = r["stats"]
+        sim = r
         print(f"simulation {args.duration:g} s: breakaway {st['t_first_breakaway']:.3f} s, sticks {int(st['n_stick'])}, "
               f"first stick {st['t_first_stick']:.3f} s, restart {st['t_second_breakaway']:.3f} s")
         if out:
@@ -77,13 +81,49 @@ def run(args) -> int:
                         np.geomspace(1.0, 120.0, n), convention=args.convention)
         m["map"] = {"n": n, "agreement": g["agreement"], "stick_slip_nonlinear": int(g["nonlinear"].sum()),
                     "stick_slip_linear": int(g["linear"].sum())}
+        grid = g
         print(f"map {n}x{n}: critical curve and simulation agree on {100 * g['agreement']:.1f} % of the points")
     if out:
         from heavecomp.report.provenance import finish
+        from heavecomp.commands._output import final
         from heavecomp.report.scenario import write_metrics
 
+        _figures_and_report(out, p, lin, Dcr, m, sim, grid)
         write_metrics(out, m)
         (out / "params.toml").write_text(pn.dumps(p))
         finish(out, params_file="params.toml", csv_files=("timeseries.csv",) if args.duration is not None else ())
-        print(f"-> {out}")
+        print(f"-> {final(args)}")
     return 0
+
+
+def _figures_and_report(out, p, lin, Dcr, m, sim, grid) -> None:
+    """``simulation.png`` (with ``--duration``), ``critical_curve.png`` (with ``--map``) and ``report.md``."""
+    import numpy as np
+
+    from heavecomp.pneumatic import stickslip as SS
+    from heavecomp.report import rigs
+    from heavecomp.report.figures import save
+    from heavecomp.report.scenario import md_table, write_report
+
+    verdict = "stick-slip" if lin.D > Dcr else "no stick-slip"
+    sections = [f"Linearisation: u_0 = {lin.u0 * 1e3:.2f} mm/s, omega_n = {lin.omega_n:.2f} rad/s, "
+                f"zeta* = {lin.zeta:.3f}, D* = {lin.D:.3f} against the critical D*_cr = {Dcr:.3f}: **{verdict}** "
+                f"predicted after a stick; minimum equilibrium velocity "
+                f"{m['minimum_velocity_linear_m_s'] * 1e3:.2f} mm/s."]
+    if sim is not None:
+        save(rigs.plot_exp2(sim, p, lin), out / "simulation.png", dpi=90)
+        st = m["simulation"]
+        sections += ["## Simulation (exact stick-slip)", md_table(
+            ["first breakaway [s]", "sticks [-]", "first stick [s]", "restart [s]"],
+            [[st["t_first_breakaway"], int(st["n_stick"]), st["t_first_stick"], st["t_second_breakaway"]]],
+            "{:.3f}"), "![simulation](simulation.png)"]
+    if grid is not None:
+        zc = np.linspace(0.005, 0.97, 300)
+        save(rigs.plot_critical_map(grid, zc, SS.critical_curve(zc), (lin.zeta, lin.D)), out / "critical_curve.png",
+             dpi=90)
+        n = grid["agree"].size
+        sections += ["## Map: critical curve against simulation",
+                     f"{grid['zeta'].shape[0]} x {grid['zeta'].shape[1]} cylinders (viscous coefficient 8..250 N s/m "
+                     f"x friction drop 1..120 N): the critical curve and the simulation agree on "
+                     f"**{100 * grid['agreement']:.1f} %** of the {n} points.", "![map](critical_curve.png)"]
+    write_report(out, "Stick-slip of paper B's pneumatic cylinder", sections)

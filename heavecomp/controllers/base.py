@@ -189,7 +189,7 @@ def parse_options(items) -> dict:
         key, sep, val = str(item).partition("=")
         key, val = key.strip(), val.strip()
         if not sep or not key:
-            raise InputError(f"--controller-option {item!r}: expected KEY=VALUE")
+            raise InputError(f"controller option {item!r}: expected KEY=VALUE", option="controller_option")
         if key not in types:
             raise InputError(f"controller option {key!r}: unknown{did_you_mean(key, types)}")
         kind = types[key]

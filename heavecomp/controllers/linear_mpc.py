@@ -45,7 +45,7 @@ class LinearMPC(PredictiveController):
     name = "linear-mpc"
     log_name = "linear MPC"
 
-    def __init__(self, params, config=None, effects=()):
+    def __init__(self, params, config=None, effects=None):
         import osqp
         import scipy.sparse as sp
 

@@ -76,7 +76,7 @@ class NonlinearMPC(PredictiveController):
     log_name = "nonlinear MPC"
     substeps = 2
 
-    def __init__(self, params, config=None, effects=()):
+    def __init__(self, params, config=None, effects=None):
         super().__init__(params, config, effects)
         self._build()
 

@@ -22,7 +22,7 @@ import numpy as np
 from heavecomp.controllers.base import Controller, ControllerConfig
 from heavecomp.controllers.estimation import DisturbanceObserver, HeavePredictor
 from heavecomp.controllers.model import ControllerFriction, controller_params, discrete_model
-from heavecomp.effects.registry import resolve
+from heavecomp.effects.spec import effects_for
 
 #: newtons per kilonewton (the MPCs' decision variables are in kN)
 KN = 1e3
@@ -105,7 +105,8 @@ class PredictiveController(Controller):
     config : ControllerConfig, optional
     effects : sequence, optional
         Effects the controller's model knows (:mod:`heavecomp.effects`: instances, names or
-        ``(name, values)``).  Every registered plant effect is taken; a channel or heave effect
+        ``(name, values)``; None: the plant effects of the parameter file's ``[[effects]]``).  Every
+        registered plant effect is taken; a channel or heave effect
         with a delay, a drift or a vessel angle has no finite-state, time-invariant model and is
         refused here, before any run, with a one-line ParameterError naming it.
     """
@@ -113,11 +114,12 @@ class PredictiveController(Controller):
     #: the controller in the fall-back log line
     log_name = "MPC"
 
-    def __init__(self, params, config=None, effects=()):
+    def __init__(self, params, config=None, effects=None):
         config = config or ControllerConfig.from_params(params)
         self.params, self.config = params, config
         self.cparams = controller_params(params, config)
-        self.effects = resolve(effects)  # effects at the plant's hooks the controller's model knows
+        # effects at the plant's hooks the controller's model knows (None: the parameter file's plant effects)
+        self.effects = effects_for(params, effects)
         self.estimation = StateEstimation(self.cparams, config, self.effects)
         self.model = self.estimation.model
         self.N = config.horizon

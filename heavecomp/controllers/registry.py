@@ -40,7 +40,7 @@ def takes_effects(name) -> bool:
     return isinstance(name, str) and name in CONTROLLERS and "effects" in inspect.signature(CONTROLLERS[name]).parameters
 
 
-def make(name, params, config: ControllerConfig | None = None, *, effects=(), **options):
+def make(name, params, config: ControllerConfig | None = None, *, effects=None, **options):
     """Build a controller by name (:data:`CONTROLLERS`) or return a given controller object.
 
     Parameters
@@ -52,8 +52,8 @@ def make(name, params, config: ControllerConfig | None = None, *, effects=(), **
     config : ControllerConfig, optional
     effects : sequence, optional
         Effects the controller's model knows (:mod:`heavecomp.effects`: instances, names or
-        ``(name, values)``), e.g. a parameter file's ``[[effects]]``: plant effects enter its
-        prediction model, a channel effect (``sensor_gain``, ``sensor_offset``) the way it reads its
+        ``(name, values)``; None: the plant effects of the parameter file's ``[[effects]]``).  Plant
+        effects enter its prediction model, a channel effect (``sensor_gain``, ``sensor_offset``) the way it reads its
         measurement.  Only the MPCs have a model; ``passive`` and ``pid`` take none (ParameterError
         for a non-empty ``effects``).
     options
@@ -68,7 +68,8 @@ def make(name, params, config: ControllerConfig | None = None, *, effects=(), **
                              f"configure your {type(name).__name__} object directly")
         return name
     if name not in CONTROLLERS:
-        raise InputError(f"--controller {name!r}: not one of {', '.join(CONTROLLERS)}{did_you_mean(name, CONTROLLERS)}")
+        raise InputError(f"controller {name!r}: not one of {', '.join(CONTROLLERS)}{did_you_mean(name, CONTROLLERS)}",
+                         option="controller")
     if config is None:
         config = ControllerConfig.from_params(params, **options)
     elif options:

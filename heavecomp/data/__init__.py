@@ -23,5 +23,11 @@ EXAMPLE_PARAMS = ROOT / "examples" / "rig_log_example.toml"
 
 
 def path(*parts: str) -> Path:
-    """Path of a shipped data file, e.g. ``path("emps", "DATA_EMPS.mat")``."""
+    """Path of a shipped data file, e.g. ``path("emps", "DATA_EMPS.mat")``.
+
+    Parameters
+    ----------
+    *parts : str
+        Path components below the package's data folder (:data:`ROOT`).
+    """
     return ROOT.joinpath(*parts)

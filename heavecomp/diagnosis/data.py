@@ -28,10 +28,11 @@ import math
 
 import numpy as np
 
+from heavecomp.effects.spec import correct, reading_effects
 from heavecomp.errors import DataError
 from heavecomp.simulate.excitation import HeaveSamples
 from heavecomp.io.series import MAX_DT_S, gaps
-from heavecomp.io.series import read_series
+from heavecomp.io.series import UNITS as SOURCE_UNITS, check_spec, read_series
 from heavecomp.signals import design_flat_lowpass, filtfilt_fir
 
 P_ATM = 101325.0  #: atmospheric pressure [Pa] (cmc-reference.md)
@@ -94,7 +95,9 @@ def load_run(path, params=None, *, columns=None, units=None) -> MeasuredRun:
 
     Parameters
     ----------
-    path : str or Path
+    path : str or Path, or pandas.DataFrame
+        A file, or a frame with the contract columns (time as column ``t`` or as the index,
+        e.g. ``SimulationResult.to_pandas()``); ``columns``/``units`` apply to a frame too.
     params : CMCParams, optional
         Nominal parameters; when given, the channel magnitudes are checked
         against the operating point (wrong-unit detection), and its ``[measurement]``
@@ -112,12 +115,45 @@ def load_run(path, params=None, *, columns=None, units=None) -> MeasuredRun:
     spec = getattr(params, "extra", {}).get("measurement") if params is not None else None
     cols = {**(spec.columns if spec else {}), **(columns or {})}
     uns = {**(spec.units if spec else {}), **(units or {})}
+    if hasattr(path, "columns") and hasattr(path, "index") and not isinstance(path, (str, bytes)):
+        return _frame_run(path, params, cols, uns)
     s = read_series(path, REQUIRED, optional=ANGLES, columns=cols, units=uns, what="measured run")
     data = dict(s.columns)
     t = data.pop("t")
+    fixes = reading_effects(params) if params is not None else []
+    if fixes:  # [[effects]] sensor effects: the log is read as the rig truly moved (docs/contracts/parameter-file.md)
+        data, notes = correct(fixes, t, data)
     run = check_run(t, data, params=params, source=s.source, rows=s.rows)
     run.warnings[:0] = s.warnings
-    run.measurement = s.measurement
+    run.measurement = dict(s.measurement or {}, corrections=notes) if fixes else s.measurement
+    return run
+
+
+def _frame_run(df, params, columns: dict, units: dict) -> MeasuredRun:
+    """:func:`load_run` of a pandas DataFrame: contract columns (or mapped ones), time as a column or the index."""
+    columns, units = check_spec(columns, units, "measurement")
+    src = "<DataFrame>"
+    names = [str(c) for c in df.columns]
+    data = {}
+    for name in REQUIRED + ANGLES:
+        want = columns.get(name, name)
+        if want in names:
+            data[name] = np.asarray(df[df.columns[names.index(want)]], dtype=float)
+        elif name == "t" and (df.index.name in (want, "time") or (want == "t" and df.index.name == "t")):
+            data[name] = np.asarray(df.index, dtype=float)
+        elif name in REQUIRED:
+            raise DataError(f"{src}: missing column '{name}' (columns: {', '.join(names[:12])}; index "
+                            f"{df.index.name!r}); map it in a column mapping, {name}=NAME",
+                            option="columns", example=f"{name}=NAME")
+    conversions = []
+    for name, unit in units.items():
+        if name in data:
+            _kind, scale, offset = SOURCE_UNITS[unit.strip().lower()]
+            data[name] = data[name] * scale + offset
+            conversions.append(f"{name}: {unit} -> SI")
+    t = data.pop("t")
+    run = check_run(t, data, params=params, source=src)
+    run.measurement = {"format": "pandas.DataFrame", "units": dict(units), "conversions": conversions}
     return run
 
 
@@ -151,7 +187,8 @@ def check_run(t, columns: dict, *, params=None, source="<array>", rows=None) -> 
     dt_med = float(np.median(np.diff(t)))
     if dt_med > MAX_DT_S:
         raise DataError(f"{source}: column 't': median interval {dt_med:.4g} s is too coarse for heave "
-                        "(waves need > 1 Hz) — time in milliseconds? convert to s or declare --units t=ms")
+                        "(waves need > 1 Hz) — time in milliseconds? convert to s or declare its unit, t=ms",
+                        option="units", example="t=ms")
     hole = gaps(t, MAX_GAP)
     if hole.size:
         i = hole[0]
@@ -179,7 +216,8 @@ def check_run(t, columns: dict, *, params=None, source="<array>", rows=None) -> 
         rms = float(np.sqrt(np.nanmean(columns[col] ** 2)))
         if rms > MAX_ANGLE_RMS:
             raise DataError(f"{source}: column '{col}': rms {rms:.4g} rad ({math.degrees(rms):.0f} deg) is no vessel "
-                            f"angle — degrees? convert the column to rad or declare --units {col}=deg")
+                            f"angle — degrees? convert the column to rad or declare its unit, {col}=deg",
+                            option="units", example=f"{col}=deg")
     d = np.diff(t)
     if np.ptp(d) > 1e-6 * np.median(d):
         warnings.append(f"non-uniform sampling (intervals {d.min():.4g}..{d.max():.4g} s): replay uses the "
@@ -204,7 +242,8 @@ def _check_mean(run, src, column, unit, symbol, nominal, band, other_units, hint
     for factor, other in other_units:
         if abs(m / (nominal * factor) - 1.0) < 0.5:
             raise DataError(f"{src}: column '{column}': mean {m:.4g} looks like {other}, expected {unit} "
-                            f"(nominal {symbol} = {nominal:.4g} {unit}); convert the column to {unit}")
+                            f"(nominal {symbol} = {nominal:.4g} {unit}); convert the column to {unit} or declare "
+                            f"its unit, {column}={other}", option="units", example=f"{column}={other}")
     if not (band[0] * nominal < m < band[1] * nominal):
         raise DataError(f"{src}: column '{column}': mean {m:.4g} {unit} is far from the nominal {symbol} = "
                         f"{nominal:.4g} {unit} ({hint})")
@@ -234,10 +273,12 @@ def check_units(run: MeasuredRun, params) -> None:
     ss = float(np.nanstd(run["stroke"]))
     if sz > 0 and ss > 100 * sz and ss > 1.0:
         raise DataError(f"{src}: column 'stroke': spread {ss:.4g} is {ss / sz:.0f} x the heave's — looks like mm, "
-                        "expected m; convert the column to m")
+                        "expected m; convert the column to m or declare its unit, stroke=mm",
+                        option="units", example="stroke=mm")
     if ss > 0 and sz > 100 * ss and sz > 1.0:
         raise DataError(f"{src}: column 'heave': spread {sz:.4g} is {sz / ss:.0f} x the stroke's — looks like mm, "
-                        "expected m; convert the column to m")
+                        "expected m; convert the column to m or declare its unit, heave=mm",
+                        option="units", example="heave=mm")
 
 
 def fill_gaps(t, y):

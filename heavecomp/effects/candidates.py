@@ -3,7 +3,7 @@
 Every registered effect marked ``candidate`` (:mod:`heavecomp.effects.registry`; one class per
 file, its terms at the plant's hooks) is a candidate, plus ``parameter_mismatch``, which is no missing physics but the
 nominal parameters being off (``kind = "nominal"``).  The withheld-effect generator
-(:mod:`heavecomp.diagnosis.generator`) brings its own truth laws, never these.
+(:mod:`heavecomp.benchmark`) brings its own truth laws, never these.
 """
 
 from __future__ import annotations

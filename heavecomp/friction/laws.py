@@ -51,12 +51,35 @@ def stribeck_curve(speed, FS, FC, vS):
 
     ``speed`` is |v| for eq. 4 and the total sliding speed sqrt(v_a^2 + v_t^2)
     for eqs. 6-7 (paper A eq. 8).
+
+    Parameters
+    ----------
+    speed : float or array [m/s]
+        Sliding speed (>= 0).
+    FS : float [N]
+        Static (breakaway) force F_S.
+    FC : float [N]
+        Coulomb force F_C.
+    vS : float [m/s]
+        Stribeck velocity v_S (> 0).
     """
     return FC + stribeck_excess(speed, FS, FC, vS)
 
 
 def stribeck_excess(speed, FS, FC, vS):
-    """(F_S - F_C) exp(-speed / v_S) — the Stribeck curve's excess over Coulomb friction [N]."""
+    """(F_S - F_C) exp(-speed / v_S) — the Stribeck curve's excess over Coulomb friction [N].
+
+    Parameters
+    ----------
+    speed : float or array [m/s]
+        Sliding speed (>= 0).
+    FS : float [N]
+        Static (breakaway) force F_S.
+    FC : float [N]
+        Coulomb force F_C.
+    vS : float [m/s]
+        Stribeck velocity v_S (> 0).
+    """
     return (FS - FC) * np.exp(-speed / vS)
 
 
@@ -96,6 +119,17 @@ def friction_jump(code, a, p, FP):
 def friction_cont(code, v, p, FP):
     """K: the part of the friction that is continuous through v = 0, K(0) = 0 [N].
 
+    Parameters
+    ----------
+    code : int
+        Law code (``NONE``, ``STRIBECK`` eq. 4, ``EQ6``, ``EQ7``; paper A).
+    v : float or array [m/s]
+        Axial piston velocity.
+    p : float or array [Pa]
+        Pressure drop across the seal (unused by K; kept for the common law signature).
+    FP : (6,) array
+        Friction parameters ``[F_S, F_C, v_S, C_v, C_p, v_t]`` [N, N, m/s, N s/m, N/Pa, m/s].
+
     Notes
     -----
     eqs. 4 and 6: K = C_v v;
@@ -115,18 +149,50 @@ def friction_smooth(code, v, p, FP, eps):
 
     ``eps`` [m/s] is the regularisation width (must be > 0).  As eps -> 0 it
     tends to the exact law for v != 0.
+
+    Parameters
+    ----------
+    code : int
+        Law code (``NONE``, ``STRIBECK`` eq. 4, ``EQ6``, ``EQ7``; paper A).
+    v : float or array [m/s]
+        Axial piston velocity.
+    p : float or array [Pa]
+        Pressure drop across the seal (cylinder gauge pressure).
+    FP : (6,) array
+        Friction parameters ``[F_S, F_C, v_S, C_v, C_p, v_t]`` [N, N, m/s, N s/m, N/Pa, m/s].
+    eps : float [m/s]
+        Regularisation width of ``tanh(v / eps)`` (> 0).
     """
     return friction_jump(code, np.abs(v), p, FP) * np.tanh(v / eps) + friction_cont(code, v, p, FP)
 
 
 def friction_exact(code, v, p, FP):
     """Exact law for sliding, J(|v|) sign(v) + K(v) [N]; at v = 0 it returns 0
-    (the friction is then set-valued, see :func:`friction_jump` for its limit)."""
+    (the friction is then set-valued, see :func:`friction_jump` for its limit).
+
+    Parameters
+    ----------
+    code : int
+        Law code (``NONE``, ``STRIBECK`` eq. 4, ``EQ6``, ``EQ7``; paper A).
+    v : float or array [m/s]
+        Axial piston velocity.
+    p : float or array [Pa]
+        Pressure drop across the seal (cylinder gauge pressure).
+    FP : (6,) array
+        Friction parameters ``[F_S, F_C, v_S, C_v, C_p, v_t]`` [N, N, m/s, N s/m, N/Pa, m/s].
+    """
     return friction_jump(code, np.abs(v), p, FP) * np.sign(v) + friction_cont(code, v, p, FP)
 
 
 def steepest_slope(code, FP) -> float:
     """Steepest slope |dF_f/dv| of the law near v = 0 [N s/m] (sets the stepper's default step).
+
+    Parameters
+    ----------
+    code : int
+        Law code (``NONE``, ``STRIBECK`` eq. 4, ``EQ6``, ``EQ7``; paper A).
+    FP : (6,) array
+        Friction parameters ``[F_S, F_C, v_S, C_v, C_p, v_t]`` [N, N, m/s, N s/m, N/Pa, m/s].
 
     Notes
     -----
@@ -149,6 +215,15 @@ def hydromechanical_friction(F_p, v, eta):
     load driving (negative load) ``F_L = F_p / eta`` and the friction magnitude
     ``(1/eta - 1) |F_p|``.  The friction opposes ``v``.  It vanishes with
     ``F_p``: the model cannot express static or Coulomb friction (paper A).
+
+    Parameters
+    ----------
+    F_p : float or array [N]
+        Pressure force on the piston.
+    v : float or array [m/s]
+        Piston velocity (the friction opposes it).
+    eta : float
+        Hydromechanical efficiency, 0 < eta <= 1 [-].
     """
     F_p = np.asarray(F_p, dtype=float)
     v = np.asarray(v, dtype=float)
@@ -171,6 +246,13 @@ def law_vector(model, values):
     :class:`heavecomp.errors.ParameterError` naming it (no silent default).  Keys the model does
     not use enter FP as 0 (their terms vanish; ``none`` computes no friction at all).  Rotating
     models with ``v_t = 0`` reduce to eq. 4 and get its code (eq. 7's v/|v| needs v_t > 0).
+
+    Parameters
+    ----------
+    model : str
+        Friction model: ``none``, ``stribeck`` (eq. 4), ``rotating_eq6`` or ``rotating_eq7``.
+    values : mapping
+        Parameter-file name -> value [SI] (:data:`FP_NAMES`; absent or ``None`` for unused keys).
     """
 
     used = MODEL_KEYS[model]

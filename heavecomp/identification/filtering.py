@@ -19,12 +19,35 @@ from heavecomp.signals import butterworth_zero_phase
 
 def zero_phase_lowpass(x, fs: float, cutoff: float, order: int = 4) -> np.ndarray:
     """Forward-backward Butterworth low-pass: :func:`heavecomp.signals.butterworth_zero_phase`
-    (the package's one signal-processing module); kept under this name for the identification."""
+    (the package's one signal-processing module); kept under this name for the identification.
+
+    Parameters
+    ----------
+    x : array
+        Signal sampled at ``fs`` (filtered along its first axis).
+    fs : float [Hz]
+        Sampling rate.
+    cutoff : float [Hz]
+        -3 dB frequency of the single-pass Butterworth filter.
+    order : int
+        Butterworth order (the forward-backward pass doubles it).
+    """
     return butterworth_zero_phase(x, fs, cutoff, order)
 
 
 def derivatives(q, fs: float, cutoff: float, order: int = 4):
     """Filtered position, velocity and acceleration by central differences.
+
+    Parameters
+    ----------
+    q : array [m]
+        Measured position sampled at ``fs``.
+    fs : float [Hz]
+        Sampling rate.
+    cutoff : float [Hz]
+        Cut-off of the zero-phase Butterworth low-pass on the position.
+    order : int
+        Butterworth order.
 
     Returns
     -------
@@ -44,6 +67,13 @@ def parallel_decimate(x, factor: int) -> np.ndarray:
 
     Applied column by column to the force and to every regressor.  ``factor`` = 1
     returns the input unchanged.
+
+    Parameters
+    ----------
+    x : array
+        Signal or regressor matrix (one column per regressor), decimated along axis 0.
+    factor : int
+        Decimation factor (>= 1).
     """
     import scipy.signal as ss
 

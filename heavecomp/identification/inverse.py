@@ -43,6 +43,13 @@ def least_squares(X, y) -> LSResult:
 
     The standard errors assume independent residuals; after decimation the
     residual of a real record is still correlated, so read them as a lower bound.
+
+    Parameters
+    ----------
+    X : (n, k) array
+        Regressor matrix (columns in the units that make ``X theta`` a force [N]).
+    y : (n,) array
+        Measured output (e.g. motor force [N]); needs n > k.
     """
     X = np.asarray(X, dtype=float)
     y = np.asarray(y, dtype=float)
@@ -179,7 +186,19 @@ class InverseModelLS:
 
 
 def cutoff_sensitivity(record: AxisRecord, cutoffs, decimate: int = 10, order: int = 4) -> dict:
-    """Estimates vs Butterworth cut-off: ``{"cutoff": [...], "mass": [...], ...}``."""
+    """Estimates vs Butterworth cut-off: ``{"cutoff": [...], "mass": [...], ...}``.
+
+    Parameters
+    ----------
+    record : AxisRecord
+        The measured axis run (:func:`heavecomp.plants.axis.load_emps`).
+    cutoffs : sequence of float [Hz]
+        Butterworth cut-offs of the position filter to try.
+    decimate : int
+        Decimation factor of the parallel filter (1: none).
+    order : int
+        Butterworth order.
+    """
     out = {"cutoff": [float(c) for c in cutoffs], **{k: [] for k in BASE_NAMES}}
     for c in cutoffs:
         est = InverseModelLS(cutoff=c, order=order, decimate=decimate).fit(record)

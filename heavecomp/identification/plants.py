@@ -138,6 +138,8 @@ class SealFriction(_Plant):
         Terms of :data:`SEAL_TERMS` the nominal lacks.
     v_min, trim : float
         Steady-sliding selection of :func:`~heavecomp.identification.seal.strokes` (m/s, fraction).
+    area : float, m^2
+        Piston area of F_f = force - p A (default the rig's bore).
 
     Notes
     -----

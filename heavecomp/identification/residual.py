@@ -52,7 +52,13 @@ def get_candidates(names=None) -> list[type]:
     classes; None = every candidate of the library (:data:`heavecomp.effects.candidates.CANDIDATES`).
     An unknown name raises with the list of known ones.  :class:`ResidualDiagnoser` fits those of the
     friction component (and ``parameter_mismatch``, the nominal law's own terms); a candidate without
-    an equation-error form on a plant (``features`` returns None) is skipped there."""
+    an equation-error form on a plant (``features`` returns None) is skipped there.
+
+    Parameters
+    ----------
+    names : sequence of str or Effect classes, optional
+        Candidate contract names or classes; ``None`` for every candidate of the library.
+    """
     if names is None:
         return list(CANDIDATES.values())
     return [n if isinstance(n, type) and issubclass(n, Effect) else get(n) for n in names]
@@ -78,6 +84,10 @@ def localise(r, v, q, a, dead_band: float = 0.005, n_velocity: int = 10, n_posit
         Velocity [m/s], position [m], acceleration [m/s^2] at the same samples.
     dead_band : float, m/s
         |v| below this counts as near rest.
+    n_velocity : int
+        Number of equal velocity bins over [-max |v|, max |v|].
+    n_position : int
+        Number of equal position bins over the range of ``q``.
 
     Returns
     -------

@@ -72,6 +72,11 @@ class SealRecord:
 def load_seal_csv(path) -> SealRecord:
     """Read one O-ring file (7 whitespace-separated columns, no header; may be gzip/bz2/xz/zip).
 
+    Parameters
+    ----------
+    path : str or Path
+        The O-ring file (plain or compressed).
+
     Raises
     ------
     DataError
@@ -115,7 +120,19 @@ def load_seal_csv(path) -> SealRecord:
 
 def velocity(t, x, half_window: int = 10, max_span: float = 0.5) -> np.ndarray:
     """Velocity [m/s] as the slope over +-``half_window`` samples; NaN where that span
-    exceeds ``max_span`` [s] (a gap in the log) or at the ends."""
+    exceeds ``max_span`` [s] (a gap in the log) or at the ends.
+
+    Parameters
+    ----------
+    t : array [s]
+        Sample times (may have jitter and gaps).
+    x : array [m]
+        Position.
+    half_window : int
+        Half the slope's span [samples].
+    max_span : float [s]
+        Longest span accepted (a longer one is a gap in the log: NaN).
+    """
     n = len(t)
     v = np.full(n, np.nan)
     k = half_window
@@ -129,7 +146,19 @@ def velocity(t, x, half_window: int = 10, max_span: float = 0.5) -> np.ndarray:
 def velocity_fir(t, x, fs: float = 100.0, cutoff: float = 2.0) -> np.ndarray:
     """Velocity [m/s] by paper B's method: ``x`` resampled to ``fs`` [Hz] by linear
     interpolation (the logger clock has jitter and gaps), differentiated through a
-    zero-phase FIR low-pass of ``cutoff`` [Hz], interpolated back onto ``t``."""
+    zero-phase FIR low-pass of ``cutoff`` [Hz], interpolated back onto ``t``.
+
+    Parameters
+    ----------
+    t : array [s]
+        Sample times (may have jitter and gaps).
+    x : array [m]
+        Position.
+    fs : float [Hz]
+        Uniform rate the position is resampled to.
+    cutoff : float [Hz]
+        Cut-off of the zero-phase FIR low-pass (paper B: 2 Hz).
+    """
     tu = np.arange(t[0], t[-1], 1.0 / fs)
     _, vu = differentiate(tu, np.interp(tu, t, x), cutoff, order=1, name="position [mm]")
     return np.interp(t, tu, vu)
@@ -162,6 +191,23 @@ def strokes(rec: SealRecord, v_min: float = 2e-3, trim: float = 0.2, min_samples
     Returns a list of dicts: ``direction`` (+1/-1), ``friction`` [N], ``dp`` gauge
     pressure [Pa] (the stroke's mean or median), ``speed`` mean |v| [m/s], ``n`` samples
     kept, ``t0``, ``t1`` [s], ``std`` of the friction within the stroke [N], ``file``.
+
+    Parameters
+    ----------
+    rec : SealRecord
+        One constant-pressure O-ring file (:func:`load_seal_csv`).
+    v_min : float [m/s]
+        Speed above which a sample counts as sliding.
+    trim : float
+        Fraction of each stroke dropped at either end (acceleration, reversal) [-].
+    min_samples : int
+        Fewest samples a trimmed stroke must keep to be used.
+    area : float [m^2]
+        Piston area of F_f = force - p A.
+    velocity : {"slope", "fir"}
+        Velocity estimator (:data:`VELOCITY_METHODS`).
+    statistic : {"mean", "median"}
+        Stroke summary (:data:`STATISTICS`).
     """
     if velocity not in VELOCITY_METHODS:
         raise ParameterError(f"velocity = {velocity!r}: must be one of {', '.join(VELOCITY_METHODS)}")
@@ -314,5 +360,15 @@ class SealFrictionFit:
 
 def scale_by_circumference(C_p: float, d_from: float, d_to: float) -> float:
     """C_p scaled by seal circumference: C_p d_to / d_from (same seal, same contact
-    pressure per unit length; an assumption, not a law)."""
+    pressure per unit length; an assumption, not a law).
+
+    Parameters
+    ----------
+    C_p : float [N/Pa]
+        Pressure coefficient of the seal of diameter ``d_from``.
+    d_from : float [m]
+        Diameter the coefficient was measured on.
+    d_to : float [m]
+        Diameter it is scaled to.
+    """
     return C_p * d_to / d_from

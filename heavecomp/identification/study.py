@@ -27,6 +27,25 @@ def emps_study(record, cutoff: float = 50.0, order: int = 4, decimate: int = 10,
 
     Returns ``{"metrics": dict, "estimator": InverseModelLS, "diagnoser": ResidualDiagnoser,
     "sensitivity": {label: dict}}``.
+
+    Parameters
+    ----------
+    record : AxisRecord
+        The EMPS estimation record (:func:`heavecomp.plants.axis.load_emps`).
+    cutoff : float [Hz]
+        Butterworth cut-off of the position filter.
+    order : int
+        Butterworth order.
+    decimate : int
+        Decimation factor of the parallel filter.
+    t_split : float [s]
+        Start of the held-out part of the record (the diagnosis fits before it).
+    sensitivity_cutoffs : sequence of float [Hz]
+        Cut-offs of the sensitivity study (:func:`cutoff_sensitivity`).
+    sensitivity_decimations : sequence of int
+        Decimation factors of the sensitivity study (1: no decimation).
+    edge : float [s]
+        Left out of the diagnosis at both ends of the record (filter edge transients).
     """
     est = InverseModelLS(cutoff, order, decimate).fit(record)
     rel = {k: est.params_[k] / EMPS_PUBLISHED[k] - 1.0 for k in BASE_NAMES}
@@ -105,7 +124,7 @@ def withheld_terms(plant_for, cases, expected: dict, labels: dict, units: dict, 
         ``case -> the withheld term's name`` (in the effects' language).
     units : dict
         Units of the terms [SI].
-    **settings
+    **settings : keyword arguments
         ``fit_window``, ``validate_window`` (and ``dead_band``) of :class:`ResidualDiagnoser`.
 
     Returns
@@ -151,6 +170,16 @@ def method_sensitivity(records, fit: SealFrictionFit, variants=None) -> dict:
     Returns {label: {"settings": dict, "C_p_split_N_per_bar", "C_p_file_means_N_per_bar" (None
     with fewer than 3 files),
     "n_strokes", "change_in_uncertainties": (C_p_split - C_p of ``fit``) / its uncertainty}}.
+
+    Parameters
+    ----------
+    records : list of SealRecord
+        The constant-pressure O-ring files.
+    fit : SealFrictionFit
+        The fitted headline (its settings are the base each variant changes).
+    variants : dict, optional
+        label -> settings of :class:`SealFrictionFit` changed; default
+        :data:`~heavecomp.identification.seal.METHOD_VARIANTS`.
     """
     base = {"v_min": fit.v_min, "trim": fit.trim, "area": fit.area, "velocity": fit.velocity,
             "statistic": fit.statistic}
@@ -174,6 +203,19 @@ def seal_study(records, n_boot: int = 2000, seed: int = 0, fit: SealFrictionFit 
 
     Returns ``{"metrics": dict, "fit": SealFrictionFit}``; pass ``fit`` (unfitted) to
     change its settings.
+
+    Parameters
+    ----------
+    records : list of SealRecord
+        The constant-pressure O-ring files (:func:`~heavecomp.identification.seal.load_seal_csv`).
+    n_boot : int
+        Bootstrap resamples of the default fit (ignored when ``fit`` is given).
+    seed : int
+        Bootstrap seed of the default fit (ignored when ``fit`` is given).
+    fit : SealFrictionFit, optional
+        An unfitted fit with other settings.
+    seal_split : float [s]
+        Of every file, the first ``seal_split`` are fitted and the rest held out.
     """
     fit = (fit or SealFrictionFit(n_boot=n_boot, seed=seed)).fit(records)
     per_file = {}

@@ -511,14 +511,16 @@ def read_series(path, required=("t",), *, optional=(), columns=None, units=None,
             hits = [j for j, (b, _u) in enumerate(norm) if b in ALIASES[name] and j not in chosen.values()]
             if len(hits) > 1:
                 raise DataError(f"{src}: columns {', '.join(repr(str(header[j])) for j in hits)} all look like "
-                                f"'{name}'; choose one with --columns {name}=NAME")
+                                f"'{name}'; choose one in a column mapping, {name}=NAME ([measurement] columns)",
+                                option="columns", example=f"{name}=NAME")
         if not hits:
             if name in required:
                 hint = ""
                 if len(header) == 1:
                     hint = " (only one column found: delimiter not recognised?)"
-                raise DataError(f"{src}: missing column '{name}' (header: {_hdr(header)}); map it with "
-                                f"--columns {name}=NAME or [measurement] columns{hint}")
+                raise DataError(f"{src}: missing column '{name}' (header: {_hdr(header)}); map it in a column "
+                                f"mapping, {name}=NAME ([measurement] columns){hint}", option="columns",
+                                example=f"{name}=NAME")
             continue
         chosen[name] = hits[0]
     out: dict[str, np.ndarray] = {}
@@ -535,7 +537,8 @@ def read_series(path, required=("t",), *, optional=(), columns=None, units=None,
         unit = decl or head_unit
         if unit is not None and unit.lower() not in UNITS:
             raise DataError(f"{src}: column '{name}' ({header[j]!r}): unknown unit {unit!r} in the header; "
-                            f"declare it with --units {name}=UNIT")
+                            f"declare its unit, {name}=UNIT ([measurement] units)", option="units",
+                            example=f"{name}=UNIT")
         if unit is not None and UNITS[unit.lower()][0] != KINDS[name]:
             raise DataError(f"{src}: column '{name}' ({header[j]!r}): unit {unit!r} is a "
                             f"{UNITS[unit.lower()][0]} unit, '{name}' is a {KINDS[name]}")
@@ -615,8 +618,8 @@ def _check_time_unit(t, declared: bool, src: str, header) -> None:
     span = float(np.nanmax(t) - np.nanmin(t))
     if dt > MAX_DT_S or span > MAX_SPAN_S:
         raise DataError(f"{src}: column 't' ({header!r}): median interval {dt:.4g} and span {span:.4g} in "
-                        f"seconds is implausible for a heave log — time in milliseconds? declare it with "
-                        "--units t=ms (or name the column 'Time [ms]')")
+                        f"seconds is implausible for a heave log — time in milliseconds? declare its unit, t=ms "
+                        "([measurement] units, or name the column 'Time [ms]')", option="units", example="t=ms")
 
 
 def gaps(t, max_gap: float, factor: float = 3.0):

@@ -78,12 +78,12 @@ def _unit(params, tname, key) -> str:
 
 def _step_cause(params, h, dt, rate, rate_fn) -> str:
     if dt is not None:
-        return f"--dt = {h:.3g} s"
+        return f"dt = {h:.3g} s"
     if rate_fn is None:
         return f"the default step {h:.3g} s"
     h_plant = min(0.05, 0.6 / rate_fn(params))
     if rate and 1.0 / rate < 0.999 * h_plant:
-        return f"a step of {h:.3g} s (one output interval of --rate = {rate:g} Hz)"
+        return f"a step of {h:.3g} s (one output interval of rate = {rate:g} Hz)"
     drivers = step_drivers(params, rate_fn)
     return (f"the default step {h:.3g} s" + (f", set by {', '.join(drivers)}" if drivers else ""))
 
@@ -114,13 +114,15 @@ def check_run_size(params, *, duration: float, h: float, n_steps: int, n_rows: i
         return
     if out_bytes > heave_bytes and n_steps <= MAX_STEPS:
         raise ParameterError(
-            f"--duration = {duration:g} s at --rate = {rate:g} Hz writes {n_rows:.3g} rows x {n_cols} columns "
-            f"({_gb(out_bytes)}), over the {MAX_BYTES / 2 ** 30:g} GiB budget; lower --rate or --duration")
+            f"duration = {duration:g} s at rate = {rate:g} Hz writes {n_rows:.3g} rows x {n_cols} columns "
+            f"({_gb(out_bytes)}), over the {MAX_BYTES / 2 ** 30:g} GiB budget; lower the rate or the duration",
+            option=("duration", "rate"))
     cause = _step_cause(params, h, dt, rate, rate_fn)
     what = (f"{n_steps:.3g} RK4 steps, over the budget of {MAX_STEPS:.3g}" if n_steps > MAX_STEPS else
             f"{_gb(heave_bytes + out_bytes)} of heave samples and output, over the {MAX_BYTES / 2 ** 30:g} GiB budget")
-    raise ParameterError(f"--duration = {duration:g} s at {cause} needs {what}; "
-                         f"shorten --duration, pass a larger --dt, or check those values")
+    raise ParameterError(f"duration = {duration:g} s at {cause} needs {what}; "
+                         f"shorten the duration, pass a larger step dt, or check those values",
+                         option=("duration", "dt", "rate"))
 
 
 def check_default_step(params, h: float, rate_fn: Callable) -> None:

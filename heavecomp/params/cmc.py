@@ -26,7 +26,7 @@ from typing import Any, Mapping
 
 from heavecomp.errors import ParameterError, did_you_mean
 from heavecomp.params.core import G, P_ATM, choice, dump_toml, from_table, q, read_text, text, to_table, toml_error_message
-from heavecomp.params import measurement, plausibility
+from heavecomp.params import effects as effects_table, measurement, plausibility
 
 
 FRICTION_MODELS = ("none", "stribeck", "rotating_eq6", "rotating_eq7")
@@ -203,6 +203,9 @@ class CMCParams:
     formation: Formation
     operating_point: OperatingPoint
     heave: Heave | None = None
+    #: ``[[effects]]``: ``((name, {parameter: value}), ...)``, checked against the effect classes by
+    #: :func:`heavecomp.effects.spec.check` (the effects layer; :mod:`heavecomp.params.effects`)
+    effects: tuple = dataclasses.field(default=(), hash=False)
     #: folder of the file it was read from (resolves ``heave.path``)
     base_dir: Path | None = dataclasses.field(default=None, compare=False, repr=False)
     #: optional extra tables registered in OPTIONAL_EXTRA (e.g. ``[active]``)
@@ -250,6 +253,10 @@ class CMCParams:
         """
         d = self.to_dict()
         for tname, upd in changes.items():
+            if tname == "effects":  # the [[effects]] array as a whole: specs or tables
+                d["effects"] = effects_table.to_tables(upd if upd and isinstance(upd[0], tuple) else
+                                                       effects_table.parse(upd or []))
+                continue
             if tname not in TABLES and tname not in OPTIONAL_EXTRA:
                 raise ParameterError(f"{tname}: unknown table{did_you_mean(tname, list(TABLES) + list(OPTIONAL_EXTRA))}")
             if upd is None:
@@ -268,6 +275,8 @@ class CMCParams:
                 out[tname] = to_table(obj)
         for tname, obj in self.extra.items():
             out[tname] = to_table(obj) if dataclasses.is_dataclass(obj) else dict(obj)
+        if self.effects:
+            out["effects"] = effects_table.to_tables(self.effects)
         return out
 
 
@@ -277,9 +286,11 @@ OPTIONAL_EXTRA: dict[str, Any] = {}
 
 def from_dict(data: Mapping[str, Any], *, base_dir: Path | None = None) -> CMCParams:
     """Validate a nested mapping (a parsed TOML file) into :class:`CMCParams`."""
+    data = dict(data)
+    fx = effects_table.parse(data.pop("effects")) if "effects" in data else ()
     for tname, value in data.items():
         if tname not in TABLES and tname not in OPTIONAL_EXTRA:
-            known = list(TABLES) + list(OPTIONAL_EXTRA)
+            known = list(TABLES) + list(OPTIONAL_EXTRA) + ["effects"]
             raise ParameterError(f"[{tname}]: unknown table{did_you_mean(tname, known)}; known tables: {', '.join(known)}")
         if not isinstance(value, Mapping):
             raise ParameterError(f"{tname}: expected a table [{tname}], got a {type(value).__name__}")
@@ -292,7 +303,7 @@ def from_dict(data: Mapping[str, Any], *, base_dir: Path | None = None) -> CMCPa
             raise ParameterError(f"[{tname}]: missing required table")
         kw[tname] = from_table(cls, data[tname], tname)
     extra = {t: OPTIONAL_EXTRA[t](data[t]) for t in OPTIONAL_EXTRA if t in data}
-    return CMCParams(**kw, base_dir=base_dir, extra=extra)
+    return CMCParams(**kw, effects=fx, base_dir=base_dir, extra=extra)
 
 
 def loads(text_: str, *, base_dir: Path | None = None, source: str = "<string>") -> CMCParams:
@@ -313,7 +324,9 @@ def load(path: str | Path) -> CMCParams:
 
 def dumps(params: CMCParams, header: str = "") -> str:
     """TOML text of a parameter set (round-trips through :func:`loads`)."""
-    return dump_toml(params.to_dict(), header=header)
+    d = params.to_dict()
+    fx = d.pop("effects", [])
+    return dump_toml(d, header=header) + ("\n" + effects_table.dump(effects_table.parse(fx)) if fx else "")
 
 
 def save(params: CMCParams, path: str | Path, header: str = "") -> Path:

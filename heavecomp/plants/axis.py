@@ -62,12 +62,39 @@ def inverse_force(ddq, dq, M, Fv, Fc, Foff):
 
 
 def friction_force(dq, Fv, Fc, Foff):
-    """Friction plus offset of the EMPS inverse model [N]: F_v q' + F_c sign(q') + F_off."""
+    """Friction plus offset of the EMPS inverse model [N]: F_v q' + F_c sign(q') + F_off.
+
+    Parameters
+    ----------
+    dq : float or array [m/s]
+        Velocity q'.
+    Fv : float [N s/m]
+        Viscous coefficient.
+    Fc : float [N]
+        Coulomb friction force.
+    Foff : float [N]
+        Constant force offset.
+    """
     return Fv * dq + Fc * np.sign(dq) + Foff
 
 
 def forward_accel(dq, F, M, Fv, Fc, Foff):
     """Acceleration q'' [m/s^2] of the axis under motor force ``F`` [N] while sliding.
+
+    Parameters
+    ----------
+    dq : float or array [m/s]
+        Velocity q' (non-zero: sliding).
+    F : float or array [N]
+        Motor force on the load.
+    M : float [kg]
+        Moving mass.
+    Fv : float [N s/m]
+        Viscous coefficient.
+    Fc : float [N]
+        Coulomb friction force.
+    Foff : float [N]
+        Constant force offset.
 
     Notes
     -----

@@ -57,13 +57,25 @@ class PlantVectors(NamedTuple):
 
 def plant_vectors(params) -> PlantVectors:
     """``(code, FP, PP, has_stiction)`` of a :class:`heavecomp.params.CMCParams` — the one
-    params -> vectors conversion (simulate, closed loop, diagnosis, generator use it)."""
+    params -> vectors conversion (simulate, closed loop, diagnosis, generator use it).
+
+    Parameters
+    ----------
+    params : CMCParams
+        The parameter set (:class:`heavecomp.params.CMCParams`).
+    """
     law = FrictionLaw.from_params(params.friction)
     return PlantVectors(int(law.code), law.FP, plant_vector(params), bool(law.has_stiction))
 
 
 def plant_vector(params) -> np.ndarray:
-    """Plant parameter vector PP (layout :data:`PP_NAMES`) from a :class:`heavecomp.params.CMCParams`."""
+    """Plant parameter vector PP (layout :data:`PP_NAMES`) from a :class:`heavecomp.params.CMCParams`.
+
+    Parameters
+    ----------
+    params : CMCParams
+        The parameter set (:class:`heavecomp.params.CMCParams`).
+    """
     c, ds, f, op = params.compensator, params.drill_string, params.formation, params.operating_point
     W0 = op.wob_setpoint
     return np.array([
@@ -77,23 +89,69 @@ def plant_vector(params) -> np.ndarray:
 # the equations (scalar; numba- and casadi-compatible)
 # ----------------------------------------------------------------------------
 def gas_pressure(s, PP):
-    """Cylinder gauge pressure p(s) [Pa]: polytropic gas, p + p_atm = (p_0+p_atm)(V_0/(V_0+A s))^n."""
+    """Cylinder gauge pressure p(s) [Pa]: polytropic gas, p + p_atm = (p_0+p_atm)(V_0/(V_0+A s))^n.
+
+    Parameters
+    ----------
+    s : float [m]
+        Stroke (from the operating point, positive up).
+    PP : (14,) array
+        Plant parameter vector [SI], layout :data:`PP_NAMES` (:func:`plant_vector`).
+    """
     return PP[P0ABS] * (PP[V0] / (PP[V0] + PP[A] * s)) ** PP[N] - PP[PATM]
 
 
 def tension(s, v, yb, vb, zh, dzh, PP):
-    """Drill-string tension T_ds [N]."""
+    """Drill-string tension T_ds [N].
+
+    Parameters
+    ----------
+    s : float [m]
+        Stroke (from the operating point, positive up).
+    v : float [m/s]
+        Stroke velocity.
+    yb : float [m]
+        Lower-mass displacement y_b from the operating point.
+    vb : float [m/s]
+        Lower-mass velocity v_b.
+    zh : float [m]
+        Heave z_h of the platform.
+    dzh : float [m/s]
+        Heave velocity.
+    PP : (14,) array
+        Plant parameter vector [SI], layout :data:`PP_NAMES` (:func:`plant_vector`).
+    """
     return PP[T0] + PP[KDS] * (zh + s - yb) + PP[CDS] * (dzh + v - vb)
 
 
 def contact_force(yb, vb, PP):
     """The formation's spring-damper force on the bit while in contact, unclamped [N]:
-    ``k_F (delta_0 - y_b) - c_F v_b``."""
+    ``k_F (delta_0 - y_b) - c_F v_b``.
+
+    Parameters
+    ----------
+    yb : float [m]
+        Lower-mass displacement y_b from the operating point.
+    vb : float [m/s]
+        Lower-mass velocity v_b.
+    PP : (14,) array
+        Plant parameter vector [SI], layout :data:`PP_NAMES` (:func:`plant_vector`).
+    """
     return PP[KF] * (PP[D0] - yb) - PP[CF] * vb
 
 
 def wob(yb, vb, PP):
-    """Weight on bit W [N]: one-sided spring-damper contact with the formation."""
+    """Weight on bit W [N]: one-sided spring-damper contact with the formation.
+
+    Parameters
+    ----------
+    yb : float [m]
+        Lower-mass displacement y_b from the operating point.
+    vb : float [m/s]
+        Lower-mass velocity v_b.
+    PP : (14,) array
+        Plant parameter vector [SI], layout :data:`PP_NAMES` (:func:`plant_vector`).
+    """
     pen = PP[D0] - yb
     return np.maximum(0.0, contact_force(yb, vb, PP)) * (pen > 0.0)
 
@@ -104,6 +162,15 @@ def contact_switch(yb, vb, PP):
     ``min(k_F pen, k_F pen - c_F v_b)`` with ``pen = delta_0 - y_b``; its zero crossings
     (lift-off and touchdown) are where :func:`wob` has a kink or a jump, located as events
     by the stepper.
+
+    Parameters
+    ----------
+    yb : float [m]
+        Lower-mass displacement y_b from the operating point.
+    vb : float [m/s]
+        Lower-mass velocity v_b.
+    PP : (14,) array
+        Plant parameter vector [SI], layout :data:`PP_NAMES` (:func:`plant_vector`).
     """
     pen = PP[D0] - yb
     return np.minimum(PP[KF] * pen, PP[KF] * pen - PP[CF] * vb)
@@ -111,23 +178,89 @@ def contact_switch(yb, vb, PP):
 
 def net_force(p, T, ddzh, u, PP):
     """Net non-friction force on the top mass in the platform frame for a cylinder pressure ``p``
-    and string tension ``T`` [N]: ``p A - M_c g - T_ds + u - M_c ddz_h``."""
+    and string tension ``T`` [N]: ``p A - M_c g - T_ds + u - M_c ddz_h``.
+
+    Parameters
+    ----------
+    p : float [Pa]
+        Cylinder gauge pressure.
+    T : float [N]
+        Drill-string tension T_ds.
+    ddzh : float [m/s^2]
+        Heave acceleration.
+    u : float [N]
+        Active-cylinder force on the top mass (0 for the passive system).
+    PP : (14,) array
+        Plant parameter vector [SI], layout :data:`PP_NAMES` (:func:`plant_vector`).
+    """
     return p * PP[A] - PP[MC] * PP[G] - T + u - PP[MC] * ddzh
 
 
 def holding_force(s, v, yb, vb, zh, dzh, ddzh, u, PP):
     """Net non-friction force on the top mass in the platform frame [N]:
-    :func:`net_force` of the gas pressure and the tension.  While stuck the friction equals it."""
+    :func:`net_force` of the gas pressure and the tension.  While stuck the friction equals it.
+
+    Parameters
+    ----------
+    s : float [m]
+        Stroke (from the operating point, positive up).
+    v : float [m/s]
+        Stroke velocity.
+    yb : float [m]
+        Lower-mass displacement y_b from the operating point.
+    vb : float [m/s]
+        Lower-mass velocity v_b.
+    zh : float [m]
+        Heave z_h of the platform.
+    dzh : float [m/s]
+        Heave velocity.
+    ddzh : float [m/s^2]
+        Heave acceleration.
+    u : float [N]
+        Active-cylinder force on the top mass (0 for the passive system).
+    PP : (14,) array
+        Plant parameter vector [SI], layout :data:`PP_NAMES` (:func:`plant_vector`).
+    """
     return net_force(gas_pressure(s, PP), tension(s, v, yb, vb, zh, dzh, PP), ddzh, u, PP)
 
 
 def lower_accel(s, v, yb, vb, zh, dzh, PP):
-    """dv_b/dt of the lower mass [m/s^2]."""
+    """dv_b/dt of the lower mass [m/s^2].
+
+    Parameters
+    ----------
+    s : float [m]
+        Stroke (from the operating point, positive up).
+    v : float [m/s]
+        Stroke velocity.
+    yb : float [m]
+        Lower-mass displacement y_b from the operating point.
+    vb : float [m/s]
+        Lower-mass velocity v_b.
+    zh : float [m]
+        Heave z_h of the platform.
+    dzh : float [m/s]
+        Heave velocity.
+    PP : (14,) array
+        Plant parameter vector [SI], layout :data:`PP_NAMES` (:func:`plant_vector`).
+    """
     return lower_accel_wob(tension(s, v, yb, vb, zh, dzh, PP), yb, vb, PP)
 
 
 def lower_accel_wob(T, yb, vb, PP):
-    """dv_b/dt for a string tension ``T`` with the clamped contact law :func:`wob` [m/s^2]."""
+    """dv_b/dt for a string tension ``T`` with the clamped contact law :func:`wob` [m/s^2].
+
+    Parameters
+    ----------
+    T : float [N]
+        Drill-string tension T_ds.
+    yb : float [m]
+        Lower-mass displacement y_b from the operating point.
+    vb : float [m/s]
+        Lower-mass velocity v_b.
+    PP : (14,) array
+        Plant parameter vector [SI], layout :data:`PP_NAMES` (:func:`plant_vector`).
+    """
     return (T - PP[MB] * PP[G] + wob(yb, vb, PP)) / PP[MB]
 
 
@@ -137,29 +270,114 @@ def lower_accel_contact(s, v, yb, vb, zh, dzh, contact, PP):
     Equal to :func:`lower_accel` wherever ``contact == (contact_switch > 0)``; the stepper
     holds the state through a step and flips it at the located lift-off / touchdown, so
     its RK4 stages never straddle the kink or the touchdown jump of W.
+
+    Parameters
+    ----------
+    s : float [m]
+        Stroke (from the operating point, positive up).
+    v : float [m/s]
+        Stroke velocity.
+    yb : float [m]
+        Lower-mass displacement y_b from the operating point.
+    vb : float [m/s]
+        Lower-mass velocity v_b.
+    zh : float [m]
+        Heave z_h of the platform.
+    dzh : float [m/s]
+        Heave velocity.
+    contact : float
+        Contact state held through the step: 1 on the rock, 0 lifted off.
+    PP : (14,) array
+        Plant parameter vector [SI], layout :data:`PP_NAMES` (:func:`plant_vector`).
     """
     return lower_accel_tension(tension(s, v, yb, vb, zh, dzh, PP), yb, vb, contact, PP)
 
 
 def lower_accel_tension(T, yb, vb, contact, PP):
     """dv_b/dt for a string tension ``T`` with the contact state held [m/s^2]:
-    ``(T - m_b g + contact k_F (delta_0 - y_b) - c_F v_b) / m_b``."""
+    ``(T - m_b g + contact k_F (delta_0 - y_b) - c_F v_b) / m_b``.
+
+    Parameters
+    ----------
+    T : float [N]
+        Drill-string tension T_ds.
+    yb : float [m]
+        Lower-mass displacement y_b from the operating point.
+    vb : float [m/s]
+        Lower-mass velocity v_b.
+    contact : float
+        Contact state held through the step: 1 on the rock, 0 lifted off.
+    PP : (14,) array
+        Plant parameter vector [SI], layout :data:`PP_NAMES` (:func:`plant_vector`).
+    """
     return (T - PP[MB] * PP[G] + contact * contact_force(yb, vb, PP)) / PP[MB]
 
 
 def stroke_accel(s, v, yb, vb, zh, dzh, ddzh, u, Ff, PP):
-    """dv/dt of the stroke for a given friction force ``Ff`` [m/s^2]."""
+    """dv/dt of the stroke for a given friction force ``Ff`` [m/s^2].
+
+    Parameters
+    ----------
+    s : float [m]
+        Stroke (from the operating point, positive up).
+    v : float [m/s]
+        Stroke velocity.
+    yb : float [m]
+        Lower-mass displacement y_b from the operating point.
+    vb : float [m/s]
+        Lower-mass velocity v_b.
+    zh : float [m]
+        Heave z_h of the platform.
+    dzh : float [m/s]
+        Heave velocity.
+    ddzh : float [m/s^2]
+        Heave acceleration.
+    u : float [N]
+        Active-cylinder force on the top mass (0 for the passive system).
+    Ff : float [N]
+        Friction force on the top mass (opposing ``v`` while sliding).
+    PP : (14,) array
+        Plant parameter vector [SI], layout :data:`PP_NAMES` (:func:`plant_vector`).
+    """
     return (holding_force(s, v, yb, vb, zh, dzh, ddzh, u, PP) - Ff) / PP[MC]
 
 
 def sliding_friction(code, direction, s, v, FP, PP):
-    """Friction while sliding in ``direction`` (+1/-1): J(direction v) direction + K(v) [N]."""
+    """Friction while sliding in ``direction`` (+1/-1): J(direction v) direction + K(v) [N].
+
+    Parameters
+    ----------
+    code : int
+        Friction law code (:mod:`heavecomp.friction.laws`: eq. 4, 6 or 7 of paper A, or none).
+    direction : float
+        Sliding direction, +1 or -1 [-].
+    s : float [m]
+        Stroke (from the operating point, positive up).
+    v : float [m/s]
+        Stroke velocity.
+    FP : (6,) array
+        Friction parameters ``[F_S, F_C, v_S, C_v, C_p, v_t]`` [N, N, m/s, N s/m, N/Pa, m/s].
+    PP : (14,) array
+        Plant parameter vector [SI], layout :data:`PP_NAMES` (:func:`plant_vector`).
+    """
     p = gas_pressure(s, PP)
     return friction_jump(code, direction * v, p, FP) * direction + friction_cont(code, v, p, FP)
 
 
 def static_limit(code, s, FP, PP):
-    """Largest friction the cylinder can hold at v = 0 [N]."""
+    """Largest friction the cylinder can hold at v = 0 [N].
+
+    Parameters
+    ----------
+    code : int
+        Friction law code (:mod:`heavecomp.friction.laws`: eq. 4, 6 or 7 of paper A, or none).
+    s : float [m]
+        Stroke (sets the gas pressure the pressure term C_p |p| acts on).
+    FP : (6,) array
+        Friction parameters ``[F_S, F_C, v_S, C_v, C_p, v_t]`` [N, N, m/s, N s/m, N/Pa, m/s].
+    PP : (14,) array
+        Plant parameter vector [SI], layout :data:`PP_NAMES` (:func:`plant_vector`).
+    """
     return friction_jump(code, 0.0 * s, gas_pressure(s, PP), FP)
 
 
@@ -175,6 +393,13 @@ def modal_matrices(params, friction_slope: float = 0.0):
     ``slope`` a friction slope dF_f/dv [N s/m] added on the stroke.  The one linear model the
     default step (:func:`eigen_rate`) and the diagnosis' band edges (:func:`eigenfrequencies`) are
     derived from; ``tests/test_conformance.py`` pins it to the jacobian of :func:`heavecomp.effects.model.casadi_model`.
+
+    Parameters
+    ----------
+    params : CMCParams
+        The parameter set (:class:`heavecomp.params.CMCParams`).
+    friction_slope : float [N s/m]
+        Friction slope dF_f/dv added to the stroke's damping (0: frictionless).
     """
     c, ds, fo = params.compensator, params.drill_string, params.formation
     K = np.array([[c.gas_stiffness + ds.stiffness, -ds.stiffness], [-ds.stiffness, ds.stiffness + fo.stiffness]])
@@ -185,7 +410,13 @@ def modal_matrices(params, friction_slope: float = 0.0):
 
 def eigen_rate(params) -> float:
     """Largest |eigenvalue| [1/s] of the linear model (stroke stuck or free), including the
-    steepest friction slope near v = 0 (:func:`heavecomp.friction.laws.steepest_slope`)."""
+    steepest friction slope near v = 0 (:func:`heavecomp.friction.laws.steepest_slope`).
+
+    Parameters
+    ----------
+    params : CMCParams
+        The parameter set (:class:`heavecomp.params.CMCParams`).
+    """
 
     plant = plant_vectors(params)
     M, C, K = modal_matrices(params, steepest_slope(plant.code, plant.FP))
@@ -198,7 +429,13 @@ def eigen_rate(params) -> float:
 
 def eigenfrequencies(params) -> list[float]:
     """Undamped eigenfrequencies [Hz] of the linear model: sliding (2 DOF: top mass on the gas
-    spring, lower mass on string and formation) and stuck (lower mass on k_ds + k_F)."""
+    spring, lower mass on string and formation) and stuck (lower mass on k_ds + k_F).
+
+    Parameters
+    ----------
+    params : CMCParams
+        The parameter set (:class:`heavecomp.params.CMCParams`).
+    """
     M, C, K = modal_matrices(params)
     lam = np.linalg.eigvals(np.linalg.solve(M, K)).real
     f = sorted(float(np.sqrt(max(x, 0.0)) / (2 * np.pi)) for x in lam)

@@ -45,7 +45,15 @@ I_F0, I_FS1, I_FC, I_C, I_UCR, I_FK = range(6)
 
 
 def mixed_shape(speed, ucr):
-    """Mixed-lubrication weight ``max(0, 1 - speed/u_cr)^2`` in [0, 1] (dimensionless)."""
+    """Mixed-lubrication weight ``max(0, 1 - speed/u_cr)^2`` in [0, 1] (dimensionless).
+
+    Parameters
+    ----------
+    speed : float [m/s]
+        Sliding speed |v| >= 0.
+    ucr : float [m/s]
+        Critical velocity u_cr, the end of mixed lubrication (> 0).
+    """
     s = np.maximum(0.0, 1.0 - speed / ucr)
     return s * s
 
@@ -53,6 +61,16 @@ def mixed_shape(speed, ucr):
 def branch_magnitude(speed, peak, FPB):
     """Friction magnitude [N] while sliding at ``speed`` = |v| >= 0 [m/s] on a branch
     whose limit at v -> 0 is ``peak`` [N].
+
+    Parameters
+    ----------
+    speed : float [m/s]
+        Sliding speed |v| >= 0.
+    peak : float [N]
+        The branch's limit at v -> 0: the static force just overcome (accelerating branch,
+        F_0 or F_s1) or F_k (decelerating branch).
+    FPB : (6,) array
+        Friction parameters ``[F_0, F_s1, F_C, C, u_cr, F_k]`` [N, N, N, N s/m, m/s, N].
 
     Notes
     -----
@@ -63,12 +81,36 @@ def branch_magnitude(speed, peak, FPB):
 
 
 def sliding_friction(v, peak, FPB):
-    """Signed sliding friction [N] opposing ``v`` [m/s] (exact form; 0 at v = 0)."""
+    """Signed sliding friction [N] opposing ``v`` [m/s] (exact form; 0 at v = 0).
+
+    Parameters
+    ----------
+    v : float [m/s]
+        Piston velocity (the friction opposes it).
+    peak : float [N]
+        The branch's limit at v -> 0: the static force just overcome (accelerating branch,
+        F_0 or F_s1) or F_k (decelerating branch).
+    FPB : (6,) array
+        Friction parameters ``[F_0, F_s1, F_C, C, u_cr, F_k]`` [N, N, N, N s/m, m/s, N].
+    """
     return np.sign(v) * branch_magnitude(np.abs(v), peak, FPB)
 
 
 def smooth_friction(v, peak, FPB, eps):
-    """Regularised friction ``tanh(v/eps) * magnitude(|v|)`` [N], width ``eps`` [m/s]."""
+    """Regularised friction ``tanh(v/eps) * magnitude(|v|)`` [N], width ``eps`` [m/s].
+
+    Parameters
+    ----------
+    v : float [m/s]
+        Piston velocity.
+    peak : float [N]
+        The branch's limit at v -> 0: the static force just overcome (accelerating branch,
+        F_0 or F_s1) or F_k (decelerating branch).
+    FPB : (6,) array
+        Friction parameters ``[F_0, F_s1, F_C, C, u_cr, F_k]`` [N, N, N, N s/m, m/s, N].
+    eps : float [m/s]
+        Regularisation width of ``tanh(v / eps)`` (> 0).
+    """
     return np.tanh(v / eps) * branch_magnitude(np.abs(v), peak, FPB)
 
 

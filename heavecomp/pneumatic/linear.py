@@ -93,6 +93,13 @@ def discharge_conductance(p, Pb: float) -> float:
 
     Choked (P_a/P_b <= b): ``g = G/P_b``; unchoked:
     ``g = S K [psi(r) - r psi'(r)]`` with ``r = P_a/P_b``, ``K = sqrt(2 kappa/((kappa-1) R T))``.
+
+    Parameters
+    ----------
+    p : PneumaticParams
+        The cylinder (:class:`heavecomp.pneumatic.plant.PneumaticParams`).
+    Pb : float [Pa]
+        Absolute pressure of the discharge chamber (upstream of the exhaust).
     """
     k, R, T = p.kappa, p.gas_constant, p.temperature
     K = math.sqrt(2 * k / ((k - 1) * R * T))
@@ -153,7 +160,15 @@ def linearise(p, position: float | None = None, convention: str = "paper") -> Li
 def casadi_jacobian(p, position: float | None = None) -> np.ndarray:
     """Jacobian d[dv/dt, dP_b/dt]/d[v, P_b] at the equilibrium, by casadi from the
     plant's own scalar functions (no restated physics); equals
-    ``linearise(p, position, "full").A``."""
+    ``linearise(p, position, "full").A``.
+
+    Parameters
+    ----------
+    p : PneumaticParams
+        The cylinder (:class:`heavecomp.pneumatic.plant.PneumaticParams`).
+    position : float [m], optional
+        Piston position (sets V_b); default a quarter of the stroke.
+    """
     ca = casadi()
     x = 0.25 * p.stroke if position is None else float(position)
     f = casadi_discharge_model(p, x)

@@ -35,6 +35,7 @@ def synthetic_validation(p=None, *, duration: float = 3.0, fs: float = 1000.0, c
     fs : float [Hz]  sampling rate of the synthetic measurement
     cutoff : float [Hz]  FIR cutoff
     pressure_noise : float [Pa]  standard deviation of each pressure sensor
+    seed : int  seed of the pressure noise
 
     Returns
     -------

@@ -69,13 +69,27 @@ LAMINAR_RATIO = 0.995
 # scalar physics (np.* only; no branching on the state)
 # ----------------------------------------------------------------------------------------------
 def critical_ratio(kappa):
-    """Critical pressure ratio b = (2/(kappa+1))^(kappa/(kappa-1)) [-] (0.528 for air)."""
+    """Critical pressure ratio b = (2/(kappa+1))^(kappa/(kappa-1)) [-] (0.528 for air).
+
+    Parameters
+    ----------
+    kappa : float
+        Ratio of specific heats [-] (1.4 for air).
+    """
     return (2.0 / (kappa + 1.0)) ** (kappa / (kappa - 1.0))
 
 
 def flow_function(r, kappa):
     """psi(r) = sqrt(r^(2/kappa) - r^((kappa+1)/kappa)) for the pressure ratio r clipped
-    to [b, 0.995] (choked below b) [-]."""
+    to [b, 0.995] (choked below b) [-].
+
+    Parameters
+    ----------
+    r : float
+        Pressure ratio P_down / P_up [-].
+    kappa : float
+        Ratio of specific heats [-] (1.4 for air).
+    """
     rr = np.minimum(np.maximum(r, critical_ratio(kappa)), LAMINAR_RATIO)
     return np.sqrt(np.maximum(rr ** (2.0 / kappa) - rr ** ((kappa + 1.0) / kappa), 0.0))
 
@@ -83,6 +97,21 @@ def flow_function(r, kappa):
 def orifice_flow(p_up, p_down, S, T, kappa, R):
     """Signed mass flow [kg/s] through an orifice of effective area ``S`` [m^2] from
     ``p_up`` to ``p_down`` [Pa abs] (negative when the flow goes the other way).
+
+    Parameters
+    ----------
+    p_up : float [Pa]
+        Upstream absolute pressure.
+    p_down : float [Pa]
+        Downstream absolute pressure.
+    S : float [m^2]
+        Effective area of the orifice.
+    T : float [K]
+        Temperature of the air upstream.
+    kappa : float
+        Ratio of specific heats [-] (1.4 for air).
+    R : float [J/(kg K)]
+        Gas constant of air.
 
     Notes
     -----
@@ -98,12 +127,34 @@ def orifice_flow(p_up, p_down, S, T, kappa, R):
 
 
 def chamber_volumes(x, PP):
-    """(V_a, V_b) [m^3] at piston position ``x`` [m] (0 = start cover)."""
+    """(V_a, V_b) [m^3] at piston position ``x`` [m] (0 = start cover).
+
+    Parameters
+    ----------
+    x : float [m]
+        Piston position (0 = start cover).
+    PP : (12,) array
+        Plant parameter vector [SI], layout :data:`PP_NAMES` (:meth:`PneumaticParams.plant_vector`).
+    """
     return PP[I_VA0] + PP[I_A] * x, PP[I_VB0] + PP[I_A] * (PP[I_L] - x)
 
 
 def pressure_rates(x, v, Pa, Pb, PP):
-    """(dP_a/dt, dP_b/dt) [Pa/s]: adiabatic chambers, meter-out circuit."""
+    """(dP_a/dt, dP_b/dt) [Pa/s]: adiabatic chambers, meter-out circuit.
+
+    Parameters
+    ----------
+    x : float [m]
+        Piston position (0 = start cover).
+    v : float [m/s]
+        Piston velocity.
+    Pa : float [Pa]
+        Absolute pressure P_a of the charging chamber a.
+    Pb : float [Pa]
+        Absolute pressure P_b of the discharge chamber b.
+    PP : (12,) array
+        Plant parameter vector [SI], layout :data:`PP_NAMES` (:meth:`PneumaticParams.plant_vector`).
+    """
     Va, Vb = chamber_volumes(x, PP)
     k, R, T, A = PP[I_KAPPA], PP[I_R], PP[I_T], PP[I_A]
     Ga = orifice_flow(PP[I_PS], Pa, PP[I_SS], T, k, R)
@@ -112,17 +163,51 @@ def pressure_rates(x, v, Pa, Pb, PP):
 
 
 def drive_force(Pa, Pb, PP):
-    """Pressure force on the piston A (P_a - P_b) [N]."""
+    """Pressure force on the piston A (P_a - P_b) [N].
+
+    Parameters
+    ----------
+    Pa : float [Pa]
+        Absolute pressure P_a of the charging chamber a.
+    Pb : float [Pa]
+        Absolute pressure P_b of the discharge chamber b.
+    PP : (12,) array
+        Plant parameter vector [SI], layout :data:`PP_NAMES` (:meth:`PneumaticParams.plant_vector`).
+    """
     return PP[I_A] * (Pa - Pb)
 
 
 def piston_accel(Pa, Pb, Ff, PP):
-    """dv/dt = (A (P_a - P_b) - F_f) / M [m/s^2]."""
+    """dv/dt = (A (P_a - P_b) - F_f) / M [m/s^2].
+
+    Parameters
+    ----------
+    Pa : float [Pa]
+        Absolute pressure P_a of the charging chamber a.
+    Pb : float [Pa]
+        Absolute pressure P_b of the discharge chamber b.
+    Ff : float [N]
+        Signed friction force (opposing the motion).
+    PP : (12,) array
+        Plant parameter vector [SI], layout :data:`PP_NAMES` (:meth:`PneumaticParams.plant_vector`).
+    """
     return (drive_force(Pa, Pb, PP) - Ff) / PP[I_M]
 
 
 def discharge_rate(v, Pb, x, PP):
-    """dP_b/dt [Pa/s] of the discharge chamber alone (used for the linearisation)."""
+    """dP_b/dt [Pa/s] of the discharge chamber alone (used for the linearisation).
+
+    Parameters
+    ----------
+    v : float [m/s]
+        Piston velocity.
+    Pb : float [Pa]
+        Absolute pressure P_b of the discharge chamber b.
+    x : float [m]
+        Piston position (0 = start cover).
+    PP : (12,) array
+        Plant parameter vector [SI], layout :data:`PP_NAMES` (:meth:`PneumaticParams.plant_vector`).
+    """
     Va, Vb = chamber_volumes(x, PP)
     k, R, T, A = PP[I_KAPPA], PP[I_R], PP[I_T], PP[I_A]
     Gb = orifice_flow(Pb, PP[I_PA], PP[I_SE], T, k, R)
@@ -203,7 +288,13 @@ class PneumaticParams:
 
 
 def from_dict(d) -> PneumaticParams:
-    """Build from ``{"pneumatic": {...}}`` strictly (unknown keys/out-of-range values raise ParameterError)."""
+    """Build from ``{"pneumatic": {...}}`` strictly (unknown keys/out-of-range values raise ParameterError).
+
+    Parameters
+    ----------
+    d : mapping
+        Parsed TOML: ``{"pneumatic": {key: value}}`` with values in the units of :class:`PneumaticParams`.
+    """
     d = dict(d or {})
     for key in d:
         if key != "pneumatic":
@@ -214,7 +305,13 @@ def from_dict(d) -> PneumaticParams:
 
 
 def load(path) -> PneumaticParams:
-    """Read a ``[pneumatic]`` TOML file (keys absent take the documented defaults)."""
+    """Read a ``[pneumatic]`` TOML file (keys absent take the documented defaults).
+
+    Parameters
+    ----------
+    path : str or Path
+        The TOML parameter file.
+    """
     import tomllib
     from pathlib import Path
 
@@ -231,6 +328,13 @@ def load(path) -> PneumaticParams:
 
 
 def dumps(p: PneumaticParams) -> str:
+    """The TOML text of ``p`` (a ``[pneumatic]`` table with a header comment), as :func:`load` reads it.
+
+    Parameters
+    ----------
+    p : PneumaticParams
+        The cylinder (:class:`heavecomp.pneumatic.plant.PneumaticParams`).
+    """
     return dump_toml(p.to_dict(), "paper B pneumatic meter-out cylinder (heavecomp stickslip)")
 
 
@@ -245,6 +349,14 @@ def equilibrium(p: PneumaticParams, x: float | None = None):
     Solves ``A (P_s - P_b) = F(u_0)`` (decelerating friction branch) and
     ``R T G_b(P_b) = P_b A u_0`` (mass balance of chamber b) for (u_0 [m/s], P_be [Pa abs]).
     Raises ParameterError when the supply cannot overcome Coulomb friction.
+
+    Parameters
+    ----------
+    p : PneumaticParams
+        The cylinder (:class:`heavecomp.pneumatic.plant.PneumaticParams`).
+    x : float [m], optional
+        Piston position; unused: with the charging side held at P_s the equilibrium does not
+        depend on it.
     """
     from scipy.optimize import brentq
 
@@ -272,7 +384,15 @@ def equilibrium(p: PneumaticParams, x: float | None = None):
 def casadi_discharge_model(p: PneumaticParams, x: float):
     """casadi Function f([v, P_b]) -> [dv/dt, dP_b/dt] with the charging side held at P_s
     (paper B's assumption) and the decelerating friction branch, at position ``x`` [m].
-    Traced from the same scalar functions the stepper compiles."""
+    Traced from the same scalar functions the stepper compiles.
+
+    Parameters
+    ----------
+    p : PneumaticParams
+        The cylinder (:class:`heavecomp.pneumatic.plant.PneumaticParams`).
+    x : float [m]
+        Piston position (sets the discharge volume V_b).
+    """
     ca = casadi()
     s = ca.SX.sym("s", 2)
     PP = p.plant_vector()

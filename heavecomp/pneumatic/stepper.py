@@ -118,6 +118,27 @@ def run(state, t_end, h, PP, FPB, moved, stop_at_stick, out, out_every):
     ``stop_at_stick`` = 1 stops at the first stick after a breakaway.
     Writes every ``out_every``-th step into ``out`` (rows of :data:`CHANNELS`);
     returns (number of rows written, stats array of :data:`STATS`).
+
+    Parameters
+    ----------
+    state : (4,) array
+        Initial ``[x, v, P_a, P_b]`` [m, m/s, Pa abs, Pa abs] (stuck if v == 0; not modified).
+    t_end : float [s]
+        Duration to integrate.
+    h : float [s]
+        RK4 step.
+    PP : (12,) array
+        Plant parameter vector [SI], layout :data:`heavecomp.pneumatic.plant.PP_NAMES`.
+    FPB : (6,) array
+        Friction parameters ``[F_0, F_s1, F_C, C, u_cr, F_k]`` [N, N, N, N s/m, m/s, N].
+    moved : int
+        1 when the piston has moved before (static limit F_s1), 0 at the first start (F_0).
+    stop_at_stick : int
+        1 to stop at the first stick after a breakaway.
+    out : (n, 8) array
+        Output rows of :data:`CHANNELS`, filled up to its length.
+    out_every : int
+        Write every ``out_every``-th step [steps].
     """
     stats = np.zeros(NST)
     stats[3] = np.nan
@@ -229,7 +250,25 @@ def run(state, t_end, h, PP, FPB, moved, stop_at_stick, out, out_every):
 
 @nb.njit(parallel=True, cache=True)
 def run_many(states, t_ends, h, PPs, FPBs, moved, stop_at_stick):
-    """Run many independent simulations in parallel (numba prange); returns stats (n, NST)."""
+    """Run many independent simulations in parallel (numba prange); returns stats (n, NST).
+
+    Parameters
+    ----------
+    states : (n, 4) array
+        Initial states ``[x, v, P_a, P_b]`` [m, m/s, Pa abs, Pa abs] (copied).
+    t_ends : (n,) array [s]
+        Duration of each run.
+    h : float [s]
+        RK4 step, shared.
+    PPs : (n, 12) array
+        Plant vectors [SI] (layout :data:`heavecomp.pneumatic.plant.PP_NAMES`).
+    FPBs : (n, 6) array
+        Friction vectors ``[F_0, F_s1, F_C, C, u_cr, F_k]`` [N, N, N, N s/m, m/s, N].
+    moved : int
+        1: static limit F_s1 (moved before), 0: F_0.
+    stop_at_stick : int
+        1 to stop each run at its first stick after a breakaway.
+    """
     n = states.shape[0]
     res = np.empty((n, NST))
     for k in nb.prange(n):
@@ -246,6 +285,13 @@ def default_step(p, position: float = 0.0) -> float:
     ratio 0.995) with the chamber volume at ``position`` [m] (the smallest volume
     the run will see when the piston moves forward from there; 0 = start cover),
     the pneumatic spring of that chamber, and the steepest friction slope.
+
+    Parameters
+    ----------
+    p : PneumaticParams
+        The cylinder (:class:`heavecomp.pneumatic.plant.PneumaticParams`).
+    position : float [m]
+        Piston position the run starts from (0 = start cover).
     """
     PP = p.plant_vector()
     A, k, R, T = p.area, p.kappa, p.gas_constant, p.temperature
@@ -277,6 +323,9 @@ def simulate(p, duration: float, *, h: float | None = None, rate: float = 1000.0
         has just switched).
     moved : bool
         Static limit F_s1 from the start (instead of F_0).
+    stop_at_stick : bool
+        Stop at the first stick after a breakaway (the stick-slip decision of
+        :func:`heavecomp.pneumatic.stickslip.nonlinear_sticks`).
     """
     h = h or default_step(p)
     out_every = max(1, int(round(1.0 / (rate * h))))

@@ -41,7 +41,15 @@ log = logging.getLogger(__name__)
 # the critical curve
 # ----------------------------------------------------------------------------------------------
 def overshoot(zeta: float, D: float) -> tuple[float, float]:
-    """(y_max, y_min) of the scaled linear velocity response after breakaway [-] (zeta < 1)."""
+    """(y_max, y_min) of the scaled linear velocity response after breakaway [-] (zeta < 1).
+
+    Parameters
+    ----------
+    zeta : float
+        Damping ratio zeta* of the linearised discharge side [-] (:mod:`heavecomp.pneumatic.linear`). Must be < 1.
+    D : float
+        Scaled friction drop D* = (F_s1 - F_lin(0)) / (M u_0 omega_n) [-].
+    """
     if zeta >= 1.0:
         raise ValueError("overshoot() needs zeta < 1")
     wd = math.sqrt(1.0 - zeta * zeta)
@@ -54,7 +62,13 @@ def overshoot(zeta: float, D: float) -> tuple[float, float]:
 
 
 def critical_D(zeta: float) -> float:
-    """D*_cr(zeta): stick-slip for D* above it (inf for zeta >= 1, 0 for zeta <= 0)."""
+    """D*_cr(zeta): stick-slip for D* above it (inf for zeta >= 1, 0 for zeta <= 0).
+
+    Parameters
+    ----------
+    zeta : float
+        Damping ratio zeta* of the linearised discharge side [-] (:mod:`heavecomp.pneumatic.linear`).
+    """
     from scipy.optimize import brentq
 
     if zeta <= 0.0:
@@ -74,12 +88,26 @@ def critical_D(zeta: float) -> float:
 
 
 def critical_curve(zetas) -> np.ndarray:
-    """D*_cr at each zeta (vectorised :func:`critical_D`)."""
+    """D*_cr at each zeta (vectorised :func:`critical_D`).
+
+    Parameters
+    ----------
+    zetas : float or array
+        Damping ratios zeta* [-].
+    """
     return np.array([critical_D(float(z)) for z in np.atleast_1d(zetas)])
 
 
 def predicts_stick_slip(zeta: float, D: float) -> bool:
-    """True above the critical curve."""
+    """True above the critical curve.
+
+    Parameters
+    ----------
+    zeta : float
+        Damping ratio zeta* of the linearised discharge side [-] (:mod:`heavecomp.pneumatic.linear`).
+    D : float
+        Scaled friction drop D* = (F_s1 - F_lin(0)) / (M u_0 omega_n) [-].
+    """
     return bool(D > critical_D(zeta))
 
 
@@ -88,19 +116,48 @@ def predicts_stick_slip(zeta: float, D: float) -> bool:
 # ----------------------------------------------------------------------------------------------
 def restart_state(p, position: float | None = None, margin: float = 1e-3) -> np.ndarray:
     """Stuck state just before a restart at ``position`` (default L/4): chamber a at
-    P_s, drive force (1 - margin) F_s1 — the state the linear analysis starts from."""
+    P_s, drive force (1 - margin) F_s1 — the state the linear analysis starts from.
+
+    Parameters
+    ----------
+    p : PneumaticParams
+        The cylinder (:class:`heavecomp.pneumatic.plant.PneumaticParams`).
+    position : float [m], optional
+        Piston position of the restart; default a quarter of the stroke.
+    margin : float
+        Relative margin below the static limit: drive force (1 - margin) F_s1 [-].
+    """
     x = 0.25 * p.stroke if position is None else float(position)
     Pb = p.supply_abs - (1.0 - margin) * p.stick_static_force / p.area
     return np.array([x, 0.0, p.supply_abs, Pb])
 
 
 def window(lin, periods: float = 8.0) -> float:
-    """Simulated time after a restart used to decide whether the piston sticks again [s]."""
+    """Simulated time after a restart used to decide whether the piston sticks again [s].
+
+    Parameters
+    ----------
+    lin : Linearisation
+        The cylinder's linearisation (:func:`heavecomp.pneumatic.linear.linearise`), for omega_n.
+    periods : float
+        Length of the window after the restart, in natural periods 2 pi / omega_n [-]
+        (0.05 s are added).
+    """
     return periods * 2 * math.pi / lin.omega_n + 0.05
 
 
 def nonlinear_sticks(p, position=None, periods: float = 8.0) -> bool:
-    """Does the nonlinear plant stick again after a restart (exact stick-slip simulation)?"""
+    """Does the nonlinear plant stick again after a restart (exact stick-slip simulation)?
+
+    Parameters
+    ----------
+    p : PneumaticParams
+        The cylinder (:class:`heavecomp.pneumatic.plant.PneumaticParams`).
+    position : float [m], optional
+        Piston position of the linearisation and the restart (sets V_b); default L/4.
+    periods : float
+        Length of the window after the restart, in natural periods 2 pi / omega_n [-].
+    """
 
     lin = PL.linearise(p, position)
     res = PS.simulate(p, window(lin, periods), state=restart_state(p, position), moved=True, stop_at_stick=True,
@@ -126,6 +183,14 @@ def grid_map(p, var_x: str, xs, var_y: str, ys, *, convention: str = "paper", po
         Values (SI).
     convention : {"paper", "full"}
         Linearisation convention (see :mod:`heavecomp.pneumatic.linear`).
+    position : float [m], optional
+        Piston position of the linearisation and the restart; default a quarter of the stroke.
+    periods : float
+        Simulated window after the restart, in natural periods 2 pi / omega_n [-].
+    parallel : bool
+        Simulate the grid in parallel (:func:`heavecomp.pneumatic.stepper.run_many`).
+    h : float [s], optional
+        RK4 step shared by the grid (default: the smallest :func:`heavecomp.pneumatic.stepper.default_step`).
 
     Returns
     -------
@@ -166,7 +231,15 @@ def grid_map(p, var_x: str, xs, var_y: str, ys, *, convention: str = "paper", po
 
 
 def vary(p, changes: dict):
-    """``p`` with fields changed; ``friction_drop`` sets F_s1 = F_C + value (F_0 follows when lower)."""
+    """``p`` with fields changed; ``friction_drop`` sets F_s1 = F_C + value (F_0 follows when lower).
+
+    Parameters
+    ----------
+    p : PneumaticParams
+        The cylinder (:class:`heavecomp.pneumatic.plant.PneumaticParams`).
+    changes : dict
+        Field name of :class:`PneumaticParams` (or ``friction_drop`` [N]) -> new value [SI].
+    """
     ch = dict(changes)
     if "friction_drop" in ch:
         drop = ch.pop("friction_drop")
@@ -185,6 +258,19 @@ def minimum_velocity(p, *, convention: str = "paper", position=None, nonlinear: 
     The linear answer solves ``D*(S_e) = D*_cr(zeta*(S_e))`` (paper B Fig. 5); the
     nonlinear answer bisects S_e with the exact stick-slip simulation.
     Returns u0 [m/s] and S_e [m^2] for both.
+
+    Parameters
+    ----------
+    p : PneumaticParams
+        The cylinder (:class:`heavecomp.pneumatic.plant.PneumaticParams`).
+    convention : {"paper", "full"}
+        Linearisation convention: neglect (paper B) or keep the volume-change term (:mod:`heavecomp.pneumatic.linear`).
+    position : float [m], optional
+        Piston position of the linearisation and the restart (sets V_b); default L/4.
+    nonlinear : bool
+        Also bisect with the exact stick-slip simulation (slower).
+    area_range : (float, float) [m^2]
+        Bracket (low, high) of the exhaust area S_e searched.
     """
     from scipy.optimize import brentq
 
@@ -233,6 +319,17 @@ def influence(p, factors=(0.5, 0.71, 1.0, 1.41, 2.0), *, convention: str = "pape
 
     The linearisation position scales with the stroke (``position_fraction * L``).
     Returns {variable: {"factor": [...], "zeta": [...], "D": [...], "stick_slip": [...]}}.
+
+    Parameters
+    ----------
+    p : PneumaticParams
+        The cylinder (:class:`heavecomp.pneumatic.plant.PneumaticParams`).
+    factors : sequence of float
+        Scale factors lambda applied to each variable [-].
+    convention : {"paper", "full"}
+        Linearisation convention: neglect (paper B) or keep the volume-change term (:mod:`heavecomp.pneumatic.linear`).
+    position_fraction : float
+        Linearisation position as a fraction of the stroke [-].
     """
 
     res = {}

@@ -12,7 +12,7 @@ import numpy as np
 from heavecomp.report.figures import REGIME_COLORS, REGIME_LABELS, _plt, save
 from heavecomp.campaign.tables import check_parquet, export_parquet
 from heavecomp.campaign.execute import read_table, run_campaign
-from heavecomp.report.provenance import stamp, stamp_report
+from heavecomp.report.provenance import declare_units, stamp, stamp_report
 
 log = logging.getLogger(__name__)
 
@@ -111,16 +111,24 @@ def plot_band_maps(st: dict, campaign, *, title=None):
     return fig
 
 
+#: units of the long-term statistics of one regime/variant group (made by heavecomp.campaign.stats)
+LONG_TERM_UNITS = {"frac_outside_band": "-", "p_leave_exposure": "-", "band_exits_per_hour": "1/h",
+                   "wob_std_rms": "N", "stick_fraction": "-", "dev_exceeded_1e-2": "N", "dev_exceeded_1e-3": "N",
+                   "dev_max_in_exposure": "N", "frac_outside_ratio_to_none": "-"}
+
+
 def summary(st: dict) -> dict:
-    """The headline numbers (metrics.json of the scenario/CLI)."""
-    out = {"band_half_width_N": st["band_half_width"], "exposure_s": st["exposure"], "n_runs": st["n_runs"],
-           "long_term": {}}
+    """The headline numbers (metrics.json of the scenario/CLI), each with its unit declared beside it."""
+    out = declare_units({"band_half_width_N": st["band_half_width"], "exposure_s": st["exposure"],
+                         "n_runs": st["n_runs"], "long_term": {}},
+                        {"band_half_width_N": "N", "exposure_s": "s", "n_runs": "count"})
     for key, g in st["groups"].items():
         lt = g["long_term"]
-        out["long_term"][key] = {k: lt[k] for k in ("frac_outside_band", "p_leave_exposure", "band_exits_per_hour",
-                                                    "wob_std_rms", "stick_fraction", "dev_exceeded_1e-2",
-                                                    "dev_exceeded_1e-3", "dev_max_in_exposure")}
-    out["regime_effect"] = st["regime_effect"]
+        out["long_term"][key] = declare_units({k: lt[k] for k in (
+            "frac_outside_band", "p_leave_exposure", "band_exits_per_hour", "wob_std_rms", "stick_fraction",
+            "dev_exceeded_1e-2", "dev_exceeded_1e-3", "dev_max_in_exposure")}, LONG_TERM_UNITS)
+    out["regime_effect"] = {key: declare_units(dict(e), {k: LONG_TERM_UNITS[k] for k in e if k in LONG_TERM_UNITS})
+                            for key, e in st["regime_effect"].items()}
     return out
 
 

@@ -109,7 +109,8 @@ def fig_spectra(diag):
         unit, sc = CH_UNITS[c]
         y = tr["measured"][c]
         ok = np.isfinite(y) & (t >= diag.split_["settle"])
-        for label, key, col in (("nominal", "nominal", "tab:red"), (f"with {tr['best_effect']}", "best", "tab:green")):
+        for label, key, col in (("nominal", "nominal", "tab:red"), (f"with {tr['best_effect']}", "best", "tab:green"))[
+                :1 if diag.verdict_["effect"] == "none" else 2]:  # none: no fitted effect to show
             f, S = residual_spectrum(t[ok], (tr[key][c][ok] - y[ok]) * sc)
             ax.loglog(f[1:], S[1:], color=col, lw=1, label=label)
         for k, (lo, hi) in diag.where_["band_edges_hz"].items():
@@ -137,10 +138,12 @@ def fig_overlay(diag, span=40.0):
     hi = min(t[-1], lo + span)
     m = (t >= lo) & (t <= hi)
     fig, axs = plt.subplots(4, 1, figsize=(11, 9), sharex=True)
+    show = diag.verdict_["effect"] != "none"  # none: the nominal is the answer, no candidate is drawn
     ax = axs[3]
     yw = tr["measured"]["wob"][m]
     ax.plot(t[m], (tr["nominal"]["wob"][m] - yw) / 1e3, color="tab:red", lw=1.0, label="nominal − measured")
-    ax.plot(t[m], (tr["best"]["wob"][m] - yw) / 1e3, color="tab:green", lw=1.0, label=f"with {tr['best_effect']} − measured")
+    if show:
+        ax.plot(t[m], (tr["best"]["wob"][m] - yw) / 1e3, color="tab:green", lw=1.0, label=f"with {tr['best_effect']} − measured")
     ax.set_ylabel("WOB residual [kN]")
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8, loc="upper right")
@@ -148,15 +151,27 @@ def fig_overlay(diag, span=40.0):
         unit, sc = CH_UNITS[c]
         ax.plot(t[m], tr["measured"][c][m] * sc, color="0.4", lw=0.8, label="measured")
         ax.plot(t[m], tr["nominal"][c][m] * sc, color="tab:red", lw=1.1, label="nominal replay")
-        ax.plot(t[m], tr["best"][c][m] * sc, color="tab:green", lw=1.1, ls="--", label=f"with {tr['best_effect']}")
+        if show:
+            ax.plot(t[m], tr["best"][c][m] * sc, color="tab:green", lw=1.1, ls="--", label=f"with {tr['best_effect']}")
         ax.set_ylabel(f"{c} [{unit}]")
         ax.grid(alpha=0.3)
     axs[0].legend(fontsize=8, loc="upper right")
     axs[-1].set_xlabel("time t [s]")
-    axs[0].set_title("Before/after on held-out data: the fitted effect closes the gap where the nominal misses",
-                     fontsize=10)
+    axs[0].set_title(overlay_title(diag.verdict_, tr["best_effect"]), fontsize=10)
     fig.tight_layout()
     return fig
+
+
+def overlay_title(v, best) -> str:
+    """The overlay's title, by what the verdict ``v`` says (``best``: the best candidate drawn)."""
+    eff = v["effect"]
+    if eff == "none":
+        return "Held-out data, verdict none: the nominal replay agrees with the measurement within the noise"
+    if eff in ("inconclusive", "discovered"):
+        return (f"Held-out data, verdict {eff}: the best named candidate ({best}, dashed) explains only "
+                f"{100 * v.get('explained', 0.0):.0f} % of the gap")
+    return (f"Before/after on held-out data: {eff} shrinks the {v.get('shrink_channel', 'wob')} gap by "
+            f"{100 * v['shrink']:.0f} % (confidence {v['confidence']})")
 
 
 def _initial_state_lines(diag) -> list:

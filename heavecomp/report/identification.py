@@ -7,7 +7,7 @@ import numpy as np
 
 from heavecomp.plants.axis import BASE_NAMES, EMPS_PUBLISHED, EMPS_UNITS
 from heavecomp.report.figures import _plt as plt
-from heavecomp.report.scenario import md_table
+from heavecomp.report.scenario import md_table, write_report
 
 
 def _plt():
@@ -157,3 +157,59 @@ def withheld_terms_table(w: dict) -> str:
     return md_table(["withheld term", "published value [unit given]", "expected [name]", "verdict",
                      "fitted [units given]", "held-out shrink [-]", "reachable shrink [-]", "held-out rms [N]",
                      "runner-up (shrink [-])", "discovered [N] (shrink [-])", "right [yes/no]"], rows)
+
+
+# ---------------------------------------------------------------- tables and reports shared by scenario and command
+def emps_parameter_table(m: dict) -> str:
+    """Published against identified (whole record) EMPS parameters."""
+    pub, got, se = m["published"], m["identified_whole_record"], m["stderr_whole_record"]
+    return md_table(["parameter", "published", "identified (whole record)", "std. error", "deviation [%]"],
+                    [(k, pub[k], got[k], se[k], 100 * m["relative_error"][k]) for k in pub], fmt="{:.4g}")
+
+
+def candidates_table(m: dict) -> str:
+    """The residual diagnosis' candidates: held-out rms, shrink and score."""
+    return md_table(["candidate", "component", "k", "held-out rms [N]", "shrink", "score (BIC-like)"],
+                    [(c["effect"], c["component"], c["n_parameters"], c["rms_after"], c["shrink"], c["score"])
+                     for c in m["candidates"]], fmt="{:.3f}")
+
+
+def candidate_parameters_table(m: dict) -> str:
+    """Each candidate's fitted parameters (SI, with units)."""
+    return md_table(["candidate", "parameters"],
+                    [(c["effect"], parameters_text(c["parameters"], c["units"])) for c in m["candidates"]])
+
+
+def seal_fits_table(m: dict) -> str:
+    """The seal friction fits: F_C, C_p with its standard errors and interval."""
+    return md_table(["fit", "F_C [N]", "C_p [N/bar]", "LS std. err. [N/bar]", "bootstrap std [N/bar]",
+                     "95 % interval [N/bar]", "rms [N]", "strokes"],
+                    [(k, f["F_C"], f["C_p_N_per_bar"], f["C_p_se_N_per_bar"], f["C_p_boot_N_per_bar"] or "-",
+                      "{:.3f} .. {:.3f}".format(*(x * 1e5 for x in f["C_p_ci95"])) if f["C_p_ci95"] else "-",
+                      f["rms"], f["n_strokes"]) for k, f in m["fits"].items()], fmt="{:.3f}")
+
+
+def emps_report(out, m: dict, source: str) -> None:
+    """``report.md`` (+ ``report.html``) of ``heavecomp identify emps`` (figures already in ``out``)."""
+    sel = m["selection"]
+    write_report(out, f"EMPS axis identification — {source}", [
+        f"Inverse-model least squares on the whole record ({m['settings']}); the residual diagnosis fits "
+        f"t < {m['split']['fit'][1]:g} s and scores on the rest.",
+        emps_parameter_table(m), "![cut-off](cutoff_sensitivity.png)",
+        f"Held-out rms residual of the base model: {m['baseline_fit_part']['rms_validate']:.3f} N.",
+        "![map](residual_map.png)", "## Candidates (held-out part)", candidates_table(m),
+        candidate_parameters_table(m),
+        "Forward selection: " + ("; ".join(f"{' + '.join(s['effects'])}: shrink {s['shrink']:.3f}" for s in sel)
+                                 or "none"),
+        "![overlay](overlay.png)", "## Withheld published terms", withheld_terms_table(m["withheld_terms"]),
+    ])
+
+
+def seal_report(out, m: dict, n_strokes: int) -> None:
+    """``report.md`` (+ ``report.html``) of ``heavecomp identify seal`` (figure already in ``out``)."""
+    write_report(out, "Seal friction against pressure", [
+        f"**C_p = {m['C_p_N_per_bar']:.3f} +- {m['C_p_uncertainty_N_per_bar']:.3f} N/bar**, "
+        f"F_C = {m['F_C_N']:.2f} N over {n_strokes} steady strokes (headline fit: `{m['headline_fit']}`).",
+        seal_fits_table(m), "![friction vs pressure](friction_vs_pressure.png)",
+        "## Withheld published term", withheld_terms_table(m["withheld_terms"]),
+    ])

@@ -15,6 +15,7 @@ Every command and scenario finishes its output folder with :func:`finish`:
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import logging
 import math
@@ -23,6 +24,7 @@ import shlex
 import shutil
 import sys
 from pathlib import Path
+from heavecomp.errors import ParameterError
 from heavecomp.report import invocation
 from heavecomp.report.html import write_html
 from heavecomp.params import dumps
@@ -136,7 +138,6 @@ _SHARE_BLOCKS = ("bands", "regimes", "frac_outside", "levels", "components")
 def _param_units() -> dict[str, str]:
     """Units of parameter keys from the parameter classes' own metadata (``q(unit=...)``);
     also merges the CMC's channel units into :data:`UNITS` (imported here, not at start-up)."""
-    import dataclasses
 
 
     UNITS.update(CHANNEL_UNITS)
@@ -162,6 +163,12 @@ def _param_units() -> dict[str, str]:
     except Exception as exc:  # noqa: BLE001
         log.debug("effect parameter units unavailable: %s", exc)
     return out
+
+
+def table_units(table: str) -> dict[str, str]:
+    """Units of the number keys of the parameter table ``table`` (``"heave"``), from its classes' metadata."""
+    cls = TABLES[table]
+    return {f.name: f.metadata["unit"] for f in dataclasses.fields(cls) if f.metadata.get("kind") == "number"}
 
 
 def unit_of(path: tuple[str, ...]) -> str | None:
@@ -216,15 +223,73 @@ def _effect_units(name: str):
     return dict(getattr(cls, "feature_units", {})), (shape[1] if shape else None)
 
 
+#: key of the block a producer puts into a result dict beside its values: ``{entry: unit}``
+#: (``"-"`` dimensionless, ``"count"``); see :func:`declare_units`
+UNITS_KEY = "_units"
+
+
+def declare_units(block: dict, units) -> dict:
+    """Attach the units of ``block``'s entries where the values are made; returns ``block``.
+
+    ``units`` maps an entry's key to its unit.  The unit of a number entry is its own; of a list,
+    every number in it; of a nested dict, every number inside that declares nothing itself.  The
+    declaration wins over any unit guessed from a key's name (:func:`unit_of`), so a result cannot
+    be given a wrong unit by a name it shares with another quantity (a stroke ``offset`` in m
+    beside a force ``offset`` in N).  :func:`annotate_json` turns the declarations into the
+    ``units`` block and removes them from the written JSON.
+    """
+    block.setdefault(UNITS_KEY, {}).update({str(k): str(u) for k, u in dict(units).items()})
+    return block
+
+
+def strip_declared(obj):
+    """Copy of a result without its :data:`UNITS_KEY` blocks."""
+    if isinstance(obj, dict):
+        return {k: strip_declared(v) for k, v in obj.items() if k != UNITS_KEY}
+    if isinstance(obj, list):
+        return [strip_declared(v) for v in obj]
+    return obj
+
+
+def undeclared(obj, path: tuple = ()) -> list[str]:
+    """Dotted paths of the numbers of a result whose unit no producer declared (:func:`declare_units`)."""
+    out: list[str] = []
+
+    def walk(x, p, has):
+        if isinstance(x, dict):
+            decl = x.get(UNITS_KEY) if isinstance(x.get(UNITS_KEY), dict) else {}
+            for k, v in x.items():
+                if k not in (UNITS_KEY, "units", "provenance"):
+                    walk(v, p + (str(k),), has or str(k) in decl)
+        elif isinstance(x, (list, tuple)):
+            for v in x:
+                walk(v, p, has)
+        elif isinstance(x, (int, float)) and not isinstance(x, bool) and not has:
+            out.append(".".join(p))
+
+    walk(obj, tuple(path), False)
+    return sorted(set(out))
+
+
 def units_of(obj, path: tuple = ()) -> tuple[dict[str, str], list[str]]:
-    """``({key: unit}, [dotted paths of numbers with no known unit])`` for a JSON-like result."""
+    """``({key: unit}, [dotted paths of numbers with no known unit])`` for a JSON-like result.
+
+    A unit declared beside the value (:func:`declare_units`) wins; otherwise it is looked up
+    by the key's name and its parents (:func:`unit_of`)."""
     global _PARAM_UNITS
     if not _PARAM_UNITS:
         _PARAM_UNITS = _param_units()
     units: dict[str, str] = {}
     missing: list[str] = []
 
-    def walk(x, p, own=None, coef=None):
+    def walk(x, p, own=None, coef=None, declared=None):
+        if isinstance(x, dict) and (declared is not None or isinstance(x.get(UNITS_KEY), dict)):
+            decl = x.get(UNITS_KEY) if isinstance(x.get(UNITS_KEY), dict) else {}
+            for k, v in x.items():  # declared beside the value, or by an enclosing block
+                if k not in (UNITS_KEY, "units", "provenance"):
+                    u = decl.get(str(k), declared)
+                    walk(v, p + (str(k),), u, declared=u)
+            return
         if isinstance(x, dict):
             # an entry that names its own unit (e.g. a fitted parameter at its bound: value, bound, unit;
             # a component row: rms and noise in its equation's unit)
@@ -244,7 +309,7 @@ def units_of(obj, path: tuple = ()) -> tuple[dict[str, str], list[str]]:
                     walk(v, p + (str(k),), own_unit if k in ("value", "bound", "rms", "noise", "stderr") else None)
         elif isinstance(x, (list, tuple)):
             for v in x:
-                walk(v, p, own)
+                walk(v, p, own, declared=declared)
         elif isinstance(x, (int, float)) and not isinstance(x, bool) and p:
             u = own or unit_of(p)
             name = p[-1] if not p[-1].isdigit() else ".".join(p[-2:])
@@ -320,17 +385,33 @@ def stamp_markdown(st: dict) -> str:
     return "*Provenance: " + "; ".join(parts) + ".*"
 
 
-def write_params(out_dir, params, name: str = "params.toml") -> Path:
+def heave_file(params) -> Path | None:
+    """The heave file a parameter set names (``heave.kind = "file"``), resolved against its folder."""
+    heave = getattr(params, "heave", None)
+    if heave is None or getattr(heave, "kind", None) != "file" or not heave.path:
+        return None
+    src = Path(heave.path)
+    if not src.is_absolute() and params.base_dir is not None:
+        src = Path(params.base_dir) / src
+    return src
+
+
+def write_params(out_dir, params, name: str = "params.toml", *, heave_used: bool = True) -> Path:
     """Write the resolved parameter set; a heave file is copied in beside it so the folder re-runs
-    by itself (``heave.path`` names the copy)."""
+    by itself (``heave.path`` names the copy).
+
+    ``heave_used=False`` (a command that takes no heave from the parameter file, e.g. the diagnosis,
+    whose heave is the measured run's): a ``[heave]`` table naming a file is left out -- the file is
+    neither copied nor recorded, and need not exist."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    heave = getattr(params, "heave", None)
-    if heave is not None and getattr(heave, "kind", None) == "file" and heave.path:
-        src = Path(heave.path)
-        if not src.is_absolute() and params.base_dir is not None:
-            src = Path(params.base_dir) / src
+    src = heave_file(params)
+    if src is not None and not heave_used:
+        params = params.replace(heave=None)
+    elif src is not None:
         copy = out / f"heave{src.suffix or '.csv'}"
+        if not src.is_file():
+            raise ParameterError(f"heave.path: {src} is not a file (the heave input of this run)")
         if src.resolve() != copy.resolve():
             shutil.copyfile(src, copy)
         params = params.replace(heave={"path": copy.name})
@@ -389,6 +470,7 @@ def annotate_json(path, st: dict, *, indent: int | None = 2) -> dict:
         units, missing = units_of(data)
         if missing:
             log.debug("%s: no unit known for %s", path.name, ", ".join(missing))
+        data = strip_declared(data)
         data["provenance"] = st
         data["units"] = units
     path.write_text(json.dumps(round_floats(_clean(data)), indent=indent) + "\n")
@@ -408,15 +490,17 @@ def stamp_report(md_path, st: dict) -> Path:
 
 
 def finish(out_dir, *, params=None, params_name: str = "params.toml", params_file: str | None = None,
-           json_files=("metrics.json",), csv_files=(), report: str = "report.md", **extra) -> dict:
+           json_files=("metrics.json",), csv_files=(), report: str = "report.md", heave_used: bool = True,
+           **extra) -> dict:
     """Make ``out_dir`` self-describing (see the module docstring); returns the stamp.
 
     ``params`` (a CMC parameter set) is written as ``params_name``; a command that wrote its
     own parameter file (e.g. paper B's pneumatic set) names it with ``params_file``.
+    ``heave_used=False``: the command took no heave from ``params`` (see :func:`write_params`).
     """
     out = Path(out_dir)
     if params is not None:
-        params_file = write_params(out, params, params_name).name
+        params_file = write_params(out, params, params_name, heave_used=heave_used).name
     st = stamp(params_file, **extra)
     for name in json_files:
         if (out / name).exists():

@@ -8,6 +8,7 @@ from typing import Callable
 
 from heavecomp.closed_loop.loop import ClosedLoopResult, output_every
 from heavecomp.report.figures import plot_wob, plot_wob_run, save
+from heavecomp.report.provenance import declare_units, table_units
 from heavecomp.simulate.core import SimulationResult
 
 
@@ -24,14 +25,25 @@ def write_outputs(res: SimulationResult, out_dir, *, title: str | None = None, f
     if figure is not None:
         figure.draw(plot_wob_run, res, title=title, path=out_dir / "wob.png", save_kwargs={"tight": False, "dpi": 100})
     res.to_csv(out_dir / "timeseries.csv", progress=progress)
-    metrics = res.metrics()
-    metrics["heave"] = {k: v for k, v in res.heave_info.items() if isinstance(v, (int, float, str))}
+    metrics = declare_units(res.metrics(), res.METRIC_UNITS)
+    metrics["heave"] = heave_block(res.heave_info)
     (out_dir / "metrics.json").write_text(json.dumps(metrics, indent=2) + "\n")
     if figure is None:
         save(plot_wob_run(res, title=title), out_dir / "wob.png", tight=False, dpi=100)
     else:
         figure.wait()
     return metrics
+
+#: units of heave entries that are not keys of the [heave] table (made by heavecomp.simulate.excitation)
+HEAVE_INFO_UNITS = {"repeat_period": "s", "kind": "", "source": ""}
+
+
+def heave_block(info: dict) -> dict:
+    """The heave's description for metrics.json, each number with the unit of its ``[heave]`` key."""
+    block = {k: v for k, v in info.items() if isinstance(v, (int, float, str))}
+    units = {**table_units("heave"), **HEAVE_INFO_UNITS}
+    return declare_units(block, {k: units[k] for k in block if k in units})
+
 
 def write_closed_loop_outputs(res: ClosedLoopResult, out_dir, *, title: str | None = None,
                               rate: float | None = None) -> dict:
@@ -41,8 +53,9 @@ def write_closed_loop_outputs(res: ClosedLoopResult, out_dir, *, title: str | No
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     res.to_csv(out_dir / "timeseries.csv", every=every)
-    metrics = res.metrics()
-    metrics["heave"] = {k: v for k, v in res.heave_info.items() if isinstance(v, (int, float, str))}
+    metrics = res.metrics()  # the controller's entries: units by name until ClosedLoopResult declares them
+    declare_units(metrics, {k: u for k, u in res.METRIC_UNITS.items() if k in metrics})
+    metrics["heave"] = heave_block(res.heave_info)
     (out_dir / "metrics.json").write_text(json.dumps(metrics, indent=2) + "\n")
     save(plot_wob({res.controller: res}, title=title, force=res.controller != "passive"), out_dir / "wob.png")
     return metrics

@@ -12,7 +12,8 @@ from typing import Callable
 import numpy as np
 
 from heavecomp.effects.compose import composition_for
-from heavecomp.effects.registry import resolve, split_effects
+from heavecomp.effects.registry import split_effects
+from heavecomp.effects.spec import effects_for
 from heavecomp.errors import InputError
 from heavecomp.params.budget import check_run_size
 from heavecomp.plants.cmc import eigen_rate, plant_vectors
@@ -103,8 +104,18 @@ class SimulationResult:
         """Boolean mask of samples at t >= start (default: after the fade-in)."""
         return self.t >= (self.stats_start if start is None else start) - 1e-12
 
+    #: unit of each entry of :meth:`metrics`, declared beside it (metrics.json's units come from here)
+    METRIC_UNITS = {"wob_mean": "N", "wob_std": "N", "wob_min": "N", "wob_max": "N", "wob_p2p": "N",
+                    "wob_setpoint": "N", "stick_fraction": "-", "stick_fraction_total": "-", "n_stick": "count",
+                    "n_breakaway": "count", "n_reversal": "count", "event_cap_hits": "count",
+                    "event_cap_first_t": "s", "friction_power_min": "W", "n_negative_friction_power": "count",
+                    "stroke_max": "m", "pressure_min": "Pa", "pressure_max": "Pa", "heave_std": "m",
+                    "k_eff_eq14": "N/m", "stats_window": "s", "duration": "s", "dt": "s", "friction_model": "",
+                    "wall_time_s": "s"}
+
     def metrics(self, start: float | None = None) -> dict:
-        """WOB statistics over t >= start (default: after the heave fade-in) [N, m, -]."""
+        """WOB statistics over t >= start (default: after the heave fade-in) [N, m, -];
+        units in :attr:`METRIC_UNITS`."""
         m = self.window(start)
         w = self["wob"][m]
         duration = float(self.t[-1])
@@ -185,7 +196,7 @@ class SimulationResult:
 
 def simulate(params, duration: float, *, dt: float | None = None, rate: float = 20.0, heave=None,
              progress: Callable[[float], None] | None = None, stats_start: float | None = None,
-             u_active: float = 0.0, effects=()) -> SimulationResult:
+             u_active: float = 0.0, effects=None) -> SimulationResult:
     """Simulate the CMC from rest at the operating point with exact stick-slip.
 
     Parameters
@@ -209,18 +220,19 @@ def simulate(params, duration: float, *, dt: float | None = None, rate: float = 
     effects : sequence, optional
         Effects at the plant's hooks (:mod:`heavecomp.effects`): instances
         (``FlowLoss(resistance=2e5)``), registered names (default parameters) or
-        ``(name, {parameter: value})`` pairs.  None: the nominal CMC (the ahead-of-time stepper).
+        ``(name, {parameter: value})`` pairs.  None: the plant effects of ``params``' ``[[effects]]``
+        (none: the nominal CMC, the ahead-of-time stepper; :func:`heavecomp.effects.spec.effects_for`).
         A heave effect (``heave_reference``) changes the heave the plant sees (the recorded
         ``heave`` stays the measured one); a channel effect (``sensor_gain``, ``sensor_offset``,
         ``sensor_delay``, each with its ``channel``) changes the recorded channel.
     """
     if not (duration > 0 and math.isfinite(duration)):
-        raise InputError(f"--duration must be a positive number of seconds, got {duration}")
+        raise InputError(f"duration must be a positive number of seconds, got {duration}", option="duration")
     if not (rate > 0 and math.isfinite(rate)):
-        raise InputError(f"--rate must be a positive number of Hz, got {rate}")
+        raise InputError(f"rate must be a positive number of Hz, got {rate}", option="rate")
     h = dt if dt is not None else default_dt(params, rate)
     if not (h > 0 and math.isfinite(h)):
-        raise InputError(f"--dt must be a positive number of seconds, got {dt}")
+        raise InputError(f"dt must be a positive number of seconds, got {dt}", option="dt")
     out_every = max(1, int(round(1.0 / (rate * h))))
     if dt is not None and abs(out_every * h * rate - 1.0) > 1e-6:
         log.warning("output interval 1/rate = %g s is not a multiple of dt = %g s; output every %d steps",
@@ -238,7 +250,7 @@ def simulate(params, duration: float, *, dt: float | None = None, rate: float = 
     else:
         t_in, z_in = heave
         hs = excitation.from_series(t_in, z_in, n_steps * h, sp, src="heave")
-    plant_fx, heave_fx, sensor_fx = split_effects(resolve(effects))
+    plant_fx, heave_fx, sensor_fx = split_effects(effects_for(params, effects))
     measured = hs
     for e in heave_fx:  # the heave the plant sees is not the measured one
         hs = e.transform(hs)
@@ -315,7 +327,7 @@ def run_kernel(plant, hs, h, n_steps, out_every, *, u_active=0.0, progress=None,
                                   f"{spike[0]:.3g} m/s^2 at t = {spike[1]:g} s, beyond the {HEAVE_ACCEL_MAX:g} m/s^2 "
                                   f"a rig floor can reach: check the heave input for a spike or a gap there")
         raise SimulationError(f"the stepper diverged near t = {t_div:g} s (non-finite state); "
-                              f"reduce --dt (now {h:g} s) or check the parameters")
+                              f"reduce the step dt (now {h:g} s) or check the parameters", option="dt")
     spike = heave_accel_outlier(hs, data[-1, 0] if len(data) else 0.0)
     if spike is not None:
         log.warning("the heave input accelerates at %.3g m/s^2 at t = %g s, beyond the %g m/s^2 a rig floor can "

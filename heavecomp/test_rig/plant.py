@@ -101,14 +101,30 @@ class RigParams:
 
 
 def kinematics(p: RigParams, t):
-    """Prescribed axial velocity and acceleration [m/s, m/s^2] (our form of eqs. 10-11)."""
+    """Prescribed axial velocity and acceleration [m/s, m/s^2] (our form of eqs. 10-11).
+
+    Parameters
+    ----------
+    p : RigParams
+        The rig (amplitude V [m/s] and cycle period [s]).
+    t : float or array [s]
+        Time.
+    """
     w = 2 * math.pi / p.cycle_period
     t = np.asarray(t, float)
     return p.velocity_amplitude * np.sin(w * t), p.velocity_amplitude * w * np.cos(w * t)
 
 
 def quadrant_index(v, a) -> np.ndarray:
-    """0..3 in the order of :data:`QUADRANTS` (v = 0 counts with the sign of a)."""
+    """0..3 in the order of :data:`QUADRANTS` (v = 0 counts with the sign of a).
+
+    Parameters
+    ----------
+    v : float or array [m/s]
+        Axial velocity.
+    a : float or array [m/s^2]
+        Axial acceleration.
+    """
     v, a = np.asarray(v, float), np.asarray(a, float)
     sv = np.where(v != 0, np.sign(v), np.sign(a))
     fwd = sv > 0
@@ -121,6 +137,17 @@ def rig_friction(p: RigParams, v, a, v_t):
 
     eq. 4 with the quadrant's parameters when v_t = 0, eq. 7 (same parameters) when v_t > 0
     (:func:`heavecomp.friction.laws.friction_exact`).
+
+    Parameters
+    ----------
+    p : RigParams
+        The rig (its per-quadrant eq. 4 parameters).
+    v : float or array [m/s]
+        Axial velocity.
+    a : float or array [m/s^2]
+        Axial acceleration (selects the quadrant).
+    v_t : float or array [m/s]
+        Tangential velocity of the rotating piston, omega d / 2 (paper A eq. 5); 0 without rotation.
     """
     v, a, v_t = np.broadcast_arrays(np.asarray(v, float), np.asarray(a, float), np.asarray(v_t, float))
     q = quadrant_index(v, a)
@@ -145,10 +172,12 @@ def run(p: RigParams, *, rotation: bool, cycles: float = 1.0, fs: float = 100.0,
 
     Parameters
     ----------
+    p : RigParams  the rig
     rotation : bool  turn the piston (within ``rotation_band``)
     cycles : float  number of velocity cycles
     fs : float [Hz]  sampling rate
     pressure_noise : float [Pa]  standard deviation added to each pressure sensor
+    seed : int  seed of the pressure noise
 
     Returns
     -------
@@ -179,6 +208,17 @@ def fit_quadrants(v, F, quadrant, *, v_min: float = 1e-4) -> list[QuadrantFricti
     """Least-squares eq. 4 fit (C_p = 0) per quadrant to a measured friction-velocity loop.
 
     Bounded: F_C >= 0, F_S - F_C >= 0, C_v >= 0, 0.1 mm/s <= v_S <= 50 mm/s.
+
+    Parameters
+    ----------
+    v : array [m/s]
+        Axial velocity.
+    F : array [N]
+        Measured friction (e.g. paper A eq. 12's reading).
+    quadrant : array of int
+        Quadrant index of each sample (:func:`quadrant_index`).
+    v_min : float [m/s]
+        Samples slower than this are left out.
     """
     from scipy.optimize import least_squares
 

@@ -1,5 +1,5 @@
-"""The validation sets of the gap diagnosis (issue 12 items 6-7): the generator's own truth laws
-and vessel response, the two disjoint sets, the scoring rules and the frozen-threshold check."""
+"""The validation sets of the gap diagnosis (issue 12 items 6-7): the benchmark's own truth laws
+and vessel model, the two disjoint sets, the scoring rules and the frozen-threshold check."""
 
 from __future__ import annotations
 
@@ -9,8 +9,11 @@ import json
 import numpy as np
 import pytest
 
-from heavecomp.diagnosis import generator as G
-from heavecomp.diagnosis import truth as T
+import heavecomp.benchmark as B
+from heavecomp.benchmark import Case, generate, VesselRAO
+from heavecomp.benchmark.truth import TRUTH
+from heavecomp.benchmark.truth.heave_reference import heave_mru, synthetic_pitch
+from heavecomp.benchmark.truth.stroke_backlash import backlash
 from heavecomp.plants.cmc import plant_vectors
 from heavecomp.report.scenario import ROOT
 
@@ -25,20 +28,21 @@ def _scenario():
 # --------------------------------------------------------------------------- vessel response
 def test_rao_passes_swell_and_resonates():
     """|H| -> 1 far below the heave resonance, peaks above 1 near it, falls off above."""
-    assert abs(G.rao_heave(1e-4, 22.0, 0.2) - 1.0) < 1e-3
+    rao = VesselRAO(22.0, 0.2)
+    assert abs(rao.frequency_response(1e-4) - 1.0) < 1e-3
     f = np.linspace(0.01, 0.2, 2000)
-    mag = np.abs(G.rao_heave(f, 22.0, 0.2))
+    mag = np.abs(rao.frequency_response(f))
     assert abs(f[np.argmax(mag)] - 1 / 22.0) < 0.01 and mag.max() > 1.2
-    assert np.abs(G.rao_heave(1 / 6.0, 22.0, 0.2)) < 0.2  # wind sea is filtered out
+    assert np.abs(rao.frequency_response(1 / 6.0)) < 0.2  # wind sea is filtered out
 
 
 def test_vessel_response_in_time_matches_the_rao():
     """The time-domain integration (lsim) of a 12 s wave settles at the RAO's gain and phase."""
     t = np.arange(0.0, 600.0, 0.1)
     z = np.sin(2 * np.pi * t / 12.0)
-    y = G.vessel_response(t, z, 22.0, 0.2)
+    y = VesselRAO(22.0, 0.2).heave(t, z)
     k = t > 300.0  # transient gone (decay time 1/(zeta w_n) = 17.5 s)
-    H = G.rao_heave(1 / 12.0, 22.0, 0.2)
+    H = VesselRAO(22.0, 0.2).frequency_response(1 / 12.0)
     ref = np.abs(H) * np.sin(2 * np.pi * t / 12.0 + np.angle(H))
     assert np.max(np.abs(y[k] - ref[k])) < 0.01 * np.abs(H)
 
@@ -47,7 +51,7 @@ def test_vessel_response_in_time_matches_the_rao():
 def test_backlash_loses_half_the_play_at_each_reversal():
     t = np.linspace(0.0, 40.0, 4001)
     y = 0.5 * np.sin(2 * np.pi * t / 10.0)
-    r = T.backlash(y, 0.04)
+    r = backlash(y, 0.04)
     assert abs(r[t > 10].max() - (0.5 - 0.02)) < 1e-3 and abs(r[t > 10].min() - (-0.5 + 0.02)) < 1e-3
     top = np.argmax(y[t < 10])  # just after the peak the reading stands still for 0.04 m of travel
     j = top + np.argmax(y[top:] < y[top] - 0.04)
@@ -56,18 +60,17 @@ def test_backlash_loses_half_the_play_at_each_reversal():
 
 def test_lagged_direction_makes_friction_asymmetric():
     """Sliding steadily, extending friction is (1 + alpha) J and retracting (1 - alpha) J."""
-    c = T.TruthLaggedDirection
-    fp = plant_vectors(G.paper_a("stribeck")).FP
+    c = TRUTH["asymmetric_friction"]
+    fp = plant_vectors(B.parameter_sets()["paper_a"]).FP
     for v, sign in ((0.3, 1.0), (-0.3, -1.0)):
         d = c.steady(v, fp, None, 0.25, 0.1, 2e-3)
-        sd = (0.0, sign) if T.SEAL_SD else ()  # the hook's stroke and direction, where it passes them
-        J = c.jump(0, abs(v), 2e6, 1e4, *sd, d, fp, 0.25, 0.1, 2e-3)
+        J = c.jump(0, abs(v), 2e6, 1e4, 0.0, sign, d, fp, 0.25, 0.1, 2e-3)  # stroke 0, direction
         assert J == pytest.approx(1e4 * (1 + 0.25 * sign), rel=0.01)
 
 
 def test_leak_stops_at_ambient_pressure_and_drops_the_preload():
-    c = T.TruthLaminarLeak
-    PP = plant_vectors(G.paper_a("stribeck")).PP
+    c = TRUTH["gas_leak"]
+    PP = plant_vectors(B.parameter_sets()["paper_a"]).PP
     assert c.rates(0.0, 0.0, 0.0, (1.0,), PP, None, 1e-4)[0] == 0.0
     assert c.rates(0.0, 0.0, 2e6, (1.0,), PP, None, 1e-4)[0] < 0.0
     p0 = 2.4e6  # 1 % of the gas gone at fixed stroke: the absolute pressure drops by about n %
@@ -78,7 +81,7 @@ def test_leak_stops_at_ambient_pressure_and_drops_the_preload():
 def test_mru_high_pass_keeps_waves_and_drops_offsets():
     t = np.arange(0.0, 2000.0, 0.1)
     cols = {"heave": 1.0 + np.sin(2 * np.pi * t / 12.0)}
-    out = T.heave_mru(t, cols, 0.9, 0.01)["heave"]
+    out = heave_mru(t, cols, 0.9, 0.01)["heave"]
     k = t > 1000.0
     assert abs(np.mean(out[k])) < 0.01
     assert np.std(out[k]) == pytest.approx(0.9 * np.std(np.sin(2 * np.pi * t[k] / 12.0)), rel=0.01)
@@ -86,7 +89,7 @@ def test_mru_high_pass_keeps_waves_and_drops_offsets():
 
 def test_synthetic_pitch_has_its_rms():
     t = np.arange(0.0, 3600.0, 0.5)
-    th = T.synthetic_pitch(t, 0.02, 10.0, 3)
+    th = synthetic_pitch(t, 0.02, 10.0, 3)
     assert np.sqrt(np.mean(th ** 2)) == pytest.approx(0.02, rel=0.25)
 
 
@@ -95,27 +98,27 @@ def test_soft_sets_soften_the_string_formation_path():
     of the path from the hook to the rock (what the WOB answers a heave error with)."""
     def k_eff(p):
         return 1 / (1 / p.drill_string.stiffness + 1 / p.formation.stiffness)
-    sets = G.validation_parameter_sets()
+    sets = B.parameter_sets()
     base = k_eff(sets["paper_a"])
     assert k_eff(sets["long_soft_string"]) < 0.8 * base and k_eff(sets["soft_rock"]) < 0.5 * base
 
 
 def test_every_truth_label_has_a_component():
-    for lab in G.CASES[1:] + G.NEW_EFFECTS + T.OUT_OF_LIBRARY:
-        assert lab in T.COMPONENT
-    assert {T.COMPONENT[x] for x in T.OUT_OF_LIBRARY} >= {"friction", "flow_line", "string_formation", "sensors"}
+    for lab in B.CASES[1:] + B.NEW_EFFECTS + B.OUT_OF_LIBRARY:
+        assert lab in B.COMPONENT
+    assert {B.COMPONENT[x] for x in B.OUT_OF_LIBRARY} >= {"friction", "flow_line", "string_formation", "sensors"}
 
 
 # --------------------------------------------------------------------------- the two sets
 def test_sets_are_disjoint_in_seeds_and_settings():
-    tun, sco = G.validation_cases("tuning"), G.validation_cases("scoring")
+    tun, sco = B.validation_cases("tuning"), B.validation_cases("scoring")
     assert 20 <= len(tun) <= 30 and 30 <= len(sco) <= 40
-    assert not {c["seed"] for c in tun} & {c["seed"] for c in sco}
+    assert not {c.seed for c in tun} & {c.seed for c in sco}
     for c in sco:  # every scoring run has at least one setting the tuning set never uses
-        new = [k for k in ("sea", "rate", "noise", "start") if c[k] not in G.TUNING_SETTINGS[k]]
+        new = [k for k in ("sea", "rate", "noise", "start") if getattr(c, k) not in B.TUNING_SETTINGS[k]]
         assert new, c
-    assert {c["label"] for c in sco if c["category"] == "out_of_library"} == set(T.OUT_OF_LIBRARY)
-    assert {c["label"] for c in sco if c["category"] == "named"} >= set(G.CASES[1:] + G.NEW_EFFECTS)
+    assert {c.label for c in sco if c.category == "out_of_library"} == set(B.OUT_OF_LIBRARY)
+    assert {c.label for c in sco if c.category == "named"} >= set(B.CASES[1:] + B.NEW_EFFECTS)
 
 
 # --------------------------------------------------------------------------- scoring rules
@@ -150,13 +153,13 @@ def test_scoring_refuses_thresholds_changed_after_tuning(tmp_path, monkeypatch, 
 def test_near_noise_and_mid_operation_runs():
     """A near-noise effect is planted inside its band, a scoring log starts moving, and the true
     model shrinks the held-out gap."""
-    case = G._case("flow_loss", 7, "near_noise", duration=120.0, sea="mixed", near=True, start=40.0)
-    tr = G.generate_case(case)
-    assert G.NEAR_NOISE[0] <= tr.truth["gap_to_noise"]["flow_loss"] <= G.NEAR_NOISE[1]
+    case = Case("flow_loss", 7, "near_noise", duration=120.0, sea="mixed", near=True, start=40.0)
+    tr = generate(case)
+    assert B.NEAR_NOISE[0] <= tr.truth["gap_to_noise"]["flow_loss"] <= B.NEAR_NOISE[1]
     assert tr.t[0] == 0.0 and tr.t[-1] == pytest.approx(120.0, abs=0.05)
     v0 = np.polyfit(tr.t[:50], tr.columns["stroke"][:50], 1)[0]  # the first second: not at rest
     assert abs(v0) > 0.01 or np.ptp(tr.columns["heave"][:50]) > 0.05
-    big = G.generate_case(G._case("flow_loss", 8, "named", duration=120.0, sea="buoy"))
+    big = generate(Case("flow_loss", 8, "named", duration=120.0, sea="buoy"))
     assert big.true_shrink()["pressure"] > 0.5
 
 

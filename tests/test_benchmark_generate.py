@@ -1,6 +1,8 @@
-"""Withheld-effect generator (issue 4): every planted effect is detectable (its own gap is at least
+"""The benchmark's generator (issue 4): every planted effect is detectable (its own gap is at least
 GAP_MIN x the noise floor), a dwell stiction is planted only where the compensator sticks, a second
-effect is a real fraction of the dominant one, and the truth laws are not the candidates' equations.
+effect is a real fraction of the dominant one, a case makes the same run every time, and a
+corrupted log continues the case's random stream (the truth laws' own battery:
+``test_benchmark_truth.py``).
 
 The gaps are recomputed here from the recorded truth (parameters, sea) with the stepper directly,
 not with the generator's own helpers."""
@@ -10,15 +12,16 @@ import math
 import numpy as np
 import pytest
 
-from heavecomp.diagnosis import generator as G
+import heavecomp.benchmark as B
+from heavecomp.benchmark import benchmark_case, benchmark_cases, corrupt, generate
+from heavecomp.benchmark.truth import LAWS, TRUTH, truth_composition
 from heavecomp.diagnosis.stepper import CHANNELS as SC, replay_dt, run_fx
-from heavecomp.diagnosis.truth import TRUTH, truth_composition
-from heavecomp.effects.registry import library
 from heavecomp.plants.cmc import plant_vectors
 from heavecomp.simulate import excitation
 
 DUR = 120.0
 OUT = ("stroke", "pressure", "wob")
+STICK_MIN = LAWS["dwell_stiction"].min_stuck_share
 
 
 def _truth(name, prm):
@@ -44,7 +47,7 @@ def test_planted_effect_is_above_the_noise_floor(name, pset, seed):
     """The weakest effects of the benchmark, on their hardest parameter sets: recomputed from the
     recorded truth, the effect moves some channel by >= GAP_MIN x the recorded noise floor in each
     half of the run; the floor is itself at least the output noise."""
-    tr = G.generate(name, seed=seed, duration=DUR, param_set=pset)
+    tr = generate(benchmark_case(name, seed=seed, duration=DUR, param_set=pset))
     t, base = _clean(tr, [])
     _, with_effect = _clean(tr, _truth(name, tr.truth["parameters"][name]))
     floor = tr.truth["noise_floor"]
@@ -53,59 +56,57 @@ def test_planted_effect_is_above_the_noise_floor(name, pset, seed):
     def gap(k):
         return {c: float(np.sqrt(np.mean((with_effect[c][k] - base[c][k]) ** 2))) / floor[c] for c in OUT}
 
-    assert all(floor[c] >= G.NOISE[c] for c in OUT)
+    assert all(floor[c] >= B.NOISE[c] for c in OUT)
     assert gap(m) == pytest.approx(tr.truth["gap_channels"][name], rel=1e-6)
     mid = 0.5 * (0.1 * DUR + DUR)  # in each half of the run, not in one burst only
     for half in (m & (t < mid), t >= mid):
-        assert max(gap(half).values()) >= G.GAP_MIN
+        assert max(gap(half).values()) >= B.GAP_MIN
     # the measured data really differ from the no-effect model by more than the noise
     meas = tr.columns
     c = max(gap(m), key=gap(m).get)
-    assert np.sqrt(np.mean((meas[c][m] - base[c][m]) ** 2)) > 2 * G.NOISE[c]
+    assert np.sqrt(np.mean((meas[c][m] - base[c][m]) ** 2)) > 2 * B.NOISE[c]
     if name == "dwell_stiction":  # planted where the compensator sticks
-        assert np.mean(base["stuck"] > 0.5) >= G.STICK_MIN
-        assert tr.truth["stick"]["stuck_share"] >= G.STICK_MIN
+        assert np.mean(base["stuck"] > 0.5) >= STICK_MIN
+        assert tr.truth["stick"]["stuck_share"] >= STICK_MIN
 
 
 def test_two_effect_run_second_is_a_real_fraction():
-    tr = G.generate(("friction_lag", "sensor_delay"), seed=7, duration=DUR, param_set="soft_formation")
+    tr = generate(benchmark_case(("friction_lag", "sensor_delay"), seed=7, duration=DUR, param_set="soft_formation"))
     first, second = tr.truth["effects"]
     gaps = tr.truth["gap_alone"]
     assert (first, second) == ("friction_lag", "sensor_delay")
     share = gaps[second] / gaps[first]
-    assert G.SECOND_SHARE[0] <= share <= G.SECOND_SHARE[1]
+    assert B.SECOND_SHARE[0] <= share <= B.SECOND_SHARE[1]
     assert share == pytest.approx(tr.truth["second_share"])
-    assert tr.truth["gap_to_noise"][first] >= G.GAP_MIN
+    assert tr.truth["gap_to_noise"][first] >= B.GAP_MIN
 
 
 def test_no_effect_run_has_no_planted_gap():
-    tr = G.generate("none", seed=2, duration=DUR, param_set="paper_a")
+    tr = generate(benchmark_case("none", seed=2, duration=DUR, param_set="paper_a"))
     t, base = _clean(tr, [])
     assert tr.truth["gap_alone"] == {} and tr.truth["parameters"] == {}
     for c in OUT:  # the measured channels are the no-effect truth plus white noise of the stated level
         r = tr.columns[c] - base[c]
-        assert np.std(r) == pytest.approx(G.NOISE[c], rel=0.1)
-
-
-@pytest.mark.parametrize("name", [e for e in G.CASES if e not in ("none", "sensor_delay", "parameter_mismatch")])
-def test_truth_laws_are_the_generators_own_classes(name):
-    """The generator plants its own truth classes (outside the library): never a registered
-    candidate class, and no truth class shares a hook method with the library's effect of that name."""
-    desc, _, _ = G._draw_effect(name, np.random.default_rng(0), G.parameter_sets()["paper_a"])
-    effects, extra = G._effect_terms(name, desc, G.parameter_sets()["paper_a"])
-    lib = library()
-    assert extra is None and len(effects) == 1
-    (e,) = effects
-    assert type(e) is TRUTH[name] and type(e) not in lib.values()
-    cand = lib[name]
-    for m in type(e).methods():
-        assert getattr(type(e), m) is not getattr(cand, m, None)
-    assert cand not in truth_composition().classes
+        assert np.std(r) == pytest.approx(B.NOISE[c], rel=0.1)
 
 
 def test_benchmark_meets_every_case_on_two_parameter_sets():
-    cases = G.benchmark_cases()
-    for e in G.CASES:
-        sets = [p for eff, _, p in cases if eff == (e,)]
+    cases = benchmark_cases()
+    for e in B.CASES:
+        sets = [c.params for c in cases if c.label == e and c.second is None]
         assert len(sets) == 2 and len(set(sets)) == 2, (e, sets)
-    assert "light_friction" not in [p for eff, _, p in cases if "dwell_stiction" in eff]
+    assert "light_friction" not in [c.params for c in cases if "dwell_stiction" in c.effects]
+
+
+def test_a_case_makes_the_same_run_and_a_corrupted_log_continues_its_stream():
+    """generate(case) is a function of the case; corrupt() draws from the case's stream after it,
+    so the corrupted log is reproducible too, and the clean run it started from is untouched."""
+    case = benchmark_case("flow_loss", seed=5, duration=60.0)
+    a, b = generate(case), generate(case)
+    assert all(np.array_equal(a.columns[c], b.columns[c]) for c in a.columns) and a.truth == b.truth
+    ca, cb = corrupt(a, jitter=True, dropouts=True), corrupt(b, jitter=True, dropouts=True)
+    assert np.array_equal(ca.t, cb.t) and not np.array_equal(ca.t, a.t)
+    assert all(np.array_equal(ca.columns[c], cb.columns[c], equal_nan=True) for c in a.columns)
+    assert {c for c in ca.columns if np.isnan(ca.columns[c]).any()} == {"heave", "wob", "pressure"}
+    assert not any(np.isnan(a.columns[c]).any() for c in a.columns)
+    assert ca.truth["corrupted"] == ["jitter", "dropouts"]

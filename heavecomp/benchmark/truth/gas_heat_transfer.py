@@ -1,0 +1,58 @@
+"""gas_heat_transfer, as generated: a thermal state theta = T/T_0, adiabatic compression with a fixed
+gamma and Newton heat exchange with time constant tau_th.
+
+The candidate (fitted, :mod:`heavecomp.effects`) is an effective polytropic index n_eff plus a
+linear loss c_g v.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from heavecomp.benchmark.truth.base import Draw, TruthLaw
+from heavecomp.effects.base import Effect
+from heavecomp.params.core import q
+from heavecomp.plants.cmc import A, P0ABS, PATM, V0
+
+
+class TruthThermalGas(Effect):
+    """Ideal gas with a temperature state theta = T/T_0: adiabatic compression, Newton heat exchange.
+
+    Notes
+    -----
+    p_abs = (p_0 + p_atm) theta V_0 / (V_0 + A s);
+    dtheta/dt = -(gamma - 1) theta A v / (V_0 + A s) + (1 - theta) / tau_th.
+    """
+
+    name = "gas_heat_transfer"
+    hook = "gas_spring"
+    states = ("theta",)
+
+    @dataclass(frozen=True)
+    class Params:
+        gamma: float = q(1.4, "-", bounds=(1.0, 1.67), symbol="gamma", doc="adiabatic index of the gas")
+        tau_th: float = q(4.0, "s", bounds=(0.0, 1e3), open_low=True, symbol="tau_th", doc="heat exchange time")
+
+    @staticmethod
+    def gas(s, v, p, x, PP, gamma, tau_th):
+        return PP[P0ABS] * x[0] * (PP[V0] / (PP[V0] + PP[A] * s)) - PP[PATM]
+
+    @staticmethod
+    def rates(s, v, p, x, PP, FP, gamma, tau_th):
+        return (-(gamma - 1.0) * x[0] * PP[A] * v / (PP[V0] + PP[A] * s) + (1.0 - x[0]) / tau_th,)
+
+    @staticmethod
+    def initial(FP, PP, gamma, tau_th):
+        return (1.0,)
+
+    @staticmethod
+    def steady(v, FP, PP, gamma, tau_th):
+        return (1.0,)
+
+
+def draw(rng, setting):
+    """Nitrogen: gamma fixed at 1.4, tau_th 2-8 s; no size knob (only a redraw changes it)."""
+    return Draw({"gamma": 1.4, "tau_th": rng.uniform(2.0, 8.0)})
+
+
+LAW = TruthLaw("gas_heat_transfer", "gas_spring", draw, plant=TruthThermalGas, group="benchmark")

@@ -1,0 +1,65 @@
+"""heave_reference, as generated: the heave signal is not the heave the compensator sees.
+
+Variant ``lever_arm`` (default): measured at a lever arm L, z_m = z + L sin(theta(t)), theta a
+synthetic pitch logged as column ``pitch`` [rad]; variant ``mru``: a motion reference unit with a
+gain error and a 2nd-order high-pass.  The candidate (fitted, :mod:`heavecomp.effects`) is a
+scaled, shifted heave less a lever arm times a pitch.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from heavecomp.benchmark.truth.base import Draw, TruthLaw
+
+
+def synthetic_pitch(t, amplitude, period, seed):
+    """A vessel pitch angle [rad]: narrow-band random (a sum of 12 components spread +-15 % around
+    ``period`` [s], random phases), rms ``amplitude`` [rad]."""
+    rng = np.random.default_rng(seed)
+    f = rng.uniform(0.85, 1.15, 12) / period
+    ph = rng.uniform(0, 2 * np.pi, 12)
+    th = np.sum(np.cos(2 * np.pi * f[:, None] * t[None, :] + ph[:, None]), axis=0)
+    return amplitude * th / np.sqrt(6.0)
+
+
+def heave_lever_arm(t, cols, lever_arm, pitch):
+    """Heave measured at a lever arm L [m] from the compensator: z_m = z + L sin(theta)."""
+    out = dict(cols)
+    out["heave"] = cols["heave"] + lever_arm * np.sin(pitch)
+    out["pitch"] = pitch
+    return out
+
+
+def heave_mru(t, cols, gain, corner=0.01):
+    """Heave from a motion reference unit with a gain error and a 2nd-order Butterworth high-pass at
+    ``corner`` [Hz] (its drift-free double integration)."""
+    from scipy.signal import butter, lfilter
+
+    b, a = butter(2, corner, btype="highpass", fs=1.0 / (t[1] - t[0]))
+    out = dict(cols)
+    out["heave"] = gain * lfilter(b, a, cols["heave"])
+    return out
+
+
+def misreference(t, cols, **parameters):
+    """The logged heave of a drawn lever arm (``lever_arm``, ``pitch_rms`` [rad], ``pitch_period`` [s],
+    ``pitch_seed``) or of a drawn MRU (``gain_error`` [-], ``corner`` [Hz])."""
+    if "lever_arm" in parameters:
+        p = parameters
+        return heave_lever_arm(t, cols, p["lever_arm"],
+                               synthetic_pitch(t, p["pitch_rms"], p["pitch_period"], p["pitch_seed"]))
+    return heave_mru(t, cols, 1.0 + parameters["gain_error"], parameters["corner"])
+
+
+def draw(rng, setting):
+    """``mru``: a gain 8-14 % low and a 0.005-0.015 Hz high-pass, size the gain error, at most 50 %;
+    else L 5-15 m, pitch rms 0.005-0.01 rad at 8-12 s, size L, at most 120 m."""
+    if setting.variant == "mru":
+        return Draw({"gain_error": -rng.uniform(0.08, 0.14), "corner": rng.uniform(0.005, 0.015)}, "gain_error", 0.5)
+    return Draw({"lever_arm": rng.uniform(5.0, 15.0), "pitch_rms": rng.uniform(0.005, 0.01),
+                 "pitch_period": rng.uniform(8.0, 12.0), "pitch_seed": int(rng.integers(2**31))}, "lever_arm", 120.0)
+
+
+LAW = TruthLaw("heave_reference", "heave_input", draw, output=misreference, on_heave=True,
+               variants=("lever_arm", "mru"))

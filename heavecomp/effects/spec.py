@@ -1,0 +1,182 @@
+"""``[[effects]]`` of a parameter file, checked against the effect classes; plant and reading effects.
+
+The params layer keeps the file's ``[[effects]]`` as raw ``(name, {parameter: value})`` specs
+(:mod:`heavecomp.params.effects`: it sits below the effects and cannot know them).  This module, in
+the effects layer, is where they become effects, strictly, like every other key of the file:
+
+- an unknown effect or parameter is a :class:`~heavecomp.errors.ParameterError` with a "did you mean";
+- every parameter is checked against its ``q()`` field (number, finite, bounds, unit in the message);
+- a channel effect (``sensor_gain``, ``sensor_offset``, ``sensor_delay``) must name its ``channel``
+  (one of :data:`heavecomp.effects.base.SENSOR_CHANNELS`); an effect without one must not;
+- a parameter may be left out only where the effect lists it as ``optional`` (it is then at its
+  null value, e.g. ``sensor_offset.drift = 0``); every other one is required.
+
+Who calls it: every command reads a parameter file with :func:`load` (``heavecomp.params.load`` plus
+:func:`check`), so a bad ``[[effects]]`` entry fails before any work; the API entries that use the
+effects (``simulate``, ``linearise``, the closed loop, ``load_run``) resolve ``params.effects`` with
+the same :func:`check` at their start.
+
+What the effects mean in a file: **plant** effects (``kind = "plant"``: terms at the plant's hooks)
+change the model every command simulates, linearises or controls.  **Reading** effects (a channel
+effect or ``heave_reference``) say how the rig's sensors misread; they do not change the plant:
+:func:`correct` undoes them when a measured log is read (:func:`heavecomp.diagnosis.data.load_run`),
+so the plant stays right and the log is read right.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from heavecomp.effects.base import ChannelEffect, Effect, HeaveEffect, SENSOR_CHANNELS
+from heavecomp.effects.discovered_term import DiscoveredTerm
+from heavecomp.effects.registry import library, resolve
+from heavecomp.errors import ParameterError, did_you_mean
+from heavecomp.params import load as load_params
+from heavecomp.params.core import check_value
+
+
+def classes() -> dict:
+    """name -> effect class of every effect a parameter file may name: the registry's, plus
+    ``discovered_term`` (the open search's term; not a candidate, not in the library composition)."""
+    return {**library(), DiscoveredTerm.name: DiscoveredTerm}
+
+
+def build(name: str, values: dict, where: str = "effects") -> Effect:
+    """One effect instance from a file entry, checked strictly (see the module docstring).
+
+    ``where`` prefixes the messages (``effects[0]``)."""
+    lib = classes()
+    if name not in lib:
+        raise ParameterError(f"{where}.name = {name!r}: unknown effect{did_you_mean(name, lib)}; known: "
+                             f"{', '.join(lib)}")
+    cls = lib[name]
+    if getattr(cls, "kind", "plant") == "nominal":  # pragma: no cover - no registered effect is one
+        raise ParameterError(f"{where}.name = {name!r}: a refit of the nominal parameters; write the values into "
+                             "their tables instead")
+    values = dict(values)
+    fields = {f.name: f for f in cls.fields()}
+    channel = values.pop("channel", None)
+    if issubclass(cls, ChannelEffect):
+        if channel is None:
+            raise ParameterError(f"{where}.channel: missing required key for effect {name!r} (one of "
+                                 f"{', '.join(SENSOR_CHANNELS)})")
+        if channel not in SENSOR_CHANNELS:
+            raise ParameterError(f"{where}.channel = {channel!r}: not a measured channel"
+                                 f"{did_you_mean(channel, SENSOR_CHANNELS)}; channels: {', '.join(SENSOR_CHANNELS)}")
+    elif channel is not None:
+        raise ParameterError(f"{where}.channel: effect {name!r} acts on no channel (it is a "
+                             f"{'heave input' if issubclass(cls, HeaveEffect) else 'plant'} effect); remove the key")
+    for key in values:
+        if key not in fields:
+            known = list(fields) + (["channel"] if issubclass(cls, ChannelEffect) else [])
+            raise ParameterError(f"{where}.{key}: unknown parameter of effect {name!r}{did_you_mean(key, known)}; "
+                                 f"parameters: {', '.join(known)}")
+    null = cls.null(None) if cls.optional else {}
+    checked = {}
+    for key, f in fields.items():
+        if key in values:
+            checked[key] = check_value(f"{where}.{key}", f, values[key])
+        elif key in cls.optional and key in (null or {}):
+            checked[key] = null[key]
+        else:
+            unit = f.metadata.get("unit", "")
+            raise ParameterError(f"{where}.{key}: missing required key of effect {name!r}"
+                                 + (f" [{unit}]" if unit and unit != "-" else ""))
+    return cls(channel=channel, **checked) if issubclass(cls, ChannelEffect) else cls(**checked)
+
+
+def check(params) -> list:
+    """The effect instances of ``params.effects`` (a file's ``[[effects]]``), checked strictly."""
+    return [build(name, values, f"effects[{i}]") for i, (name, values) in enumerate(getattr(params, "effects", ()))]
+
+
+def load(path):
+    """Read a parameter file (:func:`heavecomp.params.load`) and check its ``[[effects]]``: the
+    commands' reader; one-line :class:`ParameterError` for any bad key, before any work."""
+    params = load_params(path)
+    check(params)
+    return params
+
+
+def plant_effects(params) -> list:
+    """The plant effects of ``params``' ``[[effects]]`` (the terms at the plant's hooks), checked."""
+    return [e for e in check(params) if e.kind == "plant"]
+
+
+def reading_effects(params) -> list:
+    """The reading effects of ``params``' ``[[effects]]``: how the sensors misread (channel effects and
+    ``heave_reference``), checked; :func:`correct` undoes them on a log."""
+    return [e for e in check(params) if e.kind in ("output", "heave")]
+
+
+def effects_for(params, effects=None) -> list:
+    """The effect instances a model of ``params`` runs with: ``effects`` when given (instances, names or
+    ``(name, values)`` pairs, :func:`heavecomp.effects.registry.resolve`), else the plant effects of the
+    file's ``[[effects]]`` (its reading effects correct a log, not the plant: :func:`correct`)."""
+    return plant_effects(params) if effects is None else resolve(effects)
+
+
+def _undo_channel(e: ChannelEffect, t, y):
+    """The true channel from the reading ``y`` at times ``t`` of the channel effect ``e``."""
+    prm = e.prm
+    if getattr(e, "linear", False):  # affine reading y_meas = a0(t) + a1(t) y: invert it
+        a0 = e.apply(t, t, np.zeros_like(y), *prm)
+        a1 = e.apply(t, t, np.ones_like(y), *prm) - a0
+        if np.any(np.abs(a1) < 1e-12):
+            raise ParameterError(f"effect {e.name} on {e.channel}: a reading factor of 0 cannot be undone")
+        return (y - a0) / a1
+    if set(e.values) == {"delay"}:  # y_meas(t) = y(t - t_d): y(t) = y_meas(t + t_d), unknown past the log's end
+        d = float(e.values["delay"])
+        return np.interp(t + d, t, y, right=np.nan)
+    raise ParameterError(f"effect {e.name}: no inverse of its reading is known; it cannot correct a log")
+
+
+def correct(effects, t, columns: dict) -> tuple[dict, list]:
+    """Undo the reading effects ``effects`` (instances) on the measured ``columns`` at times ``t`` [s].
+
+    A channel effect's reading is inverted on its channel (gain and offset exactly, a delay by shifting
+    the channel back; its last t_d seconds become NaN, a dropout); ``heave_reference`` replaces the
+    measured heave by the heave the compensator sees (``seen``, less the lever arm times the logged
+    ``pitch`` when there is one).  Plant effects are ignored.
+
+    Returns
+    -------
+    (columns, notes) : the corrected columns (a new dict) and one line per correction, for the record.
+    """
+    t = np.asarray(t, dtype=float)
+    cols = dict(columns)
+    notes = []
+    for e in effects:
+        if isinstance(e, ChannelEffect):
+            if e.channel not in cols:
+                raise ParameterError(f"effect {e.name}: channel {e.channel!r} is not in the log")
+            cols[e.channel] = _undo_channel(e, t, np.asarray(cols[e.channel], dtype=float))
+            notes.append(f"{e.channel} corrected for {e!r}")
+        elif isinstance(e, HeaveEffect):
+            v = e.values
+            z = np.asarray(cols["heave"], dtype=float)
+            seen = e.seen(t, z, *[float(v[k]) for k in v if k not in e.angle_params])
+            L = float(v.get("lever_arm", 0.0))
+            if L:
+                if "pitch" not in cols:
+                    raise ParameterError(f"effect {e.name}: lever_arm = {L:g} m needs a logged 'pitch' column [rad]")
+                s = np.sin(np.asarray(cols["pitch"], dtype=float))
+                seen = seen - L * (s - s[np.flatnonzero(np.isfinite(s))[0]])
+            cols["heave"] = seen
+            notes.append(f"heave replaced by the heave the compensator sees, {e!r}")
+    return cols, notes
+
+
+def to_spec(effect: Effect) -> tuple:
+    """``(name, {parameter: value})`` of an instance (with its ``channel``), for a parameter file."""
+    vals = {k: float(v) for k, v in effect.values.items()}
+    if isinstance(effect, ChannelEffect):
+        vals = {"channel": effect.channel, **vals}
+    return effect.name, vals
+
+
+def field_units(name: str) -> dict:
+    """Parameter -> unit of the effect ``name`` (for comments and reports)."""
+    return {f.name: f.metadata.get("unit", "") for f in dataclasses.fields(classes()[name].Params)}

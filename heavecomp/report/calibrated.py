@@ -1,0 +1,87 @@
+"""The diagnosis' calibrated model in the outputs: ``calibrated.toml``, the ``calibrated`` block of
+``diagnosis.json`` (contract schema 3) and the report's "What next" section."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+from heavecomp.diagnosis.calibrate import FILE, Calibrated, write
+from heavecomp.effects.spec import field_units
+
+
+#: a refitted parameter that moved less than this share is listed as refit noise, not as a change to make
+SMALL = 0.02
+
+
+def _value(name: str, key: str, value) -> str:
+    if isinstance(value, str):
+        return f"{key} = {value}"
+    unit = field_units(name).get(key, "")
+    return f"{key} = {value:.4g}" + (f" {unit}" if unit and unit != "-" else "")
+
+
+def what_next(cal: Calibrated, out_dir, *, run_path: str = "LOG", params_path: str = "NOMINAL.toml") -> list[str]:
+    """Markdown lines of the "What next" section: what to change (the parameter, the effect, or
+    nothing), the calibrated file, and the exact commands that use it."""
+    out = Path(out_dir)
+    f = (out / FILE).as_posix()
+    lines = ["", "## What next", ""]
+    if not cal.changes:
+        lines.append(f"Nothing to change in `{params_path}`: {cal.why[0] if cal.why else 'no change'}. "
+                     f"`{f}` is that file, unchanged.")
+    params = sorted((c for c in cal.changes if c["kind"] == "parameter"), key=lambda c: -abs(math.log(c["ratio"])))
+    moved = [c for c in params if abs(c["ratio"] - 1.0) >= SMALL]
+    for c in moved:
+        lines.append(f"- Change `{c['name']}` from {c['from']:.6g} to **{c['to']:.6g}** (x {c['ratio']:.3f}).")
+    if len(moved) < len(params):
+        lines.append(f"- Refitted within {100 * SMALL:.0f} % (written too, so the file replays as the fit did): "
+                     + ", ".join(f"`{c['name']}` x {c['ratio']:.3f}" for c in params if c not in moved) + ".")
+    for c in cal.changes:
+        if c["kind"] == "parameter":
+            continue
+        elif c["role"] == "reading":
+            prm = dict(c["parameters"])
+            ch = prm.pop("channel", "heave")
+            lines.append(f"- The **{ch}** sensor misreads (`{c['name']}`: "
+                         + ", ".join(_value(c["name"], k, v) for k, v in prm.items())
+                         + "). Re-calibrate it on the rig, or keep the `[[effects]]` entry: it corrects every log read "
+                           "with this file; the plant is unchanged.")
+        else:
+            lines.append(f"- Add the effect **`{c['name']}`** to the model: "
+                         + ", ".join(_value(c["name"], k, v) for k, v in c["parameters"].items()) + ".")
+    if cal.changes:
+        lines += ["", f"`{f}` is `{params_path}` with these changes (expected held-out shrink of the gap "
+                      f"{cal.expected_shrink:.2f}); every command reads it:"]
+    else:
+        lines += ["", "Commands that use it:"]
+    lines += ["", "```",
+              f"heavecomp params {f}",
+              f"heavecomp simulate {f} --duration 600 --out {(out / 'calibrated_sim').as_posix()}",
+              f"heavecomp analyse {f} --out {(out / 'calibrated_analysis').as_posix()}",
+              f"heavecomp simulate {f} --duration 600 --controller linear-mpc "
+              f"--out {(out / 'calibrated_mpc').as_posix()}",
+              f"heavecomp diagnose {run_path} --params {f} --out {(out / 'rediagnosis').as_posix()}",
+              "```"]
+    if cal.changes:
+        lines += ["", "The last one checks the calibration: the re-diagnosis should read `none`, or a gap smaller by "
+                      "at least the expected shrink."]
+    return lines
+
+
+def write_calibrated(params, out_dir, *, run_path: str, params_path: str) -> Calibrated:
+    """Write ``out_dir/calibrated.toml`` from ``out_dir/diagnosis.json``, add the ``calibrated`` block to
+    ``diagnosis.json`` and the "What next" section to ``report.md``; returns the :class:`Calibrated`."""
+    out = Path(out_dir)
+    jpath = out / "diagnosis.json"
+    d = json.loads(jpath.read_text(encoding="utf-8"))
+    cal = write(params, d, out, source=f"{run_path} against {params_path}")
+    d["calibrated"] = cal.block(FILE)
+    jpath.write_text(json.dumps(d, indent=2) + "\n", encoding="utf-8")
+    md = out / "report.md"
+    if md.is_file():
+        md.write_text(md.read_text(encoding="utf-8").rstrip("\n") + "\n"
+                      + "\n".join(what_next(cal, out, run_path=run_path, params_path=params_path)) + "\n",
+                      encoding="utf-8")
+    return cal

@@ -1,0 +1,126 @@
+"""The calibrated model written from a verdict (issue 22 item 2): what each verdict kind writes."""
+
+from __future__ import annotations
+
+import pytest
+
+from heavecomp.diagnosis.calibrate import calibrate, to_toml
+from heavecomp.effects import spec
+from heavecomp.params import loads, paper_a
+
+NOM = paper_a()
+
+
+def _diag(effect, parameters=None, **verdict):
+    return {"verdict": {"effect": effect, "confidence": "high", "parameters": parameters or {}, "shrink": 0.6,
+                        "shrink_channel": "wob", **verdict}, "split": {"fit": [0, 100], "validate": [100, 150]}}
+
+
+def _round_trip(cal):
+    """The file as `heavecomp params` reads it: TOML text, parsed, [[effects]] checked."""
+    p = loads(to_toml(cal))
+    spec.check(p)
+    return p
+
+
+def test_none_and_inconclusive_write_the_nominal_and_say_why():
+    for eff, why in (("none", "agrees with this model"), ("inconclusive", "explains only 12 %")):
+        cal = calibrate(NOM, _diag(eff, note="best candidate flow_loss explains only 12 % of the held-out gap"))
+        assert cal.params == NOM and cal.changes == [] and cal.expected_shrink == 0.0
+        text = to_toml(cal)
+        assert why in text and f"verdict: {eff}" in text
+        assert _round_trip(cal) == NOM
+
+
+def test_a_plant_effect_becomes_an_effects_entry_with_the_fitted_values():
+    cal = calibrate(NOM, _diag("string_damping", {"damping": 4.7e4}))
+    assert cal.params.effects == (("string_damping", {"damping": 4.7e4}),)
+    assert cal.changes == [{"kind": "effect", "name": "string_damping", "role": "plant",
+                            "parameters": {"damping": 4.7e4}}]
+    assert cal.expected_shrink == 0.6
+    p = _round_trip(cal)
+    assert [e.name for e in spec.plant_effects(p)] == ["string_damping"]
+    # the rest of the model is the nominal's
+    assert p.replace(effects=()) == NOM
+
+
+def test_a_file_effect_refitted_is_replaced_not_doubled():
+    nom = NOM.replace(effects=[("string_damping", {"damping": 1e4})])
+    cal = calibrate(nom, _diag("string_damping", {"damping": 4.7e4}))
+    assert cal.params.effects == (("string_damping", {"damping": 4.7e4}),)
+
+
+def test_parameter_mismatch_writes_the_refitted_values_with_the_fit_clip():
+    fs, fc = NOM.friction.static_force, NOM.friction.coulomb_force
+    par = {"compensator.gas_stiffness": 1.3 * NOM.compensator.gas_stiffness, "friction.static_force": fs,
+           "friction.coulomb_force": 1.5 * fs, "drill_string.stiffness": NOM.drill_string.stiffness}
+    cal = calibrate(NOM, _diag("parameter_mismatch", par))
+    p = _round_trip(cal)
+    assert p.compensator.gas_stiffness == pytest.approx(1.3 * NOM.compensator.gas_stiffness)
+    assert p.friction.coulomb_force == fs  # F_C clipped to F_S, as ParameterMismatch.apply does
+    assert p.effects == ()
+    assert {c["name"] for c in cal.changes} == {"compensator.gas_stiffness", "friction.coulomb_force"}
+    assert fc != fs
+
+
+def test_a_sensor_effect_corrects_the_reading_and_leaves_the_plant():
+    cal = calibrate(NOM, _diag("sensor_gain", {"channel": "wob", "factor": 1.08}))
+    p = _round_trip(cal)
+    assert spec.plant_effects(p) == []
+    (e,) = spec.reading_effects(p)
+    assert (e.name, e.channel, e.values["factor"]) == ("sensor_gain", "wob", 1.08)
+    assert cal.changes[0]["role"] == "reading"
+    # heave_reference fitted without a logged angle: the lever arm is written at its null value
+    cal = calibrate(NOM, _diag("heave_reference", {"scale": 0.9, "delay": -0.2}))
+    (e,) = spec.reading_effects(_round_trip(cal))
+    assert e.values == {"scale": 0.9, "delay": -0.2, "lever_arm": 0.0}
+
+
+def test_a_discovered_friction_term_is_carried_as_discovered_term():
+    d = {"term": "1.9e3*sign(v)*(v>0)", "features": ["sign_v_pos"], "coefficients": {"sign_v_pos": 1.9e3},
+         "shrink": 0.6, "component": "friction"}
+    cal = calibrate(NOM, _diag("discovered", component="friction", discovered=d))
+    (e,) = spec.plant_effects(_round_trip(cal))
+    assert e.name == "discovered_term" and e.values["sign_v_pos"] == 1.9e3 and e.values["v"] == 0.0
+    assert cal.expected_shrink == 0.0 and cal.changes[0]["component_shrink"] == 0.6  # verdict.shrink is a candidate's
+    # a term elsewhere (no model form at its hook): the nominal, and the file says why
+    d = dict(d, component="gas_spring", features=["x"], coefficients={"x": 3e5}, term="3e5*(x - mean x)")
+    cal = calibrate(NOM, _diag("discovered", component="gas_spring", discovered=d))
+    assert cal.params == NOM and cal.changes == [] and "has no model form" in to_toml(cal)
+
+
+def test_a_second_effect_is_added_and_the_joint_shrink_expected():
+    diag = _diag("string_damping", {"damping": 4.7e4},
+                 second_effect={"effect": "pressure_friction", "parameters": {"extra_pressure_coefficient": 2e-3},
+                                "added_explained": 0.2, "shrink_joint": 0.8})
+    cal = calibrate(NOM, diag)
+    assert [n for n, _ in cal.params.effects] == ["string_damping", "pressure_friction"]
+    assert cal.expected_shrink == 0.8
+
+
+def test_values_that_cannot_make_a_valid_file_leave_the_nominal_and_say_why(tmp_path):
+    from heavecomp.diagnosis.calibrate import write
+
+    # a refit beyond the table's possible range (gas stiffness <= 1e8 N/m)
+    cal = write(NOM, _diag("parameter_mismatch", {"compensator.gas_stiffness": 5e8}), tmp_path)
+    assert cal.params == NOM and cal.changes == []
+    assert "compensator.gas_stiffness" in (tmp_path / "calibrated.toml").read_text()
+    # a fit a rounding beyond its bound is written at the bound
+    cal = calibrate(NOM, _diag("string_damping", {"damping": 2e6 * (1 + 1e-15)}))
+    assert cal.params.effects[0][1]["damping"] == 2e6
+
+
+def test_what_next_names_the_change_the_file_and_the_commands():
+    from heavecomp.report.calibrated import what_next
+
+    par = {"compensator.gas_stiffness": 0.6 * NOM.compensator.gas_stiffness,
+           "drill_string.stiffness": 1.001 * NOM.drill_string.stiffness}
+    text = "\n".join(what_next(calibrate(NOM, _diag("parameter_mismatch", par)), "out", run_path="log.csv",
+                               params_path="rig.toml"))
+    assert "Change `compensator.gas_stiffness`" in text and "Change `drill_string.stiffness`" not in text
+    assert "heavecomp diagnose log.csv --params out/calibrated.toml" in text
+    assert "heavecomp simulate out/calibrated.toml" in text and "--controller linear-mpc" in text
+    text = "\n".join(what_next(calibrate(NOM, _diag("sensor_gain", {"channel": "wob", "factor": 1.08})), "out"))
+    assert "**wob** sensor misreads" in text
+    text = "\n".join(what_next(calibrate(NOM, _diag("none")), "out", params_path="rig.toml"))
+    assert "Nothing to change in `rig.toml`" in text
