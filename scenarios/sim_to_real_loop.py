@@ -5,7 +5,7 @@ fault) the benchmark's truth plant (the generator's own truth law, never the can
 diagnosis fits) is run passively and logged as the generator logs it; the gap diagnosis names an effect
 and fits it; the calibrated model is the nominal plus what the verdict found; the frequency analysis
 compares the nominal and the calibrated model; and the linear MPC, designed on (i) the nominal model,
-(ii) the calibrated model and (iii) the true model, runs on the truth plant in the same irregular sea
+(ii) the calibrated model (``calibrated.toml``, :func:`heavecomp.diagnosis.calibrate.calibrate`) and (iii) the true model, runs on the truth plant in the same irregular sea
 with the same measurement noise.  ``recovered`` = (std_nominal - std_calibrated) / (std_nominal -
 std_true): the share of the WOB-std difference between the nominal and the true-model controller that
 the calibrated controller wins back (the goal is 0.8 on each plant effect).  For the sensor fault the
@@ -16,17 +16,18 @@ the set-point, which reading the measurement through the calibrated correction r
 from __future__ import annotations
 
 import logging
-import math
 import sys
 
 import numpy as np
 
 from heavecomp.analysis.summary import analyse
+from heavecomp.benchmark import Case, generate
+from heavecomp.benchmark.truth import TRUTH
+from heavecomp.benchmark.truth.sensor_gain import sensor_gain as truth_sensor_gain
 from heavecomp.closed_loop.loop import Noise, simulate_closed_loop
-from heavecomp.diagnosis.estimator import GapDiagnoser
-from heavecomp.diagnosis.generator import _case, generate_case
-from heavecomp.diagnosis.truth import TRUTH, first_order_lag, plant_truth
-from heavecomp.effects.registry import resolve
+from heavecomp.controllers import make
+from heavecomp.diagnosis.calibrate import calibrate, diagnoser
+from heavecomp.effects.spec import check
 from heavecomp.effects.sensor_gain import SensorGain
 from heavecomp.report.figures import save
 from heavecomp.report.scenario import md_table, parse_args, run, write_metrics, write_report
@@ -50,9 +51,10 @@ SEA = {"kind": "jonswap", "hs": 2.0, "tp": 12.0, "gamma": 3.3, "seed": 7, "ampli
 WAVE_PERIODS = ("5", "8", "12", "16", "20")
 
 
-class TruthWobSensor(SensorGain):
-    """The generator's WOB sensor truth law online: y_meas = g LP(y), a first-order lag of
-    ``bandwidth`` [Hz] (:func:`heavecomp.diagnosis.truth.sensor_gain`), read on the channel's history."""
+class TruthSensorGain(SensorGain):
+    """The benchmark's sensor_gain truth law online, y_meas = g LP(y) behind a first-order lag of
+    ``bandwidth`` [Hz] (:func:`heavecomp.benchmark.truth.sensor_gain.sensor_gain`, the law's own
+    function), read on the channel's history so far."""
 
     bandwidth = 5.0
 
@@ -60,16 +62,17 @@ class TruthWobSensor(SensorGain):
     def apply(t, tg, y, factor):
         if tg.size < 2:
             return factor * np.interp(t, tg, y)
-        lagged = first_order_lag(tg, y, 1.0 / (2 * math.pi * TruthWobSensor.bandwidth))
-        return factor * np.interp(t, tg, lagged)
+        lagged = truth_sensor_gain(tg, {"y": y}, "y", factor, TruthSensorGain.bandwidth)["y"]
+        return np.interp(t, tg, lagged)
 
 
 def truth_effects(name: str, parameters: dict) -> list:
-    """The truth plant's effects: the generator's truth-law instance with its planted parameters."""
+    """The truth plant's effects: the benchmark's truth-law instance with its planted parameters."""
     if name == "sensor_gain":
-        return [TruthWobSensor(channel=parameters["channel"], factor=1.0 + parameters["gain_error"])]
-    cls = TRUTH.get(name) or plant_truth(name)
-    return [cls(**parameters)]
+        e = TruthSensorGain(channel=parameters["channel"], factor=1.0 + parameters["gain_error"])
+        e.bandwidth = parameters.get("bandwidth", TruthSensorGain.bandwidth)
+        return [e]
+    return [TRUTH[name](**parameters)]
 
 
 def true_model(name: str, parameters: dict) -> tuple[list, str]:
@@ -84,18 +87,10 @@ def true_model(name: str, parameters: dict) -> tuple[list, str]:
     return truth_effects(name, parameters), "the truth law itself (traced by casadi like a library effect)"
 
 
-def calibrated_effects(verdict: dict) -> tuple[list, str]:
-    """``(effects, what)``: the calibrated model's effects from a verdict (``diagnosis.json``'s
-    ``verdict``), the shape of ``calibrated.toml``'s ``[[effects]]``: a named effect (plant or sensor)
-    with its fitted values, a second effect likewise; ``none`` / ``inconclusive``: nothing."""
-    fx = []
-    for v in (verdict, verdict.get("second_effect") or {}):
-        name = v.get("effect")
-        if name and name not in ("none", "inconclusive", "parameter_mismatch", "discovered"):
-            fx.append((name, dict(v.get("parameters") or {})))
-    what = ", ".join(f"{n}({', '.join(f'{k}={x:.4g}' if not isinstance(x, str) else f'{k}={x}' for k, x in vals.items())})"
-                     for n, vals in fx) or f"nominal ({verdict.get('effect')})"
-    return fx, what
+def _describe(specs) -> str:
+    """One line for a model's ``[[effects]]`` specs."""
+    return ", ".join(f"{n}({', '.join(f'{k}={x:.4g}' if not isinstance(x, str) else f'{k}={x}' for k, x in v.items())})"
+                     for n, v in specs) or "nominal"
 
 
 def _analysis(params, effects) -> dict:
@@ -116,27 +111,33 @@ def _loop_metrics(res, W0: float) -> dict:
 
 def loop_one(name: str, *, seed: int, log_duration: float, loop_duration: float, progress=None) -> dict:
     """The loop for one withheld effect (module docstring); returns its metrics and the three runs."""
-    tr = generate_case(_case(name, seed, "named", duration=log_duration, variant="wob" if name == "sensor_gain" else None))
+    tr = generate(Case(name, seed, "named", duration=log_duration, variant="wob" if name == "sensor_gain" else None))
     nominal = tr.nominal
     planted = tr.truth["parameters"][name]
-    d = GapDiagnoser(nominal, None, n_jobs=1)
+    # diagnose, as the command does: the gap diagnosis, then calibrated.toml's model (calibrate)
+    d = diagnoser(nominal, None, n_jobs=1)
     d.fit(tr.to_run())
     v = d.verdict_
-    cal_fx, cal_what = calibrated_effects(v)
-    cal_plant = [e for e in resolve(cal_fx) if e.kind == "plant"]
+    cal = calibrate(nominal, d.to_json())
+    cal_fx = check(cal.params)  # plant effects and reading corrections, as instances
+    cal_what = _describe(cal.params.effects)
+    if cal.params.replace(effects=()) != nominal.replace(effects=()):
+        cal_what += "; refitted: " + ", ".join(c["name"] for c in cal.changes if c.get("kind") == "parameter")
     true_fx, true_what = true_model(name, planted)
     true_plant = [e for e in true_fx if e.kind == "plant"]
-    ana = {"nominal": _analysis(nominal, ()), "calibrated": _analysis(nominal, cal_plant),
+    ana = {"nominal": _analysis(nominal, ()), "calibrated": _analysis(cal.params, None),
            "true": _analysis(nominal, true_plant)}
     p = nominal.replace(heave=SEA)
     W0 = p.operating_point.wob_setpoint
     truth_fx = truth_effects(name, planted)
+    models = {"nominal": (p, ()), "calibrated": (cal.params.replace(heave=SEA), cal_fx), "true": (p, true_fx)}
     runs, loops = {}, {}
     controllers = (CONTROLLER, "nonlinear-mpc") if name in NONLINEAR else (CONTROLLER,)
     for ctrl in controllers:
         loops[ctrl] = {}
-        for label, known in (("nominal", ()), ("calibrated", cal_fx), ("true", true_fx)):
-            res = simulate_closed_loop(p, ctrl, loop_duration, effects=truth_fx, controller_effects=known,
+        for label, (mp, known) in models.items():
+            # the controller designed on its model (parameters and effects); the plant is the truth
+            res = simulate_closed_loop(p, make(ctrl, mp, effects=known), loop_duration, effects=truth_fx,
                                        noise=Noise(seed=seed))
             runs[label] = res  # the figure shows the last controller's runs
             loops[ctrl][label] = _loop_metrics(res, W0)
@@ -149,6 +150,7 @@ def loop_one(name: str, *, seed: int, log_duration: float, loop_duration: float,
            "verdict": {"effect": v["effect"], "confidence": v["confidence"], "shrink": v["shrink"],
                        "parameters": v.get("parameters", {}),
                        "second_effect": (v.get("second_effect") or {}).get("effect")},
+           "calibrated": cal.block(), 
            "calibrated_model": cal_what, "true_model": true_what, "analysis": ana, "controller": controller,
            "loop": loop, "loops": loops,
            "std_difference_true": den,
