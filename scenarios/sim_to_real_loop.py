@@ -40,6 +40,7 @@ EFFECTS = {
     "gas_heat_transfer": ("gas", "thermal gas state: adiabatic compression, Newton heat exchange (tau_th)"),
     "string_damping": ("string", "quadratic drag c_q dv|dv| in the string tension"),
     "sensor_gain": ("sensor fault", "WOB load cell: g x its own 5 Hz first-order lag"),
+    "gas_leak": ("gas", "laminar leak of the gas mass fraction (1-3 % of the charge over the log)"),
 }
 CONTROLLER = "linear-mpc"
 #: effects whose truth the linear MPC cannot see: a quadratic drag has no slope at rest, so the linear
@@ -143,8 +144,6 @@ def loop_one(name: str, *, seed: int, log_duration: float, loop_duration: float,
             loops[ctrl][label] = _loop_metrics(res, W0)
     controller = controllers[-1]
     loop = loops[controller]
-    num = loop["nominal"]["wob_std"] - loop["calibrated"]["wob_std"]
-    den = loop["nominal"]["wob_std"] - loop["true"]["wob_std"]
     out = {"kind": EFFECTS[name][0], "truth_law": EFFECTS[name][1], "planted": planted,
            "gap_to_noise": tr.truth["gap_to_noise"][name],
            "verdict": {"effect": v["effect"], "confidence": v["confidence"], "shrink": v["shrink"],
@@ -153,12 +152,32 @@ def loop_one(name: str, *, seed: int, log_duration: float, loop_duration: float,
            "calibrated": cal.block(), 
            "calibrated_model": cal_what, "true_model": true_what, "analysis": ana, "controller": controller,
            "loop": loop, "loops": loops,
-           "std_difference_true": den,
-           "recovered": num / den if abs(den) > 0 else None}
-    if name == "sensor_gain":
-        e = {k: abs(loop[k]["wob_mean_error"]) for k in loop}
-        out["mean_error_removed"] = 1.0 - e["calibrated"] / e["nominal"] if e["nominal"] > 0 else None
-    return {"metrics": out, "runs": runs, "W0": W0}
+           }
+    return {"metrics": summarise(out), "runs": runs, "W0": W0}
+
+
+#: the true-model controller's WOB std must differ from the nominal one's by this share of it for
+#: ``recovered`` to mean something (below it the difference is the size of a re-run's spread) [-]
+MEANINGFUL = 0.02
+
+
+def summarise(m: dict) -> dict:
+    """``m`` with ``recovered`` per controller (``recovered_by_controller``; ``recovered``: the linear
+    MPC's), ``std_difference_true`` [N], ``meaningful`` (the true model is worth at least
+    :data:`MEANINGFUL` of the nominal std, and helps) and, for a sensor fault, ``mean_error_removed``."""
+    rec, diff = {}, {}
+    for ctrl, L in m["loops"].items():
+        den = L["nominal"]["wob_std"] - L["true"]["wob_std"]
+        diff[ctrl] = den
+        rec[ctrl] = (L["nominal"]["wob_std"] - L["calibrated"]["wob_std"]) / den if den != 0 else None
+    L = m["loops"][CONTROLLER]
+    m.update(recovered_by_controller=rec, std_difference_by_controller=diff, recovered=rec[CONTROLLER],
+             std_difference_true=diff[CONTROLLER],
+             meaningful=bool(diff[CONTROLLER] >= MEANINGFUL * L["nominal"]["wob_std"]))
+    if m["kind"] == "sensor fault":
+        e = {k: abs(x["wob_mean_error"]) for k, x in L.items()}
+        m["mean_error_removed"] = 1.0 - e["calibrated"] / e["nominal"] if e["nominal"] > 0 else None
+    return m
 
 
 def build(quick: bool = False, seed: int = 110) -> dict:
@@ -201,16 +220,18 @@ def main(argv=None) -> int:
 
 def write(r: dict, out, quick: bool) -> None:
     """metrics.json, wob_loop.png and report.md (+ html) in ``out`` from :func:`build`'s result."""
-    M = {n: e["metrics"] for n, e in r["effects"].items()}
+    M = {n: summarise(e["metrics"]) for n, e in r["effects"].items()}
     save(_figure(r, "WOB on the truth plant, last 60 s: the MPC designed on the nominal, calibrated and true model"),
          out / "wob_loop.png", dpi=100)
     rows = []
     for n, m in M.items():
-        for label in ("nominal", "calibrated", "true"):
-            x = m["loop"][label]
-            rows.append((n, m["controller"], label, x["wob_std"] / 1e3, x["wob_p2p"] / 1e3, x["wob_mean_error"] / 1e3, x["u_rms"] / 1e3,
-                         100 * x["u_max_used"], 100 * x["saturated_share"],
-                         (f"{m['recovered']:.2f}" if m["recovered"] is not None else "-") if label == "calibrated" else ""))
+        for ctrl, L in m["loops"].items():
+            rec = m["recovered_by_controller"][ctrl]
+            for label in ("nominal", "calibrated", "true"):
+                x = L[label]
+                rows.append((n, ctrl, label, x["wob_std"] / 1e3, x["wob_p2p"] / 1e3, x["wob_mean_error"] / 1e3,
+                             x["u_rms"] / 1e3, 100 * x["u_max_used"], 100 * x["saturated_share"], x["violations"],
+                             (f"{rec:.2f}" if rec is not None else "-") if label == "calibrated" else ""))
     verdicts = [(n, m["kind"], m["truth_law"], f"{m['gap_to_noise']:.3g}", m["verdict"]["effect"], m["verdict"]["confidence"],
                  m["calibrated_model"], m["true_model"]) for n, m in M.items()]
     ana_rows = [(n, label, a["k_eff_dc"] / 1e3, ", ".join(f"{f:.3g}" for f in a["natural_frequencies"]),
@@ -234,22 +255,44 @@ def write(r: dict, out, quick: bool) -> None:
                 "nominal one (its numbers are in metrics.json, `loops`); the nonlinear MPC carries the drag over "
                 "its horizon.",
                 md_table(["effect", "controller", "designed on", "WOB std [kN]", "WOB p2p [kN]", "mean WOB error [kN]",
-                          "rms force [kN]", "peak force [% of u_max]", "steps at a limit [%]", "recovered"], rows,
+                          "rms force [kN]", "peak force [% of u_max]", "steps at a limit [%]", "commands beyond a limit",
+                          "recovered"], rows,
                          fmt="{:.3g}"),
                 "![WOB per controller](wob_loop.png)"]
     findings = []
     for n, m in M.items():
-        L = m["loop"]
-        if n == "sensor_gain":
-            findings.append(f"- {n}: mean WOB error {L['nominal']['wob_mean_error'] / 1e3:.3g} kN with the nominal "
-                            f"controller, {L['calibrated']['wob_mean_error'] / 1e3:.3g} kN calibrated, "
-                            f"{L['true']['wob_mean_error'] / 1e3:.3g} kN true.")
+        L = m["loops"][CONTROLLER]
+        kn = {k: x["wob_std"] / 1e3 for k, x in L.items()}
+        line = (f"- {n} (verdict {m['verdict']['effect']}): WOB std with the linear MPC designed on the nominal / "
+                f"calibrated / true model {kn['nominal']:.3g} / {kn['calibrated']:.3g} / {kn['true']:.3g} kN")
+        if m["kind"] == "sensor fault":
+            e = {k: x["wob_mean_error"] / 1e3 for k, x in L.items()}
+            line += (f"; the controller's own error, the mean WOB off the set-point, {e['nominal']:.3g} / "
+                     f"{e['calibrated']:.3g} / {e['true']:.3g} kN: reading the WOB through the diagnosed gain removes "
+                     f"{100 * m['mean_error_removed']:.0f} % of it.")
+        elif not m["meaningful"]:
+            line += (f": the true model is worth {m['std_difference_true'] / 1e3:.2g} kN of std, under "
+                     f"{100 * MEANINGFUL:.0f} % of the nominal's, so `recovered` "
+                     f"({'-' if m['recovered'] is None else format(m['recovered'], '.2f')}) means nothing here")
+            for ctrl, rec in m["recovered_by_controller"].items():
+                if ctrl != CONTROLLER:
+                    Lc = m["loops"][ctrl]
+                    line += (f"; with the {ctrl}: {Lc['nominal']['wob_std'] / 1e3:.3g} / {Lc['calibrated']['wob_std'] / 1e3:.3g}"
+                             f" / {Lc['true']['wob_std'] / 1e3:.3g} kN ({Lc['true']['violations']} commands beyond a "
+                             "limit with the true model)")
+            line += "."
         else:
-            rec = "n/a" if m["recovered"] is None else f"{m['recovered']:.2f}"
-            findings.append(f"- {n}: WOB std nominal {L['nominal']['wob_std'] / 1e3:.3g} kN, calibrated "
-                            f"{L['calibrated']['wob_std'] / 1e3:.3g} kN, true {L['true']['wob_std'] / 1e3:.3g} kN; "
-                            f"recovered {rec} (the true model is worth {m['std_difference_true'] / 1e3:.3g} kN of std).")
-    sections += ["## Findings", "\n".join(findings)]
+            line += f": recovered {m['recovered']:.2f} of the {m['std_difference_true'] / 1e3:.2g} kN the true model is worth."
+        findings.append(line)
+    sections += ["## Findings", "\n".join(findings),
+                 "Where the true model is worth little: the MPCs' observer estimates a force disturbance at the "
+                 "control rate, and a gas-law error (a thermal state relaxing in seconds, a charge leaking over "
+                 "minutes) is slow against it, so most of it is absorbed there whether the model knows the law or "
+                 "not. A quadratic drag has no slope at rest, where the linear MPC linearises its model, so that "
+                 "model is the nominal one; the nonlinear MPC that carries the non-smooth drag over its horizon does "
+                 "worse than the nominal one. The candidate the diagnosis fits instead, a linear dashpot, is a damping "
+                 "the linearisation keeps, and it helps both MPCs. Effects keep the benchmark's own sizes (the "
+                 "generator's draw, sized only to be detectable in the passive log); none is enlarged here."]
     write_metrics(out, {"effects": M, "controller": CONTROLLER, "log_duration": r["log_duration"],
                              "loop_duration": r["loop_duration"], "seed": r["seed"], "quick": quick,
                              "goal": {"recovered_min": 0.8}})
