@@ -30,4 +30,4 @@ def test_sim_to_real_loop_quick(tmp_path):
         for x in e["loop"].values():
             assert x["violations"] == 0 and x["u_max_used"] <= 1.0 + 1e-9
     assert (tmp_path / "wob_loop.png").exists() and (tmp_path / "report.html").exists()
-    assert "| pressure_friction | calibrated |" in (tmp_path / "report.md").read_text()
+    assert "| pressure_friction | linear-mpc | calibrated |" in (tmp_path / "report.md").read_text()
