@@ -28,6 +28,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "params": ("heavecomp.commands.params", "write or check a parameter file (built-in sets: paper_a, ...)"),
     "analyse": ("heavecomp.commands.analyse", "linear analysis: k_eff_dc, natural frequencies, heave -> WOB frequency response"),
     "diagnose": ("heavecomp.commands.diagnose", "sim-to-real gap diagnosis of a measured run (which unmodelled effect)"),
+    "monitor": ("heavecomp.commands.monitor", "monitor a long log: when and where the sim-to-real gap appears or changes"),
     "campaign": ("heavecomp.commands.campaign", "run a sea-state campaign: WOB exceedance over a scatter diagram"),
     "stickslip": ("heavecomp.commands.stickslip", "paper B pneumatic cylinder: stick-slip analysis, simulation, map"),
     "identify": ("heavecomp.commands.identify", "identify from measured data: EMPS axis (+ residual diagnosis) or seal friction vs pressure"),
@@ -91,7 +92,18 @@ def _unknown_arguments(parser, args, extra) -> str:
 
 def build_parser(only: str | None = None) -> tuple[argparse.ArgumentParser, dict]:
     """The parser; with ``only`` the arguments of that command alone (the others' modules,
-    which import the library, are not loaded: ``heavecomp --help`` stays fast)."""
+    which import the library, are not loaded: ``heavecomp --help`` stays fast).
+
+    Parameters
+    ----------
+    only : str or None
+        The command whose module is loaded (None: all of them).
+
+    Returns
+    -------
+    (argparse.ArgumentParser, dict)
+        The parser and command name -> its loaded module.
+    """
     parser = _Parser(
         prog="heavecomp",
         description="heavecomp: heave compensation of offshore drilling rigs "
@@ -113,6 +125,19 @@ def build_parser(only: str | None = None) -> tuple[argparse.ArgumentParser, dict
 
 
 def main(argv: list[str] | None = None) -> int:
+    """Run the command line ``argv`` and return its exit code.
+
+    Parameters
+    ----------
+    argv : list of str or None
+        The arguments after ``heavecomp`` (None: ``sys.argv[1:]``).
+
+    Returns
+    -------
+    int
+        The command's code: 0 on success, 2 for bad input (one line on stderr), the no-space code of
+        :mod:`heavecomp.report.output` for a disk that filled, 130 when interrupted.
+    """
     words = list(sys.argv[1:] if argv is None else argv)
     parser, modules = build_parser(next((w for w in words if not w.startswith("-")), ""))
     _Parser.argv = words
@@ -165,7 +190,21 @@ def message(exc: InputError, leaf: argparse.ArgumentParser | None = None, args=N
     the option's name (``duration must be ...``) or with its value (``/data/run: holds ...``) starts
     with the flag instead, ``name = `` inside it becomes ``--name = ``, and ``exc.example`` is added
     as ``; use --units t=ms``.  A flag the command lacks is never suggested.  The staging folder
-    (``.DIR.partial``) is shown as the ``--out`` the user gave."""
+    (``.DIR.partial``) is shown as the ``--out`` the user gave.
+
+    Parameters
+    ----------
+    exc : heavecomp.errors.InputError
+        The library's error.
+    leaf : argparse.ArgumentParser or None
+        The parser of the command that ran (its flags are the ones that may be named); None: no flag.
+    args : argparse.Namespace or None
+        The parsed arguments (the values a message may start with, ``out_final``).
+
+    Returns
+    -------
+    str
+    """
     msg = str(exc).strip().replace("\n", " ")
     final = getattr(args, "out_final", None) if args is not None else None
     if final:

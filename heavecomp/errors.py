@@ -19,6 +19,15 @@ class InputError(ValueError):
     value for it (``"t=ms"``).  The command line turns them into its own flag, when the command
     has one: ``duration must be ...`` becomes ``--duration must be ...``, and a hint such as
     ``; use --units t=ms`` is added (:func:`heavecomp.cli.message`).
+
+    Parameters
+    ----------
+    *args : str
+        The message (one line), as for ``ValueError``.
+    option : str or tuple of str or None
+        The library argument(s) that carry the bad value or would fix it.
+    example : str or None
+        A value for ``option`` that the hint shows.
     """
 
     def __init__(self, *args, option: str | tuple[str, ...] | None = None, example: str | None = None):

@@ -74,7 +74,7 @@ def test_dwell_stiction_lengthens_sticking():
 
 def test_thermal_gas_at_rest_relaxes_to_the_isothermal_pressure():
     """Truth thermal model: stuck at rest the gas temperature relaxes to the wall's (theta -> 1)."""
-    p = paper_a().replace(heave={"amplitude": 1e-6})  # essentially no heave: stays stuck at s = 0
+    p = paper_a().replace(heave={"amplitude": 0.0})  # no heave: stays stuck at s = 0
     r = simulate_fx(p, 20.0, [TruthThermalGas(gamma=1.4, tau_th=2.0)], rate=50.0,
                     comp=truth_composition())
     assert np.all(r["stuck"] == 1.0)

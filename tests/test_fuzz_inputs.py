@@ -258,6 +258,8 @@ def measured_runs(draw):
         tab.refuse = "column 't'"  # too few samples or too short a span, whichever is met first
     elif defect == "gap":
         tab.refuse = "without samples"
+    elif defect == "inf_cell":  # the contract: non-finite values are an error (issue 21: was a dropout)
+        tab.refuse = "non-finite value"
     elif defect in ("dup_timestamp", "backwards"):
         tab.refuse = "not strictly increasing"
     if units in ("rig_undeclared", "ms_undeclared") and tab.refuse is None:

@@ -40,6 +40,7 @@ LAYER_OF = {
     "heavecomp.identification": "analysis",
     "heavecomp.benchmark": "analysis",        # the withheld-effect benchmark: checks diagnosis, beside it
     "heavecomp.estimator": "analysis",        # base of the gap diagnosers
+    "heavecomp.benchmark": "analysis",        # generated truth: withheld effects, corrupted logs
     "heavecomp.report": "report",
     # the wings (paper B's pneumatic cylinder, paper A's rotating-piston rig) keep the same order
     "heavecomp.pneumatic.friction": "physics",

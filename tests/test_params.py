@@ -452,3 +452,65 @@ def test_tangential_velocity_zero_means_no_rotation_and_a_tiny_one_is_refused():
     assert paper_a("rotating_eq7").replace(friction={"tangential_velocity": 0.0}).friction.tangential_velocity == 0.0
     with pytest.raises(ParameterError, match=r"^friction.tangential_velocity = 0.0005 m/s: use 0 .* is it in mm/s"):
         paper_a("rotating_eq7").replace(friction={"tangential_velocity": 5e-4})
+
+
+# ---- issue 21 item 5: no traceback on any TOML, heave.path named, a sea beyond the stroke ----------------------
+
+REPRO = __import__("pathlib").Path(__file__).parent / "data" / "corrupt_2026_11"
+
+
+@pytest.mark.parametrize("name,key", [
+    ("P5_deep_inline_table_500", "nested too deep"),
+    ("P6_heave_path_empty", "heave.path"),
+    ("P6b_heave_path_devnull", "heave.path"),
+    ("P7_hs_16m_hexint", "heave.hs"),
+    ("P8_amplitude_mm_as_m", "heave.amplitude"),
+    ("P8b_amplitude_5e-324", "heave.amplitude"),
+])
+def test_reproducers_of_issue_21_are_one_line(capsys, name, key):
+    _assert_one_line(*_main(["params", REPRO / f"{name}.toml"], capsys), key)
+
+
+@pytest.mark.parametrize("nest", ["{a = ", "["])
+def test_any_nesting_depth_is_one_line_or_valid(tmp_path, capsys, nest):
+    close = "}" if nest.startswith("{") else "]"
+    for depth in (10, 2000, 20000):
+        f = tmp_path / "deep.toml"
+        f.write_text(f"deep = {nest * depth}1{close * depth}\n" + CONTRACT_EXAMPLE)
+        code, err = _main(["params", f], capsys)
+        assert code == 2 and len(err.splitlines()) == 1 and "Traceback" not in err, err
+
+
+@pytest.mark.parametrize("path,fragment", [("", "empty"), ("/dev/null", "not a regular file"), (".", "a folder"),
+                                           ("missing.csv", "file not found"), ("empty.csv", "empty file")])
+def test_heave_path_is_checked_when_the_file_is_read(tmp_path, capsys, path, fragment):
+    (tmp_path / "empty.csv").write_text("")
+    f = _bad_file(tmp_path, 'kind = "sine"\namplitude = 1.0\nperiod = 12.0\n', f'kind = "file"\npath = "{path}"\n',
+                  CONTRACT_EXAMPLE.replace("ramp = 24.0\n", ""))
+    code, err = _main(["params", f], capsys)
+    _assert_one_line(code, err, "heave.path")
+    assert fragment in err
+
+
+def test_heave_file_that_exists_passes(tmp_path):
+    (tmp_path / "h.csv").write_text("t,heave\n0,0\n1,0.1\n2,0\n")
+    f = _bad_file(tmp_path, 'kind = "sine"\namplitude = 1.0\nperiod = 12.0\n', 'kind = "file"\npath = "h.csv"\n',
+                  CONTRACT_EXAMPLE.replace("ramp = 24.0\n", ""))
+    assert load(f).heave.path == "h.csv"
+
+
+@pytest.mark.parametrize("sea,key,ok", [
+    ('kind = "sine"\namplitude = 3.8\nperiod = 12.0\n', "heave.amplitude", True),    # 7.6 m crest to trough
+    ('kind = "sine"\namplitude = 3.9\nperiod = 12.0\n', "heave.amplitude", False),   # 7.8 m: past a 25 ft stroke
+    ('kind = "jonswap"\nhs = 4.0\ntp = 12.0\n', "heave.hs", True),                   # largest wave 7.44 m
+    ('kind = "jonswap"\nhs = 4.2\ntp = 12.0\n', "heave.hs", False),                  # largest wave 7.81 m
+    ('kind = "sine"\namplitude = 0.0\nperiod = 12.0\n', "heave.amplitude", True),    # no heave: valid
+    ('kind = "sine"\namplitude = 0.009\nperiod = 12.0\n', "heave.amplitude", False),  # under 1 cm
+])
+def test_the_heave_stays_within_the_longest_stroke(tmp_path, capsys, sea, key, ok):
+    f = _bad_file(tmp_path, 'kind = "sine"\namplitude = 1.0\nperiod = 12.0\n', sea)
+    code, err = _main(["params", f], capsys)
+    if ok:
+        assert code == 0, err
+    else:
+        _assert_one_line(code, err, key)

@@ -14,7 +14,9 @@ sea, or measured buoy heave through a vessel RAO), the channels get white measur
 nominal parameter set varies between runs (:func:`parameter_sets`).  Plus runs with no effect and
 with two effects.  The sets: :func:`benchmark_cases` (the benchmark's own runs) and
 :func:`validation_cases` (the tuning and scoring sets of ``scenarios/diagnosis_validation.py``).
-A generated run can be post-processed into a corrupted log (:func:`corrupt`).
+A generated run can be post-processed with sampling jitter and dropouts (:func:`corrupt`), and its
+arrays into a corrupted log of one of the classes the input checks must catch
+(:mod:`heavecomp.benchmark.corruption`: frozen, spikes, time base, clock skew, torn, non-finite, ...).
 """
 
 from heavecomp.benchmark.case import (benchmark_case, benchmark_cases, Case, CASES, NEW_EFFECTS, parameter_sets,

@@ -159,6 +159,13 @@ def benchmark_cases(quick=False, seed0=1000):
     Returns
     -------
     list of Case
+
+    Parameters
+    ----------
+    quick : bool
+        Three 120 s runs instead of the full set.
+    seed0 : int
+        Seed of the first case; the others count up from it.
     """
     if quick:
         return [benchmark_case(e, seed=s, duration=120.0, param_set=p)

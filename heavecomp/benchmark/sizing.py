@@ -12,7 +12,17 @@ NEAR_NOISE = (1.2, 2.0)  #: near-noise runs: the effect's largest channel gap ov
 
 
 def energy(g):
-    """Squared noise-normalised gap summed over the channels [-]."""
+    """Squared noise-normalised gap summed over the channels [-].
+
+    Parameters
+    ----------
+    g : dict
+        Channel -> the effect's own gap over the noise floor (rms ratio) [-].
+
+    Returns
+    -------
+    float [-]
+    """
     return float(sum(v * v for v in g.values()))
 
 

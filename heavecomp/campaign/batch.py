@@ -155,7 +155,22 @@ def check_budget(campaign, runs, base=None) -> None:
     """Refuse, before any chunk runs, a campaign whose runs or chunks cannot fit the run-size budget
     (:mod:`heavecomp.params.budget`): per run its RK4 steps, per chunk the heave samples of its
     ``chunk_size`` runs, which a chunk holds at once (twice: as generated and padded into one array).
-    Raises a one-line :class:`ParameterError`."""
+    Raises a one-line :class:`ParameterError`.
+
+    Parameters
+    ----------
+    campaign : heavecomp.campaign.spec.Campaign
+        The campaign (its settings, regimes and variants).
+    runs : list of heavecomp.campaign.spec.Run
+        The runs to check (one parameter set per regime and variant).
+    base : heavecomp.params.CMCParams or None
+        The base parameter set, when the caller already built it (None: ``campaign.base_params()``).
+
+    Raises
+    ------
+    heavecomp.errors.ParameterError
+        A run over the run-size budget, or a chunk whose heave samples exceed :data:`MAX_BYTES`.
+    """
     s = campaign.settings
     base = base if base is not None else campaign.base_params()
     longest = 0
@@ -180,7 +195,24 @@ def check_budget(campaign, runs, base=None) -> None:
 
 
 def prepare(campaign, runs, base=None):
-    """Per-run arrays for the compiled driver (parameters, steps, heave samples)."""
+    """Per-run arrays for the compiled driver (parameters, steps, heave samples).
+
+    Parameters
+    ----------
+    campaign : heavecomp.campaign.spec.Campaign
+        The campaign (its settings, regimes and variants).
+    runs : list of heavecomp.campaign.spec.Run
+    base : heavecomp.params.CMCParams or None
+        The base parameter set, when the caller already built it (None: ``campaign.base_params()``).
+
+    Returns
+    -------
+    dict
+        Arrays over the runs: plant codes and vectors (``codes``, ``FPs``, ``PPs``, ``smooth``), step
+        ``hsteps`` [s], ``nsteps``, ``out_every``, statistics start ``t_stat`` [s], setpoint ``W0`` [N],
+        band half width ``half`` [N], heave ``Zs`` [m], ``DZs`` [m/s], ``DDZs`` [m/s^2] (padded to a
+        common length), and the fade-in's end ``kink_step``, ``ddz_left`` [m/s^2].
+    """
     s = campaign.settings
     base = base if base is not None else campaign.base_params()
     n = len(runs)
@@ -233,12 +265,46 @@ def prepare(campaign, runs, base=None):
 
 def jonswap_samples(hs, tp, gamma, seed, ramp, duration, spacing, spectra=None):
     """:func:`heavecomp.simulate.excitation.jonswap` with its amplitude spectrum cached in
-    ``spectra`` (a dict) across the runs of a campaign (one spectrum per sea state)."""
+    ``spectra`` (a dict) across the runs of a campaign (one spectrum per sea state).
+
+    Parameters
+    ----------
+    hs : float [m]
+        Significant wave height.
+    tp : float [s]
+        Peak period.
+    gamma : float [-]
+        JONSWAP peak enhancement factor.
+    seed : int
+        Seed of the random phases.
+    ramp : float [s]
+        Fade-in time of the heave.
+    duration : float [s]
+        Length to synthesise.
+    spacing : float [s]
+        Sample spacing.
+    spectra : dict or None
+        Cache of amplitude spectra, shared across calls.
+
+    Returns
+    -------
+    heavecomp.simulate.excitation.HeaveSamples
+    """
     return excitation.jonswap(hs, tp, gamma, seed, ramp, duration, spacing, spectra=spectra)
 
 
 def hist_columns(nbins: int) -> tuple[list[str], list[str]]:
-    """Column names of the dW histogram (under, bins, over) and of the cycle-peak histogram."""
+    """Column names of the dW histogram (under, bins, over) and of the cycle-peak histogram.
+
+    Parameters
+    ----------
+    nbins : int
+        Bins of the WOB deviation histogram (the cycle-peak histogram has half as many).
+
+    Returns
+    -------
+    (list of str, list of str)
+    """
     dev = ["dev_under"] + [f"dev_{k:03d}" for k in range(nbins)] + ["dev_over"]
     pk = [f"peak_{k:03d}" for k in range(nbins // 2)] + ["peak_over"]
     return dev, pk
@@ -254,6 +320,13 @@ def simulate_batch(campaign, runs, *, threads: int | None = None, base=None) -> 
     runs : list of Run
     threads : int, optional
         numba threads for this call (default: numba's current setting).
+    base : heavecomp.params.CMCParams, optional
+        The base parameter set, when the caller already built it (default: ``campaign.base_params()``).
+
+    Returns
+    -------
+    list of dict
+        One row per run, in the order of ``runs``: the columns of ``runs.csv`` [SI].
 
     Notes
     -----
@@ -314,6 +387,21 @@ def simulate_batch(campaign, runs, *, threads: int | None = None, base=None) -> 
 
 
 def run_chunk(campaign, run_ids, threads: int | None = 1) -> list[dict]:
-    """Task unit for process pools and Dask workers: simulate the runs named by ``run_ids``."""
+    """Task unit for process pools and Dask workers: simulate the runs named by ``run_ids``.
+
+    Parameters
+    ----------
+    campaign : heavecomp.campaign.spec.Campaign
+        The campaign (its settings, regimes and variants).
+    run_ids : sequence of str
+        ``run_id`` of each run to simulate (runs of ``campaign``).
+    threads : int or None
+        numba threads for this call (None: numba's current setting).
+
+    Returns
+    -------
+    list of dict
+        The table rows (:func:`simulate_batch`).
+    """
     by_id = {r.run_id: r for r in campaign.runs()}
     return simulate_batch(campaign, [by_id[i] for i in run_ids], threads=threads)

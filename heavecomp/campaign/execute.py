@@ -88,7 +88,23 @@ def _check_manifest(campaign, out: Path):
 
 
 def finished_ids(path: Path) -> tuple[set, list | None]:
-    """run_ids already in ``runs.csv`` and its header; a partial last line is cut off."""
+    """run_ids already in ``runs.csv`` and its header; a partial last line is cut off.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The results table (need not exist).
+
+    Returns
+    -------
+    (set of str, list of str or None)
+        The run_ids and the header; (empty set, None) for a missing or empty table.
+
+    Raises
+    ------
+    heavecomp.errors.InputError
+        The table has no ``run_id`` column.
+    """
     if not path.is_file():
         return set(), None
     raw = path.read_bytes()
@@ -293,6 +309,18 @@ def read_table(path, campaign=None) -> dict:
     the same ``run_id``, a ``run_id`` that is not a run of ``campaign`` (when given), a row
     with more or fewer fields than the header and a non-numeric cell are one-line
     :class:`InputError` naming the row or run.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The results table.
+    campaign : heavecomp.campaign.spec.Campaign or None
+        When given, every ``run_id`` must be one of its runs.
+
+    Returns
+    -------
+    dict
+        Column name -> array over the runs [SI, the units of ``runs.csv``].
     """
     import numpy as np
 

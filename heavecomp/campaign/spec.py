@@ -330,7 +330,21 @@ def _parse_outputs(t):
 
 
 def loads(text_: str, *, base_dir=None, source: str = "<string>") -> Campaign:
-    """Parse campaign TOML text (see module docstring); raises ParameterError."""
+    """Parse campaign TOML text (see module docstring); raises ParameterError.
+
+    Parameters
+    ----------
+    text_ : str
+        The campaign TOML.
+    base_dir : str or os.PathLike or None
+        Folder that relative paths in the text (the base parameter file) are resolved from.
+    source : str
+        Name of the text in messages (its file).
+
+    Returns
+    -------
+    Campaign
+    """
     try:
         data = tomllib.loads(text_)
     except tomllib.TOMLDecodeError as exc:
@@ -367,7 +381,22 @@ def loads(text_: str, *, base_dir=None, source: str = "<string>") -> Campaign:
 
 
 def load(path) -> Campaign:
-    """Read and validate a campaign TOML file."""
+    """Read and validate a campaign TOML file.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The campaign file; relative paths inside it are resolved from its folder.
+
+    Returns
+    -------
+    Campaign
+
+    Raises
+    ------
+    heavecomp.errors.ParameterError
+        A missing or unreadable file, or an invalid campaign.
+    """
     path = Path(path)
     raw = read_text(path, "campaign file")
     return loads(raw, base_dir=path.resolve().parent, source=str(path))

@@ -53,7 +53,18 @@ def _abs_bins(hist, nbins):
 
 
 def exceedance_from_counts(counts):
-    """P(X > x_m) for x_m at the lower edge of each bin: counts of bins 0..K-1 plus overflow."""
+    """P(X > x_m) for x_m at the lower edge of each bin: counts of bins 0..K-1 plus overflow.
+
+    Parameters
+    ----------
+    counts : array_like
+        Histogram counts, bins along the last axis (overflow last).
+
+    Returns
+    -------
+    numpy.ndarray [-]
+        Exceedance probability per bin, same shape; nan where a histogram is empty.
+    """
     counts = np.asarray(counts, dtype=float)
     tot = counts.sum(axis=-1, keepdims=True)
     tail = np.cumsum(counts[..., ::-1], axis=-1)[..., ::-1]  # sum of bins >= m
@@ -62,7 +73,22 @@ def exceedance_from_counts(counts):
 
 
 def level_at(x, q, level):
-    """Smallest x with Q(x) <= level (linear interpolation in log Q); nan if not reached."""
+    """Smallest x with Q(x) <= level (linear interpolation in log Q); nan if not reached.
+
+    Parameters
+    ----------
+    x : array_like
+        Levels, increasing [their unit, e.g. N].
+    q : array_like [-]
+        Exceedance probability at ``x``.
+    level : float [-]
+        The probability looked for (> 0).
+
+    Returns
+    -------
+    float
+        The level [the unit of ``x``], or nan.
+    """
     q = np.asarray(q, dtype=float)
     idx = np.flatnonzero(q <= level)
     if idx.size == 0:

@@ -51,7 +51,24 @@ def runs_frame(table):
     """One row per run (scalar columns only), integers as ``int64``, regime/variant as categories.
 
     ``table``: a campaign folder (``"camp/"``), its ``runs.csv``, or the dict of
-    :func:`heavecomp.campaign.execute.read_table`."""
+    :func:`heavecomp.campaign.execute.read_table`.
+
+    Parameters
+    ----------
+    table : str or os.PathLike or dict
+        A campaign folder, its ``runs.csv``, or the columns of
+        :func:`heavecomp.campaign.execute.read_table`.
+
+    Returns
+    -------
+    pandas.DataFrame
+        ``df.attrs["units"]``: column -> unit.
+
+    Raises
+    ------
+    ValueError
+        An integer column holds a value that is not a whole number.
+    """
     import pandas as pd
 
     table = _table(table)
@@ -81,6 +98,24 @@ def histograms_frame(table: dict, deviation_max: float, bins: int):
     Columns: ``run_id``; ``histogram`` (``"deviation"``: WOB - W_0, ``"cycle_peak"``: max |WOB - W_0|
     between zero up-crossings); ``bin`` (int, -1 = underflow); ``lower_N``, ``upper_N`` (bin edges [N],
     +-inf for the overflow bins); ``count`` (int64).  ``table`` as for :func:`runs_frame`.
+
+    Parameters
+    ----------
+    table : str or os.PathLike or dict
+        As for :func:`runs_frame`.
+    deviation_max : float [N]
+        Largest |WOB - W_0| the histograms cover (``outputs.deviation_max``).
+    bins : int
+        Bins of the deviation histogram (``outputs.bins``).
+
+    Returns
+    -------
+    pandas.DataFrame
+
+    Raises
+    ------
+    ValueError
+        A histogram column for ``bins`` is missing.
     """
     import pandas as pd
 
@@ -128,7 +163,24 @@ def check_parquet() -> None:
 
 
 def export_parquet(table: dict, out_dir, deviation_max: float, bins: int) -> tuple[Path, Path]:
-    """Write ``runs.parquet`` and ``histograms.parquet`` (tidy, typed) into ``out_dir``."""
+    """Write ``runs.parquet`` and ``histograms.parquet`` (tidy, typed) into ``out_dir``.
+
+    Parameters
+    ----------
+    table : str or os.PathLike or dict
+        As for :func:`runs_frame`.
+    out_dir : str or os.PathLike
+        Existing folder the two files go into.
+    deviation_max : float [N]
+        Largest |WOB - W_0| the histograms cover.
+    bins : int
+        Bins of the deviation histogram.
+
+    Returns
+    -------
+    (pathlib.Path, pathlib.Path)
+        ``runs.parquet`` and ``histograms.parquet``.
+    """
     check_parquet()
     out = Path(out_dir)
     runs, hists = runs_frame(table), histograms_frame(table, deviation_max, bins)

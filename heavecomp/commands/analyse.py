@@ -9,6 +9,13 @@ import argparse
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
+    """Add the arguments of ``heavecomp analyse`` to its parser.
+
+    Parameters
+    ----------
+    p : argparse.ArgumentParser
+        The sub-command's parser (:func:`heavecomp.cli.build_parser`).
+    """
     p.add_argument("params", metavar="PARAMS.toml", help="CMC parameter file (contract: docs/contracts/parameter-file.md)")
     p.add_argument("--out", required=True, metavar="DIR", help="output folder")
     p.add_argument("--points", type=int, default=1000, metavar="N",
@@ -38,6 +45,25 @@ def _check(args):
 
 
 def run(args) -> int:
+    """Run ``heavecomp analyse``: the linear analysis of the parameter file written to ``--out``
+    (:func:`heavecomp.report.analysis.write_analysis`), its summary printed on one line.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The arguments of :func:`add_arguments`; while it runs ``args.out`` is the staging folder and
+        ``args.out_final`` the folder the user named.
+
+    Returns
+    -------
+    int
+        Exit code (0).
+
+    Raises
+    ------
+    heavecomp.errors.InputError
+        Bad input (the CLI prints one line and exits 2).
+    """
     from pathlib import Path
 
     from heavecomp.report.analysis import write_analysis

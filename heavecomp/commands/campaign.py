@@ -6,6 +6,13 @@ import argparse
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
+    """Add the arguments of ``heavecomp campaign`` to its parser.
+
+    Parameters
+    ----------
+    p : argparse.ArgumentParser
+        The sub-command's parser (:func:`heavecomp.cli.build_parser`).
+    """
     p.add_argument("campaign", metavar="CAMPAIGN.toml",
                    help="campaign definition (docs/campaign.md); 'default' = the built-in illustrative campaign")
     p.add_argument("--out", required=True, metavar="DIR", help="results folder (rerun into it to resume)")
@@ -16,6 +23,26 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run(args) -> int:
+    """Run ``heavecomp campaign``: simulate (or resume) the campaign into ``--out`` and write its report
+    (:func:`heavecomp.report.campaign.run_and_report`); print the counts and the long-term
+    statistics per regime.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The arguments of :func:`add_arguments`; while it runs ``args.out`` is the staging folder and
+        ``args.out_final`` the folder the user named.
+
+    Returns
+    -------
+    int
+        Exit code (0).
+
+    Raises
+    ------
+    heavecomp.errors.InputError
+        Bad input (the CLI prints one line and exits 2).
+    """
     import logging
     from pathlib import Path
 

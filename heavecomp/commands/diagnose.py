@@ -43,7 +43,7 @@ def run(args) -> int:
 
     columns, units = check_spec(parse_mapping(args.columns, "--columns"), parse_mapping(args.units, "--units"),
                                 "cli")
-    params = load(args.params)
+    params = load(args.params, heave_file=False)  # the log carries the heave: an unused heave file may be absent
     cands = None
     if args.candidates:
         from heavecomp.effects import get

@@ -9,6 +9,13 @@ import argparse
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
+    """Add the arguments of ``heavecomp identify`` to its parser.
+
+    Parameters
+    ----------
+    p : argparse.ArgumentParser
+        The sub-command's parser (:func:`heavecomp.cli.build_parser`).
+    """
     sub = p.add_subparsers(dest="kind", metavar="KIND", required=True)
     e = sub.add_parser("emps", help="EMPS axis: M, F_v, F_c, offset by inverse-model least squares, "
                                     "then the held-out residual diagnosis")
@@ -29,6 +36,25 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run(args) -> int:
+    """Run ``heavecomp identify``: the EMPS study (``emps``) or the seal-friction fit (``seal``) written to
+    ``--out`` (figures, metrics.json, report), the identified values printed on one line.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The arguments of :func:`add_arguments`; while it runs ``args.out`` is the staging folder and
+        ``args.out_final`` the folder the user named.
+
+    Returns
+    -------
+    int
+        Exit code (0).
+
+    Raises
+    ------
+    heavecomp.errors.InputError
+        Bad input (the CLI prints one line and exits 2).
+    """
     from pathlib import Path
 
     from heavecomp.errors import ParameterError

@@ -6,6 +6,13 @@ import argparse
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
+    """Add the arguments of ``heavecomp params`` to its parser.
+
+    Parameters
+    ----------
+    p : argparse.ArgumentParser
+        The sub-command's parser (:func:`heavecomp.cli.build_parser`).
+    """
     p.add_argument("source", metavar="NAME|PARAMS.toml",
                    help="a built-in set (paper_a) or a parameter file to check")
     p.add_argument("--friction", default=None, metavar="MODEL", help="friction model for a built-in set")
@@ -13,6 +20,24 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run(args) -> int:
+    """Run ``heavecomp params``: a built-in set or a checked copy of a parameter file, as TOML on stdout or
+    written whole to ``-o``.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The arguments of :func:`add_arguments`.
+
+    Returns
+    -------
+    int
+        Exit code (0).
+
+    Raises
+    ------
+    heavecomp.errors.InputError
+        Bad input (the CLI prints one line and exits 2).
+    """
     import sys
     from pathlib import Path
 

@@ -6,6 +6,13 @@ import argparse
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
+    """Add the arguments of ``heavecomp stickslip`` to its parser.
+
+    Parameters
+    ----------
+    p : argparse.ArgumentParser
+        The sub-command's parser (:func:`heavecomp.cli.build_parser`).
+    """
     p.add_argument("params", metavar="PARAMS.toml|default",
                    help="[pneumatic] parameter file, or 'default' for the documented default cylinder")
     p.add_argument("--dump", action="store_true", help="print the (validated) parameters as TOML and exit")
@@ -22,6 +29,26 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run(args) -> int:
+    """Run ``heavecomp stickslip``: linearisation and stick-slip prediction of the pneumatic cylinder,
+    optionally a simulation (``--duration``) and a map (``--map``); with ``--out`` the figures,
+    metrics and report.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The arguments of :func:`add_arguments`; while it runs ``args.out`` is the staging folder and
+        ``args.out_final`` the folder the user named.
+
+    Returns
+    -------
+    int
+        Exit code (0).
+
+    Raises
+    ------
+    heavecomp.errors.InputError
+        Bad input (the CLI prints one line and exits 2).
+    """
     import math
     import sys
     from pathlib import Path

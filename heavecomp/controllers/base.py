@@ -182,7 +182,23 @@ def parse_options(items) -> dict:
     """``["horizon=30", "model_frame=stroke", ...]`` -> typed :class:`ControllerConfig` overrides.
 
     One-line :class:`InputError` naming the option for a missing ``=``, an unknown name
-    (with a suggestion) or a value of the wrong type."""
+    (with a suggestion) or a value of the wrong type.
+
+    Parameters
+    ----------
+    items : iterable of str or None
+        ``KEY=VALUE`` strings, each key a field of :class:`ControllerConfig` (None: none).
+
+    Returns
+    -------
+    dict
+        Field -> value converted to the field's type (bool, int, finite float or str).
+
+    Raises
+    ------
+    heavecomp.errors.InputError
+        A missing ``=``, an unknown key or a value of the wrong type.
+    """
     types = {f.name: f.type for f in dataclasses.fields(ControllerConfig)}
     out = {}
     for item in items or ():
@@ -212,14 +228,36 @@ def parse_options(items) -> dict:
 
 
 def limit(u_cmd: float, u_prev: float, cfg: ControllerConfig) -> float:
-    """Clip a command to |u| <= u_max and |u - u_prev| <= rate_max dt [N]."""
+    """Clip a command to |u| <= u_max and |u - u_prev| <= rate_max dt [N].
+
+    Parameters
+    ----------
+    u_cmd : float [N]
+        The command asked for.
+    u_prev : float [N]
+        The command of the previous control interval.
+    cfg : ControllerConfig
+        ``u_max`` [N] and ``du_max`` [N per control interval].
+
+    Returns
+    -------
+    float [N]
+    """
     du = cfg.du_max
     u = min(max(u_cmd, u_prev - du), u_prev + du)
     return float(min(max(u, -cfg.u_max), cfg.u_max))
 
 
 class Controller:
-    """Base class: bookkeeping of solve times, failures and fallbacks."""
+    """Base class: bookkeeping of solve times, failures and fallbacks.
+
+    Parameters
+    ----------
+    params : heavecomp.params.CMCParams
+        The plant's parameters.
+    config : ControllerConfig or None
+        Tuning and limits; None: ``ControllerConfig.from_params(params)``.
+    """
 
     name = "base"
 

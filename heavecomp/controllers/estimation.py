@@ -231,6 +231,11 @@ class ARBlockPredictor:
         Fit window.
     decimate : int
         Samples per block (default 4: 20 Hz -> 5 Hz).
+    past_blocks : int
+        Measured block means (the latest) that, with the AR forecast, carry the least-squares
+        polynomial the predicted trajectory comes from.
+    poly_degree : int
+        Degree of that polynomial (its derivatives give the velocity and acceleration).
     """
 
     def __init__(self, dt: float, order: int = 10, window: float = 60.0, decimate: int = 4,

@@ -38,8 +38,13 @@ class LinearMPC(PredictiveController):
 
     Parameters
     ----------
-    params, config, effects
-        As :class:`~heavecomp.controllers.predictive.PredictiveController` (``effects``: what its model knows).
+    params : heavecomp.params.CMCParams
+        The plant's parameters (the model uses :func:`~heavecomp.controllers.model.controller_params`
+        of them).
+    config : ControllerConfig or None
+        Horizon, weights, limits; None: ``ControllerConfig.from_params(params)``.
+    effects : sequence
+        Effects its model knows, as :class:`~heavecomp.controllers.predictive.PredictiveController`.
     """
 
     name = "linear-mpc"

@@ -66,7 +66,20 @@ class DiscreteModel:
 def controller_params(params, config):
     """The parameters the controller *believes*: gas stiffness scaled by ``gas_stiffness_scale``
     and the friction forces (:data:`heavecomp.friction.laws.FORCE_KEYS`) by ``friction_scale``,
-    for robustness studies; the one place both MPCs take them from."""
+    for robustness studies; the one place both MPCs take them from.
+
+    Parameters
+    ----------
+    params : heavecomp.params.CMCParams
+        The true parameters.
+    config : ControllerConfig
+        ``gas_stiffness_scale`` and ``friction_scale`` [-].
+
+    Returns
+    -------
+    heavecomp.params.CMCParams
+        ``params`` itself when both scales are 1.
+    """
 
     if config.gas_stiffness_scale != 1.0:
         params = params.replace(compensator={"gas_stiffness": params.compensator.gas_stiffness
@@ -90,6 +103,19 @@ def earth_frame(f, heave=(1.0, 0.0)):
     Raises ValueError if the transformed dynamics still depend on ddz_h (they must
     not: the heave acceleration acts on the top mass only through the relative
     coordinates).
+
+    Parameters
+    ----------
+    f : casadi.Function
+        The model in the relative frame, ``f(x, u) -> (xdot, y)`` (the effects' states after the
+        four plant states).
+    heave : (float, float)
+        The heave map (a [-], b [m]).
+
+    Returns
+    -------
+    casadi.Function
+        ``cmc_earth(x, u) -> (xdot, y)`` in the earth frame.
     """
     ca = casadi()
     n = f.size1_in(0)  # 4 plant states, then the effects' states (unchanged by the frame)
@@ -109,7 +135,32 @@ def controller_model(params, *, eps=None, frame: str = "earth", effects=(), fric
     """The casadi model the controllers predict with (``frame``: see the module docstring;
     ``effects``: effects at the plant's hooks the controller knows, :mod:`heavecomp.effects`;
     ``eps`` [m/s]: the smoothing width of every friction term, the law's and the effects';
-    ``friction=False``: no seal friction, :func:`heavecomp.effects.model.casadi_model`)."""
+    ``friction=False``: no seal friction, :func:`heavecomp.effects.model.casadi_model`).
+
+    Parameters
+    ----------
+    params : heavecomp.params.CMCParams
+        The parameters the controller believes (:func:`controller_params`).
+    eps : float or None [m/s]
+        Regularisation width of the friction terms; required when the friction law or an effect has
+        stiction (:func:`heavecomp.effects.model.casadi_model`).
+    frame : str
+        ``earth`` or ``stroke`` (:data:`FRAMES`).
+    effects : sequence
+        Effects the controller knows (instances, names or ``(name, values)``).
+    friction : bool
+        Include the seal friction.
+
+    Returns
+    -------
+    casadi.Function
+        ``f(x, u) -> (xdot, y)``.
+
+    Raises
+    ------
+    ValueError
+        ``frame`` is not one of :data:`FRAMES`.
+    """
     if frame not in FRAMES:
         raise ValueError(f"model frame {frame!r}: not one of {', '.join(FRAMES)}")
     effects = resolve(effects)

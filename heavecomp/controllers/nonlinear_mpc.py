@@ -50,7 +50,26 @@ _OK = ("Solve_Succeeded", "Solved_To_Acceptable_Level")
 
 def rk4_steps(f, x, u, h, M):
     """``M`` classical RK4 steps of size ``h`` of the casadi model ``f(x, u) -> (xdot, y)``
-    with ``u`` held: the MPC's discretisation (symbolic in, symbolic out)."""
+    with ``u`` held: the MPC's discretisation (symbolic in, symbolic out).
+
+    Parameters
+    ----------
+    f : casadi.Function
+        The model ``f(x, u) -> (xdot, y)``.
+    x : casadi.SX or casadi.MX
+        State at the start of the interval [SI, model order].
+    u : casadi.SX or casadi.MX
+        Input held over the ``M`` steps [SI].
+    h : float [s]
+        Step size.
+    M : int
+        Number of steps.
+
+    Returns
+    -------
+    casadi.SX or casadi.MX
+        State after ``M h`` [SI].
+    """
     for _ in range(M):
         k1 = f(x, u)[0]
         k2 = f(x + h / 2 * k1, u)[0]
@@ -68,8 +87,13 @@ class NonlinearMPC(PredictiveController):
 
     Parameters
     ----------
-    params, config, effects
-        As :class:`~heavecomp.controllers.predictive.PredictiveController` (``effects``: what its model knows).
+    params : heavecomp.params.CMCParams
+        The plant's parameters (the model uses :func:`~heavecomp.controllers.model.controller_params`
+        of them).
+    config : ControllerConfig or None
+        Horizon, weights, limits; None: ``ControllerConfig.from_params(params)``.
+    effects : sequence
+        Effects its model knows, as :class:`~heavecomp.controllers.predictive.PredictiveController`.
     """
 
     name = "nonlinear-mpc"

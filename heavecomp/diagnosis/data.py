@@ -28,6 +28,7 @@ import math
 
 import numpy as np
 
+from heavecomp.diagnosis import quality
 from heavecomp.effects.spec import correct, reading_effects
 from heavecomp.errors import DataError
 from heavecomp.simulate.excitation import HeaveSamples
@@ -65,6 +66,8 @@ class MeasuredRun:
     warnings: list = dataclasses.field(default_factory=list)
     #: how the file was read: format, columns, units, conversions (heavecomp.io.series)
     measurement: dict = dataclasses.field(default_factory=dict)
+    #: corruption found by :func:`heavecomp.diagnosis.quality.assess` (``load_run``), or None
+    quality: object = None
 
     def __getitem__(self, name):
         if name == "t":
@@ -126,7 +129,7 @@ def load_run(path, params=None, *, columns=None, units=None) -> MeasuredRun:
     run = check_run(t, data, params=params, source=s.source, rows=s.rows)
     run.warnings[:0] = s.warnings
     run.measurement = dict(s.measurement or {}, corrections=notes) if fixes else s.measurement
-    return run
+    return quality.checked(run, params, rows=s.rows)  # corruption: refused, or warned about with a confidence cap
 
 
 def _frame_run(df, params, columns: dict, units: dict) -> MeasuredRun:
@@ -154,7 +157,7 @@ def _frame_run(df, params, columns: dict, units: dict) -> MeasuredRun:
     t = data.pop("t")
     run = check_run(t, data, params=params, source=src)
     run.measurement = {"format": "pandas.DataFrame", "units": dict(units), "conversions": conversions}
-    return run
+    return quality.checked(run, params)
 
 
 def check_run(t, columns: dict, *, params=None, source="<array>", rows=None) -> MeasuredRun:
@@ -167,10 +170,10 @@ def check_run(t, columns: dict, *, params=None, source="<array>", rows=None) -> 
     t = np.asarray(t, dtype=float)
     columns = {k: np.asarray(v, dtype=float) for k, v in columns.items()}
     checked = REQUIRED[1:] + tuple(a for a in ANGLES if a in columns)
-    for col in checked:  # an inf cell is a dropout like an empty one (never averaged into a check)
-        if col in columns and np.isinf(columns[col]).any():
-            columns[col] = np.where(np.isinf(columns[col]), np.nan, columns[col])
     line = (lambda i: int(rows[i])) if rows is not None else (lambda i: int(i) + 2)
+    for col in checked:  # the contract: non-finite values are an error (an inf, e.g. 1e400, is no dropout)
+        if col in columns and np.isinf(columns[col]).any():
+            raise DataError(f"{source}: column '{col}', row {line(np.flatnonzero(np.isinf(columns[col]))[0])}: non-finite value")
     for col in REQUIRED[1:]:
         if col not in columns:
             raise DataError(f"{source}: missing column '{col}'")
@@ -238,7 +241,7 @@ def _runs(mask):
 def _check_mean(run, src, column, unit, symbol, nominal, band, other_units, hint):
     """One-line DataError when a column's mean looks like another unit (within 50 % of the
     nominal value converted to it) or lies outside ``band`` x the nominal value."""
-    m = float(np.nanmean(run[column]))
+    m = float(np.nanmedian(run[column]))  # the median: one spike (1e9 N) is no unit
     for factor, other in other_units:
         if abs(m / (nominal * factor) - 1.0) < 0.5:
             raise DataError(f"{src}: column '{column}': mean {m:.4g} looks like {other}, expected {unit} "
@@ -259,7 +262,7 @@ def check_units(run: MeasuredRun, params) -> None:
     src = run.source
     p0 = params.p0
     W0 = params.operating_point.wob_setpoint
-    pm = float(np.nanmean(run["pressure"]))
+    pm = float(np.nanmedian(run["pressure"]))
     if abs(pm - p0 - P_ATM) < 0.3 * P_ATM < abs(pm - p0):
         run.warnings.append(f"column 'pressure': mean {pm:.4g} Pa is p_0 + {(pm - p0) / 1e5:.2f} bar — absolute "
                             "pressure? the contract is gauge; if so declare --units pressure=bara (or Pa_abs)")

@@ -60,6 +60,7 @@ from heavecomp.diagnosis.data import (ANGLES, derivative_zero_phase, HEAVE_CUTOF
 from heavecomp.plants.cmc import D0, KF, plant_vectors
 from heavecomp.diagnosis import start as S
 from heavecomp.diagnosis import components as CR
+from heavecomp.diagnosis.quality import apply_quality  # corrupted data: the verdict's confidence at most its cap
 from heavecomp.diagnosis import equation_error as EE
 from heavecomp.effects.base import COMPONENTS
 
@@ -743,7 +744,9 @@ class GapDiagnoser(GapEstimator):
         from threadpoolctl import threadpool_limits
 
         with threadpool_limits(limits=1, user_api="blas"):
-            return self._fit(run)
+            self._fit(run)
+        self.verdict_ = apply_quality(self.verdict_, getattr(run, "quality", None))
+        return self
 
     def _fit(self, run):
         t_wall = time.perf_counter()

@@ -92,10 +92,22 @@ def check(params) -> list:
     return [build(name, values, f"effects[{i}]") for i, (name, values) in enumerate(getattr(params, "effects", ()))]
 
 
-def load(path):
+def load(path, *, heave_file=True):
     """Read a parameter file (:func:`heavecomp.params.load`) and check its ``[[effects]]``: the
-    commands' reader; one-line :class:`ParameterError` for any bad key, before any work."""
-    params = load_params(path)
+    commands' reader; one-line :class:`ParameterError` for any bad key, before any work.
+
+    Parameters
+    ----------
+    path : str or Path
+        The TOML parameter file.
+    heave_file : bool
+        As :func:`heavecomp.params.load`: False for a command that takes no heave from the file.
+
+    Returns
+    -------
+    CMCParams
+    """
+    params = load_params(path, heave_file=heave_file)
     check(params)
     return params
 

@@ -219,6 +219,9 @@ class CMCParams:
                 f"suspended weight (M_c + m_b) g = {g_load:g} N (the cylinder pressure would be <= 0)")
 
         plausibility.check(self)  # cross-key plausibility: unit slips inside each key's bounds
+        if self.heave is not None and self.heave.kind == "file" and not self.heave.path.strip():
+            raise ParameterError('heave.path = "": empty; give the heave CSV (columns t, heave), relative to the '
+                                 "parameter file's folder")
 
     # ---- derived quantities (cmc-reference.md) ---------------------------------
     @property
@@ -280,6 +283,36 @@ class CMCParams:
         return out
 
 
+def check_heave_path(heave, base_dir) -> None:
+    """``heave.path`` (kind ``file``) names a readable, non-empty regular file: one-line
+    :class:`ParameterError` naming ``heave.path`` for a missing file, a folder, a device (``/dev/null``)
+    or an empty file (an empty string is refused by :class:`CMCParams` itself).  A relative path is
+    resolved against ``base_dir`` (the parameter file's folder).  :func:`load` calls it: a file's
+    heave is checked when the file is read; a set built or changed in code is checked when its heave
+    is read (:func:`heavecomp.simulate.excitation.read_heave_csv`)."""
+    if heave is None or heave.kind != "file" or not heave.path.strip():
+        return
+    path = Path(heave.path)
+    if not path.is_absolute():
+        if base_dir is None:
+            return
+        path = Path(base_dir) / path
+    try:
+        st = path.stat()
+    except FileNotFoundError:
+        raise ParameterError(f"heave.path = {heave.path!r}: file not found ({path})") from None
+    except OSError as exc:
+        raise ParameterError(f"heave.path = {heave.path!r}: cannot read ({type(exc).__name__})") from None
+    import stat
+
+    if stat.S_ISDIR(st.st_mode):
+        raise ParameterError(f"heave.path = {heave.path!r}: a folder, not a heave file")
+    if not stat.S_ISREG(st.st_mode):
+        raise ParameterError(f"heave.path = {heave.path!r}: not a regular file (a device or pipe); give the heave CSV")
+    if st.st_size == 0:
+        raise ParameterError(f"heave.path = {heave.path!r}: empty file ({path})")
+
+
 #: optional tables other modules add: name -> callable(table_dict) -> object (validated)
 OPTIONAL_EXTRA: dict[str, Any] = {}
 
@@ -312,14 +345,34 @@ def loads(text_: str, *, base_dir: Path | None = None, source: str = "<string>")
         data = tomllib.loads(text_)
     except (tomllib.TOMLDecodeError, ValueError) as exc:  # ValueError: an integer of > 4300 digits
         raise ParameterError(toml_error_message(text_, exc, source)) from None
+    except RecursionError:  # tomllib parses nested inline tables / arrays recursively
+        raise ParameterError(f"{source}: not valid TOML for a parameter file: tables or arrays nested too deep "
+                             "(a parameter file is one level of tables)") from None
     return from_dict(data, base_dir=base_dir)
 
 
-def load(path: str | Path) -> CMCParams:
-    """Read and validate a CMC parameter file."""
+def load(path: str | Path, *, heave_file: bool = True) -> CMCParams:
+    """Read and validate a CMC parameter file.
+
+    Parameters
+    ----------
+    path : str or Path
+        The TOML parameter file.
+    heave_file : bool
+        Check that a ``[heave] kind = "file"`` names a readable file beside it (the default).  A
+        command that takes no heave from the file (``diagnose``, ``monitor``: the log carries the
+        heave) passes False, so an unused, missing heave file does not stop it.
+
+    Returns
+    -------
+    CMCParams
+    """
     path = Path(path)
     raw = read_text(path, "parameter file")
-    return loads(raw, base_dir=path.resolve().parent, source=str(path))
+    p = loads(raw, base_dir=path.resolve().parent, source=str(path))
+    if heave_file:
+        check_heave_path(p.heave, p.base_dir)  # a file's heave.path names a file beside it (not a set built in code)
+    return p
 
 
 def dumps(params: CMCParams, header: str = "") -> str:

@@ -26,6 +26,10 @@ natural frequencies        frictionless, two masses                           0.
 fade-in                    heave.ramp / period                                2            0, or 0.1-100
 active force               [active].u_max / ((M_c + m_b) g)                   5.6 %        <= 100 %
 active force rate          [active].u_max / rate_max                          0.2 s        1 ms - 60 s
+heave within the stroke    crest to trough 2 a (sine), 1.86 H_s (jonswap)     2 m          <= 7.62 m
+smallest heave             a (sine), H_s (jonswap)                            1 m          0, or >= 1 cm
+smallest friction term     C_v * 1 m/s, C_p p_0 as a share of p_0 A           1.0, 0.5 %   0, or >= 0.01 %
+smallest damping           c_ds, c_F: own damping ratio on their spring       0, 0.006     0, or >= 1e-4
 ========================  =================================================  ===========  ==============
 
 Why these limits: a compensator is a soft gas spring carrying the suspended
@@ -35,6 +39,18 @@ load (30 % would mean a seized cylinder); drill pipe buckles in compression, so
 the WOB comes from the lower mass's weight; the bit-bounce and compensator
 modes of real rigs lie between ~0.01 and ~10 Hz.  ``scripts/unit_slips.py``
 counts which x1000 / /1000 slips of the shipped sets these checks catch.
+
+The last four rows close the slips that used to pass as "small but valid" (2026-11):
+
+- the stroke follows the heave, so a heave whose largest wave is longer than the longest compensator
+  stroke built (25 ft = 7.62 m; the largest of ~1000 waves of a sea state is 1.86 H_s, Rayleigh) drives
+  the stroke past its physical range: the plant has no end stops and would report a 10 m stroke
+  (H_s 16 m) as if it were possible;
+- a non-zero heave under 1 cm is below what a motion reference unit resolves (heave accuracy 5 cm or
+  5 %) and than any sea moves a drilling unit: a platform at rest is written 0; 1 mm is a metre slipped;
+- a non-zero friction term under 0.01 % of the cylinder load, or a damping below the material damping
+  of steel (damping ratio 1e-4), cannot be told from none by any measurement: it is written 0, and a
+  value that small is a slip by 1000.
 """
 
 from __future__ import annotations
@@ -56,6 +72,11 @@ DAMPING_RATIO = 10.0  #: largest damping ratio of either mass on its springs
 MODES_HZ = (0.002, 25.0)  #: natural frequencies of the frictionless rig [Hz]
 RAMP_PERIODS = (0.1, 100.0)  #: heave.ramp in periods (or 0)
 FULL_FORCE_TIME = (1e-3, 60.0)  #: [active] u_max / rate_max [s]
+STROKE_MAX = 7.62  #: longest compensator stroke built (25 ft) [m]
+HMAX_PER_HS = 1.86  #: largest of ~1000 waves over the significant height (Rayleigh) [-]
+HEAVE_MIN = 0.01  #: smallest non-zero heave amplitude or H_s [m] (MRU heave resolution ~ cm)
+MIN_SHARE = 1e-4  #: smallest non-zero friction term as a share of p_0 A [-]
+MIN_DAMPING_RATIO = 1e-4  #: smallest non-zero damping ratio of a string or formation damper [-] (steel)
 
 
 def _g(x: float) -> str:
@@ -95,10 +116,23 @@ def check(p) -> None:
                 f"friction.viscous_coefficient = {_g(f.viscous_coefficient)} N s/m gives "
                 f"{_g(f.viscous_coefficient * V_REF)} N at {V_REF:g} m/s, over {100 * VISCOUS_SHARE:.0f} % of the "
                 f"cylinder load p_0 A = {_g(load)} N")
+        for key, force in (("viscous_coefficient", f.viscous_coefficient * V_REF),
+                           ("pressure_coefficient", f.pressure_coefficient * p.p0)):
+            if 0 < force < MIN_SHARE * load:
+                raise ParameterError(
+                    f"friction.{key} = {_g(getattr(f, key))} gives {_g(force)} N, under {100 * MIN_SHARE:g} % of the "
+                    f"cylinder load p_0 A = {_g(load)} N: no measurement tells that from none (write 0), or a unit "
+                    "slip by 1000?")
         if f.static_force > STRIBECK_RATIO * f.coulomb_force:
             raise ParameterError(
                 f"friction.coulomb_force = {_g(f.coulomb_force)} N is below 1/{STRIBECK_RATIO:g} of "
                 f"friction.static_force = {_g(f.static_force)} N (cylinder seals: F_S/F_C ~ 1-3); is it in kN? (SI: N)")
+    for key, c_, k_ in (("drill_string.damping", ds.damping, ds.stiffness), ("formation.damping", fo.damping, fo.stiffness)):
+        zeta = c_ / (2 * math.sqrt(k_ * ds.lower_mass))
+        if 0 < zeta < MIN_DAMPING_RATIO:
+            raise ParameterError(f"{key} = {_g(c_)} N s/m is a damping ratio of {_g(zeta)} on its spring, under "
+                                 f"{MIN_DAMPING_RATIO:g} (the material damping of steel): write 0 for none, or a unit "
+                                 "slip by 1000?")
     zeta_b = (ds.damping + fo.damping) / (2 * math.sqrt((ds.stiffness + fo.stiffness) * ds.lower_mass))
     if zeta_b > DAMPING_RATIO:
         key = "formation.damping" if fo.damping >= ds.damping else "drill_string.damping"
@@ -110,6 +144,7 @@ def check(p) -> None:
         raise ParameterError(f"drill_string.damping = {_g(ds.damping)} N s/m makes the top mass's damping ratio "
                              f"{_g(zeta_c)} (at most {DAMPING_RATIO:g})")
     _check_modes(p)
+    _check_sea(p.heave)
     _check_ramp(p.heave)
     act = p.extra.get("active")
     if act is not None:
@@ -154,6 +189,22 @@ def _check_modes(p) -> None:
 def _get(p, dotted: str) -> float:
     table, key = dotted.split(".")
     return getattr(getattr(p, table), key)
+
+
+def _check_sea(h) -> None:
+    """The heave's size: not below :data:`HEAVE_MIN` unless 0, and its largest crest to trough within the
+    longest stroke (:data:`STROKE_MAX`)."""
+    if h is None or h.kind == "file":
+        return
+    key, x = ("heave.amplitude", h.amplitude) if h.kind == "sine" else ("heave.hs", h.hs)
+    if 0 < x < HEAVE_MIN:
+        raise ParameterError(f"{key} = {_g(x)} m is under {100 * HEAVE_MIN:g} cm: no sea moves a drilling unit that "
+                             "little and no motion sensor resolves it (write 0 for no heave), or a unit slip by 1000?")
+    span, how = (2 * x, "2 x heave.amplitude") if h.kind == "sine" else (HMAX_PER_HS * x, f"the largest wave, {HMAX_PER_HS:g} x heave.hs")
+    if span > STROKE_MAX:
+        raise ParameterError(f"{key} = {_g(x)} m: {how} = {_g(span)} m crest to trough is longer than any compensator's "
+                             f"stroke ({STROKE_MAX:g} m, 25 ft) — the stroke would pass its physical range (the model has "
+                             "no end stops); drilling stops long before such a sea")
 
 
 def _check_ramp(h) -> None:

@@ -45,6 +45,12 @@ def bode_figure(curves: dict, *, natural_frequencies=(), k_eff_eq14: float | Non
         Marked as vertical lines.
     k_eff_eq14 : float [N/m], optional
         Paper A eq. 14, drawn as a horizontal line.
+    title : str
+        Figure title ("": the default one).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
     """
     plt = _plt()
     fig, (am, ap) = plt.subplots(2, 1, figsize=(8, 6), sharex=True, gridspec_kw={"height_ratios": [2, 1]})
@@ -79,6 +85,12 @@ def map_figure(m: dict, *, marker=None, title: str = ""):
         From :func:`heavecomp.analysis.sweeps.eigenfrequency_map`.
     marker : (length [m], k_F [N/m]), optional
         A point to mark (e.g. the paper-A set).
+    title : str
+        Figure title ("": the default one).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
     """
     plt = _plt()
     L, kF = m["lengths"], m["formation_stiffness"]
@@ -106,7 +118,22 @@ def map_figure(m: dict, *, marker=None, title: str = ""):
 
 
 def transmissibility_map_figure(m: dict, period_index: int, *, marker=None):
-    """|k_eff(omega)|/k_eff(0) at one wave period over (L, k_F) (frictionless)."""
+    """|k_eff(omega)|/k_eff(0) at one wave period over (L, k_F) (frictionless).
+
+    Parameters
+    ----------
+    m : dict
+        From :func:`heavecomp.analysis.sweeps.eigenfrequency_map` (``lengths`` [m],
+        ``formation_stiffness`` [N/m], ``wave_periods`` [s], ``transmissibility`` [-]).
+    period_index : int
+        Index of the wave period in ``m["wave_periods"]``.
+    marker : (length [m], k_F [N/m]), optional
+        A point to mark (e.g. the paper-A set).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     plt = _plt()
     L, kF = m["lengths"], m["formation_stiffness"]
     T = m["wave_periods"][period_index]
@@ -129,7 +156,20 @@ def transmissibility_map_figure(m: dict, period_index: int, *, marker=None):
 
 
 def df_figure(rows: list[dict], *, title: str = ""):
-    """WOB first-harmonic amplitude vs heave amplitude: describing function, simulator, linear."""
+    """WOB first-harmonic amplitude vs heave amplitude: describing function, simulator, linear.
+
+    Parameters
+    ----------
+    rows : list of dict
+        From :func:`heavecomp.analysis.describing.compare_with_simulation`: ``friction``, ``period``
+        [s], ``amplitude`` [m], ``wob_df``, ``wob_sim``, ``wob_linear`` [N]; one panel per friction.
+    title : str
+        Figure title ("": the default one).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     plt = _plt()
     frictions = sorted({r["friction"] for r in rows})
     fig, axes = plt.subplots(1, len(frictions), figsize=(5.2 * len(frictions), 4.2), sharey=True, squeeze=False)
@@ -166,6 +206,18 @@ def write_analysis(params, out, *, source: str = "", **kw) -> dict:
     """Write ``analysis.json``, ``frequency_response.csv``, ``bode.png`` and ``report.md`` into ``out``.
 
     Returns the analysis.json content.
+
+    Parameters
+    ----------
+    params : heavecomp.params.CMCParams
+        The parameter set.
+    out : str or os.PathLike
+        Output folder (created if missing).
+    source : str
+        Where the set comes from, in titles (e.g. ``(rig.toml)``).
+    **kw : dict
+        Passed to :func:`heavecomp.analysis.summary.analyse` (``n_points``, ``omega_min`` [rad/s],
+        ``omega_max`` [rad/s], ``sliding_velocity`` [m/s]).
     """
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
@@ -192,7 +244,19 @@ MODE_NAMES = ("mode 1: top mass on the gas spring", "mode 2: lower mass on drill
 
 
 def mode_rows(freqs_rad_s, damping=None) -> list[tuple]:
-    """``(name, omega [rad/s], f [Hz], period [s], zeta [-])`` per mode, sorted by frequency."""
+    """``(name, omega [rad/s], f [Hz], period [s], zeta [-])`` per mode, sorted by frequency.
+
+    Parameters
+    ----------
+    freqs_rad_s : sequence of float [rad/s]
+        Undamped natural frequencies.
+    damping : sequence of float [-] or None
+        Damping ratio of each (None: nan).
+
+    Returns
+    -------
+    list of tuple
+    """
     damping = list(damping) if damping is not None else [math.nan] * len(freqs_rad_s)
     names = MODE_NAMES if len(freqs_rad_s) == len(MODE_NAMES) else [f"mode {i + 1}" for i in range(len(freqs_rad_s))]
     order = np.argsort(freqs_rad_s)
@@ -201,7 +265,19 @@ def mode_rows(freqs_rad_s, damping=None) -> list[tuple]:
 
 
 def report_markdown(s: dict, source: str = "") -> str:
-    """Markdown frequency-response report from an analysis.json dict."""
+    """Markdown frequency-response report from an analysis.json dict.
+
+    Parameters
+    ----------
+    s : dict
+        The analysis.json content (:func:`write_analysis`).
+    source : str
+        Where the set comes from, in the heading.
+
+    Returns
+    -------
+    str
+    """
     inband = any(s["modes_in_wave_band"])
     modes = ["| mode | natural frequency (undamped) [rad/s] | [Hz] | natural period [s] | damping ratio [-] |",
              "|---|---|---|---|---|"]

@@ -23,7 +23,19 @@ def _label(key, g, multi_variant):
 
 
 def plot_long_term(st: dict, *, title=None):
-    """Long-term P(|dW| > x) and cycle-peak exceedance per regime (log scale)."""
+    """Long-term P(|dW| > x) and cycle-peak exceedance per regime (log scale).
+
+    Parameters
+    ----------
+    st : dict
+        The campaign statistics (:func:`heavecomp.campaign.stats.statistics`).
+    title : str or None
+        Figure title (None: the default one).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     plt = _plt()
     fig, (ax, ax2) = plt.subplots(1, 2, figsize=(11, 4.3))
     x = np.asarray(st["x_abs"]) / 1e3
@@ -59,7 +71,19 @@ def _panel_groups(st, max_panels=4):
 
 
 def plot_short_term(st: dict, *, title=None):
-    """Short-term P(|dW| > x) per sea state, one panel per regime, coloured by H_s."""
+    """Short-term P(|dW| > x) per sea state, one panel per regime, coloured by H_s.
+
+    Parameters
+    ----------
+    st : dict
+        The campaign statistics (:func:`heavecomp.campaign.stats.statistics`).
+    title : str or None
+        Figure title (None: the default one).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     plt = _plt()
     groups, note = _panel_groups(st)
     fig, axes = plt.subplots(1, len(groups), figsize=(4.2 * len(groups), 4), sharey=True, squeeze=False)
@@ -84,7 +108,21 @@ def plot_short_term(st: dict, *, title=None):
 
 
 def plot_band_maps(st: dict, campaign, *, title=None):
-    """Fraction of time outside the tolerance band on the H_s x T_p grid, per regime."""
+    """Fraction of time outside the tolerance band on the H_s x T_p grid, per regime.
+
+    Parameters
+    ----------
+    st : dict
+        The campaign statistics (:func:`heavecomp.campaign.stats.statistics`).
+    campaign : heavecomp.campaign.spec.Campaign
+        Its scatter diagram gives the H_s [m] x T_p [s] grid.
+    title : str or None
+        Figure title (None: the default one).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     plt = _plt()
     groups, note = _panel_groups(st)
     hs, tp = campaign.scatter.hs, campaign.scatter.tp
@@ -118,7 +156,17 @@ LONG_TERM_UNITS = {"frac_outside_band": "-", "p_leave_exposure": "-", "band_exit
 
 
 def summary(st: dict) -> dict:
-    """The headline numbers (metrics.json of the scenario/CLI), each with its unit declared beside it."""
+    """The headline numbers (metrics.json of the scenario/CLI), each with its unit declared beside it.
+
+    Parameters
+    ----------
+    st : dict
+        The campaign statistics (:func:`heavecomp.campaign.stats.statistics`).
+
+    Returns
+    -------
+    dict
+    """
     out = declare_units({"band_half_width_N": st["band_half_width"], "exposure_s": st["exposure"],
                          "n_runs": st["n_runs"], "long_term": {}},
                         {"band_half_width_N": "N", "exposure_s": "s", "n_runs": "count"})
@@ -137,7 +185,23 @@ def _f(x, scale=1.0, fmt="{:.3g}"):
 
 
 def write_report(out_dir, campaign, st: dict, run_info=None) -> Path:
-    """``report.md``, ``statistics.json``, ``metrics.json`` and the figures into ``out_dir``."""
+    """``report.md``, ``statistics.json``, ``metrics.json`` and the figures into ``out_dir``.
+
+    Parameters
+    ----------
+    out_dir : str or os.PathLike
+        The campaign's results folder (exists).
+    campaign : heavecomp.campaign.spec.Campaign
+    st : dict
+        The campaign statistics (:func:`heavecomp.campaign.stats.statistics`).
+    run_info : dict or None
+        Executor, workers, run counts and wall time [s], written to the untracked ``timings.json``.
+
+    Returns
+    -------
+    pathlib.Path
+        The ``report.md`` written.
+    """
     out = Path(out_dir)
     figs = []
     if campaign.outputs.figures:
@@ -222,7 +286,17 @@ def _clean(x, digits=None):
 def run_and_report(campaign, out_dir, **kw):
     """:func:`run_campaign`, then (when every run is in the table) the statistics,
     ``report.md``, ``metrics.json``, ``statistics.json``, figures and, if asked,
-    ``runs.parquet``.  Returns ``(CampaignRun, statistics dict or None)``."""
+    ``runs.parquet``.  Returns ``(CampaignRun, statistics dict or None)``.
+
+    Parameters
+    ----------
+    campaign : heavecomp.campaign.spec.Campaign
+    out_dir : str or os.PathLike
+        Results folder (created; rerunning into it resumes).
+    **kw : dict
+        Passed to :func:`heavecomp.campaign.execute.run_campaign` (``workers``, ``scheduler``,
+        ``client``, ``progress``, ``limit``).
+    """
     from heavecomp.campaign import stats
 
     if campaign.outputs.format == "parquet":

@@ -8,7 +8,22 @@ from heavecomp.report.figures import REGIME_LABELS, _plt
 
 
 def plot_wob_controllers(results: dict, window, *, title: str):
-    """WOB and active force over time for several controllers (label -> ClosedLoopResult)."""
+    """WOB and active force over time for several controllers (label -> ClosedLoopResult).
+
+    Parameters
+    ----------
+    results : dict
+        Controller label -> :class:`heavecomp.closed_loop.ClosedLoopResult` (the first gives the
+        setpoint and the force limit).
+    window : (float, float) [s]
+        Time span shown.
+    title : str
+        Figure title.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
 
     plt = _plt()
     fig, (ax, axu) = plt.subplots(2, 1, figsize=(10, 6.2), sharex=True, gridspec_kw={"height_ratios": [3, 2]})
@@ -35,7 +50,21 @@ def plot_wob_controllers(results: dict, window, *, title: str):
 
 
 def plot_std_table(table: dict, sea: str, *, title: str):
-    """Grouped bars: WOB std per friction regime and controller."""
+    """Grouped bars: WOB std per friction regime and controller.
+
+    Parameters
+    ----------
+    table : dict
+        ``table[sea][regime][controller]["wob_std"]`` [N].
+    sea : str
+        The sea whose bars are drawn.
+    title : str
+        Figure title.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
 
     plt = _plt()
     fig, ax = plt.subplots(figsize=(9, 4.2))
@@ -57,7 +86,21 @@ def plot_std_table(table: dict, sea: str, *, title: str):
 
 
 def plot_sweeps(sweeps: dict, passive_std: float, *, title: str):
-    """One panel per swept option: WOB std (left axis) against the option value."""
+    """One panel per swept option: WOB std (left axis) against the option value.
+
+    Parameters
+    ----------
+    sweeps : dict
+        Option label -> (unit, {controller: [{"value": option value, "wob_std": [N]}, ...]}).
+    passive_std : float [N]
+        WOB std of the passive compensator (the goal line is 20 % of it).
+    title : str
+        Figure title.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
 
     plt = _plt()
     n = len(sweeps)

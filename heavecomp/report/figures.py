@@ -31,7 +31,23 @@ def pyplot():
 
 
 def save(fig, path, dpi: int = 110, tight: bool = True) -> Path:
-    """Save and close a figure (``tight=False`` skips the extra layout pass of bbox_inches="tight")."""
+    """Save and close a figure (``tight=False`` skips the extra layout pass of bbox_inches="tight").
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+    path : str or os.PathLike
+        The image file (its folder is created).
+    dpi : int
+        Resolution [dots per inch].
+    tight : bool
+        Crop to the drawn content (``bbox_inches="tight"``).
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``.
+    """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=dpi, bbox_inches="tight" if tight else None)
@@ -41,7 +57,22 @@ def save(fig, path, dpi: int = 110, tight: bool = True) -> Path:
 
 def envelope(t, y, max_points: int = 4000):
     """Min/max envelope of a long series for plotting: at most ``max_points`` points that draw
-    exactly the same band as the full series at figure resolution (short series pass through)."""
+    exactly the same band as the full series at figure resolution (short series pass through).
+
+    Parameters
+    ----------
+    t : array_like
+        Sample times [s] (or any abscissa).
+    y : array_like
+        The series [any unit].
+    max_points : int
+        Largest number of points returned.
+
+    Returns
+    -------
+    (numpy.ndarray, numpy.ndarray)
+        The kept ``t`` and ``y`` (each bin's minimum and maximum, in time order).
+    """
     t = np.asarray(t)
     y = np.asarray(y)
     if t.size <= max_points:
@@ -58,7 +89,26 @@ def plot_wob(results: dict, *, title: str | None = None, static_estimate: bool =
              force: bool = False):
     """WOB over time for several runs (label -> SimulationResult), with heave and
     paper A's static estimate W_0 - k_eff z_h (eqs. 13-14); ``force``: a third panel with each
-    closed-loop run's actuator force ``u_active`` [kN] and its limits +-u_max."""
+    closed-loop run's actuator force ``u_active`` [kN] and its limits +-u_max.
+
+    Parameters
+    ----------
+    results : dict
+        Label -> :class:`heavecomp.simulate.SimulationResult` or
+        :class:`heavecomp.closed_loop.ClosedLoopResult` (the first gives the heave and the estimate).
+    title : str or None
+        Title of the WOB panel (None: the default one).
+    static_estimate : bool
+        Draw the static estimate.
+    window : (float, float) [s] or None
+        Time span shown (None: the whole run).
+    force : bool
+        Add the actuator-force panel (closed-loop results only).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     plt = _plt()
     ratios = [3, 1, 1.4] if force else [3, 1]
     fig, axes = plt.subplots(len(ratios), 1, figsize=(10, 6.2 + 2.0 * force), sharex=True,
@@ -105,7 +155,21 @@ def plot_wob(results: dict, *, title: str | None = None, static_estimate: bool =
 
 def plot_wob_run(res, *, title: str | None = None, zoom: float | None = None):
     """One run at a glance: the WOB band over the whole run (min/max per bin) and a zoom on
-    its last seconds with the static estimate of eqs. 13-14 and the heave."""
+    its last seconds with the static estimate of eqs. 13-14 and the heave.
+
+    Parameters
+    ----------
+    res : heavecomp.simulate.SimulationResult
+        The run.
+    title : str or None
+        Title of the top panel (None: the default one).
+    zoom : float [s] or None
+        Length of the zoom (None: 5 heave periods, 12 s for a heave without one; at most the run).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     plt = _plt()
     t, w, z = res["t"], res["wob"] / 1e3, res["heave"]
     p = res.params
@@ -152,7 +216,21 @@ def plot_wob_run(res, *, title: str | None = None, zoom: float | None = None):
 
 def plot_friction_laws(curves: dict, *, title: str | None = None, pneumatic: dict | None = None):
     """Friction force vs axial velocity for several laws (label -> (v, F, style)); an optional
-    second panel for paper B's pneumatic seal (label -> (v, F, style), in N)."""
+    second panel for paper B's pneumatic seal (label -> (v, F, style), in N).
+
+    Parameters
+    ----------
+    curves : dict
+        Label -> (v [m/s], F [N], matplotlib style).
+    title : str or None
+        Figure title (None: the default one).
+    pneumatic : dict or None
+        Label -> (v [m/s], F [N], style) for the second panel (None: no second panel).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     plt = _plt()
     if pneumatic:
         fig, (ax, axb) = plt.subplots(1, 2, figsize=(13, 5), gridspec_kw={"width_ratios": [1.3, 1]})
@@ -182,7 +260,25 @@ def plot_friction_laws(curves: dict, *, title: str | None = None, pneumatic: dic
 
 
 def bar_metrics(rows: dict, keys=("wob_p2p", "wob_std"), *, title: str = "", unit_scale=1e-3, unit="kN"):
-    """Grouped bars of metrics per label (label -> metrics dict)."""
+    """Grouped bars of metrics per label (label -> metrics dict).
+
+    Parameters
+    ----------
+    rows : dict
+        Label -> metrics dict.
+    keys : sequence of str
+        The metrics drawn, one bar each per label.
+    title : str
+        Figure title.
+    unit_scale : float
+        Factor from the metrics' unit to ``unit`` (1e-3: N -> kN).
+    unit : str
+        Unit of the axis.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     plt = _plt()
     fig, ax = plt.subplots(figsize=(8, 4))
     labels = list(rows)

@@ -48,7 +48,21 @@ def _embed_images(body: str, folder: Path) -> str:
 
 
 def markdown_to_html(text: str, folder, *, title: str | None = None) -> str:
-    """A complete HTML page for the Markdown ``text`` whose figures live in ``folder``."""
+    """A complete HTML page for the Markdown ``text`` whose figures live in ``folder``.
+
+    Parameters
+    ----------
+    text : str
+        The Markdown.
+    folder : str or os.PathLike
+        Folder the relative image paths of ``text`` are resolved from (the images are embedded).
+    title : str or None
+        The page title (None: the first ``#`` heading, else ``heavecomp report``).
+
+    Returns
+    -------
+    str
+    """
     import markdown  # lazy: only report writing needs it
 
     body = markdown.markdown(text, extensions=["tables", "fenced_code", "sane_lists"], output_format="html")
@@ -62,7 +76,18 @@ def markdown_to_html(text: str, folder, *, title: str | None = None) -> str:
 
 
 def write_html(md_path) -> Path:
-    """Write ``report.html`` beside ``report.md`` (same stem)."""
+    """Write ``report.html`` beside ``report.md`` (same stem).
+
+    Parameters
+    ----------
+    md_path : str or os.PathLike
+        The Markdown report (UTF-8); its figures are resolved from its folder.
+
+    Returns
+    -------
+    pathlib.Path
+        The HTML file written.
+    """
     md_path = Path(md_path)
     out = md_path.with_suffix(".html")
     out.write_text(markdown_to_html(md_path.read_text(encoding="utf-8"), md_path.parent), encoding="utf-8")

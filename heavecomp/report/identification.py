@@ -15,7 +15,25 @@ def _plt():
 
 
 def emps_overlay(t, measured, model_before, model_after, label_after: str):
-    """Measured vs model force on the held-out part."""
+    """Measured vs model force on the held-out part.
+
+    Parameters
+    ----------
+    t : numpy.ndarray [s]
+        Sample times of the held-out part.
+    measured : numpy.ndarray [N]
+        Measured motor force.
+    model_before : numpy.ndarray [N]
+        Force of the base EMPS model.
+    model_after : numpy.ndarray [N]
+        Force of the model with the selected effects.
+    label_after : str
+        The selected effects, for the legend.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     plt = _plt()
     fig, (ax, axr) = plt.subplots(2, 1, figsize=(10, 5.6), sharex=True, gridspec_kw={"height_ratios": [2, 1]})
     ax.plot(t, measured, color="0.2", lw=1.2, label="measured F = g_tau v_ir")
@@ -39,7 +57,24 @@ def emps_overlay(t, measured, model_before, model_after, label_after: str):
 
 
 def emps_residual_map(v, q, r_before, r_after, where_before, where_after):
-    """Residual vs velocity and vs position, with the per-bin rms before/after."""
+    """Residual vs velocity and vs position, with the per-bin rms before/after.
+
+    Parameters
+    ----------
+    v : numpy.ndarray [m/s]
+        Velocity of the held-out samples.
+    q : numpy.ndarray [m]
+        Position of the held-out samples.
+    r_before, r_after : numpy.ndarray [N]
+        Residuals of the base and of the augmented model.
+    where_before, where_after : dict
+        :func:`heavecomp.identification.residual.localise` of each residual (``velocity`` and
+        ``position`` bins with ``lo``, ``hi`` [m/s or m], ``n``, ``rms`` [N]; ``direction``).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     plt = _plt()
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.4), sharey=True)
     for ax, x, key, scale, unit in ((axes[0], v, "velocity", 1e3, "velocity q' [mm/s]"),
@@ -68,6 +103,16 @@ def emps_cutoff_sensitivity(sens: dict):
     """Estimates vs Butterworth cut-off, as % deviation from the published values.
 
     ``sens``: label -> output of :func:`heavecomp.identification.inverse.cutoff_sensitivity`.
+
+    Parameters
+    ----------
+    sens : dict
+        Label -> :func:`heavecomp.identification.inverse.cutoff_sensitivity` (``cutoff`` [Hz] and
+        one list per base parameter [SI]).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
     """
     plt = _plt()
     fig, axes = plt.subplots(2, 2, figsize=(10, 6.4), sharex=True)
@@ -90,7 +135,20 @@ def emps_cutoff_sensitivity(sens: dict):
 
 
 def seal_friction_vs_pressure(strokes: list, fits: dict):
-    """Per-stroke friction vs gauge pressure, per direction, with the fitted lines."""
+    """Per-stroke friction vs gauge pressure, per direction, with the fitted lines.
+
+    Parameters
+    ----------
+    strokes : list of dict
+        Steady strokes (``SealFrictionFit.strokes_``): ``direction`` (+1/-1), ``dp`` [Pa], ``friction`` [N].
+    fits : dict
+        ``SealFrictionFit.fits_``: ``positive``, ``negative``, ``split`` (each ``F_C`` [N], ``C_p``
+        [N/Pa]; ``split`` also ``C_p_boot`` [N/Pa]) and maybe ``file_means`` (``C_p_se`` [N/Pa]).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     plt = _plt()
     fig, ax = plt.subplots(figsize=(8, 5))
     bar = 1e5
@@ -128,7 +186,19 @@ def _fmt(x) -> str:
 
 
 def parameters_text(params: dict, units: dict) -> str:
-    """``name = value unit, ...`` of a candidate's fitted parameters (the refitted base left out)."""
+    """``name = value unit, ...`` of a candidate's fitted parameters (the refitted base left out).
+
+    Parameters
+    ----------
+    params : dict
+        Parameter name -> fitted value [SI].
+    units : dict
+        Parameter name -> unit.
+
+    Returns
+    -------
+    str
+    """
     return ", ".join(f"{k} = {_fmt(v)} {units.get(k, '')}".rstrip() for k, v in params.items()
                      if not k.startswith("base_"))
 
@@ -140,7 +210,18 @@ def _cell(text: str) -> str:
 
 def withheld_terms_table(w: dict) -> str:
     """Markdown table of :func:`heavecomp.identification.study.withheld_terms` (one row per nominal
-    model that lacks a published term; the first row is the control with nothing withheld)."""
+    model that lacks a published term; the first row is the control with nothing withheld).
+
+    Parameters
+    ----------
+    w : dict
+        :func:`heavecomp.identification.study.withheld_terms`.
+
+    Returns
+    -------
+    str
+        The Markdown table.
+    """
     rows = []
     for r in w["rows"]:
         unit = r["unit"]
@@ -161,27 +242,75 @@ def withheld_terms_table(w: dict) -> str:
 
 # ---------------------------------------------------------------- tables and reports shared by scenario and command
 def emps_parameter_table(m: dict) -> str:
-    """Published against identified (whole record) EMPS parameters."""
+    """Published against identified (whole record) EMPS parameters.
+
+    Parameters
+    ----------
+    m : dict
+        The EMPS metrics (:func:`heavecomp.identification.study.emps_study`): ``published``,
+        ``identified_whole_record``, ``stderr_whole_record`` [SI], ``relative_error`` [-].
+
+    Returns
+    -------
+    str
+        The Markdown table.
+    """
     pub, got, se = m["published"], m["identified_whole_record"], m["stderr_whole_record"]
     return md_table(["parameter", "published", "identified (whole record)", "std. error", "deviation [%]"],
                     [(k, pub[k], got[k], se[k], 100 * m["relative_error"][k]) for k in pub], fmt="{:.4g}")
 
 
 def candidates_table(m: dict) -> str:
-    """The residual diagnosis' candidates: held-out rms, shrink and score."""
+    """The residual diagnosis' candidates: held-out rms, shrink and score.
+
+    Parameters
+    ----------
+    m : dict
+        The EMPS metrics; ``candidates`` with ``effect``, ``component``, ``n_parameters``,
+        ``rms_after`` [N], ``shrink`` [-], ``score``.
+
+    Returns
+    -------
+    str
+        The Markdown table.
+    """
     return md_table(["candidate", "component", "k", "held-out rms [N]", "shrink", "score (BIC-like)"],
                     [(c["effect"], c["component"], c["n_parameters"], c["rms_after"], c["shrink"], c["score"])
                      for c in m["candidates"]], fmt="{:.3f}")
 
 
 def candidate_parameters_table(m: dict) -> str:
-    """Each candidate's fitted parameters (SI, with units)."""
+    """Each candidate's fitted parameters (SI, with units).
+
+    Parameters
+    ----------
+    m : dict
+        The EMPS metrics; ``candidates`` with ``effect``, ``parameters`` [SI] and ``units``.
+
+    Returns
+    -------
+    str
+        The Markdown table.
+    """
     return md_table(["candidate", "parameters"],
                     [(c["effect"], parameters_text(c["parameters"], c["units"])) for c in m["candidates"]])
 
 
 def seal_fits_table(m: dict) -> str:
-    """The seal friction fits: F_C, C_p with its standard errors and interval."""
+    """The seal friction fits: F_C, C_p with its standard errors and interval.
+
+    Parameters
+    ----------
+    m : dict
+        The seal metrics (:func:`heavecomp.identification.study.seal_study`); ``fits``: name ->
+        ``F_C`` [N], ``C_p_N_per_bar``, its standard errors and ``C_p_ci95`` [N/Pa], ``rms`` [N],
+        ``n_strokes``.
+
+    Returns
+    -------
+    str
+        The Markdown table.
+    """
     return md_table(["fit", "F_C [N]", "C_p [N/bar]", "LS std. err. [N/bar]", "bootstrap std [N/bar]",
                      "95 % interval [N/bar]", "rms [N]", "strokes"],
                     [(k, f["F_C"], f["C_p_N_per_bar"], f["C_p_se_N_per_bar"], f["C_p_boot_N_per_bar"] or "-",
@@ -190,7 +319,17 @@ def seal_fits_table(m: dict) -> str:
 
 
 def emps_report(out, m: dict, source: str) -> None:
-    """``report.md`` (+ ``report.html``) of ``heavecomp identify emps`` (figures already in ``out``)."""
+    """``report.md`` (+ ``report.html``) of ``heavecomp identify emps`` (figures already in ``out``).
+
+    Parameters
+    ----------
+    out : str or os.PathLike
+        Output folder.
+    m : dict
+        The EMPS metrics (:func:`heavecomp.identification.study.emps_study`).
+    source : str
+        The data file's name, in the title.
+    """
     sel = m["selection"]
     write_report(out, f"EMPS axis identification — {source}", [
         f"Inverse-model least squares on the whole record ({m['settings']}); the residual diagnosis fits "
@@ -206,7 +345,17 @@ def emps_report(out, m: dict, source: str) -> None:
 
 
 def seal_report(out, m: dict, n_strokes: int) -> None:
-    """``report.md`` (+ ``report.html``) of ``heavecomp identify seal`` (figure already in ``out``)."""
+    """``report.md`` (+ ``report.html``) of ``heavecomp identify seal`` (figure already in ``out``).
+
+    Parameters
+    ----------
+    out : str or os.PathLike
+        Output folder.
+    m : dict
+        The seal metrics (:func:`heavecomp.identification.study.seal_study`).
+    n_strokes : int
+        Steady strokes the fit used.
+    """
     write_report(out, "Seal friction against pressure", [
         f"**C_p = {m['C_p_N_per_bar']:.3f} +- {m['C_p_uncertainty_N_per_bar']:.3f} N/bar**, "
         f"F_C = {m['F_C_N']:.2f} N over {n_strokes} steady strokes (headline fit: `{m['headline_fit']}`).",

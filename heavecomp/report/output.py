@@ -72,12 +72,36 @@ def _side(final: Path, what: str) -> Path:
 
 
 def lock_path(final) -> Path:
-    """The lock file of the output folder ``final``: ``.NAME.lock`` beside it."""
+    """The lock file of the output folder ``final``: ``.NAME.lock`` beside it.
+
+    Parameters
+    ----------
+    final : str or os.PathLike
+        The output folder (made absolute; need not exist).
+
+    Returns
+    -------
+    pathlib.Path
+        ``.NAME.lock`` beside ``final``; inside it (``.heavecomp.lock``) when ``final`` is an existing folder
+        whose parent takes no files.
+    """
     return _side(Path(final).absolute(), "lock")
 
 
 def staging_path(final) -> Path:
-    """The staging folder of the output folder ``final``: ``.NAME.partial`` beside it."""
+    """The staging folder of the output folder ``final``: ``.NAME.partial`` beside it.
+
+    Parameters
+    ----------
+    final : str or os.PathLike
+        The output folder (made absolute; need not exist).
+
+    Returns
+    -------
+    pathlib.Path
+        ``.NAME.partial`` beside ``final``; inside it (``.heavecomp.partial``) when ``final`` is an existing folder
+        whose parent takes no files.
+    """
     return _side(Path(final).absolute(), "partial")
 
 
@@ -122,7 +146,17 @@ def _fsync(path: Path, *, strict: bool = True) -> None:
 
 
 def is_result_folder(path) -> bool:
-    """True if ``path`` is a result folder heavecomp moved into place (holds :data:`MARKER`)."""
+    """True if ``path`` is a result folder heavecomp moved into place (holds :data:`MARKER`).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The folder to test (need not exist).
+
+    Returns
+    -------
+    bool
+    """
     p = Path(path)
     return p.is_dir() and (p / MARKER).is_file()
 
@@ -130,18 +164,18 @@ def is_result_folder(path) -> bool:
 class Staged:
     """Lock and staging folder of one output folder (see the module docstring).
 
+    Use as a context manager: ``with Staged(out) as work: ...`` writes into ``work``; a normal exit
+    moves it into place (:meth:`commit`), an exception leaves ``final`` untouched (:meth:`abort`).
+
     Parameters
     ----------
-    final : path
+    final : str or os.PathLike
         The output folder as the user named it.
     flag : str
         The option that named it, for messages (``--out``).
     resumable : bool
         Keep a staging folder left by a killed run and resume from it; seed a new one from the
         :data:`RESUME_FILES` of an existing ``final`` (campaigns).
-
-    Use as a context manager: ``with Staged(out) as work: ...`` writes into ``work``; a normal exit
-    moves it into place (:meth:`commit`), an exception leaves ``final`` untouched (:meth:`abort`).
     """
 
     def __init__(self, final, flag: str = "--out", *, resumable: bool = False):
@@ -341,7 +375,24 @@ def need_space(folder, nbytes: float, flag: str = "--out", shown=None) -> None:
     """Refuse before any work when the file system of ``folder`` has less than ``nbytes`` free.
 
     ``nbytes`` is a low estimate of what the run will write (a check, not a reservation: a disk
-    that fills during the run still ends in one line, :data:`EXIT_NO_SPACE`)."""
+    that fills during the run still ends in one line, :data:`EXIT_NO_SPACE`).
+
+    Parameters
+    ----------
+    folder : str or os.PathLike
+        The output folder; its nearest existing ancestor gives the file system.
+    nbytes : float [bytes]
+        What the run will write at least.
+    flag : str
+        The option that named ``folder``, first word of the message.
+    shown : str or None
+        ``folder`` as the user spelled it, for the message (None: ``folder``).
+
+    Raises
+    ------
+    heavecomp.errors.InputError
+        Less than ``nbytes`` free.
+    """
     q = Path(folder).absolute()
     while not q.exists():
         q = q.parent
@@ -359,7 +410,22 @@ def _size(n: float) -> str:
 
 
 def write_text_atomic(path, text: str, encoding: str = "utf-8") -> Path:
-    """Write ``text`` to ``path`` whole or not at all (temporary file beside it, fsync, rename)."""
+    """Write ``text`` to ``path`` whole or not at all (temporary file beside it, fsync, rename).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file to write (its folder must exist); an existing file keeps its mode.
+    text : str
+        The whole content.
+    encoding : str
+        Text encoding.
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``.
+    """
     path = Path(path)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".partial", dir=path.parent if str(path.parent) else ".")
     try:
@@ -385,6 +451,18 @@ def write_text_atomic(path, text: str, encoding: str = "utf-8") -> Path:
 
 
 def no_space_message(exc: OSError, where: str) -> str:
-    """One line for a disk that filled during the run."""
+    """One line for a disk that filled during the run.
+
+    Parameters
+    ----------
+    exc : OSError
+        The error of the full disk (its ``errno`` gives the text).
+    where : str
+        What was being written, as the user named it (``--out DIR``).
+
+    Returns
+    -------
+    str
+    """
     return (f"{where}: {os.strerror(exc.errno)} while writing the results; nothing was written "
             "(the previous result, if any, is unchanged)")

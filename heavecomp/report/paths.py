@@ -34,6 +34,18 @@ def out_dir(path, flag: str = "--out") -> Path:
     Nothing is created: the nearest existing ancestor is probed with a temporary file.
     Raises :class:`InputError` (one line, naming ``flag``) when ``path`` or an ancestor
     is an existing file, or the folder is not writable.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The output folder.
+    flag : str
+        The option that named it, first word of a message.
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``.
     """
     p = Path(path)
     if len(str(p)) > 4000:
@@ -50,7 +62,25 @@ def out_dir(path, flag: str = "--out") -> Path:
 
 
 def out_file(path, flag: str = "-o") -> Path:
-    """Check that the file ``path`` can be written (its folder exists and is writable)."""
+    """Check that the file ``path`` can be written (its folder exists and is writable).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file to write.
+    flag : str
+        The option that named it, first word of a message.
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``.
+
+    Raises
+    ------
+    heavecomp.errors.InputError
+        ``path`` is a folder, its folder does not exist, or it cannot be written.
+    """
     p = Path(path)
     if p.is_dir():
         raise InputError(f"{flag} {path}: is a folder, not a file")

@@ -166,13 +166,34 @@ def _param_units() -> dict[str, str]:
 
 
 def table_units(table: str) -> dict[str, str]:
-    """Units of the number keys of the parameter table ``table`` (``"heave"``), from its classes' metadata."""
+    """Units of the number keys of the parameter table ``table`` (``"heave"``), from its classes' metadata.
+
+    Parameters
+    ----------
+    table : str
+        A parameter table name (a key of ``TABLES``).
+
+    Returns
+    -------
+    dict
+        Key -> unit.
+    """
     cls = TABLES[table]
     return {f.name: f.metadata["unit"] for f in dataclasses.fields(cls) if f.metadata.get("kind") == "number"}
 
 
 def unit_of(path: tuple[str, ...]) -> str | None:
-    """Unit of the entry at ``path`` (keys from the JSON root), or None if unknown."""
+    """Unit of the entry at ``path`` (keys from the JSON root), or None if unknown.
+
+    Parameters
+    ----------
+    path : tuple of str
+        Keys from the JSON root to the entry (a numeric last key takes its parent's unit).
+
+    Returns
+    -------
+    str or None
+    """
     global _PARAM_UNITS
     if not _PARAM_UNITS:
         _PARAM_UNITS = _param_units()
@@ -237,13 +258,30 @@ def declare_units(block: dict, units) -> dict:
     be given a wrong unit by a name it shares with another quantity (a stroke ``offset`` in m
     beside a force ``offset`` in N).  :func:`annotate_json` turns the declarations into the
     ``units`` block and removes them from the written JSON.
+
+    Parameters
+    ----------
+    block : dict
+        A result block, changed in place (its :data:`UNITS_KEY` entry is added or extended).
+    units : dict or iterable of (str, str) pairs
+        Entry key -> unit.
     """
     block.setdefault(UNITS_KEY, {}).update({str(k): str(u) for k, u in dict(units).items()})
     return block
 
 
 def strip_declared(obj):
-    """Copy of a result without its :data:`UNITS_KEY` blocks."""
+    """Copy of a result without its :data:`UNITS_KEY` blocks.
+
+    Parameters
+    ----------
+    obj : dict, list or scalar
+        A JSON-like result.
+
+    Returns
+    -------
+    dict, list or scalar
+    """
     if isinstance(obj, dict):
         return {k: strip_declared(v) for k, v in obj.items() if k != UNITS_KEY}
     if isinstance(obj, list):
@@ -252,7 +290,20 @@ def strip_declared(obj):
 
 
 def undeclared(obj, path: tuple = ()) -> list[str]:
-    """Dotted paths of the numbers of a result whose unit no producer declared (:func:`declare_units`)."""
+    """Dotted paths of the numbers of a result whose unit no producer declared (:func:`declare_units`).
+
+    Parameters
+    ----------
+    obj : dict, list or scalar
+        A JSON-like result.
+    path : tuple of str
+        Keys of ``obj`` from the root (the prefix of the paths returned).
+
+    Returns
+    -------
+    list of str
+        Sorted, without repeats.
+    """
     out: list[str] = []
 
     def walk(x, p, has):
@@ -275,7 +326,15 @@ def units_of(obj, path: tuple = ()) -> tuple[dict[str, str], list[str]]:
     """``({key: unit}, [dotted paths of numbers with no known unit])`` for a JSON-like result.
 
     A unit declared beside the value (:func:`declare_units`) wins; otherwise it is looked up
-    by the key's name and its parents (:func:`unit_of`)."""
+    by the key's name and its parents (:func:`unit_of`).
+
+    Parameters
+    ----------
+    obj : dict, list or scalar
+        A JSON-like result.
+    path : tuple of str
+        Keys of ``obj`` from the root.
+    """
     global _PARAM_UNITS
     if not _PARAM_UNITS:
         _PARAM_UNITS = _param_units()
@@ -325,7 +384,17 @@ def units_of(obj, path: tuple = ()) -> tuple[dict[str, str], list[str]]:
 
 
 def split_timings(obj):
-    """``(result without wall-clock entries, the timings)`` (nested like the result)."""
+    """``(result without wall-clock entries, the timings)`` (nested like the result).
+
+    Parameters
+    ----------
+    obj : dict, list or scalar
+        A JSON-like result; a wall-clock entry is one whose key matches ``TIMING_KEY``.
+
+    Returns
+    -------
+    (dict, list or scalar; dict, list or None)
+    """
     if isinstance(obj, dict):
         keep, times = {}, {}
         for k, v in obj.items():
@@ -368,7 +437,19 @@ def command_line() -> str:
 
 def stamp(params_file: str | None = None, **extra) -> dict:
     """The provenance block: heavecomp version, command line, parameter file (no dates or host:
-    a re-run writes the same bytes)."""
+    a re-run writes the same bytes).
+
+    Parameters
+    ----------
+    params_file : str or None
+        The parameter file written into the output folder (its name).
+    **extra : dict
+        Further entries of the block.
+
+    Returns
+    -------
+    dict
+    """
 
     s = {"heavecomp_version": __version__, "command": command_line()}
     if params_file:
@@ -378,7 +459,17 @@ def stamp(params_file: str | None = None, **extra) -> dict:
 
 
 def stamp_markdown(st: dict) -> str:
-    """The stamp as one Markdown paragraph for reports."""
+    """The stamp as one Markdown paragraph for reports.
+
+    Parameters
+    ----------
+    st : dict
+        The stamp (:func:`stamp`).
+
+    Returns
+    -------
+    str
+    """
     parts = [f"heavecomp {st['heavecomp_version']}", f"command `{st['command']}`"]
     if st.get("parameters"):
         parts.append(f"parameters `{st['parameters']}`")
@@ -386,7 +477,18 @@ def stamp_markdown(st: dict) -> str:
 
 
 def heave_file(params) -> Path | None:
-    """The heave file a parameter set names (``heave.kind = "file"``), resolved against its folder."""
+    """The heave file a parameter set names (``heave.kind = "file"``), resolved against its folder.
+
+    Parameters
+    ----------
+    params : heavecomp.params.CMCParams
+        The parameter set.
+
+    Returns
+    -------
+    pathlib.Path or None
+        None when the heave is not read from a file.
+    """
     heave = getattr(params, "heave", None)
     if heave is None or getattr(heave, "kind", None) != "file" or not heave.path:
         return None
@@ -402,7 +504,29 @@ def write_params(out_dir, params, name: str = "params.toml", *, heave_used: bool
 
     ``heave_used=False`` (a command that takes no heave from the parameter file, e.g. the diagnosis,
     whose heave is the measured run's): a ``[heave]`` table naming a file is left out -- the file is
-    neither copied nor recorded, and need not exist."""
+    neither copied nor recorded, and need not exist.
+
+    Parameters
+    ----------
+    out_dir : str or os.PathLike
+        Output folder (created if missing).
+    params : heavecomp.params.CMCParams
+        The parameter set.
+    name : str
+        File name of the set.
+    heave_used : bool
+        The command takes its heave from ``params``.
+
+    Returns
+    -------
+    pathlib.Path
+        The parameter file written.
+
+    Raises
+    ------
+    heavecomp.errors.ParameterError
+        The heave file the set names does not exist (``heave_used`` only).
+    """
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     src = heave_file(params)
@@ -423,7 +547,27 @@ def write_params(out_dir, params, name: str = "params.toml", *, heave_used: bool
 
 
 def write_units_csv(csv_path, columns, units: dict | None = None) -> Path:
-    """``<name>.units.csv`` beside a CSV table: one row per column, ``column,unit``."""
+    """``<name>.units.csv`` beside a CSV table: one row per column, ``column,unit``.
+
+    Parameters
+    ----------
+    csv_path : str or os.PathLike
+        The CSV table.
+    columns : sequence of str
+        Its columns, in order.
+    units : dict or None
+        Column -> unit, winning over the unit looked up by name (:func:`unit_of`).
+
+    Returns
+    -------
+    pathlib.Path
+        The units file written.
+
+    Raises
+    ------
+    KeyError
+        A column whose unit is neither given nor known.
+    """
     csv_path = Path(csv_path)
     units = units or {}
     rows = []
@@ -444,7 +588,19 @@ DIGITS = 12
 
 
 def round_floats(x, digits: int = DIGITS):
-    """Copy of a JSON-like value with every float rounded to ``digits`` significant digits."""
+    """Copy of a JSON-like value with every float rounded to ``digits`` significant digits.
+
+    Parameters
+    ----------
+    x : dict, list or scalar
+        A JSON-like value.
+    digits : int
+        Significant digits.
+
+    Returns
+    -------
+    dict, list or scalar
+    """
     if isinstance(x, float):
         return float(f"{x:.{digits}g}")
     if isinstance(x, dict):
@@ -456,7 +612,22 @@ def round_floats(x, digits: int = DIGITS):
 
 def annotate_json(path, st: dict, *, indent: int | None = 2) -> dict:
     """Move timings out of a JSON result into ``timings.json``; add ``provenance`` and ``units``;
-    round floats to :data:`DIGITS` significant digits."""
+    round floats to :data:`DIGITS` significant digits.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The JSON result, rewritten in place.
+    st : dict
+        The provenance stamp (:func:`stamp`).
+    indent : int or None
+        JSON indentation (None: one line).
+
+    Returns
+    -------
+    dict or list
+        The data as written.
+    """
 
     path = Path(path)
     data = json.loads(path.read_text())
@@ -478,7 +649,20 @@ def annotate_json(path, st: dict, *, indent: int | None = 2) -> dict:
 
 
 def stamp_report(md_path, st: dict) -> Path:
-    """End the Markdown report with the stamp (replacing an older one) and write its HTML twin."""
+    """End the Markdown report with the stamp (replacing an older one) and write its HTML twin.
+
+    Parameters
+    ----------
+    md_path : str or os.PathLike
+        The Markdown report, rewritten in place.
+    st : dict
+        The provenance stamp (:func:`stamp`).
+
+    Returns
+    -------
+    pathlib.Path
+        The HTML report written beside it.
+    """
 
     md_path = Path(md_path)
     lines = [ln for ln in md_path.read_text(encoding="utf-8").rstrip("\n").split("\n")
@@ -497,6 +681,31 @@ def finish(out_dir, *, params=None, params_name: str = "params.toml", params_fil
     ``params`` (a CMC parameter set) is written as ``params_name``; a command that wrote its
     own parameter file (e.g. paper B's pneumatic set) names it with ``params_file``.
     ``heave_used=False``: the command took no heave from ``params`` (see :func:`write_params`).
+
+    Parameters
+    ----------
+    out_dir : str or os.PathLike
+        The output folder.
+    params : heavecomp.params.CMCParams or None
+        The parameter set to write (None: none).
+    params_name : str
+        Its file name.
+    params_file : str or None
+        A parameter file the command wrote itself (used when ``params`` is None).
+    json_files : sequence of str
+        JSON results to annotate (:func:`annotate_json`), where present.
+    csv_files : sequence of str
+        CSV tables that get a units file (:func:`write_units_csv`), where present.
+    report : str or None
+        The Markdown report to stamp, where present.
+    heave_used : bool
+        The command takes its heave from ``params``.
+    **extra : dict
+        Further entries of the stamp.
+
+    Returns
+    -------
+    dict
     """
     out = Path(out_dir)
     if params is not None:

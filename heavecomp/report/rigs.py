@@ -16,7 +16,22 @@ from heavecomp.test_rig.plant import QUADRANTS
 
 
 def plot_exp2(r, p, lin=None):
-    """Exp. 2-like response: velocity, pressures, friction vs time."""
+    """Exp. 2-like response: velocity, pressures, friction vs time.
+
+    Parameters
+    ----------
+    r : dict
+        A run of :func:`heavecomp.pneumatic.stepper.simulate`: ``t`` [s], ``velocity`` [m/s],
+        ``pressure_a``, ``pressure_b`` [Pa, absolute], ``friction`` [N], ``stuck``.
+    p : heavecomp.pneumatic.plant.PneumaticParams
+        The cylinder.
+    lin : heavecomp.pneumatic.linear.Linearisation or None
+        Its equilibrium velocity ``u0`` [m/s] is drawn (None: not drawn).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     plt = _plt()
     fig, ax = plt.subplots(3, 1, figsize=(9, 7.5), sharex=True)
     t = r["t"]
@@ -45,7 +60,25 @@ def plot_exp2(r, p, lin=None):
 
 
 def plot_friction_velocity(v, F_true, F_meas, mask, title):
-    """Measured (paper B's method) vs true friction against velocity."""
+    """Measured (paper B's method) vs true friction against velocity.
+
+    Parameters
+    ----------
+    v : numpy.ndarray [m/s]
+        Measured piston velocity.
+    F_true : numpy.ndarray [N]
+        The model's friction.
+    F_meas : numpy.ndarray [N]
+        Friction as paper B measures it (pressure force minus inertia).
+    mask : numpy.ndarray of bool
+        The samples drawn.
+    title : str
+        Figure title.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     plt = _plt()
     fig, ax = plt.subplots(figsize=(7.5, 5))
     ax.plot(v[mask] * 1e3, F_true[mask], ".", ms=2, color="0.5", label="true (model) friction")
@@ -60,7 +93,24 @@ def plot_friction_velocity(v, F_true, F_meas, mask, title):
 
 
 def plot_critical_map(g, zc, Dc, default_point=None):
-    """Grid points in the (zeta*, D*) plane coloured by the nonlinear outcome, with the critical curve."""
+    """Grid points in the (zeta*, D*) plane coloured by the nonlinear outcome, with the critical curve.
+
+    Parameters
+    ----------
+    g : dict
+        :func:`heavecomp.pneumatic.stickslip.grid_map`: ``zeta``, ``D`` [-], ``nonlinear`` (stick-slip
+        in the simulation), ``agree`` per point, ``agreement`` [-].
+    zc : array_like [-]
+        Damping ratio zeta* along the critical curve.
+    Dc : array_like [-]
+        Critical D*_cr at ``zc`` (:func:`heavecomp.pneumatic.stickslip.critical_curve`).
+    default_point : (float, float) or None
+        (zeta*, D*) [-] of the default cylinder, marked (None: not marked).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     plt = _plt()
     fig, ax = plt.subplots(figsize=(8, 6))
     z, D, nl, ag = g["zeta"].ravel(), g["D"].ravel(), g["nonlinear"].ravel(), g["agree"].ravel()
@@ -85,7 +135,25 @@ def plot_critical_map(g, zc, Dc, default_point=None):
 
 
 def plot_min_velocity(p, zc, Dc, mv):
-    """Critical curve mapped to equilibrium velocity for the default cylinder (paper B Fig. 5)."""
+    """Critical curve mapped to equilibrium velocity for the default cylinder (paper B Fig. 5).
+
+    Parameters
+    ----------
+    p : heavecomp.pneumatic.plant.PneumaticParams
+        The cylinder.
+    zc : array_like [-]
+        Damping ratio zeta* along the critical curve.
+    Dc : array_like [-]
+        Critical D*_cr at ``zc`` (:func:`heavecomp.pneumatic.stickslip.critical_curve`).
+        Not drawn: the margin D*/D*_cr is recomputed for each exhaust area.
+    mv : dict
+        :func:`heavecomp.pneumatic.stickslip.minimum_velocity`: ``linear_u0`` and, if simulated,
+        ``nonlinear_u0`` [m/s].
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     plt = _plt()
     S = np.geomspace(0.02e-6, 1.0e-6, 40)
     u0, margin = [], []
@@ -110,7 +178,22 @@ def plot_min_velocity(p, zc, Dc, mv):
 
 
 def plot_influence(inf, zc, Dc):
-    """Paper B Fig. 6: where (zeta*, D*) moves when each variable is scaled 0.5..2."""
+    """Paper B Fig. 6: where (zeta*, D*) moves when each variable is scaled 0.5..2.
+
+    Parameters
+    ----------
+    inf : dict
+        :func:`heavecomp.pneumatic.stickslip.influence`: variable -> {``zeta``, ``D`` [-] per scale
+        factor}.
+    zc : array_like [-]
+        Damping ratio zeta* along the critical curve.
+    Dc : array_like [-]
+        Critical D*_cr at ``zc`` (:func:`heavecomp.pneumatic.stickslip.critical_curve`).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     plt = _plt()
     fig, ax = plt.subplots(figsize=(10, 6))
     zs = np.concatenate([np.asarray(r["zeta"], float) for r in inf.values()])
@@ -140,7 +223,20 @@ def plot_influence(inf, zc, Dc):
 
 def plot_cmc_map(m, breakout):
     """CMC main cylinder over heave amplitude x period, one column per friction law:
-    fraction of time stuck (top) and mean duration of one stick (bottom)."""
+    fraction of time stuck (top) and mean duration of one stick (bottom).
+
+    Parameters
+    ----------
+    m : dict
+        :func:`heavecomp.pneumatic.stickslip.cmc_stick_map`: ``amplitudes`` [m], ``periods`` [s] and,
+        per friction model, ``stick_fraction`` [-] and ``mean_stick_s`` [s] over the grid.
+    breakout : dict
+        Friction model -> quasi-static breakout heave amplitude [m] per period (dashed line).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     plt = _plt()
     models = [k for k in m if k not in ("amplitudes", "periods")]
     fig, axs = plt.subplots(2, len(models), figsize=(4.6 * len(models), 7.6), sharey=True, sharex=True,
@@ -168,7 +264,20 @@ def plot_cmc_map(m, breakout):
 
 
 def plot_rig(r_norot, r_rot, p):
-    """Paper A Figs. 7 and 8: friction-velocity loops without and with rotation (eq. 12 readings)."""
+    """Paper A Figs. 7 and 8: friction-velocity loops without and with rotation (eq. 12 readings).
+
+    Parameters
+    ----------
+    r_norot, r_rot : dict
+        Rig runs without and with rotation (:func:`heavecomp.test_rig.plant.run`): ``t`` [s], ``v``
+        [m/s], ``friction``, ``friction_eq12`` [N], ``quadrant``.
+    p : heavecomp.test_rig.plant.RigParams
+        The rig (piston diameter [m], tangential velocity [m/s] in the title).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     plt = _plt()
     fig, axs = plt.subplots(1, 2, figsize=(12, 4.8), sharey=True)
     for ax, r, ttl in ((axs[0], r_norot, "without rotation (Fig. 7): hysteresis, Stribeck when accelerating"),
@@ -190,7 +299,17 @@ def plot_rig(r_norot, r_rot, p):
 
 
 def plot_seal(rows_by_file):
-    """Seal friction against velocity for each supply pressure (TU Delft O-ring data)."""
+    """Seal friction against velocity for each supply pressure (TU Delft O-ring data).
+
+    Parameters
+    ----------
+    rows_by_file : dict
+        File name -> {``velocity`` [m/s], ``friction`` [N], ``pressure`` [Pa]}.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     plt = _plt()
     fig, ax = plt.subplots(figsize=(7.5, 5))
     for i, (name, r) in enumerate(rows_by_file.items()):

@@ -17,7 +17,24 @@ ROOT = Path(__file__).resolve().parents[2]
 
 
 def parse_args(argv, name: str, doc: str | None = None, extra=None) -> argparse.Namespace:
-    """``--quick`` and ``--out DIR`` (default ``reports/<name>``) for every scenario."""
+    """``--quick`` and ``--out DIR`` (default ``reports/<name>``) for every scenario.
+
+    Parameters
+    ----------
+    argv : list of str or None
+        The arguments (None: ``sys.argv[1:]``).
+    name : str
+        The scenario (its file name without ``.py``).
+    doc : str or None
+        The scenario's docstring; its first line is the help description.
+    extra : callable or None
+        ``extra(parser)`` adds the scenario's own arguments.
+
+    Returns
+    -------
+    argparse.Namespace
+        ``out`` a :class:`pathlib.Path` to a folder that exists.
+    """
     p = argparse.ArgumentParser(prog=f"scenarios/{name}.py", description=(doc or "").strip().splitlines()[0] if doc else None)
     p.add_argument("--quick", action="store_true", help="short runs (for tests and a first look)")
     p.add_argument("--out", default=str(ROOT / "reports" / name), help=f"output folder (default reports/{name})")
@@ -39,7 +56,20 @@ def parse_args(argv, name: str, doc: str | None = None, extra=None) -> argparse.
 
 def run(main, argv=None) -> int:
     """Run a scenario's ``main``: bad input (any :class:`InputError`) is one line on stderr and exit
-    code 2, never a traceback; Ctrl-C is exit 130."""
+    code 2, never a traceback; Ctrl-C is exit 130.
+
+    Parameters
+    ----------
+    main : callable
+        ``main(argv) -> int or None``: the scenario.
+    argv : list of str or None
+        Passed to ``main``.
+
+    Returns
+    -------
+    int
+        Exit code.
+    """
 
     try:
         return int(main(argv) or 0)
@@ -54,7 +84,20 @@ def run(main, argv=None) -> int:
 
 def write_metrics(out: Path, metrics: dict) -> Path:
     """``metrics.json`` with a provenance stamp and units; wall-clock timings go to the untracked
-    ``timings.json`` (a re-run leaves the tracked result unchanged)."""
+    ``timings.json`` (a re-run leaves the tracked result unchanged).
+
+    Parameters
+    ----------
+    out : pathlib.Path
+        Output folder.
+    metrics : dict
+        The metrics [SI; units by key].
+
+    Returns
+    -------
+    pathlib.Path
+        The ``metrics.json`` written.
+    """
 
     path = Path(out) / "metrics.json"
     path.write_text(json.dumps(_clean(metrics), indent=2) + "\n")
@@ -63,7 +106,21 @@ def write_metrics(out: Path, metrics: dict) -> Path:
 
 
 def md_table(header, rows, fmt="{:.2f}") -> str:
-    """Markdown table; floats formatted with ``fmt``."""
+    """Markdown table; floats formatted with ``fmt``.
+
+    Parameters
+    ----------
+    header : sequence of str
+        Column headers.
+    rows : iterable of sequence
+        One sequence of cells per row.
+    fmt : str
+        Format of a float cell.
+
+    Returns
+    -------
+    str
+    """
     def cell(v):
         return fmt.format(v) if isinstance(v, float) else str(v)
     lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
@@ -72,7 +129,22 @@ def md_table(header, rows, fmt="{:.2f}") -> str:
 
 
 def write_report(out: Path, title: str, sections: list[str]) -> Path:
-    """``report.md`` (ending with the provenance stamp) and its self-contained ``report.html``."""
+    """``report.md`` (ending with the provenance stamp) and its self-contained ``report.html``.
+
+    Parameters
+    ----------
+    out : pathlib.Path
+        Output folder.
+    title : str
+        The report's ``#`` heading.
+    sections : list of str
+        Markdown sections, in order.
+
+    Returns
+    -------
+    pathlib.Path
+        The ``report.md`` written.
+    """
 
     path = Path(out) / "report.md"
     path.write_text(f"# {title}\n\n" + "\n\n".join(s.strip() for s in sections) + "\n")

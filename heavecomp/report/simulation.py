@@ -19,6 +19,24 @@ def write_outputs(res: SimulationResult, out_dir, *, title: str | None = None, f
     ``figure`` may be a :class:`heavecomp.report.background.BackgroundFigure`
     started before the simulation (the CLI does), so the figure is drawn in
     parallel with the CSV.  ``progress(fraction)`` follows the CSV being written.
+
+    Parameters
+    ----------
+    res : heavecomp.simulate.SimulationResult
+        The simulation.
+    out_dir : str or os.PathLike
+        Output folder (created if missing).
+    title : str or None
+        Title of the figure.
+    figure : heavecomp.report.background.BackgroundFigure or None
+        A figure process already started (None: drawn here after the CSV).
+    progress : callable or None
+        ``progress(fraction)`` [-] while the CSV is written.
+
+    Returns
+    -------
+    dict
+        The metrics as written to ``metrics.json`` (with their units and the ``heave`` block).
     """
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
@@ -39,7 +57,18 @@ HEAVE_INFO_UNITS = {"repeat_period": "s", "kind": "", "source": ""}
 
 
 def heave_block(info: dict) -> dict:
-    """The heave's description for metrics.json, each number with the unit of its ``[heave]`` key."""
+    """The heave's description for metrics.json, each number with the unit of its ``[heave]`` key.
+
+    Parameters
+    ----------
+    info : dict
+        The heave's description (``SimulationResult.heave_info``).
+
+    Returns
+    -------
+    dict
+        Its numbers and strings, units declared.
+    """
     block = {k: v for k, v in info.items() if isinstance(v, (int, float, str))}
     units = {**table_units("heave"), **HEAVE_INFO_UNITS}
     return declare_units(block, {k: units[k] for k in block if k in units})
@@ -48,7 +77,24 @@ def heave_block(info: dict) -> dict:
 def write_closed_loop_outputs(res: ClosedLoopResult, out_dir, *, title: str | None = None,
                               rate: float | None = None) -> dict:
     """Write ``timeseries.csv`` (with ``u_active``; at ``rate`` [Hz], which must divide
-    the control rate; default the control rate), ``metrics.json`` and ``wob.png``."""
+    the control rate; default the control rate), ``metrics.json`` and ``wob.png``.
+
+    Parameters
+    ----------
+    res : heavecomp.closed_loop.ClosedLoopResult
+        The closed-loop run.
+    out_dir : str or os.PathLike
+        Output folder (created if missing).
+    title : str or None
+        Title of the figure.
+    rate : float or None [Hz]
+        Output rate of the CSV.
+
+    Returns
+    -------
+    dict
+        The metrics as written to ``metrics.json``.
+    """
     every = output_every(rate, res.control["control_rate"])
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)

@@ -61,7 +61,18 @@ OUT_OF_LIBRARY = tuple(n for n, law in LAWS.items() if not law.named)
 
 def truth_composition(name=None):
     """The compiled truth stepper holding the plant law ``name`` (any other name or None: the
-    benchmark's six, which also runs a plant with no truth effect)."""
+    benchmark's six, which also runs a plant with no truth effect).
+
+    Parameters
+    ----------
+    name : str or None
+        A truth law of :data:`LAWS`.
+
+    Returns
+    -------
+    heavecomp.effects.compose.Composition
+        The compiled composition of the plant laws of that law's ``group``.
+    """
     law = LAWS.get(name)
     group = law.group if law is not None and law.plant is not None else "benchmark"
     return composition(tuple(x.plant for x in LAWS.values() if x.plant is not None and x.group == group))

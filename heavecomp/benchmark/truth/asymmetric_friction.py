@@ -46,7 +46,20 @@ class TruthLaggedDirection(Effect):
 
 
 def draw(rng, setting):
-    """alpha +-0.15-0.35, T_d 0.05-0.2 s; its size is |alpha|, at most 0.8."""
+    """alpha +-0.15-0.35, T_d 0.05-0.2 s; its size is |alpha|, at most 0.8.
+
+    Parameters
+    ----------
+    rng : numpy.random.Generator
+        The case's random stream.
+    setting : heavecomp.benchmark.truth.Setting
+        What the draw may depend on; this law reads none of it (the signature every draw shares).
+
+    Returns
+    -------
+    heavecomp.benchmark.truth.Draw
+        The law's parameters [SI], the parameter that sets its size and that size's cap.
+    """
     return Draw({"alpha": float(rng.choice([-1, 1]) * rng.uniform(0.15, 0.35)), "t_flip": rng.uniform(0.05, 0.2),
                  "v_e": 2e-3}, "alpha", 0.8)
 

@@ -37,7 +37,21 @@ class TruthDwell(Effect):
 
 def draw(rng, setting):
     """dF 35-65 % of the nominal static friction F_S, tau_d 0.5-2 s; its size is dF, at most F_S
-    (static friction at most doubles)."""
+    (static friction at most doubles).
+
+    Parameters
+    ----------
+    rng : numpy.random.Generator
+        The case's random stream.
+    setting : heavecomp.benchmark.truth.Setting
+        What the draw may depend on; this law reads the nominal static friction
+        ``nominal.friction.static_force`` [N].
+
+    Returns
+    -------
+    heavecomp.benchmark.truth.Draw
+        The law's parameters [SI], the parameter that sets its size and that size's cap.
+    """
     fs = setting.nominal.friction.static_force
     return Draw({"dF": rng.uniform(0.35, 0.65) * fs, "tau_d": rng.uniform(0.5, 2.0)}, "dF", fs)
 

@@ -30,7 +30,20 @@ class TruthOrifice(Effect):
 
 
 def draw(rng, setting):
-    """K 1.5-4 x 10^5 Pa s^2/m^2; its size is K, at most 10^6."""
+    """K 1.5-4 x 10^5 Pa s^2/m^2; its size is K, at most 10^6.
+
+    Parameters
+    ----------
+    rng : numpy.random.Generator
+        The case's random stream.
+    setting : heavecomp.benchmark.truth.Setting
+        What the draw may depend on; this law reads none of it (the signature every draw shares).
+
+    Returns
+    -------
+    heavecomp.benchmark.truth.Draw
+        The law's parameters [SI], the parameter that sets its size and that size's cap.
+    """
     return Draw({"K": rng.uniform(1.5e5, 4e5)}, "K", 1e6)
 
 

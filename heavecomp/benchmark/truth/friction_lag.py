@@ -50,7 +50,20 @@ class TruthSpeedLag(Effect):
 
 
 def draw(rng, setting):
-    """T_w 0.8-3 s; its size is the lag, at most 8 s."""
+    """T_w 0.8-3 s; its size is the lag, at most 8 s.
+
+    Parameters
+    ----------
+    rng : numpy.random.Generator
+        The case's random stream.
+    setting : heavecomp.benchmark.truth.Setting
+        What the draw may depend on; this law reads none of it (the signature every draw shares).
+
+    Returns
+    -------
+    heavecomp.benchmark.truth.Draw
+        The law's parameters [SI], the parameter that sets its size and that size's cap.
+    """
     return Draw({"lag_time_speed": rng.uniform(0.8, 3.0)}, "lag_time_speed", 8.0)
 
 

@@ -51,7 +51,20 @@ class TruthThermalGas(Effect):
 
 
 def draw(rng, setting):
-    """Nitrogen: gamma fixed at 1.4, tau_th 2-8 s; no size knob (only a redraw changes it)."""
+    """Nitrogen: gamma fixed at 1.4, tau_th 2-8 s; no size knob (only a redraw changes it).
+
+    Parameters
+    ----------
+    rng : numpy.random.Generator
+        The case's random stream.
+    setting : heavecomp.benchmark.truth.Setting
+        What the draw may depend on; this law reads none of it (the signature every draw shares).
+
+    Returns
+    -------
+    heavecomp.benchmark.truth.Draw
+        The law's parameters [SI], the parameter that sets its size and that size's cap.
+    """
     return Draw({"gamma": 1.4, "tau_th": rng.uniform(2.0, 8.0)})
 
 

@@ -43,7 +43,21 @@ class TruthLaminarLeak(Effect):
 
 
 def draw(rng, setting):
-    """1-3 % of the charge lost over the run; its size is the leak rate, at most 15 % over the run."""
+    """1-3 % of the charge lost over the run; its size is the leak rate, at most 15 % over the run.
+
+    Parameters
+    ----------
+    rng : numpy.random.Generator
+        The case's random stream.
+    setting : heavecomp.benchmark.truth.Setting
+        What the draw may depend on; this law reads the run length ``duration`` [s] (the leak rate is a share of
+        the charge over it).
+
+    Returns
+    -------
+    heavecomp.benchmark.truth.Draw
+        The law's parameters [SI], the parameter that sets its size and that size's cap.
+    """
     return Draw({"leak_rate": rng.uniform(0.01, 0.03) / setting.duration}, "leak_rate", 0.15 / setting.duration)
 
 

@@ -15,7 +15,24 @@ from heavecomp.benchmark.truth.base import Draw, TruthLaw
 
 def synthetic_pitch(t, amplitude, period, seed):
     """A vessel pitch angle [rad]: narrow-band random (a sum of 12 components spread +-15 % around
-    ``period`` [s], random phases), rms ``amplitude`` [rad]."""
+    ``period`` [s], random phases), rms ``amplitude`` [rad].
+
+    Parameters
+    ----------
+    t : numpy.ndarray [s]
+        Sample times.
+    amplitude : float [rad]
+        Rms of the pitch angle.
+    period : float [s]
+        Centre period of the 12 components.
+    seed : int
+        Seed of the components' frequencies and phases.
+
+    Returns
+    -------
+    numpy.ndarray [rad]
+        Pitch angle at ``t``.
+    """
     rng = np.random.default_rng(seed)
     f = rng.uniform(0.85, 1.15, 12) / period
     ph = rng.uniform(0, 2 * np.pi, 12)
@@ -24,7 +41,24 @@ def synthetic_pitch(t, amplitude, period, seed):
 
 
 def heave_lever_arm(t, cols, lever_arm, pitch):
-    """Heave measured at a lever arm L [m] from the compensator: z_m = z + L sin(theta)."""
+    """Heave measured at a lever arm L [m] from the compensator: z_m = z + L sin(theta).
+
+    Parameters
+    ----------
+    t : numpy.ndarray [s]
+        Sample times (uniform).
+    cols : dict
+        Clean logged channel -> array [SI].
+    lever_arm : float [m]
+        Horizontal distance L from the heave sensor to the compensator.
+    pitch : numpy.ndarray [rad]
+        Vessel pitch angle theta at ``t``.
+
+    Returns
+    -------
+    dict
+        ``cols`` with ``heave`` measured at the lever arm and a ``pitch`` column [rad] added (a new dict).
+    """
     out = dict(cols)
     out["heave"] = cols["heave"] + lever_arm * np.sin(pitch)
     out["pitch"] = pitch
@@ -33,7 +67,24 @@ def heave_lever_arm(t, cols, lever_arm, pitch):
 
 def heave_mru(t, cols, gain, corner=0.01):
     """Heave from a motion reference unit with a gain error and a 2nd-order Butterworth high-pass at
-    ``corner`` [Hz] (its drift-free double integration)."""
+    ``corner`` [Hz] (its drift-free double integration).
+
+    Parameters
+    ----------
+    t : numpy.ndarray [s]
+        Sample times (uniform).
+    cols : dict
+        Clean logged channel -> array [SI].
+    gain : float [-]
+        Factor of the MRU's heave (1: no gain error).
+    corner : float [Hz]
+        Corner frequency of the high-pass.
+
+    Returns
+    -------
+    dict
+        ``cols`` with ``heave`` replaced by the MRU's reading [m] (a new dict).
+    """
     from scipy.signal import butter, lfilter
 
     b, a = butter(2, corner, btype="highpass", fs=1.0 / (t[1] - t[0]))
@@ -44,7 +95,23 @@ def heave_mru(t, cols, gain, corner=0.01):
 
 def misreference(t, cols, **parameters):
     """The logged heave of a drawn lever arm (``lever_arm``, ``pitch_rms`` [rad], ``pitch_period`` [s],
-    ``pitch_seed``) or of a drawn MRU (``gain_error`` [-], ``corner`` [Hz])."""
+    ``pitch_seed``) or of a drawn MRU (``gain_error`` [-], ``corner`` [Hz]).
+
+    Parameters
+    ----------
+    t : numpy.ndarray [s]
+        Sample times (uniform).
+    cols : dict
+        Clean logged channel -> array [SI].
+    **parameters : dict
+        The drawn parameters: ``lever_arm`` [m], ``pitch_rms`` [rad], ``pitch_period`` [s],
+        ``pitch_seed`` (int); or ``gain_error`` [-], ``corner`` [Hz].
+
+    Returns
+    -------
+    dict
+        ``cols`` with the misreferenced ``heave`` [m] (and ``pitch`` [rad] for a lever arm).
+    """
     if "lever_arm" in parameters:
         p = parameters
         return heave_lever_arm(t, cols, p["lever_arm"],
@@ -54,7 +121,20 @@ def misreference(t, cols, **parameters):
 
 def draw(rng, setting):
     """``mru``: a gain 8-14 % low and a 0.005-0.015 Hz high-pass, size the gain error, at most 50 %;
-    else L 5-15 m, pitch rms 0.005-0.01 rad at 8-12 s, size L, at most 120 m."""
+    else L 5-15 m, pitch rms 0.005-0.01 rad at 8-12 s, size L, at most 120 m.
+
+    Parameters
+    ----------
+    rng : numpy.random.Generator
+        The case's random stream.
+    setting : heavecomp.benchmark.truth.Setting
+        What the draw may depend on; this law reads ``variant`` (``mru``, else a lever arm).
+
+    Returns
+    -------
+    heavecomp.benchmark.truth.Draw
+        The law's parameters [SI], the parameter that sets its size and that size's cap.
+    """
     if setting.variant == "mru":
         return Draw({"gain_error": -rng.uniform(0.08, 0.14), "corner": rng.uniform(0.005, 0.015)}, "gain_error", 0.5)
     return Draw({"lever_arm": rng.uniform(5.0, 15.0), "pitch_rms": rng.uniform(0.005, 0.01),

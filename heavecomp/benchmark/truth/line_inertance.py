@@ -43,7 +43,20 @@ class TruthLineInertance(Effect):
 
 
 def draw(rng, setting):
-    """I 1-3 x 10^5 Pa s^2/m^3, T_i 0.05 s; its size is I, at most 5 x 10^6."""
+    """I 1-3 x 10^5 Pa s^2/m^3, T_i 0.05 s; its size is I, at most 5 x 10^6.
+
+    Parameters
+    ----------
+    rng : numpy.random.Generator
+        The case's random stream.
+    setting : heavecomp.benchmark.truth.Setting
+        What the draw may depend on; this law reads none of it (the signature every draw shares).
+
+    Returns
+    -------
+    heavecomp.benchmark.truth.Draw
+        The law's parameters [SI], the parameter that sets its size and that size's cap.
+    """
     return Draw({"inertance": rng.uniform(1e5, 3e5), "t_i": 0.05}, "inertance", 5e6)
 
 

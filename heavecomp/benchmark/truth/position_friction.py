@@ -47,7 +47,20 @@ class TruthWornBand(Effect):
 
 
 def draw(rng, setting):
-    """beta 0.3-0.6 in a band centred -0.3..0.3 m, half width 0.15-0.3 m; its size is beta, at most 3."""
+    """beta 0.3-0.6 in a band centred -0.3..0.3 m, half width 0.15-0.3 m; its size is beta, at most 3.
+
+    Parameters
+    ----------
+    rng : numpy.random.Generator
+        The case's random stream.
+    setting : heavecomp.benchmark.truth.Setting
+        What the draw may depend on; this law reads none of it (the signature every draw shares).
+
+    Returns
+    -------
+    heavecomp.benchmark.truth.Draw
+        The law's parameters [SI], the parameter that sets its size and that size's cap.
+    """
     return Draw({"beta": rng.uniform(0.3, 0.6), "s_c": rng.uniform(-0.3, 0.3), "w": rng.uniform(0.15, 0.3)},
                 "beta", 3.0)
 

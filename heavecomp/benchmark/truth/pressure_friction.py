@@ -33,7 +33,21 @@ class TruthEnergisedSeal(Effect):
 
 
 def draw(rng, setting):
-    """k 0.02-0.04 N/Pa above 0.9 p_0; its size is k, at most 0.1 N/Pa."""
+    """k 0.02-0.04 N/Pa above 0.9 p_0; its size is k, at most 0.1 N/Pa.
+
+    Parameters
+    ----------
+    rng : numpy.random.Generator
+        The case's random stream.
+    setting : heavecomp.benchmark.truth.Setting
+        What the draw may depend on; this law reads the nominal precharge pressure ``nominal.p0`` [Pa] (the
+        threshold is 0.9 of it).
+
+    Returns
+    -------
+    heavecomp.benchmark.truth.Draw
+        The law's parameters [SI], the parameter that sets its size and that size's cap.
+    """
     return Draw({"k": rng.uniform(0.02, 0.04), "p_th": 0.9 * setting.nominal.p0}, "k", 0.1)
 
 

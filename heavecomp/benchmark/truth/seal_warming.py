@@ -44,7 +44,20 @@ class TruthSealWarming(Effect):
 
 
 def draw(rng, setting):
-    """beta 0.15-0.3 at v_ref 0.3 m/s, T_th 60-200 s; its size is beta, at most 0.8."""
+    """beta 0.15-0.3 at v_ref 0.3 m/s, T_th 60-200 s; its size is beta, at most 0.8.
+
+    Parameters
+    ----------
+    rng : numpy.random.Generator
+        The case's random stream.
+    setting : heavecomp.benchmark.truth.Setting
+        What the draw may depend on; this law reads none of it (the signature every draw shares).
+
+    Returns
+    -------
+    heavecomp.benchmark.truth.Draw
+        The law's parameters [SI], the parameter that sets its size and that size's cap.
+    """
     return Draw({"beta": rng.uniform(0.15, 0.3), "v_ref": 0.3, "t_th": rng.uniform(60.0, 200.0)}, "beta", 0.8)
 
 

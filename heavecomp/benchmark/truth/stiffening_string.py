@@ -29,7 +29,20 @@ class TruthStiffeningString(Effect):
 
 
 def draw(rng, setting):
-    """k_3 0.5-2 x 10^9 N/m^3; its size is k_3, at most 10^12."""
+    """k_3 0.5-2 x 10^9 N/m^3; its size is k_3, at most 10^12.
+
+    Parameters
+    ----------
+    rng : numpy.random.Generator
+        The case's random stream.
+    setting : heavecomp.benchmark.truth.Setting
+        What the draw may depend on; this law reads none of it (the signature every draw shares).
+
+    Returns
+    -------
+    heavecomp.benchmark.truth.Draw
+        The law's parameters [SI], the parameter that sets its size and that size's cap.
+    """
     return Draw({"k3": rng.uniform(0.5e9, 2e9)}, "k3", 1e12)
 
 

@@ -31,7 +31,20 @@ class TruthQuadraticDrag(Effect):
 
 
 def draw(rng, setting):
-    """c_q 3-8 x 10^5 N s^2/m^2; its size is c_q, at most 4 x 10^6."""
+    """c_q 3-8 x 10^5 N s^2/m^2; its size is c_q, at most 4 x 10^6.
+
+    Parameters
+    ----------
+    rng : numpy.random.Generator
+        The case's random stream.
+    setting : heavecomp.benchmark.truth.Setting
+        What the draw may depend on; this law reads none of it (the signature every draw shares).
+
+    Returns
+    -------
+    heavecomp.benchmark.truth.Draw
+        The law's parameters [SI], the parameter that sets its size and that size's cap.
+    """
     return Draw({"c_q": rng.uniform(3e5, 8e5)}, "c_q", 4e6)
 
 

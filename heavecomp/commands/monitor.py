@@ -1,0 +1,81 @@
+"""Monitor a long measured log: when and where the sim-to-real gap appears or changes, segment by segment."""
+
+from __future__ import annotations
+
+import argparse
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    """The ``monitor`` subcommand's arguments.
+
+    Parameters
+    ----------
+    p : argparse.ArgumentParser
+        The ``monitor`` subcommand's parser.
+    """
+    p.add_argument("run", metavar="LOG", help="measured log: columns t, heave, stroke, pressure, wob; CSV (any "
+                   "delimiter, decimal comma, .gz/.bz2/.xz/.zip), Parquet or .mat (docs/contracts/measured-run.md)")
+    p.add_argument("--columns", default=None, metavar="t=NAME,...",
+                   help="map contract columns to the file's, e.g. t=Time,heave=MRU_heave,wob=WOB")
+    p.add_argument("--units", default=None, metavar="t=ms,...",
+                   help="declare units, e.g. t=ms,pressure=bar,wob=kN,stroke=mm (converted to SI and recorded)")
+    p.add_argument("--params", required=True, metavar="NOMINAL.toml", help="nominal CMC parameter file")
+    p.add_argument("--out", required=True, metavar="DIR", help="output folder (monitor.json, report.md/html, timeline.png)")
+    p.add_argument("--block", type=float, default=None, metavar="S",
+                   help="statistic block [s] (default 10 s, about one wave period)")
+    p.add_argument("--diagnose", action="store_true",
+                   help="diagnose each segment that starts at an effect change (the gap diagnosis on its first "
+                        "600 s; segments[].verdict in monitor.json, segment_<i>/diagnosis.json)")
+    p.add_argument("--jobs", type=int, default=1, metavar="N", help="candidates fitted concurrently by --diagnose")
+
+
+def run(args) -> int:
+    """Monitor the log (and with ``--diagnose`` diagnose its segments); returns the exit code.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed arguments of :func:`add_arguments`.
+    """
+    import sys
+    import time
+    from pathlib import Path
+
+    from heavecomp.diagnosis import monitor as M
+    from heavecomp.diagnosis.data import load_run
+    from heavecomp.errors import InputError
+    from heavecomp.io.series import check_spec, parse_mapping
+    from heavecomp.effects.spec import load  # the file with its [[effects]] checked
+    from heavecomp.report.monitor import write_report, write_segment_diagnoses
+    from heavecomp.report.provenance import finish
+
+    columns, units = check_spec(parse_mapping(args.columns, "--columns"), parse_mapping(args.units, "--units"),
+                                "cli")
+    params = load(args.params, heave_file=False)  # the log carries the heave: an unused heave file may be absent
+    block = M.BLOCK if args.block is None else args.block
+    if not block > 0:
+        raise InputError(f"--block must be > 0 s, got {args.block}")
+    if args.jobs < 1:
+        raise InputError(f"--jobs must be >= 1, got {args.jobs}")
+    run_ = load_run(args.run, params, columns=columns, units=units)
+    if run_.duration < M.MIN_DURATION:
+        raise InputError(f"{run_.source}: column 't': the log spans {run_.duration:.3g} s; monitor needs at least "
+                         f"{M.MIN_DURATION:g} s (a reference stretch and a few blocks to compare)")
+    t0 = time.perf_counter()
+
+    def progress(frac, msg):
+        if not getattr(args, "quiet", False):
+            print(f"[{time.perf_counter() - t0:6.1f} s {100 * frac:3.0f} %] {msg}", file=sys.stderr, flush=True)
+
+    res = M.monitor(run_, params, block=block, progress=progress)
+    diagnoses = M.diagnose_segments(res, run_, params, n_jobs=args.jobs, progress=progress) if args.diagnose else {}
+    write_report(res, args.out, source=run_.source, extra={"measurement": run_.measurement} if run_.measurement else None)
+    write_segment_diagnoses(diagnoses, args.out)
+    finish(args.out, params=params, json_files=("monitor.json",), heave_used=False, measured_run=str(Path(args.run).resolve()))
+    eff = [c for c in res.changes if c["kind"] == "effect"]
+    ops = [c for c in res.changes if c["kind"] == "operating"]
+    print(f"{len(eff)} effect change(s), {len(ops)} operating change(s), {len(res.segments)} segment(s)"
+          + "".join(f"; {c['component']} at {c['t']:.0f} s" for c in eff[:5])
+          + "".join(f"; segment {i}: {res.segments[i]['verdict']['effect']}" for i in diagnoses)
+          + f" -> {args.out}/monitor.json")
+    return 0

@@ -1,0 +1,813 @@
+"""Monitor a long log: when and where the sim-to-real gap appears or changes (issue 23 item 2).
+
+The component residuals (equation error, :mod:`heavecomp.diagnosis.components`: each model equation
+evaluated on the measured signals, split into the model components' parts) are local in time and
+cheap.  The monitor computes them window by window over a log of any length and follows, per block
+of :data:`BLOCK` seconds, the mean square of each equation residual and of each component's part of
+it over the equation's noise variance.
+
+Three passes, each streaming over the log (peak memory set by :data:`CHUNK`, not by the log):
+
+1. **operating point** per block: the mean WOB, stroke, pressure and heave.  A two-sided CUSUM on
+   the block-mean WOB finds set-point changes.  A change counts as *operating* only when the load
+   balance carries it: the mean pressure moves with it, ``A dp = -dW`` within :data:`CONSISTENT`
+   of ``dW`` (a new set-point is a new charge pressure; a WOB channel that starts to misread moves
+   the WOB alone, and is reported as an effect in ``sensors``);
+2. **component residuals** in chunks of :data:`CHUNK` seconds (plus :data:`PAD` on each side for
+   the filters), each operating segment with its own operating point (``wob_setpoint`` from its
+   median block-mean WOB, the heave reference from its median block-mean heave), so a new
+   operating point does not read as a gap; blocks within :data:`BLANK` of an operating change are
+   left out (the filters straddle it);
+3. **changes**: a two-sided, self-starting, clipped CUSUM (:func:`cusum`) on every monitored series
+   (:func:`columns`): per equation, log(1 + block statistic), standardised by its block-to-block noise
+   (1.4826 MAD of first differences / sqrt 2, robust to steps, floored at :data:`SIGMA_MIN`); and per
+   equation and feature of its split (``components.SPLIT``; the seal friction's sign(v) and v in the
+   top-mass balance), the block's joint least-squares **coefficient** of the equation residual on
+   those features (:meth:`BlockSums.coefficients`), signed and standardised the same way.  A
+   coefficient series carries its own baseline (what the nominal model's filters and stick events
+   leave in it), which the self-starting CUSUM learns at the start of each stretch and subtracts: a
+   softer formation moves the lower-mass coefficient of the relative displacement by Delta k although
+   the equation's mean square, dominated by that baseline, hardly moves.  The component of a change
+   comes from the structure (:func:`_attribute_change`): the equations that moved with it (any of
+   their series by :data:`MOVED` sigmas); exactly the equations that read one channel
+   (``components.READS``) -> ``sensors`` (or ``heave_input``); else the component of the feature
+   coefficient that moved most in the equations that moved (its law's own shape); else the
+   component part of the alarming equation that grew.  Every CUSUM then restarts.  Effect alarms
+   an operating change explains (:func:`absorbed`) are dropped.
+
+Why CUSUM and not ``ruptures``: ruptures' PELT (l2 cost, exact search in Python) took 3 s on 500
+blocks, 15 s on 1000 and 77 s on 2000 here (O(n^2.3) when changes are few): a 24 h log has 8640
+blocks of 10 s, tens of minutes against the 60 s budget of the whole pass.  A CUSUM is O(n),
+sequential (its alarm time *is* the detection delay) and its change-point estimate (the last time the
+sum was zero) gives the segment boundary.
+
+``changes[].t`` is the alarm time (end of the block in which the CUSUM crossed), ``onset`` the
+CUSUM's estimate of when the change began.  ``size_to_noise``: the mean shift of the standardised
+statistic between onset and alarm [block noise sigmas] (for an operating change: of the block-mean
+WOB).  ``segments[].gap_to_noise``: per component, sqrt(1 + gap) over the segment, the gap as
+:meth:`ComponentResiduals.gap` computes it (no nominal-replay floor: the monitor runs no replay).
+
+Settings (:data:`DRIFT`, :data:`THRESHOLD`, :data:`THRESHOLD_OP`, :data:`LEARN`, :data:`CLIP`,
+:data:`MOVED`, :data:`MIN_EXCITATION`) were chosen on the tuning set of ``scenarios/monitor_validation.py``
+(false alarms first) and frozen before its scoring set ran; docs/monitoring.md gives each one's reason.
+
+``--diagnose`` (:func:`diagnose_segments`): each segment that starts at an effect change is diagnosed
+by :class:`heavecomp.diagnosis.estimator.GapDiagnoser` on that segment, sliced from the log
+(:func:`segment_run`; the diagnosis estimates the state it starts from).
+
+The chunked residuals are fitted on the chunk (the split of an equation residual into components is
+a least-squares fit over the chunk): the monitor is offline over a finished log; a block's statistic
+may use up to one chunk of data after it.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+import math
+import warnings
+
+import numpy as np
+
+from heavecomp.diagnosis import components as CR
+from heavecomp.diagnosis.data import MeasuredRun, noise_floor
+from heavecomp.diagnosis.estimator import GapDiagnoser
+from heavecomp.effects.base import COMPONENTS
+
+log = logging.getLogger(__name__)
+
+SCHEMA = 1  #: monitor.json schema (diagnosis-contract.md, schema 3 section)
+BLOCK = 10.0  #: statistic block [s] (about one wave period)
+CHUNK = 600.0  #: component-residual window [s]: the monitor's memory is set by this
+PAD = 15.0  #: extra samples on each side of a chunk for the zero-phase filters [s] (> components.EDGE)
+WINDOW = 180  #: blocks of the CUSUM's reference (30 min of 10 s blocks): a slowly changing sea is followed [-]
+LEARN = 30  #: blocks the reference is learnt from before any alarm, at the log's start and after an operating change [-]
+RELEARN = 12  #: the same after an effect alarm (shorter: the detector is blind meanwhile) [-]
+MOVED_BLOCKS = 3  #: the last blocks up to an alarm compared with the reference to see what moved [-]
+#: an equation moved with a change: one of its series (mean square or a block coefficient) by this many
+#: sigmas and this share of the alarming series' move (monitor2, tuning set: at 1 sigma one of 20 series
+#: moved by chance at almost every alarm, and a seal friction read as a misread stroke)
+MOVED, MOVED_SHARE = 3.0, 0.3
+COEF_MOVED = 1.0  #: a block coefficient that moved less than this [sigmas] does not name the component
+OP_SLACK = 120.0  #: s around an operating change within which an effect alarm is the operating change
+CLIP = 4.0  #: largest deviation one block adds to a CUSUM [block sigmas]
+DRIFT = 1.0  #: CUSUM allowance k [block sigmas]: shifts below it are not accumulated
+THRESHOLD = 10.0  #: CUSUM decision threshold h [block sigmas] (tuning set: scenarios/monitor_validation.py)
+THRESHOLD_OP = 10.0  #: the same for the block-mean WOB [block sigmas]
+CONSISTENT = 0.35  #: an operating change: |dW + A dp| at most this share of |dW| [-]
+BLANK = 2  #: blocks on each side of an operating change left out of the component statistics [-]
+#: smallest block-to-block noise of a standardised statistic [log units]: the spread of log(1 + z) of a
+#: block at the noise level, z a mean of about 2 x CUTOFF x BLOCK independent squares, is ~sqrt(2/20)/2
+SIGMA_MIN = 0.15
+REFERENCE = 30  #: blocks before an onset the naming compares with [-]
+#: features of the equations' own split (components.SPLIT) left out of the block coefficients: within
+#: one block the time ``t`` is the constant again
+NOT_PER_BLOCK = ("t",)
+MIN_BLOCK_SAMPLES = 10  #: a block coefficient needs this many analysed samples (else NaN) [-]
+#: a block coefficient needs its feature's sum of squares to reach this share of the median block's
+#: (else NaN): a block in which the feature hardly varies (a small stroke for a position feature) gives a
+#: coefficient of heavy tails, which a CUSUM reads as a change [-]
+MIN_EXCITATION = 0.5
+#: smallest block-to-block noise of a standardised block coefficient, as a share of its median
+#: magnitude (a feature the residual never carries would otherwise be standardised by ~0) [-]
+COEF_SIGMA_MIN = 1e-3
+RIDGE = 1e-6  #: relative ridge of a block's normalised normal equations (features of unit scale) [-]
+OP_CHANNELS = ("heave", "stroke", "pressure", "wob")
+MIN_DURATION = 120.0  #: shortest log monitored [s]: a reference stretch of LEARN blocks and as many to compare
+
+
+@dataclasses.dataclass
+class MonitorResult:
+    """What :func:`monitor` found (``to_json()``: the contract's ``monitor.json``).
+
+    Attributes
+    ----------
+    t_blocks : array [s]  start of every block
+    block : float [s]
+    stats : {component: array}  block statistic (mean square of its parts / noise variance) [-]
+    op : {channel: array}  block means [SI]
+    sums : BlockSums  per block sums of the equation residuals and their parts
+    changes : list of dict  (contract keys ``t``, ``component``, ``size_to_noise``, ``kind``; plus
+        ``onset`` [s])
+    segments : list of dict  (``start``, ``end``, ``operating_point``, ``gap_to_noise``)
+    noise : {channel: sigma [SI]}
+    sensors : list of channels the log had
+    """
+
+    t_blocks: np.ndarray
+    block: float
+    stats: dict
+    op: dict
+    sums: object
+    changes: list
+    segments: list
+    noise: dict
+    sensors: list
+    duration: float
+
+    def to_json(self) -> dict:
+        return {"schema": SCHEMA, "changes": self.changes, "segments": self.segments,
+                "sensors": list(self.sensors), "block_s": self.block, "duration_s": self.duration,
+                "noise": self.noise,
+                "method": {"statistic": "log of the block mean square of each equation residual over its noise "
+                                        "variance, and the block least-squares coefficients of each equation "
+                                        "residual on its split's features",
+                           "detector": "two-sided CUSUM", "drift_sigmas": DRIFT, "threshold_sigmas": THRESHOLD,
+                           "threshold_op_sigmas": THRESHOLD_OP, "learn_blocks": LEARN, "chunk_s": CHUNK}}
+
+
+# ---------------------------------------------------------------------------- helpers
+def _block_edges(t, block):
+    """Sample index where each block starts (and the end)."""
+    starts = t[0] + block * np.arange(int(math.floor((t[-1] - t[0]) / block)) + 1)
+    edges = np.searchsorted(t, starts)
+    return np.unique(np.append(edges, t.size))
+
+
+def _block_means(y, edges):
+    ok = np.isfinite(y)
+    s = np.add.reduceat(np.where(ok, y, 0.0), edges[:-1])
+    n = np.add.reduceat(ok.astype(float), edges[:-1])
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(n > 0, s / np.maximum(n, 1), np.nan)
+
+
+def robust_sigma(x) -> float:
+    """Block-to-block noise of a series: 1.4826 MAD of its first differences / sqrt 2 (a step is
+    one outlier among the differences, not a spread) [unit of x].
+
+    Parameters
+    ----------
+    x : array
+        A block series [any unit].
+    """
+    d = np.diff(np.asarray(x, float))
+    d = d[np.isfinite(d)]
+    if d.size < 4:
+        return math.nan
+    return float(1.4826 * np.median(np.abs(d - np.median(d))) / math.sqrt(2.0))
+
+
+def cusum(u, learn=LEARN, drift=DRIFT, threshold=THRESHOLD, start=0, window=WINDOW, clip=CLIP):
+    """First alarm of a two-sided CUSUM on the columns of ``u`` (blocks x series, standardised).
+
+    Self-starting: each column's reference is the mean of its finite values over the ``window`` blocks
+    (from ``start`` on) before the CUSUM's current change-point estimate (the last block at which the
+    sum was zero), so a change in progress does not leak into it and a slow drift of the sea state is
+    followed; no alarm before ``learn`` finite values.  NaN blocks are skipped.  Each block's
+    deviation is clipped at +-``clip`` sigmas (a robust CUSUM: one stick-slip burst in one block
+    cannot raise an alarm alone; a lasting shift still adds every block).
+
+    Returns (alarm block, column, onset block, mean shift between onset and alarm [sigmas]) or None.
+
+    Parameters
+    ----------
+    u : array (blocks,) or (blocks, series)
+        Standardised series [block sigmas]; NaN blocks skipped.
+    learn : int
+        Finite blocks before any alarm [-].
+    drift : float [sigmas]
+        Allowance k.
+    threshold : float [sigmas]
+        Decision threshold h.
+    start : int
+        First block of the stretch.
+    window : int
+        Blocks of the reference before the change-point estimate.
+    clip : float [sigmas]
+        Largest deviation one block adds.
+    """
+    u = np.asarray(u, float)
+    if u.ndim == 1:
+        u = u[:, None]
+    n, m = u.shape
+    ok = np.isfinite(u[start:])
+    v = np.where(ok, u[start:], 0.0)
+    cs = np.vstack([np.zeros((1, m)), np.cumsum(v, axis=0)])   # prefix sums from ``start``
+    cn = np.vstack([np.zeros((1, m)), np.cumsum(ok, axis=0)])
+    hi, lo = np.zeros(m), np.zeros(m)
+    z_hi, z_lo = np.zeros(m, int), np.zeros(m, int)  # local index of the change-point estimates
+    for i in range(n - start):
+        row = v[i]
+        for j in range(m):
+            if not ok[i, j]:
+                continue
+            cut = min(z_hi[j], z_lo[j])
+            w0 = max(0, cut - window)
+            nref = cn[cut, j] - cn[w0, j]
+            if cn[cut, j] < learn or nref < 1:  # still learning: no evidence of change yet
+                z_hi[j] = z_lo[j] = i + 1
+                continue
+            d = min(max(row[j] - (cs[cut, j] - cs[w0, j]) / nref, -clip), clip)
+            hi[j] = max(0.0, hi[j] + d - drift)
+            lo[j] = max(0.0, lo[j] - d - drift)
+            if hi[j] == 0.0:
+                z_hi[j] = i + 1
+            if lo[j] == 0.0:
+                z_lo[j] = i + 1
+        over = np.maximum(hi, lo) / threshold
+        if (over >= 1.0).any():
+            j = int(np.argmax(over))
+            on = int(z_hi[j] if hi[j] >= lo[j] else z_lo[j])
+            cut = min(z_hi[j], z_lo[j])
+            w0 = max(0, cut - window)
+            ref = (cs[cut, j] - cs[w0, j]) / max(cn[cut, j] - cn[w0, j], 1)
+            k = cn[i + 1, j] - cn[on, j]
+            shift = (cs[i + 1, j] - cs[on, j]) / k - ref if k > 0 else 0.0
+            return start + i, j, start + on, float(abs(shift))
+    return None
+
+
+def _sensors(run) -> list:
+    return [c for c in OP_CHANNELS if c in run.columns and np.isfinite(run[c]).any()]
+
+
+# ---------------------------------------------------------------------------- pass 1: operating point
+def operating_changes(op, block_t, block, params, *, threshold=THRESHOLD_OP, learn=LEARN):
+    """Changes of the block-mean WOB; each classified by the load balance (module docstring).
+
+    Returns (list of change dicts, list of operating boundaries as block indices).
+
+    Parameters
+    ----------
+    op : dict
+        Block means per channel (``wob``, ``pressure``, ...) [SI].
+    block_t : array [s]
+        Start of every block.
+    block : float [s]
+        Block length.
+    params : CMCParams
+        Nominal parameters (the cylinder area of the load balance).
+    threshold : float [sigmas]
+        CUSUM threshold of the block-mean WOB.
+    learn : int
+        Blocks learnt before any alarm.
+    """
+    w, p = op["wob"], op["pressure"]
+    sw = robust_sigma(w)
+    out, bounds = [], []
+    if not (sw > 0):
+        return out, bounds
+    u = (w / sw)[:, None]
+    start = 0
+    while True:
+        hit = cusum(u, learn=learn, threshold=threshold, start=start)
+        if hit is None:
+            break
+        b, _, onset, size = hit
+        before = w[max(onset - learn, 0):onset]
+        after = w[onset + 1:min(onset + 1 + learn, w.size)]
+        pb, pa = p[max(onset - learn, 0):onset], p[onset + 1:min(onset + 1 + learn, w.size)]
+        dW = float(np.nanmedian(after) - np.nanmedian(before)) if after.size and before.size else math.nan
+        dp = float(np.nanmedian(pa) - np.nanmedian(pb)) if pa.size and pb.size else math.nan
+        operating = math.isfinite(dW) and math.isfinite(dp) and abs(dW + params.area * dp) <= CONSISTENT * abs(dW)
+        out.append({"t": float(block_t[b] + block), "component": "operating_point" if operating else "sensors",
+                    "size_to_noise": size, "kind": "operating" if operating else "effect",
+                    "onset": float(block_t[onset]), "wob_step": dW, "pressure_step": dp})
+        if operating:
+            bounds.append(onset)
+        start = b + 1
+    return out, bounds
+
+
+# ---------------------------------------------------------------------------- pass 2: residuals
+def _chunks(lo, hi, per):
+    """Block-index ranges [a, b) of at most ``per`` blocks covering blocks lo..hi."""
+    a = lo
+    while a < hi:
+        yield a, min(a + per, hi)
+        a = min(a + per, hi)
+
+
+@dataclasses.dataclass
+class BlockSums:
+    """Per block: sums of squares of each equation residual and of each component's part of it, and
+    the samples they cover (raw, in the equation's unit squared); ``noise`` {equation: [unit]} is the
+    equation noise of the first chunk, which normalises every block (a per-chunk noise estimate
+    would step at every chunk edge)."""
+
+    eq: dict
+    parts: dict
+    count: dict
+    noise: dict
+    xtx: dict = dataclasses.field(default_factory=dict)
+    xtr: dict = dataclasses.field(default_factory=dict)
+
+    def coefficients(self, e) -> np.ndarray:
+        """Block least-squares coefficients of equation ``e``'s residual on its features
+        (:func:`coefficient_features`), jointly per block (blocks x features) [residual unit per feature
+        unit]; NaN where the block has fewer than :data:`MIN_BLOCK_SAMPLES`, and for a feature whose
+        sum of squares in the block is below :data:`MIN_EXCITATION` of the median block's (it is left
+        out of that block's fit)."""
+        A, y = self.xtx[e], self.xtr[e]
+        nb, m = y.shape
+        d = np.einsum("bii->bi", A).copy()
+        ok_b = self.count[e] >= MIN_BLOCK_SAMPLES
+        ex = np.zeros((nb, m), bool)
+        for k in range(m):
+            good = ok_b & (d[:, k] > 0)
+            if good.any():
+                ex[:, k] = good & (d[:, k] >= MIN_EXCITATION * float(np.median(d[good, k])))
+        sc = np.where(ex, np.sqrt(np.where(ex, d, 1.0)), 1.0)
+        An = A / (sc[:, :, None] * sc[:, None, :])
+        yn = y / sc
+        mask2 = ex[:, :, None] & ex[:, None, :]
+        eye = np.broadcast_to(np.eye(m), An.shape)
+        An = np.where(mask2, An, eye) + RIDGE * eye  # a feature left out: its own row, coefficient 0
+        yn = np.where(ex, yn, 0.0)
+        beta = np.linalg.solve(An, yn[..., None])[..., 0] / sc
+        return np.where(ex, beta, np.nan)
+
+    def z_eq(self, e) -> np.ndarray:
+        """Block mean square of equation ``e``'s residual over its noise variance [-]."""
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return np.where(self.count[e] > 0, self.eq[e] / np.maximum(self.count[e], 1), np.nan) / self.noise[e] ** 2
+
+    def z_part(self, c, e) -> np.ndarray:
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return np.where(self.count[e] > 0, self.parts[(c, e)] / np.maximum(self.count[e], 1),
+                            np.nan) / self.noise[e] ** 2
+
+    def stats(self) -> dict:
+        """{component: block mean square of its parts over their equations' noise variances} [-]."""
+        out = {}
+        for c in COMPONENTS:
+            zs = [self.z_part(c2, e) for (c2, e) in self.parts if c2 == c]
+            out[c] = np.sum(zs, axis=0) if zs else np.full(next(iter(self.eq.values())).size, np.nan)
+        return out
+
+
+def coefficient_features() -> dict:
+    """{equation: ((component, feature), ...)}: the features whose block coefficients the monitor follows
+    (the equation's own split, :data:`heavecomp.diagnosis.components.SPLIT`, less :data:`NOT_PER_BLOCK`;
+    the own component's nominal structure, ``components.STRUCTURE``, where the split lists none: the
+    seal friction's sign(v) and v in the top-mass balance)."""
+    out = {}
+    for e, split in CR.SPLIT.items():
+        keys = [(c, f) for c, fs in split.items() for f in fs if f not in NOT_PER_BLOCK]
+        own = CR.OWN[e]
+        if not split.get(own):
+            keys += [(own, f) for f in CR.STRUCTURE.get(own, ())]
+        out[e] = tuple(keys)
+    return out
+
+
+def component_blocks(run, params, edges, op_bounds, op, noise, *, block=BLOCK, chunk=CHUNK, pad=PAD,
+                     progress=None) -> BlockSums:
+    """Block sums of the equation residuals and their component parts (pass 2), chunk by chunk, each
+    operating segment with its own operating point.
+
+    Parameters
+    ----------
+    run : MeasuredRun
+    params : CMCParams
+        Nominal parameters.
+    edges : array of int
+        Sample index where each block starts, and the end.
+    op_bounds : list of int
+        Blocks where an operating change begins.
+    op : dict
+        Block means per channel [SI].
+    noise : dict
+        Channel -> noise sigma [SI].
+    block : float [s]
+    chunk : float [s]
+        Component-residual window.
+    pad : float [s]
+        Extra samples on each side of a chunk.
+    progress : callable (fraction, message), optional
+    """
+    nb = edges.size - 1
+    t = run.t
+    sums = None
+    seg_edges = [0] + sorted(op_bounds) + [nb]
+    per = max(1, int(round(chunk / block)))
+    done = 0
+    feats = coefficient_features()
+    for s0, s1 in zip(seg_edges[:-1], seg_edges[1:]):
+        if s1 <= s0:
+            continue
+        w0 = float(np.nanmedian(op["wob"][s0:s1]))
+        prm = params if not (w0 > 0) else params.replace(operating_point={"wob_setpoint": w0})
+        zref = float(np.nanmedian(op["heave"][s0:s1]))
+        for a, b in _chunks(s0, s1, per):
+            i0, i1 = edges[a], edges[b]
+            j0 = int(np.searchsorted(t, t[i0] - pad))
+            j1 = int(np.searchsorted(t, t[i1 - 1] + pad, side="right"))
+            if j1 - j0 < 50:
+                continue
+            sub = MeasuredRun(t[j0:j1], {k: run[k][j0:j1] for k in OP_CHANNELS}, source=run.source)
+            cr = CR.residuals(sub, prm, heave_reference=zref, noise=noise)
+            if sums is None:
+                sums = BlockSums({e: np.zeros(nb) for e in cr.equations}, {}, {e: np.zeros(nb) for e in cr.equations},
+                                 dict(cr.noise))
+                for e in cr.equations:
+                    m = len(feats.get(e, ()))
+                    sums.xtx[e], sums.xtr[e] = np.zeros((nb, m, m)), np.zeros((nb, m))
+            loc = edges[a:b + 1] - j0
+            for e, r in cr.equations.items():
+                ok = cr.mask & np.isfinite(r)
+                sums.eq[e][a:b] = np.add.reduceat(np.where(ok, r * r, 0.0), loc[:-1])
+                sums.count[e][a:b] = np.add.reduceat(ok.astype(float), loc[:-1])
+                X = [np.where(ok, CR._column(cr.signals, f), 0.0) for _, f in feats.get(e, ())]
+                r0 = np.where(ok, r, 0.0)
+                for i, xi in enumerate(X):
+                    sums.xtr[e][a:b, i] = np.add.reduceat(xi * r0, loc[:-1])
+                    for k in range(i + 1):
+                        sums.xtx[e][a:b, i, k] = sums.xtx[e][a:b, k, i] = np.add.reduceat(xi * X[k], loc[:-1])
+                for c in COMPONENTS:
+                    part = cr.parts.get(c, {}).get(e)
+                    if part is not None:
+                        key = (c, e)
+                        if key not in sums.parts:
+                            sums.parts[key] = np.zeros(nb)
+                        sums.parts[key][a:b] = np.add.reduceat(np.where(ok, part * part, 0.0), loc[:-1])
+            done += b - a
+            if progress:
+                progress(done / max(nb, 1), f"component residuals to {t[i1 - 1]:.0f} s")
+    for bnd in op_bounds:  # the filters straddle an operating change
+        for e in sums.count:
+            sums.count[e][max(bnd - BLANK, 0):bnd + BLANK] = 0.0
+    return sums
+
+
+# ---------------------------------------------------------------------------- pass 3: changes
+def _standardised(z):
+    """log(1 + z) over its block-to-block noise (floored at :data:`SIGMA_MIN`)."""
+    x = np.log1p(np.maximum(z, 0.0))
+    return x / max(robust_sigma(x), SIGMA_MIN)
+
+
+def _name(sums, e, onset, alarm, start):
+    """The component of equation ``e`` whose part grew most between the reference blocks (before the
+    onset, at most :data:`REFERENCE` of them) and onset..alarm [noise variances]."""
+    ref = slice(max(start, onset - REFERENCE), onset)
+    new = slice(onset, alarm + 1)
+    best, grow = None, -math.inf
+    for (c, e2) in sums.parts:
+        if e2 != e:
+            continue
+        z = sums.z_part(c, e)
+        d = float(np.nanmean(z[new]) - np.nanmean(z[ref])) if np.isfinite(z[ref]).any() else float(np.nanmean(z[new]))
+        if d > grow:
+            best, grow = c, d
+    return best
+
+
+def _component(sums, moved, e, onset, alarm, start):
+    """The component of a change from the equations that moved (the structure,
+    :mod:`heavecomp.diagnosis.structure`): one equation -> the part of it that grew; the set of
+    equations that read one channel (``components.READS``; the heave: ``structure.HEAVE_READS``) ->
+    ``heave_input`` if its parts changed more than the equations' own rests, else ``sensors`` (a
+    channel that misreads shows in every equation reading it; its rests may grow or shrink)."""
+    if len(moved) > 1 and any(moved == set(eqs) for eqs in CR.READS.values()):
+        own = sum(abs(_growth(sums, [(CR.OWN[x], x)], onset, alarm, start)) for x in moved)
+        hv = sum(abs(_growth(sums, [("heave_input", x)], onset, alarm, start)) for x in moved)
+        return "heave_input" if hv > own else "sensors"
+    return _name(sums, e, onset, alarm, start)
+
+
+def _growth(sums, keys, onset, alarm, start) -> float:
+    ref = slice(max(start, onset - REFERENCE), onset)
+    new = slice(onset, alarm + 1)
+    g = 0.0
+    for c, e in keys:
+        if (c, e) in sums.parts:
+            z = sums.z_part(c, e)
+            g += float(np.nanmean(z[new]) - (np.nanmean(z[ref]) if np.isfinite(z[ref]).any() else 0.0))
+    return g
+
+
+def _standardised_coef(c):
+    """A block coefficient over its block-to-block noise (floored at :data:`COEF_SIGMA_MIN` of its median
+    magnitude): signed, so a change of the law's coefficient is seen with its sign."""
+    c = np.asarray(c, float)
+    sig = robust_sigma(c)
+    med = float(np.nanmedian(np.abs(c))) if np.isfinite(c).any() else 0.0
+    floor = max(COEF_SIGMA_MIN * med, 1e-300)
+    return c / max(sig if math.isfinite(sig) else floor, floor)
+
+
+def columns(sums):
+    """The monitored block series: (names, components, equations, standardised matrix).
+
+    One column per equation (its mean square, :func:`_standardised`; component None: named from its
+    parts) and one per (equation, feature) block coefficient (:func:`coefficient_features`; the
+    component whose law the feature belongs to).
+
+    Parameters
+    ----------
+    sums : BlockSums
+    """
+    names, comps, eqs, cols = [], [], [], []
+    for e in sums.eq:
+        names.append(e), comps.append(None), eqs.append(e), cols.append(_standardised(sums.z_eq(e)))
+    for e, keys in coefficient_features().items():
+        if e not in sums.xtr:
+            continue
+        beta = sums.coefficients(e)
+        for k, (c, f) in enumerate(keys):
+            names.append(f"{e}:{f}"), comps.append(c), eqs.append(e)
+            cols.append(_standardised_coef(beta[:, k]))
+    return names, comps, eqs, np.column_stack(cols)
+
+
+def _shift(u, onset, alarm, start):
+    """Per column: |mean over the last :data:`MOVED_BLOCKS` up to the alarm - mean over the reference
+    blocks before the onset| [block sigmas] (0 where the reference has no finite block)."""
+    ref = slice(max(start, onset - REFERENCE), onset)
+    new = slice(max(onset, alarm + 1 - MOVED_BLOCKS), alarm + 1)
+    with warnings.catch_warnings():  # an all-NaN column (nothing analysed): no move
+        warnings.simplefilter("ignore", RuntimeWarning)
+        d = np.abs(np.nanmean(u[new], axis=0) - np.nanmean(u[ref], axis=0))
+    return np.nan_to_num(d)
+
+
+def _attribute_change(sums, names, comps, eqs, u, j, onset, alarm, start):
+    """(component, equations that moved) of an alarm in column ``j``, from the structure.
+
+    The columns that moved with it (:data:`MOVED` sigmas and :data:`MOVED_SHARE` of the alarming
+    column's move) give the equations that moved.  Exactly the equations that read one channel
+    (``components.READS``), more than one -> ``sensors`` (or ``heave_input``: :func:`_component`).
+    Otherwise the component of the feature coefficient that moved most among the moved equations'
+    features (the law's own shape: a softer formation moves the lower-mass coefficient of the
+    relative displacement, a leak the gas law's constant, a seal friction the top-mass coefficients
+    of sign(v)); if no coefficient moved, the part of the alarming equation that grew."""
+    d = _shift(u, onset, alarm, start)
+    move = {}
+    for k, e in enumerate(eqs):
+        move[e] = max(move.get(e, 0.0), d[k])
+    moved = {e for e, x in move.items() if x >= MOVED and x >= MOVED_SHARE * d[j]} | {eqs[j]}
+    if len(moved) > 1 and any(moved == set(r) for r in CR.READS.values()):
+        return _component(sums, moved, eqs[j], onset, alarm, start), moved
+    coef = [k for k in range(len(names)) if comps[k] is not None and eqs[k] in moved and d[k] >= COEF_MOVED]
+    if coef:
+        return comps[max(coef, key=lambda k: d[k])], moved
+    return _name(sums, eqs[j], onset, alarm, start), moved
+
+
+def component_changes(sums, block_t, block, op_bounds, *, threshold=THRESHOLD, learn=LEARN):
+    """CUSUM changes of the equation statistics and block coefficients (pass 3), named by
+    :func:`_attribute_change`, restarting at every operating boundary and after every alarm.
+
+    Parameters
+    ----------
+    sums : BlockSums
+    block_t : array [s]
+        Start of every block.
+    block : float [s]
+    op_bounds : list of int
+        Blocks where an operating change begins.
+    threshold : float [sigmas]
+        CUSUM threshold.
+    learn : int
+        Blocks learnt at a stretch's start.
+    """
+    names, comps, eqs, u = columns(sums)
+    out = []
+    nb = u.shape[0]
+    restarts = sorted(set(op_bounds) | {0})
+    start = 0
+    while start < nb:
+        stop = next((r for r in restarts if r > start), nb)
+        hit = cusum(u[:stop], learn=learn if start in restarts else RELEARN, threshold=threshold, start=start)
+        if hit is None:
+            start = stop
+            continue
+        b, j, onset, size = hit
+        comp, moved = _attribute_change(sums, names, comps, eqs, u, j, onset, b, start)
+        out.append({"t": float(block_t[b] + block), "component": comp, "size_to_noise": size, "kind": "effect",
+                    "onset": float(block_t[onset]), "equations": sorted(moved), "column": names[j]})
+        start = b + 1
+    return out
+
+
+def absorbed(effect, op_changes) -> bool:
+    """An effect alarm that an operating change explains: it falls between :data:`OP_SLACK` before the
+    operating change's onset and its alarm (the new set-point reached the residuals before the
+    block-mean WOB had moved enough).
+
+    Parameters
+    ----------
+    effect : dict
+        An effect change.
+    op_changes : list of dict
+        The operating changes.
+    """
+    return any(o["kind"] == "operating" and o["onset"] - OP_SLACK <= effect["t"] <= o["t"] + OP_SLACK
+               and effect["onset"] <= o["t"] for o in op_changes)
+
+
+def _segment_gap(sums, a, b) -> dict:
+    """gap_to_noise per component over blocks a..b: sqrt(1 + gap), the gap as ComponentResiduals.gap
+    computes it (its parts' mean squares over their equations' noise variances, less the noise's
+    expected 1 for an equation's own rest), without a replay floor."""
+    gap = dict.fromkeys(COMPONENTS, 0.0)
+    for (c, e), sq in sums.parts.items():
+        n = float(sums.count[e][a:b].sum())
+        if n > 0:
+            z = float(sq[a:b][sums.count[e][a:b] > 0].sum()) / n / sums.noise[e] ** 2
+            gap[c] += max(z - (1.0 if CR.OWN[e] == c else 0.0), 0.0)
+    return {c: math.sqrt(1.0 + g) for c, g in gap.items()}
+
+
+def segments(changes, block_t, block, op, sums, duration) -> list:
+    """The stationary stretches between changes (boundaries at the changes' onsets), each with its
+    operating point (medians of the block means) and gap_to_noise.
+
+    Parameters
+    ----------
+    changes : list of dict
+        Every change.
+    block_t : array [s]
+    block : float [s]
+    op : dict
+        Block means per channel [SI].
+    sums : BlockSums
+    duration : float [s]
+        Length of the log.
+    """
+    cuts = sorted({c["onset"] for c in changes})
+    bounds = [0.0] + [c for c in cuts if 0.0 < c < duration] + [duration]
+    out = []
+    for s, e in zip(bounds[:-1], bounds[1:]):
+        a = int(np.searchsorted(block_t, s))
+        b = max(int(np.searchsorted(block_t, e)), a + 1)
+        sl = slice(a, b)
+        opp = {"wob_setpoint": float(np.nanmedian(op["wob"][sl])),
+               "static_stroke": float(np.nanmedian(op["stroke"][sl])),
+               "static_pressure": float(np.nanmedian(op["pressure"][sl]))}
+        out.append({"start": float(s), "end": float(e), "operating_point": opp,
+                    "gap_to_noise": _segment_gap(sums, a, b)})
+    return out
+
+
+def monitor(run, params, *, block=BLOCK, chunk=CHUNK, threshold=THRESHOLD, threshold_op=THRESHOLD_OP,
+            learn=LEARN, noise=None, progress=None) -> MonitorResult:
+    """Monitor a measured run (:class:`heavecomp.diagnosis.data.MeasuredRun`) against the nominal ``params``.
+
+    Parameters
+    ----------
+    run : MeasuredRun
+        The log.
+    params : CMCParams
+        The nominal parameters.
+    learn : int
+        Blocks learnt before any alarm (:data:`LEARN`).
+    block : float [s]
+        Statistic block (:data:`BLOCK`).
+    chunk : float [s]
+        Window of the component residuals (:data:`CHUNK`): memory is set by it.
+    threshold, threshold_op : float [block sigmas]
+        CUSUM thresholds of the component statistics and of the block-mean WOB.
+    noise : {channel: sigma [SI]}, optional
+        Channel noise (default: :func:`heavecomp.diagnosis.data.noise_floor` of the first chunk).
+    progress : callable (fraction, message), optional
+
+    Returns
+    -------
+    MonitorResult
+    """
+    t = run.t
+    edges = _block_edges(t, block)
+    block_t = t[edges[:-1]]
+    op = {k: _block_means(run[k], edges) for k in OP_CHANNELS}
+    if noise is None:
+        first = t <= t[0] + chunk
+        noise = {k: noise_floor(run[k][first]) for k in OP_CHANNELS}
+    if progress:
+        progress(0.0, f"{edges.size - 1} blocks of {block:g} s; operating point")
+    op_changes, op_bounds = operating_changes(op, block_t, block, params, threshold=threshold_op, learn=learn)
+    sums = component_blocks(run, params, edges, op_bounds, op, noise, block=block, chunk=chunk, progress=progress)
+    eff = [e for e in component_changes(sums, block_t, block, op_bounds, threshold=threshold, learn=learn)
+           if not absorbed(e, op_changes)]
+    changes = sorted(op_changes + eff, key=lambda c: c["t"])
+    segs = segments(changes, block_t, block, op, sums, run.duration)
+    return MonitorResult(block_t, block, sums.stats(), op, sums, changes, segs,
+                         {k: float(v) for k, v in noise.items()}, _sensors(run), run.duration)
+
+
+# ---------------------------------------------------------------------------- --diagnose: one verdict per segment
+DIAGNOSE_SPAN = 600.0  #: a segment is diagnosed on at most its first this many seconds (the diagnosis' benchmarked length) [s]
+DIAGNOSE_MIN = 120.0  #: a segment shorter than this is not diagnosed (a fitted and a held-out part of several wave periods) [s]
+
+
+def carries_gap(segment, changes) -> bool:
+    """A segment carries a gap when it starts at an effect change (the monitor saw the gap appear or
+    change there).  The first segment is the log's reference stretch: its gap, if any, is the one
+    ``heavecomp diagnose`` of the log's start finds.
+
+    Parameters
+    ----------
+    segment : dict
+        A segment of :func:`segments`.
+    changes : list of dict
+        Every change.
+    """
+    return any(c["kind"] == "effect" and math.isclose(c["onset"], segment["start"], abs_tol=1e-6) for c in changes)
+
+
+def segment_run(run, start, end) -> MeasuredRun:
+    """The part of ``run`` from ``start`` to ``end`` [s, log time] as a run of its own, its clock restarted
+    at 0 (the diagnosis estimates the state it starts from, as for any log that starts mid-operation).
+
+    Parameters
+    ----------
+    run : MeasuredRun
+    start, end : float [s]
+        The part to slice, in log time.
+    """
+    k = (run.t >= start) & (run.t <= end)
+    t = run.t[k]
+    return MeasuredRun(t - t[0], {c: y[k] for c, y in run.columns.items()},
+                       source=f"{run.source} [{start:.0f}-{end:.0f} s]", measurement=dict(run.measurement))
+
+
+def diagnose_segments(result, run, params, *, candidates=None, n_jobs=1, span=DIAGNOSE_SPAN, progress=None) -> dict:
+    """Diagnose every segment of ``result`` (:func:`monitor`) that carries a gap (:func:`carries_gap`) with
+    :class:`heavecomp.diagnosis.estimator.GapDiagnoser` on that segment (at most its first ``span`` s).
+
+    Adds ``verdict`` (``effect``, ``confidence``, ``component``, ``shrink``, ``span`` [s, log time]) to
+    each diagnosed segment of ``result.segments``, and ``verdict = {"effect": "not_diagnosed",
+    "reason": ...}`` to a segment that carries a gap but is shorter than :data:`DIAGNOSE_MIN`.
+
+    Parameters
+    ----------
+    result : MonitorResult
+        What :func:`monitor` found; its segments gain ``verdict``.
+    run : MeasuredRun
+        The log it ran on.
+    params : CMCParams
+        The nominal parameters.
+    candidates : sequence of str, optional
+        Effect names (default: every candidate).
+    n_jobs : int
+        Candidates fitted concurrently.
+    span : float [s]
+        Longest part of a segment diagnosed.
+    progress : callable (fraction, message), optional
+
+    Returns
+    -------
+    dict
+        Segment index -> the segment's full ``diagnosis.json`` content (``GapDiagnoser.to_json``).
+    """
+    out = {}
+    todo = [i for i, s in enumerate(result.segments) if carries_gap(s, result.changes)]
+    for n, i in enumerate(todo):
+        seg = result.segments[i]
+        a, b = seg["start"], min(seg["end"], seg["start"] + span)
+        if b - a < DIAGNOSE_MIN:
+            seg["verdict"] = {"effect": "not_diagnosed",
+                              "reason": f"segment of {b - a:.0f} s, shorter than {DIAGNOSE_MIN:g} s"}
+            continue
+        if progress:
+            progress(n / len(todo), f"diagnosing segment {i} ({a:.0f}-{b:.0f} s)")
+        d = GapDiagnoser(params, candidates, n_jobs=n_jobs)
+        d.fit(segment_run(run, a, b))
+        v = d.verdict_
+        seg["verdict"] = {"effect": v["effect"], "confidence": v.get("confidence"), "component": v.get("component"),
+                          "shrink": v.get("shrink"), "span": [float(a), float(b)]}
+        out[i] = d.to_json()
+        log.info("segment %d (%.0f-%.0f s): %s (%s)", i, a, b, v["effect"], v.get("confidence"))
+    return out

@@ -1,0 +1,410 @@
+"""Data quality of a measured run: corruption that passes the contract's per-cell checks.
+
+:func:`heavecomp.diagnosis.data.check_run` refuses what is wrong cell by cell (a missing column, a
+non-numeric or non-finite cell, time going backwards, a unit a factor off).  A corrupted log can pass
+all of that and still be read with confidence: a frozen sensor, a spike, a time base at the wrong
+scale, a clock skew between channels, a torn last row, a WOB in the wrong unit that happens to be a
+plausible number.  :func:`assess` is a pure function of the checked run and the nominal parameters;
+it raises :class:`~heavecomp.errors.DataError` naming the column where the log cannot describe the
+rig at all (*refusals*), and otherwise returns a :class:`Quality` with one warning per problem and a
+``confidence_cap`` that :func:`apply_quality` applies to the verdict.  :func:`checked` runs it and
+returns the cleaned run (spikes and frozen stretches excluded like dropouts, a torn last row
+dropped) with the quality attached (``run.quality``).
+
+Every threshold is a physical argument, not a fit to the reproducers (``docs/contracts/measured-run.md``,
+section *Corrupted logs*):
+
+=================  ==================================================================  ===============
+check              criterion                                                           outcome
+=================  ==================================================================  ===============
+torn last row      the last sample off the line through the two before by              row dropped,
+                   ``TORN_NOISE`` robust second-difference sigmas (a row cut           warning
+                   mid-number loses digits; dropping a row costs nothing)
+spike              one sample departs from the median of itself and its neighbours     sample excluded,
+                   by > ``SPIKE_NOISE`` x the channel's sample-to-sample scale and     warning, cap low
+                   > ``SPIKE_SPREAD`` x the channel's 1-99 % range
+frozen channel     the same value repeated exactly for > ``FROZEN_PERIODS`` dominant  excluded, cap low;
+                   heave periods (>= ``FROZEN_MIN_S``)                                 refused beyond
+                                                                                       ``MAX_MISSING``
+impossible         pressure below vacuum or above ``MAX_PRESSURE_RATIO`` p_0; stroke  refused
+magnitude          range over ``STROKE_MAX`` (the longest compensator stroke built);
+                   heave range over 2 x 15 m; |WOB| over ``MAX_WOB_RATIO`` x the
+                   suspended weight
+WOB mean           mean above the lower mass's weight m_b g or <= 0 (the string would  refused
+                   push / the bit is off bottom)
+                   mean more than ``WOB_MEAN_FACTOR`` x off W_0 (another operating     warning, cap low
+                   point than the nominal file describes)
+time base          dominant heave period outside ``WAVE_PERIOD`` (3-25 s); the WOB's   warning, cap low
+                   resonance more than ``MODE_RATIO`` x off the rig's mode
+clock skew         heave -> stroke / pressure cross-correlation lag over               warning, cap low
+                   ``MAX_SKEW_S`` (the largest sensor lag the diagnosis models), with
+                   the correlation at lag 0 clearly weaker (``ZERO_LAG_SHARE``)
+=================  ==================================================================  ===============
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+import math
+
+import numpy as np
+
+from heavecomp.errors import DataError
+from heavecomp.params.plausibility import natural_frequencies
+
+log = logging.getLogger(__name__)
+
+G = 9.81  #: gravity [m/s^2] (contract value)
+P_ATM = 101325.0  #: atmospheric pressure [Pa]
+MAX_MISSING = 0.2  #: as :data:`heavecomp.diagnosis.data.MAX_MISSING`: largest excluded share of a channel
+CONFIDENCE = ("low", "medium", "high")  #: verdict confidences, lowest first
+
+# ---- spikes: one-sample departures that no plant motion makes
+SPIKE_NOISE = 30.0  #: spike margin in robust sample-to-sample standard deviations of the channel [-]
+SPIKE_SPREAD = 0.25  #: spike margin as a share of the channel's 1-99 % range [-]
+TORN_NOISE = 30.0  #: torn last row: off the line through the two samples before by this many robust second-difference sigmas [-]
+TORN_SPREAD = 1e-3  #: ... and by more than this share of the channel's 1-99 % range (a noise-free channel) [-]
+# ---- frozen sensors
+FROZEN_PERIODS = 2.0  #: a live channel changes within this many dominant heave periods [-]
+FROZEN_MIN_S = 10.0  #: ... and never stays exactly constant this long [s]
+# ---- impossible magnitudes
+STROKE_MAX = 7.62  #: longest compensator stroke built (25 ft) [m]
+HEAVE_MAX = 15.0  #: largest platform heave amplitude (``heave.amplitude``'s bound) [m]
+MAX_PRESSURE_RATIO = 10.0  #: largest main-cylinder pressure over p_0 [-]
+MAX_WOB_RATIO = 3.0  #: largest |WOB| over the suspended weight (M_c + m_b) g [-]
+WOB_MEAN_FACTOR = 2.0  #: a mean WOB outside [W_0 / f, W_0 f] is another operating point [-]
+# ---- time base
+WAVE_PERIOD = (3.0, 25.0)  #: plausible dominant (mean, T_m01) period of a platform heave [s]
+MODE_RATIO = 1.5  #: largest ratio of the WOB resonance's frequency to the nominal mode's [-]
+MODE_PROMINENCE = 5.0  #: a resonance is read only when it stands this far above the band's median [-]
+# ---- clock skew
+MAX_SKEW_S = 3.0  #: largest sensor lag (``sensor_delay.delay``'s bound) [s]
+MIN_CORRELATION = 0.5  #: a lag is read only from a cross-correlation peak at least this strong [-]
+#: ... and only when the correlation at lag 0 is weaker than this share of the peak's [-]: a regular heave
+#: correlates (with the opposite sign) as well half a period away, a skewed clock's channel does not at 0
+ZERO_LAG_SHARE = 0.8
+CHANNELS = ("heave", "stroke", "pressure", "wob")
+
+
+@dataclasses.dataclass
+class Quality:
+    """What :func:`assess` found.
+
+    Attributes
+    ----------
+    issues : list of dict
+        One per problem: ``kind`` (``spike``, ``torn``, ``frozen``, ``wob_setpoint``, ``time_base``,
+        ``clock_skew``), ``column``, ``message`` (one line naming the column), ``cap`` (the largest
+        confidence it allows, or None).
+    exclude : dict of str to ndarray of int
+        Sample indices per column to exclude (treated as dropouts).
+    drop_last : bool
+        The last row is torn: drop it.
+    """
+
+    issues: list = dataclasses.field(default_factory=list)
+    exclude: dict = dataclasses.field(default_factory=dict)
+    drop_last: bool = False
+
+    @property
+    def warnings(self) -> list:
+        return [i["message"] for i in self.issues]
+
+    @property
+    def confidence_cap(self):
+        """The lowest cap of any issue (``"low"``, ...), or None when nothing caps the verdict."""
+        caps = [i["cap"] for i in self.issues if i.get("cap")]
+        return min(caps, key=CONFIDENCE.index) if caps else None
+
+    def to_json(self) -> dict:
+        return {"confidence_cap": self.confidence_cap,
+                "issues": [{k: v for k, v in i.items()} for i in self.issues]}
+
+
+def _issue(q, kind, column, message, cap="low"):
+    q.issues.append({"kind": kind, "column": column, "message": f"column '{column}': {message}", "cap": cap})
+
+
+def _liner(rows):
+    """Sample index -> file line (``rows`` from the reader; default: header on line 1, one sample a line)."""
+    return (lambda i: int(rows[i])) if rows is not None else (lambda i: int(i) + 2)
+
+
+def _uniform(t, y):
+    ok = np.isfinite(y)
+    dt = float(np.median(np.diff(t)))
+    tu = np.arange(t[0], t[-1] + 1e-9 * dt, dt)
+    return tu, np.interp(tu, t[ok], y[ok]) if ok.sum() >= 2 else np.zeros_like(tu)
+
+
+def mean_period(t, z) -> float:
+    """Spectral mean period T_m01 = m0 / m1 [s] of a heave (the band 0.02-1 Hz, Welch spectrum)."""
+    from scipy.signal import welch
+
+    tu, zu = _uniform(t, z)
+    fs = 1.0 / (tu[1] - tu[0])
+    n = int(min(zu.size, max(64, 120.0 * fs)))
+    f, P = welch(zu - zu.mean(), fs, nperseg=n)
+    m = (f >= 0.02) & (f <= 1.0)
+    m1 = float(np.sum(f[m] * P[m]))
+    return float(np.sum(P[m]) / m1) if m1 > 0 else math.inf
+
+
+def spikes(y, last=True):
+    """Indices of one-sample spikes of a channel (module table), and whether the last sample is one.
+
+    A sample is a spike when it departs from the median of itself and its two neighbours (the last
+    sample: from the one before) by more than ``SPIKE_NOISE`` robust standard deviations of the
+    channel's sample-to-sample change *and* by more than ``SPIKE_SPREAD`` of its 1-99 % range.  A
+    median of three keeps steps (a stick-slip breakaway) and removes a lone sample.  A plant motion
+    sampled at >= 6 samples per period of the rig's fastest mode (0.44 / 1.8 Hz for paper A, 10 Hz
+    logs and up) moves a lone sample off that median by at most (1 - cos(2 pi / 6)) = 1/2 of its own
+    amplitude, a quarter of the range at most for a mode as large as the whole channel.
+    """
+    y = np.asarray(y, dtype=float)
+    ok = np.isfinite(y)
+    if ok.sum() < 10:
+        return np.array([], dtype=int), False
+    yv = y[ok]
+    idx = np.flatnonzero(ok)
+    d = np.diff(yv)
+    scale = 1.4826 * float(np.median(np.abs(d - np.median(d)))) / math.sqrt(2.0)
+    lo, hi = np.percentile(yv, [1.0, 99.0])
+    margin = max(SPIKE_NOISE * scale, SPIKE_SPREAD * float(hi - lo))
+    med = np.median(np.stack([yv[:-2], yv[1:-1], yv[2:]]), axis=0)
+    r = np.abs(yv[1:-1] - med)
+    hit = list(idx[1:-1][r > margin])
+    if abs(yv[0] - yv[1]) > margin and abs(yv[1] - yv[2]) <= margin:
+        hit.insert(0, idx[0])
+    # the last row: a file cut mid-write loses digits; dropping one row costs nothing, so the test is the
+    # noise's: the last sample off the line through the two before by TORN_NOISE robust second differences
+    d2 = np.diff(yv, 2)
+    s2 = 1.4826 * float(np.median(np.abs(d2 - np.median(d2))))
+    off = abs(yv[-1] - (2 * yv[-2] - yv[-3]))
+    floor = max(TORN_NOISE * s2, TORN_SPREAD * float(hi - lo))  # a tear under 0.1 % of the range does no harm
+    torn = last and off > floor and abs(d2[-2]) <= floor
+    return np.asarray(hit[:-1] if hit and hit[-1] == idx[-2] and torn else hit, dtype=int), \
+        bool(torn and idx[-1] == y.size - 1)
+
+
+def frozen_runs(y, min_len):
+    """(start, stop) index pairs of stretches where ``y`` repeats one value exactly for >= ``min_len`` samples."""
+    y = np.asarray(y, dtype=float)
+    same = np.concatenate([[False], (np.diff(y) == 0.0) & np.isfinite(y[1:])])
+    out = []
+    m = np.concatenate([[0], same.astype(int), [0]])
+    dm = np.diff(m)
+    for a, b in zip(np.flatnonzero(dm == 1), np.flatnonzero(dm == -1)):
+        if b - (a - 1) >= min_len:
+            out.append((a - 1, b))
+    return out
+
+
+def _lag(t, a, b, max_lag):
+    """(lag [s] of b behind a at the largest |normalised cross-correlation|, that correlation, the
+    |correlation| at lag 0)."""
+    tu, au = _uniform(t, a)
+    _, bu = _uniform(t, b)
+    dt = tu[1] - tu[0]
+    au, bu = au - au.mean(), bu - bu.mean()
+    n = au.size
+    k = int(min(max_lag / dt, n // 3))
+    if k < 1 or not (au.std() > 0 and bu.std() > 0):
+        return 0.0, 0.0, 0.0
+    nfft = 1 << int(math.ceil(math.log2(2 * n)))
+    cc = np.fft.irfft(np.conj(np.fft.rfft(au, nfft)) * np.fft.rfft(bu, nfft), nfft)
+    lags = np.concatenate([np.arange(0, k + 1), np.arange(-k, 0)])
+    vals = np.concatenate([cc[:k + 1], cc[-k:]]) / (n - np.abs(lags))  # unbiased
+    vals = vals / (au.std() * bu.std())
+    i = int(np.argmax(np.abs(vals)))
+    return float(lags[i] * dt), float(abs(vals[i])), float(abs(vals[0]))
+
+
+def _mode_peak(t, w, f_mode, f_wave):
+    """Frequency [Hz] of the WOB's resonance near ``f_mode`` (the largest of f^2 x PSD between the wave
+    band's edge and 3.5 f_mode) when it stands ``MODE_PROMINENCE`` x above the band's median, else None."""
+    from scipy.signal import welch
+
+    tu, wu = _uniform(t, w)
+    fs = 1.0 / (tu[1] - tu[0])
+    n = int(min(wu.size // 4, max(64, 60.0 * fs)))
+    if n < 64:
+        return None
+    f, P = welch(wu - wu.mean(), fs, nperseg=n)
+    lo = max(f_mode / (MODE_RATIO * 1.7), 2.0 * f_wave)
+    hi = min(3.5 * f_mode, 0.4 * fs)
+    m = (f >= lo) & (f <= hi)
+    if m.sum() < 8:
+        return None
+    s = P[m] * f[m] ** 2
+    i = int(np.argmax(s))
+    if i in (0, s.size - 1) or s[i] < MODE_PROMINENCE * float(np.median(s)):
+        return None
+    return float(f[m][i])
+
+
+def assess(run, params=None, *, rows=None) -> Quality:
+    """Look for corruption in a checked :class:`~heavecomp.diagnosis.data.MeasuredRun` (module table).
+
+    Parameters
+    ----------
+    run : MeasuredRun
+        As :func:`heavecomp.diagnosis.data.check_run` returns it (times from 0 s, NaN where missing).
+    params : CMCParams, optional
+        The nominal parameters; the checks against the operating point and the rig's modes need them.
+    rows : array of int, optional
+        File line of each sample, for messages (default: header on line 1, one sample a line).
+
+    Returns
+    -------
+    Quality
+
+    Raises
+    ------
+    DataError
+        One line naming the column where the log cannot be the rig's (impossible magnitudes, a WOB
+        mean the lower mass cannot make, a channel frozen or spiked over more than ``MAX_MISSING``).
+    """
+    src = run.source
+    line = _liner(rows)
+    t = np.asarray(run.t, dtype=float)
+    q = Quality()
+    cols = {c: np.array(run[c], dtype=float) for c in CHANNELS}
+    n = t.size
+    # ---- torn last row, spikes
+    for c in CHANNELS:
+        hit, torn = spikes(cols[c])
+        if torn:
+            q.drop_last = True
+            _issue(q, "torn", c, f"row {line(n - 1)} (the last) reads {cols[c][-1]:.6g} against "
+                                 f"{cols[c][-2]:.6g} before: torn mid-number? the row is dropped", cap=None)
+        if hit.size:
+            q.exclude.setdefault(c, set()).update(int(i) for i in hit)
+            shown = ", ".join(f"row {line(int(i))} = {cols[c][i]:.4g}" for i in hit[:3])
+            _issue(q, "spike", c, f"{hit.size} spike(s) ({shown}{', ...' if hit.size > 3 else ''}) departing from "
+                                  "their neighbours by more than the channel's range allows: excluded, confidence low")
+    last = n - 1 if q.drop_last else n
+    for c, s in q.exclude.items():
+        cols[c][sorted(s)] = np.nan
+    if q.drop_last:
+        t = t[:-1]
+        cols = {c: y[:-1] for c, y in cols.items()}
+        q.exclude = {c: {i for i in s if i < last} for c, s in q.exclude.items()}
+    # ---- dominant period, frozen stretches
+    T_wave = mean_period(t, cols["heave"])
+    dt = float(np.median(np.diff(t)))
+    per = T_wave if math.isfinite(T_wave) else WAVE_PERIOD[1]
+    min_len = int(math.ceil(max(FROZEN_MIN_S, FROZEN_PERIODS * min(max(per, WAVE_PERIOD[0]), WAVE_PERIOD[1])) / dt))
+    for c in CHANNELS:
+        runs_ = frozen_runs(cols[c], min_len)
+        if not runs_:
+            continue
+        k = sum(b - a for a, b in runs_)
+        a, b = max(runs_, key=lambda r: r[1] - r[0])
+        what = (f"{cols[c][a]:.6g} repeated exactly from row {line(a)} for {t[min(b, t.size - 1)] - t[a]:.1f} s"
+                f"{f' ({len(runs_)} stretches, {k} samples)' if len(runs_) > 1 else ''}")
+        missing = (np.isnan(cols[c]).sum() + k) / t.size
+        if c == "heave" or missing > MAX_MISSING:
+            raise DataError(f"{src}: column '{c}': frozen: {what} — a stuck sensor or logger "
+                            + ("(the heave is the replay's input)" if c == "heave" else
+                               f"({100 * missing:.0f} % of the channel unusable, at most {100 * MAX_MISSING:.0f} %)"))
+        for a, b in runs_:
+            q.exclude.setdefault(c, set()).update(range(a, b))
+            cols[c][a:b] = np.nan
+        _issue(q, "frozen", c, f"frozen: {what} (a live channel changes within {FROZEN_PERIODS:g} wave periods): "
+                               "excluded, confidence low")
+    # ---- impossible magnitudes
+    z, s, p, w = cols["heave"], cols["stroke"], cols["pressure"], cols["wob"]
+    if np.nanmax(z) - np.nanmin(z) > 2 * HEAVE_MAX:
+        raise DataError(f"{src}: column 'heave': range {np.nanmax(z) - np.nanmin(z):.4g} m is more than a platform heaves "
+                        f"(at most {2 * HEAVE_MAX:g} m crest to trough)")
+    if np.nanmax(s) - np.nanmin(s) > STROKE_MAX:
+        raise DataError(f"{src}: column 'stroke': range {np.nanmax(s) - np.nanmin(s):.4g} m is longer than any "
+                        f"compensator's stroke (at most {STROKE_MAX:g} m, 25 ft) — wrong unit (cm, in)?")
+    if np.nanmin(p) < -P_ATM:
+        raise DataError(f"{src}: column 'pressure': {np.nanmin(p):.4g} Pa (gauge) is below vacuum (-{P_ATM:g} Pa)")
+    if params is not None:
+        c_, ds, op = params.compensator, params.drill_string, params.operating_point
+        p0, W0 = params.p0, op.wob_setpoint
+        if np.nanmax(p) > MAX_PRESSURE_RATIO * p0:
+            raise DataError(f"{src}: column 'pressure': {np.nanmax(p):.4g} Pa is over {MAX_PRESSURE_RATIO:g} x the "
+                            f"operating pressure p_0 = {p0:.4g} Pa (the gas spring cannot compress that far)")
+        weight = (c_.moving_mass + ds.lower_mass) * G
+        if np.nanmax(np.abs(w)) > MAX_WOB_RATIO * weight:
+            raise DataError(f"{src}: column 'wob': |WOB| reaches {np.nanmax(np.abs(w)):.4g} N, over {MAX_WOB_RATIO:g} x "
+                            f"the suspended weight (M_c + m_b) g = {weight:.4g} N")
+        wm = float(np.nanmean(w))
+        mbg = ds.lower_mass * G
+        if wm >= mbg or wm <= 0:
+            raise DataError(f"{src}: column 'wob': mean {wm:.4g} N is "
+                            + (f"above the lower mass's weight m_b g = {mbg:.4g} N (the drill string would push; "
+                               f"nominal W_0 = {W0:.4g} N) — wrong unit or unit declaration (kN as t?)" if wm > 0 else
+                               "not positive (the bit is off bottom; nominal W_0 = {W0:.4g} N)")
+                            + " or wrong parameter file?")
+        if not W0 / WOB_MEAN_FACTOR <= wm <= W0 * WOB_MEAN_FACTOR:
+            _issue(q, "wob_setpoint", "wob", f"mean {wm:.4g} N is {wm / W0:.2f} x the set-point W_0 = {W0:.4g} N: "
+                                            "another operating point than the parameter file's (or a unit): confidence low")
+    # ---- time base
+    if not WAVE_PERIOD[0] <= T_wave <= WAVE_PERIOD[1]:
+        _issue(q, "time_base", "t", f"the heave's mean period is {T_wave:.3g} s, outside the {WAVE_PERIOD[0]:g}-"
+                                    f"{WAVE_PERIOD[1]:g} s of sea states: time base wrong (scale, unit)? confidence low")
+    elif params is not None:
+        modes = [float(f) for f in natural_frequencies(params)[0] if f > 0]
+        f_pk = _mode_peak(t, w, modes[0], 1.0 / T_wave) if modes else None
+        near = min(modes, key=lambda f: abs(math.log(f_pk / f))) if f_pk is not None else None
+        if near is not None and not 1.0 / MODE_RATIO <= f_pk / near <= MODE_RATIO:  # off every mode of the rig
+            _issue(q, "time_base", "t", f"the WOB resonates at {f_pk:.3g} Hz, {f_pk / near:.2f} x the nearest of the rig's "
+                                        f"modes ({', '.join(f'{f:.3g}' for f in modes)} Hz from the parameter file): time "
+                                        "base at the wrong scale (or the wrong parameter file)? confidence low")
+    # ---- clock skew: stroke and pressure follow the heave through the gas spring
+    max_lag = min(30.0, 0.25 * float(t[-1] - t[0]))
+    lags = {}
+    for c in ("stroke", "pressure"):
+        lag, r, r0 = _lag(t, z, cols[c], max_lag)
+        if r >= MIN_CORRELATION and r0 < ZERO_LAG_SHARE * r:  # a periodic heave correlates at half periods too
+            lags[c] = lag
+    far = {c: g for c, g in lags.items() if abs(g) > MAX_SKEW_S}
+    if far:
+        col = "heave" if len(far) == len(lags) == 2 else next(iter(far))
+        shown = ", ".join(f"{c} {g:+.2f} s" for c, g in lags.items())
+        _issue(q, "clock_skew", col, f"clock skew? offset from the heave by {shown} (cross-correlation peak), more "
+                                     f"than any sensor lag ({MAX_SKEW_S:g} s): confidence low")
+    q.exclude = {c: np.array(sorted(s), dtype=int) for c, s in q.exclude.items() if s}
+    return q
+
+
+def cleaned(run, q: Quality):
+    """The run with ``q``'s exclusions as dropouts (NaN), its torn last row dropped, ``q``'s warnings
+    appended and ``run.quality = q`` (a new :class:`MeasuredRun`; ``run`` is unchanged)."""
+    cols = {k: np.array(v, dtype=float) for k, v in run.columns.items()}
+    for c, idx in q.exclude.items():
+        cols[c][idx] = np.nan
+    t = np.asarray(run.t, dtype=float)
+    if q.drop_last:
+        t = t[:-1]
+        cols = {k: v[:-1] for k, v in cols.items()}
+    return dataclasses.replace(run, t=t, columns=cols, warnings=list(run.warnings) + q.warnings, quality=q)
+
+
+def checked(run, params=None, *, rows=None):
+    """:func:`assess` then :func:`cleaned`: the run :func:`heavecomp.diagnosis.data.load_run` returns."""
+    return cleaned(run, assess(run, params, rows=rows))
+
+
+def apply_quality(verdict: dict, quality) -> dict:
+    """The verdict with its confidence at most ``quality.confidence_cap`` (a new dict).
+
+    A capped verdict says so: ``verdict["data_quality"]`` lists the problems' kinds and columns and
+    ``confidence_capped_from`` the confidence it had.  ``quality`` None or without a cap: unchanged.
+    """
+    cap = getattr(quality, "confidence_cap", None)
+    if cap is None:
+        return verdict
+    v = dict(verdict)
+    was = v.get("confidence", "high")
+    v["data_quality"] = [{"kind": i["kind"], "column": i["column"]} for i in quality.issues if i.get("cap")]
+    if was in CONFIDENCE and CONFIDENCE.index(was) > CONFIDENCE.index(cap):
+        v["confidence"] = cap
+        v["confidence_capped_from"] = was
+    return v

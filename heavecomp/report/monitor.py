@@ -1,0 +1,162 @@
+"""Monitor outputs: ``monitor.json`` (diagnosis-contract.md, schema 3 section), the timeline figure and ``report.md``."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+
+from heavecomp.diagnosis.components import UNITS
+from heavecomp.effects.base import COMPONENTS
+from heavecomp.report.figures import _plt, save
+from heavecomp.report.scenario import _clean as clean
+from heavecomp.report.scenario import md_table
+
+
+def timeline_figure(res, *, title=""):
+    """One row per component: the block statistic as rms over noise (sqrt of the block's mean square
+    of the component's parts over the noise variance) against time, on a log scale; the block-mean
+    WOB on top; effect changes as solid red lines, operating changes dashed.
+
+    Parameters
+    ----------
+    res : heavecomp.diagnosis.monitor.MonitorResult
+    title : str
+        Figure title (default: a description of the rows).
+    """
+    plt = _plt()
+    rows = 1 + len(COMPONENTS)
+    fig, axes = plt.subplots(rows, 1, figsize=(11, 1.5 * rows + 1), sharex=True)
+    long = res.duration > 2 * 3600
+    scale, unit = (1 / 3600.0, "h") if long else (1 / 60.0, "min")
+    tb = (res.t_blocks + 0.5 * res.block) * scale
+    axes[0].plot(tb, res.op["wob"] * 1e-3, color="k", lw=0.8)
+    axes[0].set_ylabel("WOB\nblock mean [kN]")
+    for ax, c in zip(axes[1:], COMPONENTS):
+        ax.semilogy(tb, np.sqrt(np.maximum(res.stats[c], 1e-6)), lw=0.7)
+        ax.set_ylabel(f"{c}\nrms/noise [-]", fontsize=8)
+    for ch in res.changes:
+        op = ch["kind"] == "operating"
+        for ax in axes:
+            ax.axvline(ch["t"] * scale, color="tab:orange" if op else "tab:red", ls="--" if op else "-", lw=1.0)
+        if not op and ch["component"] in COMPONENTS:
+            ax = axes[1 + COMPONENTS.index(ch["component"])]
+            ax.annotate(f"{ch['size_to_noise']:.1f} σ", (ch["t"] * scale, 1), xycoords=("data", "axes fraction"),
+                        va="top", fontsize=7, color="tab:red")
+    axes[-1].set_xlabel(f"time [{unit}]")
+    axes[0].set_title(title or "Component residuals over time (red: effect change, orange dashed: operating change)",
+                      fontsize=10)
+    fig.tight_layout()
+    return fig
+
+
+def write_json(res, path, extra=None) -> Path:
+    """Write ``monitor.json`` (:meth:`heavecomp.diagnosis.monitor.MonitorResult.to_json`, plus ``extra``).
+
+    Parameters
+    ----------
+    res : heavecomp.diagnosis.monitor.MonitorResult
+    path : str or Path
+        The ``monitor.json`` to write.
+    extra : dict, optional
+        Keys added at the top level (e.g. ``measurement``).
+    """
+    d = res.to_json()
+    d.update(extra or {})
+    path = Path(path)
+    path.write_text(json.dumps(clean(d), indent=2) + "\n", encoding="utf-8")
+    return path
+
+
+def write_segment_diagnoses(diagnoses, out) -> list:
+    """Each diagnosed segment's ``diagnosis.json`` (``{index: content}``, :func:`heavecomp.diagnosis.monitor.
+    diagnose_segments`) as ``out/segment_<index>/diagnosis.json``; returns the paths.
+
+    Parameters
+    ----------
+    diagnoses : dict
+        Segment index -> ``diagnosis.json`` content.
+    out : str or Path
+        Output folder.
+    """
+    paths = []
+    for i, d in sorted(diagnoses.items()):
+        sub = Path(out) / f"segment_{i}"
+        sub.mkdir(parents=True, exist_ok=True)
+        p = sub / "diagnosis.json"
+        p.write_text(json.dumps(clean(d), indent=2) + "\n", encoding="utf-8")
+        paths.append(p)
+    return paths
+
+
+def report_markdown(res, source="", figure="timeline.png") -> str:
+    """The monitor's ``report.md``: the changes, the segments (with their verdicts) and the method.
+
+    Parameters
+    ----------
+    res : heavecomp.diagnosis.monitor.MonitorResult
+    source : str
+        Name of the log, for the title.
+    figure : str
+        File name of the timeline figure, relative to the report.
+    """
+    lines = [f"# Monitor — {source}" if source else "# Monitor", "",
+             f"{res.duration / 3600:.2f} h of log, sensors {', '.join(res.sensors)}; statistic blocks of "
+             f"{res.block:g} s. {sum(c['kind'] == 'effect' for c in res.changes)} effect change(s), "
+             f"{sum(c['kind'] == 'operating' for c in res.changes)} operating change(s).", "",
+             f"![timeline]({figure})", "", "## Changes", ""]
+    if res.changes:
+        lines.append(md_table(["detected t [s]", "onset [s]", "component", "size [noise σ]", "kind"],
+                              [[f"{c['t']:.0f}", f"{c['onset']:.0f}", c["component"], f"{c['size_to_noise']:.1f}",
+                                c["kind"]] for c in res.changes]))
+    else:
+        lines.append("No change: every component's residual stayed at its level over the whole log.")
+    lines += ["", "`size`: the mean shift of the component's standardised block statistic between onset and "
+              "detection, in its block-to-block noise σ (an operating change: of the block-mean WOB). An "
+              "operating change is one the load balance carries (the mean pressure moves with the WOB, "
+              "A Δp = -ΔW); a WOB that moves alone is a misreading (`sensors`).", "", "## Segments", ""]
+    hdr = ["start [s]", "end [s]", "WOB set-point [kN]", "static stroke [m]", "static pressure [MPa]"] + \
+          [f"{c} gap/noise [-]" for c in COMPONENTS] + ["verdict"]
+    rows = [[f"{s['start']:.0f}", f"{s['end']:.0f}", f"{s['operating_point']['wob_setpoint'] * 1e-3:.1f}",
+             f"{s['operating_point']['static_stroke']:.3f}", f"{s['operating_point']['static_pressure'] * 1e-6:.3f}"]
+            + [f"{s['gap_to_noise'][c]:.2f}" for c in COMPONENTS] + [_verdict(s)] for s in res.segments]
+    lines += [md_table(hdr, rows), "",
+              "gap/noise: per component, sqrt(1 + gap) over the segment: the rms of its residual parts over their "
+              "equations' noise, less the noise's own share (1.00: at the noise). Residual units: "
+              + ", ".join(f"{c} {UNITS[c]}" for c in COMPONENTS) + ".", "",
+              "Method: component residuals (equation error) in windows, a two-sided CUSUM per component on the "
+              "log of its block statistic (docs/monitoring.md)."]
+    return "\n".join(lines) + "\n"
+
+
+def _verdict(segment) -> str:
+    v = segment.get("verdict")
+    if not v:
+        return "-"
+    if v["effect"] == "not_diagnosed":
+        return f"not diagnosed ({v['reason']})"
+    return f"{v['effect']} ({v.get('confidence')}; {v.get('component') or '-'})"
+
+
+def write_report(res, out, *, source="", extra=None) -> Path:
+    """``monitor.json``, ``timeline.png`` and ``report.md`` in ``out`` (the HTML comes with the provenance
+    stamp, :func:`heavecomp.report.provenance.finish`).
+
+    Parameters
+    ----------
+    res : heavecomp.diagnosis.monitor.MonitorResult
+    out : str or Path
+        Output folder.
+    source : str
+        Name of the log, for the title.
+    extra : dict, optional
+        Keys added to ``monitor.json``.
+    """
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    write_json(res, out / "monitor.json", extra)
+    save(timeline_figure(res), out / "timeline.png")
+    p = out / "report.md"
+    p.write_text(report_markdown(res, source), encoding="utf-8")
+    return p

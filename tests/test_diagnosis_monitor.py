@@ -1,0 +1,188 @@
+"""The monitor (heavecomp.diagnosis.monitor): change detection on window statistics, operating vs
+effect changes by the load balance, and the command's bad-input handling."""
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from heavecomp.diagnosis import monitor as M
+from heavecomp.params.sets import paper_a
+
+
+def test_cusum_finds_a_step_after_it_and_not_noise():
+    rng = np.random.default_rng(3)
+    u = rng.normal(size=3000)
+    assert M.cusum(u) is None  # 3000 blocks (8 h) of white noise: no alarm at h = 12
+    u[1500:] += 2.0
+    b, j, onset, size = M.cusum(u)
+    # a 2-sigma step: the sum grows by ~1.5 sigma per block past the allowance, crossing 12 in ~8 blocks
+    assert 1500 <= b <= 1520 and abs(onset - 1500) <= 5
+    assert 1.0 < size < 3.5
+
+
+def test_cusum_skips_gaps_and_names_the_column():
+    rng = np.random.default_rng(4)
+    u = rng.normal(size=(800, 3))
+    u[400:, 1] -= 3.0
+    u[100:120, :] = np.nan
+    b, j, onset, _ = M.cusum(u)
+    assert j == 1 and 400 <= b < 420
+
+
+def test_robust_sigma_ignores_a_step():
+    rng = np.random.default_rng(5)
+    x = rng.normal(0.0, 2.0, 5000)
+    x[2500:] += 50.0
+    assert abs(M.robust_sigma(x) - 2.0) < 0.1
+
+
+def _op(n, w0, p0, dw=0.0, dp=0.0, at=None, seed=0):
+    rng = np.random.default_rng(seed)
+    w = w0 + rng.normal(0.0, 1e3, n)
+    p = p0 + rng.normal(0.0, 2e3, n)
+    if at is not None:
+        w[at:] += dw
+        p[at:] += dp
+    return {"wob": w, "pressure": p, "stroke": np.zeros(n), "heave": np.zeros(n)}
+
+
+def test_a_new_set_point_is_operating_a_wob_alone_is_a_misreading():
+    """The load balance p A + W = (M_c + m_b) g: a set-point change moves the mean pressure by -dW/A; a WOB
+    channel that starts to misread moves the WOB alone."""
+    p = paper_a("stribeck")
+    n = 600
+    bt = np.arange(n) * 10.0
+    dw = 12e3
+    ch, bounds = M.operating_changes(_op(n, p.operating_point.wob_setpoint, p.p0, dw, -dw / p.area, 300), bt, 10.0, p)
+    assert [c["kind"] for c in ch] == ["operating"] and bounds and abs(bounds[0] - 300) <= 3
+    ch, bounds = M.operating_changes(_op(n, p.operating_point.wob_setpoint, p.p0, dw, 0.0, 300), bt, 10.0, p)
+    assert [(c["kind"], c["component"]) for c in ch] == [("effect", "sensors")] and not bounds
+
+
+@pytest.mark.slow
+def test_monitor_finds_a_seal_friction_onset_on_a_generated_log(tmp_path):
+    """A 40-minute 10 Hz log with pressure friction switched on at 1200 s at 5x its noise: one effect
+    change, in friction, within a few wave periods; none before it."""
+    from heavecomp.benchmark.long_logs import long_log
+
+    tr = long_log([(1200.0, "pressure_friction")], seed=11, duration=2400.0, rate=10.0)
+    res = M.monitor(tr.to_run(), tr.nominal)
+    eff = [c for c in res.changes if c["kind"] == "effect"]
+    assert eff and all(c["t"] > 1200.0 for c in res.changes)
+    assert eff[0]["component"] == "friction" and eff[0]["t"] - 1200.0 < 120.0
+    d = res.to_json()
+    assert d["schema"] == 1 and set(d["changes"][0]) >= {"t", "component", "size_to_noise", "kind"}
+    assert set(d["segments"][0]) >= {"start", "end", "operating_point", "gap_to_noise"}
+    assert math.isclose(d["segments"][-1]["end"], tr.t[-1], rel_tol=1e-9)
+
+
+def test_cli_bad_input_is_one_line(tmp_path, capsys):
+    from heavecomp.cli import main
+
+    p = paper_a("stribeck")
+    prm = tmp_path / "p.toml"
+    from heavecomp.params import save
+
+    save(p, prm)
+    t = np.arange(0.0, 300.0, 0.1)
+    log = tmp_path / "log.csv"
+    log.write_text("t,heave,stroke,wob\n" + "\n".join(f"{x:.1f},0,0,{p.operating_point.wob_setpoint}" for x in t))
+    rc = main(["monitor", str(log), "--params", str(prm), "--out", str(tmp_path / "o")])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert rc == 2 and len(err) == 1 and "pressure" in err[0]
+    assert not (tmp_path / "o" / "monitor.json").exists()
+
+
+def _sums(nb=400, seed=0, step_at=None, dk=0.0):
+    """BlockSums of a synthetic lower-mass residual r = k0 rel + noise (+ dk rel from ``step_at``), its
+    block normal equations accumulated as component_blocks does."""
+    rng = np.random.default_rng(seed)
+    feats = M.coefficient_features()
+    sums = M.BlockSums({e: np.ones(nb) for e in feats}, {}, {e: np.full(nb, 100.0) for e in feats},
+                       dict.fromkeys(feats, 1.0))
+    for e, keys in feats.items():
+        m = len(keys)
+        sums.xtx[e], sums.xtr[e] = np.zeros((nb, m, m)), np.zeros((nb, m))
+        for b in range(nb):
+            X = rng.normal(size=(100, m))
+            names = [f for _, f in keys]
+            if "const" in names:
+                X[:, names.index("const")] = 1.0
+            beta = np.zeros(m)
+            if e == "lower_mass":
+                beta[names.index("rel")] = -1.0 + (dk if step_at is not None and b >= step_at else 0.0)
+            r = X @ beta + rng.normal(0.0, 0.3, 100)
+            sums.xtx[e][b], sums.xtr[e][b] = X.T @ X, X.T @ r
+    return sums
+
+
+def test_block_coefficients_recover_the_law_and_skip_an_unexcited_feature():
+    sums = _sums(nb=50)
+    keys = M.coefficient_features()["lower_mass"]
+    k = [f for _, f in keys].index("rel")
+    beta = sums.coefficients("lower_mass")
+    assert np.allclose(beta[:, k], -1.0, atol=0.15)  # joint least squares per block, not a univariate ratio
+    sums.xtx["lower_mass"][7, k, :] = sums.xtx["lower_mass"][7, :, k] = 0.0  # the feature never varied in block 7
+    beta = sums.coefficients("lower_mass")
+    assert np.isnan(beta[7, k]) and np.isfinite(beta[7]).sum() == len(keys) - 1
+
+
+def test_a_coefficient_step_is_found_and_named_by_its_feature():
+    """A softer formation: the lower-mass coefficient of the relative displacement steps; the equation's
+    mean square does not move (its statistic is flat here). The change is found there and named
+    string_formation, not sensors."""
+    sums = _sums(step_at=200, dk=0.2, seed=1)
+    ch = M.component_changes(sums, np.arange(400) * 10.0, 10.0, [])
+    assert ch and 2000.0 <= ch[0]["t"] <= 2150.0
+    assert ch[0]["column"] == "lower_mass:rel" and ch[0]["component"] == "string_formation"
+
+
+def test_a_segment_is_sliced_with_its_own_clock_and_only_effect_segments_carry_a_gap():
+    from heavecomp.diagnosis.data import MeasuredRun
+
+    t = np.arange(0.0, 100.0, 0.5)
+    run = MeasuredRun(t, {"heave": np.sin(t), "wob": t.copy()}, source="x")
+    sub = M.segment_run(run, 20.0, 30.0)
+    assert sub.t[0] == 0.0 and math.isclose(sub.duration, 10.0) and sub["wob"][0] == 20.0
+    changes = [{"kind": "operating", "onset": 40.0}, {"kind": "effect", "onset": 70.0}]
+    segs = [{"start": 0.0}, {"start": 40.0}, {"start": 70.0}]
+    assert [M.carries_gap(s, changes) for s in segs] == [False, False, True]
+
+
+def test_diagnose_segments_fits_each_effect_segment_on_its_own_slice(monkeypatch):
+    """--diagnose: the diagnoser is given the segment's own slice (clock at 0, at most DIAGNOSE_SPAN long);
+    its verdict lands in segments[].verdict; a segment without an effect change is left alone and a too
+    short one says why."""
+    from heavecomp.diagnosis.data import MeasuredRun
+
+    seen = []
+
+    class Fake:
+        def __init__(self, nominal, candidates=None, **kw):
+            self.nominal = nominal
+
+        def fit(self, run):
+            seen.append((run.t[0], run.duration, run["wob"][0]))
+            self.verdict_ = {"effect": "pressure_friction", "confidence": "high", "component": "friction",
+                             "shrink": 0.5}
+            return self
+
+        def to_json(self):
+            return {"schema": 2, "verdict": self.verdict_}
+
+    monkeypatch.setattr(M, "GapDiagnoser", Fake)
+    t = np.arange(0.0, 3000.0, 1.0)
+    run = MeasuredRun(t, {"wob": t.copy()}, source="x")
+    res = M.MonitorResult(np.arange(300) * 10.0, 10.0, {}, {}, None,
+                          [{"kind": "effect", "onset": 1000.0, "t": 1030.0},
+                           {"kind": "effect", "onset": 2950.0, "t": 2990.0}],
+                          [{"start": 0.0, "end": 1000.0}, {"start": 1000.0, "end": 2950.0},
+                           {"start": 2950.0, "end": 2999.0}], {}, ["wob"], 2999.0)
+    out = M.diagnose_segments(res, run, paper_a("stribeck"))
+    assert seen == [(0.0, M.DIAGNOSE_SPAN, 1000.0)] and list(out) == [1]
+    assert "verdict" not in res.segments[0]
+    assert res.segments[1]["verdict"]["effect"] == "pressure_friction"
+    assert res.segments[1]["verdict"]["span"] == [1000.0, 1000.0 + M.DIAGNOSE_SPAN]
+    assert res.segments[2]["verdict"]["effect"] == "not_diagnosed"
