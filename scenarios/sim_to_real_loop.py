@@ -38,7 +38,7 @@ log = logging.getLogger(__name__)
 EFFECTS = {
     "pressure_friction": ("seal friction with stiction", "energised seal: + k max(p - p_th, 0) on the friction jump"),
     "gas_heat_transfer": ("gas", "thermal gas state: adiabatic compression, Newton heat exchange (tau_th)"),
-    "string_damping": ("string", "quadratic drag c_q dv|dv| in the string tension"),
+    "string_damping": ("string", "quadratic drag c_q dv abs(dv) in the string tension"),
     "sensor_gain": ("sensor fault", "WOB load cell: g x its own 5 Hz first-order lag"),
     "gas_leak": ("gas", "laminar leak of the gas mass fraction (1-3 % of the charge over the log)"),
 }
