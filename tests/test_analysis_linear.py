@@ -118,3 +118,17 @@ def test_sliding_operating_point_carries_the_law_friction(pa):
     assert not op.equilibrium
     assert op.xdot[1] == pytest.approx(-F / pa.compensator.moving_mass, rel=1e-9)
     assert op.u[1] == -v0  # platform moves, top mass at rest
+
+
+def test_a_seal_effect_with_stiction_leaves_the_frictionless_linearisation_and_enters_the_sliding_one():
+    """A parameter file with pressure_friction (stiction at the seal hook): the frictionless model has
+    no seal friction, so it equals the nominal one; sliding, the effect's friction slope is there."""
+    from heavecomp.analysis.linear import linearise_details
+    from heavecomp.params import paper_a
+
+    p = paper_a("stribeck")
+    fx = [("pressure_friction", {"extra_pressure_coefficient": 0.01})]
+    A0 = linearise_details(p, friction="none").sys.A
+    assert np.allclose(linearise_details(p, friction="none", effects=fx).sys.A, A0)
+    As = linearise_details(p, friction="sliding", velocity=0.2).sys.A
+    assert not np.allclose(linearise_details(p, friction="sliding", velocity=0.2, effects=fx).sys.A, As)

@@ -351,3 +351,33 @@ def test_the_closed_loop_wob_figure_has_an_actuator_force_panel(tmp_path, monkey
     drawn = np.concatenate([ln.get_ydata() for ln in axu.get_lines() if len(ln.get_ydata()) > 2])
     assert np.max(np.abs(drawn)) == pytest.approx(np.max(np.abs(res["u_active"])) / 1e3)
     assert {ln.get_ydata()[0] for ln in axu.get_lines() if len(ln.get_ydata()) == 2} == {-60.0, 60.0}
+
+
+def test_a_wob_gain_fault_misleads_the_controller_unless_it_knows_it():
+    """A load cell reading 1.1 x the true WOB: the MPC that does not know it holds a reading near
+    the set-point, so the true WOB sits below it; told about the fault (``controller_effects``) it
+    reads the measurement through it and holds the true WOB at the set-point."""
+    from heavecomp.effects.sensor_gain import SensorGain
+
+    p = paper_a("stribeck")
+    W0 = p.operating_point.wob_setpoint
+    fault = SensorGain(channel="wob", factor=1.1)
+    err = {}
+    for known in ((), (fault,)):
+        r = simulate_closed_loop(p, "linear-mpc", 60.0, effects=(fault,), controller_effects=known)
+        err[bool(known)] = float(np.mean(r["wob"][r.window()])) / W0 - 1.0
+    assert err[False] < -0.01  # misled: the true WOB below the set-point (the reading is 1.1 x it)
+    assert abs(err[True]) < 0.3 * abs(err[False])
+
+
+def test_effects_reach_a_named_controller_and_are_refused_without_a_model():
+    from heavecomp.controllers import make
+    from heavecomp.errors import ParameterError
+
+    p = paper_a("stribeck")
+    mpc = make("linear-mpc", p, effects=[("string_damping", {"damping": 2e5})])
+    assert [e.name for e in mpc.effects] == ["string_damping"]
+    with pytest.raises(ParameterError, match="pid"):
+        make("pid", p, effects=["string_damping"])
+    with pytest.raises(ParameterError, match="heave effect"):
+        simulate_closed_loop(p, "passive", 1.0, effects=["heave_reference"])

@@ -266,7 +266,8 @@ def linearise_details(params, *, friction: str = "none", velocity: float | None 
         Regularisation width of sign(v) (default |v0|/25).
     effects : sequence, optional
         Effects at the plant's hooks (:mod:`heavecomp.effects`: instances, registered names or
-        ``(name, values)``).
+        ``(name, values)``; None: the file's plant effects).  The seal-friction effects count only in
+        the sliding linearisation, like the friction law.
     """
     import control as ct
 
@@ -287,6 +288,10 @@ def linearise_details(params, *, friction: str = "none", velocity: float | None 
 
 
     effects = effects_for(params, effects)  # None: the file's [[effects]] (plant)
+    if friction != "sliding":  # no seal friction in a frictionless or viscous linearisation: nor its effects'
+        effects = [e for e in effects if e.hook != "seal_friction"]
+    elif eps is None and any(e.adds_stiction for e in effects):
+        eps = abs(v0) / 25.0  # as _default_eps: a seal effect with stiction needs a smooth sign
     op = operating_point(pl, velocity=v0, eps=eps, effects=effects)
     _, _, A, B, C, D = _eval_model(pl, op.x, op.u, eps, effects)
     B0, B1, B2, Bu = B[:, 0], B[:, 1], B[:, 2], B[:, 3]

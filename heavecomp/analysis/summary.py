@@ -12,7 +12,7 @@ from heavecomp.analysis.frequency import dc_gain, frequency_grid, modes, respons
 
 
 def analyse(params, *, n_points: int = 1000, omega_min: float = 1e-3, omega_max: float | None = None,
-            sliding_velocity: float | None = None) -> dict:
+            sliding_velocity: float | None = None, effects=None) -> dict:
     """Everything ``heavecomp analyse`` reports for one parameter set (no files).
 
     Parameters
@@ -27,6 +27,10 @@ def analyse(params, *, n_points: int = 1000, omega_min: float = 1e-3, omega_max:
         Highest frequency; default 10 x the fastest pole.
     sliding_velocity : float [m/s], optional
         Also linearise about sliding at this velocity (friction models other than ``none``).
+    effects : sequence, optional
+        Effects at the plant's hooks (:mod:`heavecomp.effects`: instances, names or ``(name, values)``),
+        linearised with the plant (:func:`heavecomp.analysis.linear.linearise_details`); None: the
+        plant effects of ``params``' ``[[effects]]``.
 
     Returns
     -------
@@ -35,7 +39,7 @@ def analyse(params, *, n_points: int = 1000, omega_min: float = 1e-3, omega_max:
         frictionless model), ``curves`` (label -> (omega, k_eff(omega))).
     """
 
-    L0 = linearise_details(params, friction="none")
+    L0 = linearise_details(params, friction="none", effects=effects)
     sys = L0.sys
     w = frequency_grid(sys, n_points, omega_min, omega_max)
     table = response_table(sys, w)
@@ -64,7 +68,7 @@ def analyse(params, *, n_points: int = 1000, omega_min: float = 1e-3, omega_max:
     }
     curves = {"frictionless": (w, -(table["wob_per_heave_mag"] * np.exp(1j * np.radians(table["wob_per_heave_phase_deg"]))))}
     if params.friction.viscous_coefficient is not None:
-        Lv = linearise_details(params, friction="viscous")
+        Lv = linearise_details(params, friction="viscous", effects=effects)
         mv = modes(Lv.sys)
         tv = response_table(Lv.sys, w)
         summary["viscous"] = {"viscous_coefficient": params.friction.viscous_coefficient,
@@ -73,7 +77,7 @@ def analyse(params, *, n_points: int = 1000, omega_min: float = 1e-3, omega_max:
         curves[f"viscous C_v = {params.friction.viscous_coefficient / 1e3:g} kN s/m"] = (
             w, -(tv["wob_per_heave_mag"] * np.exp(1j * np.radians(tv["wob_per_heave_phase_deg"]))))
     if sliding_velocity is not None and params.friction.model != "none":
-        Ls = linearise_details(params, friction="sliding", velocity=sliding_velocity)
+        Ls = linearise_details(params, friction="sliding", velocity=sliding_velocity, effects=effects)
         ms = modes(Ls.sys)
         ts = response_table(Ls.sys, w)
         summary["sliding"] = {"velocity": sliding_velocity, "friction_slope": Ls.friction_slope,

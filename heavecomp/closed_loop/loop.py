@@ -4,8 +4,9 @@ The plant is the foundation's compiled stepper (:mod:`heavecomp.simulate.stepper
 called one RK4 step at a time so that the active force can change between
 steps.  Per control interval (``[active].control_rate``, 20 Hz by default):
 
-1. the rig's measurements (stroke, pressure, WOB, heave; Gaussian noise,
-   seeded) and the actuator's force are handed to ``controller.step``;
+1. the rig's measurements (stroke, pressure, WOB, heave; as the true plant's channel effects
+   read them, e.g. a WOB load cell ``sensor_gain``, plus Gaussian noise, seeded) and the
+   actuator's force are handed to ``controller.step``;
 2. the command, as the controller decided it, is checked against the limits
    (``violations_u_max``: ``|u_cmd| > u_max``; ``violations_rate``: the clipped
    command is further than ``rate_max / control_rate`` from the force the
@@ -31,9 +32,10 @@ from pathlib import Path
 import numpy as np
 
 from heavecomp.controllers import ControllerConfig, Measurement, make
-from heavecomp.errors import InputError
+from heavecomp.errors import InputError, ParameterError
 from heavecomp.params.budget import check_run_size
 from heavecomp.params.cmc import active
+from heavecomp.effects.registry import split_effects
 from heavecomp.effects.spec import effects_for
 from heavecomp.plants.cmc import eigen_rate, plant_vectors
 from heavecomp.simulate import excitation
@@ -110,7 +112,8 @@ def _percentile_ms(x, q):
 
 def simulate_closed_loop(params, controller="passive", duration: float = 120.0, *, dt: float | None = None,
                          heave=None, noise: Noise | None = Noise(), preview: str = "predicted",
-                         stats_start: float | None = None, progress=None, effects=None, **options) -> ClosedLoopResult:
+                         stats_start: float | None = None, progress=None, effects=None, controller_effects=None,
+                         **options) -> ClosedLoopResult:
     """Simulate the CMC with an active cylinder under ``controller``.
 
     Parameters
@@ -130,9 +133,16 @@ def simulate_closed_loop(params, controller="passive", duration: float = 120.0, 
         ``predicted``: the controller predicts heave from its measurements (AR);
         ``perfect``: it is given the true future heave (an upper bound).
     effects : sequence, optional
-        Effects at the true plant's hooks (:mod:`heavecomp.effects`; the controller knows
-        them only if it was built with them).  None: the plant effects of ``params``' ``[[effects]]``
-        (a named controller is built with them too).
+        The true plant's effects (:mod:`heavecomp.effects`: instances, names or ``(name, values)``;
+        None: the plant effects of ``params``' ``[[effects]]``): plant effects act at its hooks; a
+        channel effect (``sensor_gain``, ``sensor_offset``, ``sensor_delay``, each with its
+        ``channel``) changes the measurement the controller receives (before the noise): a sensor
+        fault of the rig.  A heave effect is refused (ParameterError).
+    controller_effects : sequence, optional
+        The effects a named MPC's model knows (:func:`heavecomp.controllers.make`'s ``effects``):
+        its plant effects enter the prediction, its channel effects how it reads the measurement
+        (the calibrated correction of a sensor fault).  None: the plant effects of ``params``'
+        ``[[effects]]`` (``passive`` and ``pid`` have no model).
     options
         :class:`~heavecomp.controllers.ControllerConfig` overrides (when
         ``controller`` is a name).
@@ -150,7 +160,11 @@ def simulate_closed_loop(params, controller="passive", duration: float = 120.0, 
     if preview not in ("predicted", "perfect"):
         raise InputError(f"preview {preview!r}: not one of predicted, perfect")
     act = active(params)
-    ctrl = make(controller, params, **options)
+    plant_fx, heave_fx, sensor_fx = split_effects(effects_for(params, effects))
+    if heave_fx:
+        raise ParameterError(f"effect {heave_fx[0].name}: a heave effect is not modelled in the closed loop "
+                             "(the plant would see another heave than the controller measures)")
+    ctrl = make(controller, params, effects=controller_effects, **options)
     name = getattr(ctrl, "name", type(ctrl).__name__)
     cfg = getattr(ctrl, "config", None)
     if not isinstance(cfg, ControllerConfig):  # a user's own controller: the preview horizon of the defaults
@@ -179,7 +193,8 @@ def simulate_closed_loop(params, controller="passive", duration: float = 120.0, 
         t_in, z_in = heave
         hs = excitation.from_series(t_in, z_in, n_ctrl * Tc + horizon_t, sp, src="heave")
     plant = plant_vectors(params)  # the one params -> vectors conversion
-    advance, state, args = plant_stepper(plant, effects_for(params, effects))  # the compiled stepper (loaded on first use)
+    advance, state, args = plant_stepper(plant, plant_fx)  # the compiled stepper (loaded on first use)
+    reads = _channel_readers(sensor_fx, n_ctrl + 1, Tc)
     rng = np.random.default_rng(noise.seed if noise else 0)
     sig = np.array([noise.stroke, noise.pressure, noise.wob, noise.heave]) if noise else np.zeros(4)
 
@@ -205,7 +220,7 @@ def simulate_closed_loop(params, controller="passive", duration: float = 120.0, 
         rows[k] = rec[0]
         if k == n_ctrl:
             break
-        noisy = rec[0, [2, 3, 4, 1]] + sig * rng.standard_normal(4)
+        noisy = reads(k, rec[0, MEASURED]) + sig * rng.standard_normal(4)
         meas = Measurement(t=t, stroke=noisy[0], pressure=noisy[1], wob=noisy[2], heave=noisy[3], u_active=u)
         pv = None
         if preview == "perfect":
@@ -262,6 +277,31 @@ def simulate_closed_loop(params, controller="passive", duration: float = 120.0, 
     return ClosedLoopResult(data=rows, params=params, dt=h, stats=dict(zip(L.STATS, stats.tolist())),
                             heave_info=hs.info, wall_time=wall, stats_start=stats_start,
                             controller=name, control=control)
+
+
+#: kernel columns of the measurements stroke, pressure, wob, heave (the order of :class:`Noise`)
+MEASURED = [L.COL_STROKE, L.COL_PRESSURE, L.COL_WOB, L.COL_HEAVE]
+MEASURED_NAMES = ("stroke", "pressure", "wob", "heave")
+
+
+def _channel_readers(sensor_fx, n_rows: int, Tc: float):
+    """``reads(k, y) -> y_meas``: the measurements at control instant ``k`` (time k Tc) as the
+    channel effects ``sensor_fx`` read the true values ``y`` (stroke, pressure, wob, heave).  Each
+    effect reads the history of its channel so far (a delay reads the past), chained in order;
+    the identity without effects."""
+    if not sensor_fx:
+        return lambda k, y: y
+    tg = Tc * np.arange(n_rows)
+    stages = [(e, MEASURED_NAMES.index(e.channel), np.empty(n_rows)) for e in sensor_fx]
+
+    def reads(k, y):
+        out = np.array(y, dtype=float)
+        for e, j, hist in stages:
+            hist[k] = out[j]
+            out[j] = e.measure(tg[k:k + 1], tg[:k + 1], hist[:k + 1])[0]
+        return out
+
+    return reads
 
 
 def _preview_error(previews, hs, sp, Tc, heave_at) -> dict:

@@ -14,11 +14,12 @@ This module sits above the controllers it registers, so ``base.py``,
 from __future__ import annotations
 
 import dataclasses
+import inspect
 
 from heavecomp.controllers.base import ControllerConfig, PassiveController, PIDController
 from heavecomp.controllers.linear_mpc import LinearMPC
 from heavecomp.controllers.nonlinear_mpc import NonlinearMPC
-from heavecomp.errors import InputError, did_you_mean
+from heavecomp.errors import InputError, ParameterError, did_you_mean
 
 #: name -> class(params, config)
 CONTROLLERS = {
@@ -34,7 +35,12 @@ def is_controller(obj) -> bool:
     return callable(getattr(obj, "step", None))
 
 
-def make(name, params, config: ControllerConfig | None = None, **options):
+def takes_effects(name) -> bool:
+    """True if the registered controller ``name`` has a model that can hold effects (the MPCs)."""
+    return isinstance(name, str) and name in CONTROLLERS and "effects" in inspect.signature(CONTROLLERS[name]).parameters
+
+
+def make(name, params, config: ControllerConfig | None = None, *, effects=None, **options):
     """Build a controller by name (:data:`CONTROLLERS`) or return a given controller object.
 
     Parameters
@@ -44,6 +50,12 @@ def make(name, params, config: ControllerConfig | None = None, **options):
         (returned as it is; ``options`` then do not apply).
     params : CMCParams
     config : ControllerConfig, optional
+    effects : sequence, optional
+        Effects the controller's model knows (:mod:`heavecomp.effects`: instances, names or
+        ``(name, values)``; None: the plant effects of the parameter file's ``[[effects]]``).  Plant
+        effects enter its prediction model, a channel effect (``sensor_gain``, ``sensor_offset``) the way it reads its
+        measurement.  Only the MPCs have a model; ``passive`` and ``pid`` take none (ParameterError
+        for a non-empty ``effects``).
     options
         :class:`ControllerConfig` overrides (limits default to ``params``' ``[active]`` table).
     """
@@ -51,8 +63,8 @@ def make(name, params, config: ControllerConfig | None = None, **options):
         if not is_controller(name):
             raise InputError(f"controller {type(name).__name__!r}: neither a name ({', '.join(CONTROLLERS)}) "
                              "nor an object with a step(t, measurement, preview=None) method")
-        if options:
-            raise InputError(f"controller options {', '.join(sorted(options))}: only for a named controller; "
+        if options or effects:
+            raise InputError(f"controller options {', '.join(sorted(options) + (['effects'] if effects else []))}: only for a named controller; "
                              f"configure your {type(name).__name__} object directly")
         return name
     if name not in CONTROLLERS:
@@ -62,4 +74,10 @@ def make(name, params, config: ControllerConfig | None = None, **options):
         config = ControllerConfig.from_params(params, **options)
     elif options:
         config = dataclasses.replace(config, **options)
-    return CONTROLLERS[name](params, config)
+    cls = CONTROLLERS[name]
+    if takes_effects(name):
+        return cls(params, config, effects=effects)
+    if effects:
+        raise ParameterError(f"controller {name}: has no model to hold effects "
+                             f"({', '.join(getattr(e, 'name', str(e)) for e in effects)}); use linear-mpc or nonlinear-mpc")
+    return cls(params, config)
