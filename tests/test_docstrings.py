@@ -56,7 +56,6 @@ PENDING = {
     "heavecomp/effects/model.py",
     "heavecomp/effects/registry.py",
     "heavecomp/report/diagnosis.py",
-    "heavecomp/simulate/core.py",
     "heavecomp/simulate/excitation.py",
 }
 
