@@ -56,7 +56,6 @@ PENDING = {
     "heavecomp/effects/model.py",
     "heavecomp/effects/registry.py",
     "heavecomp/report/diagnosis.py",
-    "heavecomp/simulate/excitation.py",
 }
 
 _ENTRY = re.compile(r"^(?P<names>\*{0,2}\w+(?:\s*,\s*\*{0,2}\w+)*)(?:\s+:\s*(?P<type>\S.*))?$")
