@@ -51,7 +51,6 @@ PENDING = {
     "heavecomp/diagnosis/where.py",
     "heavecomp/effects/base.py",
     "heavecomp/effects/candidates.py",
-    "heavecomp/effects/compose.py",
     "heavecomp/effects/features.py",
     "heavecomp/effects/model.py",
     "heavecomp/effects/registry.py",
