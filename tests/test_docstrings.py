@@ -52,7 +52,6 @@ PENDING = {
     "heavecomp/effects/base.py",
     "heavecomp/effects/candidates.py",
     "heavecomp/effects/features.py",
-    "heavecomp/effects/model.py",
     "heavecomp/effects/registry.py",
     "heavecomp/report/diagnosis.py",
 }
