@@ -28,7 +28,17 @@ KEYS = ("wob_std", "wob_p2p", "u_active_max", "u_active_rms", "solve_time_ms_p50
 
 
 def case_params(regime: str, sea: str, active: dict | None = None):
-    """Paper A parameters for a friction regime and a sea (optionally another [active] table)."""
+    """Paper A parameters for a friction regime and a sea (optionally another [active] table).
+
+    Parameters
+    ----------
+    regime : str
+        Friction regime of :func:`heavecomp.params.paper_a` (one of :data:`REGIMES`).
+    sea : str
+        Key of :data:`SEAS`.
+    active : dict, optional
+        Entries replacing the ``[active]`` table (actuator limits ``u_max`` [N], ``rate_max`` [N/s]).
+    """
     p = paper_a(regime)
     if SEAS[sea] is not None:
         p = p.replace(heave=SEAS[sea])
@@ -38,7 +48,26 @@ def case_params(regime: str, sea: str, active: dict | None = None):
 
 
 def run_case(regime: str, sea: str, controller: str, duration: float, *, active=None, keep=False, **options):
-    """One closed-loop run; returns its metrics (and the result when ``keep``)."""
+    """One closed-loop run; returns its metrics (and the result when ``keep``).
+
+    Parameters
+    ----------
+    regime : str
+        Friction regime of :func:`heavecomp.params.paper_a` (one of :data:`REGIMES`).
+    sea : str
+        Key of :data:`SEAS`.
+    controller : str
+        Controller name (one of :data:`CONTROLLERS`).
+    duration : float [s]
+        Simulated time of each run.
+    active : dict, optional
+        Entries replacing the ``[active]`` table (:func:`case_params`).
+    keep : bool
+        Also return the closed-loop result (``(metrics, result)``).
+    **options : dict
+        Controller options (:func:`heavecomp.closed_loop.loop.simulate_closed_loop`; ignored for
+        ``"passive"``).
+    """
     p = case_params(regime, sea, active)
     res = simulate_closed_loop(p, controller, duration, **({} if controller == "passive" else options))
     m = res.metrics()
@@ -49,7 +78,22 @@ def run_case(regime: str, sea: str, controller: str, duration: float, *, active=
 
 
 def compare(regimes, seas, controllers, durations: dict, options: dict | None = None):
-    """Metrics table[sea][regime][controller] and the results of the first sea's runs (for figures)."""
+    """Metrics table[sea][regime][controller] and the results of every run, keyed (sea, regime,
+    controller) (for figures).
+
+    Parameters
+    ----------
+    regimes : iterable of str
+        Friction regimes (of :data:`REGIMES`).
+    seas : iterable of str
+        Keys of :data:`SEAS`.
+    controllers : iterable of str
+        Controller names (of :data:`CONTROLLERS`).
+    durations : dict
+        sea -> simulated time of each run on it [s].
+    options : dict, optional
+        controller -> its options (:func:`run_case`).
+    """
     table, kept = {}, {}
     for sea in seas:
         table[sea] = {}
@@ -63,7 +107,26 @@ def compare(regimes, seas, controllers, durations: dict, options: dict | None = 
 
 
 def sweep(regime, sea, controller, duration, name, values, **fixed):
-    """Metrics for each value of one option (``name`` is a ControllerConfig field or ``u_max``/``rate_max``)."""
+    """Metrics for each value of one option (``name`` is a ControllerConfig field or ``u_max``/``rate_max``).
+
+    Parameters
+    ----------
+    regime : str
+        Friction regime of :func:`heavecomp.params.paper_a` (one of :data:`REGIMES`).
+    sea : str
+        Key of :data:`SEAS`.
+    controller : str
+        Controller name (one of :data:`CONTROLLERS`).
+    duration : float [s]
+        Simulated time of each run.
+    name : str
+        The option swept: a controller option or an ``[active]`` limit (``u_max`` [N],
+        ``rate_max`` [N/s]).
+    values : iterable
+        Its values (in the option's unit).
+    **fixed : dict
+        Further options of every run (:func:`run_case`).
+    """
     rows = []
     for v in values:
         if name in ("u_max", "rate_max"):
@@ -75,18 +138,46 @@ def sweep(regime, sea, controller, duration, name, values, **fixed):
 
 
 def robust_label(sea: str, name: str, value: float) -> str:
-    """Key of one robustness run, e.g. ``"jonswap: friction_scale x0.7"``."""
+    """Key of one robustness run, e.g. ``"jonswap: friction_scale x0.7"``.
+
+    Parameters
+    ----------
+    sea : str
+        Key of :data:`SEAS`.
+    name : str
+        The controller model's scaled quantity (``friction_scale``, ``gas_stiffness_scale``).
+    value : float [-]
+        Its scale factor.
+    """
     return f"{sea}: {name} x{value:g}"
 
 
 def label_sea(label: str) -> str:
-    """The sea of a :func:`robust_label`."""
+    """The sea of a :func:`robust_label`.
+
+    Parameters
+    ----------
+    label : str
+        A key made by :func:`robust_label`.
+    """
     return label.split(": ", 1)[0]
 
 
 def robustness(seas, controllers, durations: dict, values=(0.7, 1.3)) -> dict:
     """Full static friction with the controller's friction forces and gas stiffness scaled:
-    ``{controller: {robust_label: metrics}}``."""
+    ``{controller: {robust_label: metrics}}``.
+
+    Parameters
+    ----------
+    seas : iterable of str
+        Keys of :data:`SEAS`.
+    controllers : iterable of str
+        Controller names (of :data:`CONTROLLERS`).
+    durations : dict
+        sea -> simulated time of each run on it [s].
+    values : iterable of float [-]
+        Scale factors of the controller model's friction forces and gas stiffness.
+    """
     return {c: {robust_label(sea, name, v): run_case("stribeck", sea, c, durations[sea], **{name: v})
                 for sea in seas for name in ("friction_scale", "gas_stiffness_scale") for v in values}
             for c in controllers}
@@ -100,14 +191,39 @@ FRAME_RUNS = {"model_frame = stroke": {"model_frame": "stroke"},
 
 def frame_study(sea: str, controllers, duration: float) -> dict:
     """Full static friction with the MPC model in the stroke and the earth frame, and with a
-    perfect heave preview: ``{controller: {label: metrics}}`` (labels: :data:`FRAME_RUNS`)."""
+    perfect heave preview: ``{controller: {label: metrics}}`` (labels: :data:`FRAME_RUNS`).
+
+    Parameters
+    ----------
+    sea : str
+        Key of :data:`SEAS`.
+    controllers : iterable of str
+        Controller names (of :data:`CONTROLLERS`).
+    duration : float [s]
+        Simulated time of each run.
+    """
     return {c: {label: run_case("stribeck", sea, c, duration, **opts) for label, opts in FRAME_RUNS.items()}
             for c in controllers}
 
 
 # ------------------------------------------------------------------ figures
 def findings(table: dict, sweeps: dict, robust: dict, frames: dict | None = None, frame_sea: str = "jonswap") -> list[str]:
-    """Plain-language findings computed from the metrics (no numbers typed in)."""
+    """Plain-language findings computed from the metrics (no numbers typed in).
+
+    Parameters
+    ----------
+    table : dict
+        Metrics table[sea][regime][controller] of :func:`compare` (with ``"stribeck"`` and
+        ``"passive"``).
+    sweeps : dict
+        option -> (unit, {controller: rows of :func:`sweep`}).
+    robust : dict
+        Result of :func:`robustness`.
+    frames : dict, optional
+        Result of :func:`frame_study`.
+    frame_sea : str
+        Sea of ``frames`` (a key of :data:`SEAS`).
+    """
     out = []
     for sea in table:
         st = table[sea]["stribeck"]

@@ -46,6 +46,12 @@ GENERATED = ("gas_fx", "cylinder_pressure_fx", "tension_fx", "plant_fx", "jump_f
 class Composition:
     """The hook functions of the CMC for the effect classes ``classes`` (registry order).
 
+    Parameters
+    ----------
+    classes : sequence of Effect classes
+        The plant effects of the composition (``kind == "plant"``), each once, in the order their
+        hooks are applied (registry order).
+
     Attributes
     ----------
     classes : tuple of Effect classes
@@ -215,7 +221,13 @@ _CACHE: dict = {}
 
 
 def composition(classes=()) -> Composition:
-    """The (memoised) :class:`Composition` of ``classes``."""
+    """The (memoised) :class:`Composition` of ``classes``.
+
+    Parameters
+    ----------
+    classes : sequence of Effect classes
+        The plant effects of the composition, in the order their hooks are applied.
+    """
     key = tuple(classes)
     if key not in _CACHE:
         _CACHE[key] = Composition(key)
@@ -230,7 +242,13 @@ def library_composition() -> Composition:
 
 def composition_for(effects) -> Composition:
     """The library composition when every effect in ``effects`` (instances) is registered,
-    else the composition of exactly their classes (e.g. the benchmark generator's truth laws)."""
+    else the composition of exactly their classes (e.g. the benchmark generator's truth laws).
+
+    Parameters
+    ----------
+    effects : sequence of Effect
+        Plant effect instances.
+    """
 
     lib = library()
     if all(lib.get(e.name) is type(e) for e in effects):

@@ -24,11 +24,13 @@ def casadi_model(params, *, eps: float | None = None, sym: str = "SX", effects=(
     Parameters
     ----------
     params : CMCParams
+        Validated parameter set (:mod:`heavecomp.params`).
     eps : float, optional
         Regularisation width of the friction's sign [m/s]; required when the
         friction law or an effect has stiction (there is no smooth exact law).
         Ignored without.
     sym : {"SX", "MX"}
+        casadi symbol type of the traced function.
     effects : sequence, optional
         Effects at the plant's hooks (:mod:`heavecomp.effects`: instances, registered names or
         ``(name, values)``).  Their hook methods are traced by casadi from the same source the
@@ -149,7 +151,15 @@ def _static_affine(e):
 
 def seen_heave(u, ab) -> tuple:
     """(z_h, dz_h, ddz_h) the plant sees from the measured heave in the input ``u`` [m, m/s, m/s^2] under the
-    heave map ``ab`` = (a, b) of :func:`heave_map`: (a u0 + b, a u1, a u2); the input itself when (1, 0)."""
+    heave map ``ab`` = (a, b) of :func:`heave_map`: (a u0 + b, a u1, a u2); the input itself when (1, 0).
+
+    Parameters
+    ----------
+    u : casadi symbol or sequence
+        Model input (z_h [m], dz_h [m/s], ddz_h [m/s^2], u_active [N]); its first three are read.
+    ab : (float, float) [-], [m]
+        Heave map ``(a, b)`` of :func:`heave_map`: gain and offset.
+    """
     a, b = ab
     return (u[0], u[1], u[2]) if (a, b) == (1.0, 0.0) else (a * u[0] + b, a * u[1], a * u[2])
 
@@ -158,7 +168,13 @@ def heave_map(effects) -> tuple:
     """``(a, b)``: the heave the plant sees is ``a z_meas + b`` (its derivatives ``a`` times the
     measured ones) for the heave and channel effects among ``effects`` (instances): a heave
     effect's gain, the inverse of a heave sensor's reading g z + o.  ParameterError for a map with
-    memory or a drift (no finite-state, time-invariant model)."""
+    memory or a drift (no finite-state, time-invariant model).
+
+    Parameters
+    ----------
+    effects : sequence of Effect
+        Effect instances; those of kind ``heave`` and the channel effects on ``heave`` count.
+    """
     a, b = 1.0, 0.0
     for e in effects:
         if e.kind == "heave":
@@ -175,7 +191,16 @@ def heave_map(effects) -> tuple:
 
 
 def initial_effect_states(params, effects=()) -> np.ndarray:
-    """The effect states of :func:`casadi_model` at rest at the operating point (its x[4:])."""
+    """The effect states of :func:`casadi_model` at rest at the operating point (its x[4:]).
+
+    Parameters
+    ----------
+    params : CMCParams
+        Validated parameter set (:mod:`heavecomp.params`).
+    effects : sequence, optional
+        Effects as for :func:`casadi_model` (instances, registered names or ``(name, values)``);
+        only the plant effects have states.
+    """
     plant = plant_vectors(params)
     effects = split_effects(resolve(effects))[0]
     comp = composition(tuple(dict.fromkeys(type(e) for e in effects)))

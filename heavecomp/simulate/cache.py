@@ -67,7 +67,15 @@ def source_key(files=(), extra: str = "") -> str:
     """16-hex-digit key of :data:`KERNEL_SOURCES`, the package-relative ``files`` and ``extra`` text.
 
     The relative path of every file goes into the hash with its contents, so a renamed file
-    changes the key too."""
+    changes the key too.
+
+    Parameters
+    ----------
+    files : iterable of str
+        Package-relative paths (``effects/flow_loss.py``) hashed with :data:`KERNEL_SOURCES`.
+    extra : str
+        Further text hashed after the files (a generated source, compiled method texts).
+    """
     h = hashlib.sha256()
     for rel in sorted(set(KERNEL_SOURCES) | set(files)):
         h.update(rel.encode())
@@ -78,7 +86,13 @@ def source_key(files=(), extra: str = "") -> str:
 
 def module_file(module: str) -> str | None:
     """Package-relative file of a ``heavecomp`` module (``heavecomp.effects.flow_loss`` ->
-    ``effects/flow_loss.py``), None for a module outside the package."""
+    ``effects/flow_loss.py``), None for a module outside the package.
+
+    Parameters
+    ----------
+    module : str
+        Dotted module name (``func.__module__``).
+    """
     parts = module.split(".")
     if parts[0] != "heavecomp" or len(parts) < 2:
         return None
@@ -88,7 +102,13 @@ def module_file(module: str) -> str | None:
 
 def function_text(func) -> str:
     """The source of ``func`` with what it reads from its module: the value of each constant, the
-    source of each function it calls (modules by name).  What numba compiles of it, in short."""
+    source of each function it calls (modules by name).  What numba compiles of it, in short.
+
+    Parameters
+    ----------
+    func : callable
+        A Python function or a numba dispatcher's ``py_func``.
+    """
     import inspect
     import types
 
@@ -114,7 +134,13 @@ def composition_key(comp) -> str:
     """Key of the stepper of an effect composition (:class:`heavecomp.effects.compose.Composition`):
     the kernel sources, the composition's generated source and the compiled hook methods of its
     effects (:func:`function_text`).  An edit of an effect's other parts (its diagnosis metadata,
-    its docs, its casadi-only code) recompiles nothing."""
+    its docs, its casadi-only code) recompiles nothing.
+
+    Parameters
+    ----------
+    comp : Composition
+        The effect composition (:func:`heavecomp.effects.compose.composition`).
+    """
     extra = [comp.source]
     for c in comp.classes:
         for m in c.methods():
@@ -124,7 +150,13 @@ def composition_key(comp) -> str:
 
 
 def cache_dir(key: str) -> Path:
-    """The numba cache folder of ``key``."""
+    """The numba cache folder of ``key``.
+
+    Parameters
+    ----------
+    key : str
+        A key of :func:`source_key` or :func:`composition_key`.
+    """
     return base_dir() / f"numba-{key}"
 
 
@@ -134,7 +166,13 @@ def keyed(key: str):
 
     numba fixes a function's cache folder when it is decorated, so the folder of every
     ``njit(cache=True)`` inside this block is the keyed one.  Without a writable place (or with
-    ``NUMBA_CACHE_DIR`` set by the user) numba's own choice stands."""
+    ``NUMBA_CACHE_DIR`` set by the user) numba's own choice stands.
+
+    Parameters
+    ----------
+    key : str
+        A key of :func:`source_key` or :func:`composition_key`.
+    """
     from numba.core import config
 
     if os.environ.get("NUMBA_CACHE_DIR"):
@@ -156,7 +194,15 @@ def keyed(key: str):
 
 def jit(files=(), **options):
     """``numba.njit(cache=True, **options)`` cached under :func:`source_key` ``(files)``: for a
-    compiled driver that calls the stepper (``files``: its own module, package-relative)."""
+    compiled driver that calls the stepper (``files``: its own module, package-relative).
+
+    Parameters
+    ----------
+    files : iterable of str
+        Package-relative paths of the driver's own sources (hashed with the kernel sources).
+    **options : dict
+        Further ``numba.njit`` options (``parallel=True``, ...).
+    """
     import numba as nb
 
     def decorate(func):

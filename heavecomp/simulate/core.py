@@ -44,6 +44,14 @@ def default_dt(params, rate: float | None = None) -> float:
     paper-A case with full static friction is within 15 N rms of WOB (1 h, vs
     dt = 1 ms), ~0.03 % of its WOB std (``docs/numerics.md``).  Pass ``dt``
     explicitly for more accuracy: the scheme converges with order 4.
+
+    Parameters
+    ----------
+    params : CMCParams
+        Validated parameter set (:mod:`heavecomp.params`).
+    rate : float [Hz], optional
+        Output sampling rate; the step is made a divisor of its interval 1/rate (None: no such
+        constraint).
     """
     h = min(0.05, 0.6 / eigen_rate(params))
     if rate:
@@ -56,7 +64,20 @@ def write_csv(path, data: np.ndarray, columns, fmt: str = "%.10g", block: int = 
               progress: Callable[[float], None] | None = None) -> Path:
     """CSV with a header row; formats whole blocks of rows at once (~2x np.savetxt).
 
-    ``progress(fraction)`` is called after each block (the CLI draws a bar for large files).
+    Parameters
+    ----------
+    path : str or Path
+        File to write (overwritten).
+    data : (n, ncol) array
+        Rows to write, one column per entry of ``columns`` (units as the caller's channels).
+    columns : sequence of str
+        Header names.
+    fmt : str
+        printf-style format of one value.
+    block : int
+        Rows formatted at once.
+    progress : callable(fraction), optional
+        Called as ``progress(fraction)`` after each block (the CLI draws a bar for large files).
     """
     path = Path(path)
     ncol = data.shape[1]
@@ -204,6 +225,7 @@ def simulate(params, duration: float, *, dt: float | None = None, rate: float = 
     params : CMCParams
         Validated parameter set (:mod:`heavecomp.params`).
     duration : float [s]
+        Simulated time.
     dt : float [s], optional
         RK4 step; default :func:`default_dt`.
     rate : float [Hz]
@@ -273,8 +295,29 @@ def simulate(params, duration: float, *, dt: float | None = None, rate: float = 
 def run_kernel(plant, hs, h, n_steps, out_every, *, u_active=0.0, progress=None, chunk_steps=200_000, effects=()):
     """Run the compiled stepper from rest (stuck) at the operating point.
 
-    ``plant`` is :func:`heavecomp.plants.cmc.plant_vectors`; ``effects`` (instances) act at its
-    hooks (:func:`heavecomp.simulate.stepper.plant_stepper`).
+    Returns ``(data, stats, wall)``: the output rows (columns :data:`CHANNELS`), the stepper's
+    counters (:data:`STATS`) and the wall time [s] of the run.
+
+    Parameters
+    ----------
+    plant : PlantVectors
+        The plant (:func:`heavecomp.plants.cmc.plant_vectors`).
+    hs : HeaveSamples
+        Heave samples spaced h/2 covering the run (:func:`heavecomp.simulate.excitation.make_heave`).
+    h : float [s]
+        RK4 step.
+    n_steps : int
+        Number of steps.
+    out_every : int
+        Steps between output rows.
+    u_active : float [N]
+        Constant active-cylinder force.
+    progress : callable(fraction), optional
+        Called after each chunk of steps.
+    chunk_steps : int
+        Steps per call of the compiled stepper (between progress calls).
+    effects : sequence of Effect
+        Effect instances at the plant's hooks (:func:`heavecomp.simulate.stepper.plant_stepper`).
     """
     n_out = n_steps // out_every + 1
     out = np.empty((n_out, NCH))
@@ -317,7 +360,15 @@ HEAVE_ACCEL_MAX = 9.81
 
 def heave_accel_outlier(hs, t_end: float):
     """``(|d2z_h/dt2|, t)`` of the largest heave acceleration [m/s^2, s] of the samples ``hs``
-    up to ``t_end`` when it exceeds :data:`HEAVE_ACCEL_MAX`, else None."""
+    up to ``t_end`` when it exceeds :data:`HEAVE_ACCEL_MAX`, else None.
+
+    Parameters
+    ----------
+    hs : HeaveSamples
+        Heave samples (:mod:`heavecomp.simulate.excitation`).
+    t_end : float [s]
+        Last time looked at (the samples beyond it are not checked).
+    """
     n = min(hs.ddz.size, int(t_end / hs.spacing) + 2)
     if n <= 0:
         return None
@@ -330,7 +381,15 @@ def check_events(data, stats: dict) -> int:
     """The stepper's own diagnostics: log a warning when a step hit the event cap (more
     than 8 mode switches in one step, finished without event location) or when a recorded
     sample has friction power F_f v < 0 (friction driving the stroke: a stepper fault).
-    Returns the number of such samples."""
+    Returns the number of such samples.
+
+    Parameters
+    ----------
+    data : (n, len(CHANNELS)) array
+        Output rows of the stepper (columns :data:`CHANNELS`, SI).
+    stats : dict
+        The stepper's counters by name (:data:`STATS`).
+    """
     if stats.get("event_cap_hits", 0) > 0:
         log.warning("stepper event cap hit in %d step(s), first at t = %.6g s: more than 8 stick-slip/contact "
                     "events inside one step, finished without event location (please report)",
@@ -352,6 +411,23 @@ def drive(step, hs, h, n_steps, out_every, *, progress=None, chunk_steps=200_000
     The fade-in's end, where d2z/dt2 jumps, is made a step boundary: the steps up to it get
     the heave samples up to it with the left-limit ``ddz`` there, so no RK4 step straddles the
     jump (only when it falls on the step and output grids).
+
+    Parameters
+    ----------
+    step : callable
+        ``step(t0, n, Z, DZ, DDZ, out_pos) -> out_pos``: runs ``n`` steps from time ``t0`` [s].
+    hs : HeaveSamples
+        Heave samples spaced h/2 covering the run.
+    h : float [s]
+        RK4 step.
+    n_steps : int
+        Number of steps.
+    out_every : int
+        Steps between output rows (chunks are whole multiples of it).
+    progress : callable(fraction), optional
+        Called after each chunk.
+    chunk_steps : int
+        Steps per call of ``step`` (at most).
     """
     done, pos = 0, 0
     if hs.kink is not None and hs.kink[0] % 2 == 0:

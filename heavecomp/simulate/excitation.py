@@ -45,7 +45,15 @@ class HeaveSamples:
 
 
 def ramp_factor(t, ramp):
-    """Fade-in r(t) = sin^2(pi/2 min(t/T_r, 1)) and its first two derivatives."""
+    """Fade-in r(t) = sin^2(pi/2 min(t/T_r, 1)) and its first two derivatives.
+
+    Parameters
+    ----------
+    t : float or array [s]
+        Time(s).
+    ramp : float [s]
+        Fade-in duration T_r (<= 0: no fade-in).
+    """
     t = np.asarray(t, dtype=float)
     if ramp <= 0:
         one = np.ones_like(t)
@@ -59,7 +67,19 @@ def ramp_factor(t, ramp):
 
 
 def ramp_kink(spacing, z, ddz, ramp):
-    """(index, left-limit ddz) of the sample at t = ramp, or None if no sample is there."""
+    """(index, left-limit ddz) of the sample at t = ramp, or None if no sample is there.
+
+    Parameters
+    ----------
+    spacing : float [s]
+        Sample spacing.
+    z : (n,) array [m]
+        Heave samples (faded in).
+    ddz : (n,) array [m/s^2]
+        Heave acceleration samples (faded in; right limit at the kink).
+    ramp : float [s]
+        Fade-in duration T_r (<= 0: no fade-in).
+    """
     if ramp <= 0:
         return None
     k = int(round(ramp / spacing))
@@ -81,7 +101,21 @@ def _apply_ramp(t, z, dz, ddz, ramp):
 
 
 def sine(amplitude, period, ramp, duration, spacing) -> HeaveSamples:
-    """z_h = r(t) a sin(2 pi t / T) (cmc-reference.md)."""
+    """z_h = r(t) a sin(2 pi t / T) (cmc-reference.md).
+
+    Parameters
+    ----------
+    amplitude : float [m]
+        Heave amplitude a.
+    period : float [s]
+        Heave period T.
+    ramp : float [s]
+        Fade-in duration T_r (<= 0: no fade-in).
+    duration : float [s]
+        Time covered by the samples.
+    spacing : float [s]
+        Sample spacing (h/2 of the stepper).
+    """
     t = np.arange(int(math.ceil(duration / spacing)) + 1) * spacing
     w = 2 * np.pi / period
     z, dz, ddz = _apply_ramp(t, amplitude * np.sin(w * t), amplitude * w * np.cos(w * t),
@@ -95,6 +129,17 @@ def jonswap_spectrum(f, hs, tp, gamma=3.3):
 
     DNV-RP-C205 form with sigma = 0.07 (f <= f_p) / 0.09 (f > f_p); the
     normalisation is done numerically so H_s is exact for any gamma.
+
+    Parameters
+    ----------
+    f : float or array [Hz]
+        Frequencies (S = 0 at f <= 0).
+    hs : float [m]
+        Significant wave height H_s.
+    tp : float [s]
+        Peak period T_p.
+    gamma : float [-]
+        Peak enhancement factor.
     """
     f = np.asarray(f, dtype=float)
     fp = 1.0 / tp
@@ -121,6 +166,27 @@ def jonswap(hs, tp, gamma, seed, ramp, duration, spacing, *, f_cut_factor=6.0, s
     Components above ``f_cut_factor / T_p`` are dropped (they carry < 0.1 % of
     the variance and would only add high-frequency acceleration).  ``spectra``, a dict,
     caches the amplitude spectrum per (H_s, T_p, gamma, grid) across calls (campaigns).
+
+    Parameters
+    ----------
+    hs : float [m]
+        Significant wave height H_s.
+    tp : float [s]
+        Peak period T_p.
+    gamma : float [-]
+        Peak enhancement factor.
+    seed : int
+        Seed of the random phases.
+    ramp : float [s]
+        Fade-in duration T_r (<= 0: no fade-in).
+    duration : float [s]
+        Time covered by the samples.
+    spacing : float [s]
+        Sample spacing (h/2 of the stepper).
+    f_cut_factor : float [-]
+        Components above ``f_cut_factor / T_p`` are dropped.
+    spectra : dict, optional
+        Cache of amplitude spectra shared across calls (filled here).
     """
     from scipy import fft as sfft
 
@@ -154,7 +220,15 @@ def jonswap(hs, tp, gamma, seed, ramp, duration, spacing, *, f_cut_factor=6.0, s
 
 
 def spectral_hs_tp(z, dt):
-    """H_s = 4 std(z) and T_p from a smoothed (Welch) spectrum of a heave series."""
+    """H_s = 4 std(z) and T_p from a smoothed (Welch) spectrum of a heave series.
+
+    Parameters
+    ----------
+    z : (n,) array [m]
+        Heave series, uniformly sampled.
+    dt : float [s]
+        Sampling interval.
+    """
     from scipy.signal import welch
 
     z = np.asarray(z, dtype=float)
@@ -287,6 +361,19 @@ def from_series(t, z, duration, spacing, src="heave") -> HeaveSamples:
 
     Holes of more than 1.5 sampling intervals are first bridged linearly (warning); holes over
     ``max(MAX_HEAVE_GAP, 3 intervals)`` are refused (:func:`_check_series`).
+
+    Parameters
+    ----------
+    t : (n,) array [s]
+        Sample times, strictly increasing.
+    z : (n,) array [m]
+        Heave samples.
+    duration : float [s]
+        Time covered by the output samples (at most the record's span).
+    spacing : float [s]
+        Output sample spacing (h/2 of the stepper).
+    src : str
+        Name of the record in messages (a file path).
     """
     from scipy.interpolate import CubicSpline
 
@@ -304,8 +391,22 @@ def from_series(t, z, duration, spacing, src="heave") -> HeaveSamples:
 
 
 def make_heave(heave, duration, spacing, base_dir=None, measurement=None) -> HeaveSamples:
-    """Samples for a :class:`heavecomp.params.cmc.Heave` table (``measurement``: the file's
-    ``[measurement]`` table, for a heave file's column names and units)."""
+    """Samples for a :class:`heavecomp.params.cmc.Heave` table.
+
+    Parameters
+    ----------
+    heave : Heave
+        The parameter file's ``[heave]`` table (:class:`heavecomp.params.cmc.Heave`; sine, jonswap
+        or file).
+    duration : float [s]
+        Time covered by the samples.
+    spacing : float [s]
+        Sample spacing (h/2 of the stepper).
+    base_dir : str or Path, optional
+        Folder a relative heave file path is resolved against (the parameter file's).
+    measurement : Measurement, optional
+        The file's ``[measurement]`` table, for a heave file's column names and units.
+    """
     if heave is None:
         raise ParameterError("[heave]: missing table (simulate needs a heave input: sine, jonswap or file)")
     if heave.kind == "sine":
@@ -324,6 +425,13 @@ def load_waverider(path, start_hours=0.0):
 
     Returns ``(t, z)`` with t from 0 [s] and z the sea-surface heave [m]; rows
     with a bad signal-quality flag or non-finite heave are dropped.
+
+    Parameters
+    ----------
+    path : str or Path
+        The Waverider CSV (columns ``unix_time_s``, ``heave_m``, optional ``sig_qual``).
+    start_hours : float [h]
+        Rows before this time from the record's start are dropped.
     """
     data = np.genfromtxt(path, delimiter=",", names=True)
     t = data["unix_time_s"]
@@ -351,6 +459,19 @@ def vessel_heave(t, z, natural_period=22.0, damping_ratio=0.15, dt=None):
     (default: its median sampling interval).
 
     Returns ``(t_uniform, z_platform)``.
+
+    Parameters
+    ----------
+    t : (n,) array [s]
+        Sample times of the sea-surface record.
+    z : (n,) array [m]
+        Sea-surface heave.
+    natural_period : float [s]
+        Heave natural period of the vessel.
+    damping_ratio : float [-]
+        Damping ratio zeta of the heave RAO.
+    dt : float [s], optional
+        Uniform grid spacing (default the record's median sampling interval).
     """
     t = np.asarray(t, dtype=float)
     z = np.asarray(z, dtype=float)

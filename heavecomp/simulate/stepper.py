@@ -45,8 +45,17 @@ log = logging.getLogger(__name__)
 def plant_args(plant, EP=None, smooth=None) -> Plant:
     """The stepper's :class:`Plant` of ``plant`` (:func:`heavecomp.plants.cmc.plant_vectors`).
 
-    ``EP``: effect parameters of the stepper's composition (default none: the nominal stepper);
-    ``smooth``: default True when the friction law has no part that jumps with sign(v)."""
+    Parameters
+    ----------
+    plant : PlantVectors
+        The plant (:func:`heavecomp.plants.cmc.plant_vectors`).
+    EP : (n_ep,) array or None
+        Effect parameters of the stepper's composition [SI, layout of the composition]; None (the
+        default): none, the nominal stepper.
+    smooth : bool or None
+        True when the friction has no part that jumps with sign(v); None (the default): True when
+        the friction law has no stiction.
+    """
     EP = np.zeros(0) if EP is None else np.ascontiguousarray(EP, dtype=float)
     if smooth is None:
         smooth = not plant.has_stiction
@@ -110,7 +119,13 @@ def _jit_kernel(comp):
 
 def kernel_for(comp):
     """The compiled stepper of an effect composition (:class:`heavecomp.effects.compose.Composition`;
-    the composition of no effect: the JIT nominal stepper), compiled (or loaded from the cache) now."""
+    the composition of no effect: the JIT nominal stepper), compiled (or loaded from the cache) now.
+
+    Parameters
+    ----------
+    comp : Composition
+        The effect composition (:func:`heavecomp.effects.compose.composition`).
+    """
     return _jit_kernel(comp)
 
 
@@ -120,7 +135,15 @@ def plant_stepper(plant, effects=()):
     point and its :class:`Plant` (effect parameters bound).
 
     Without effects the nominal stepper (:func:`nominal`), with effects the stepper of their
-    composition (:func:`heavecomp.effects.compose.composition_for`)."""
+    composition (:func:`heavecomp.effects.compose.composition_for`).
+
+    Parameters
+    ----------
+    plant : PlantVectors
+        The plant (:func:`heavecomp.plants.cmc.plant_vectors`).
+    effects : sequence of Effect
+        Effect instances at the plant's hooks (default none: the nominal stepper).
+    """
     if not effects:
         return nominal(), composition(()).initial_state(plant.FP, plant.PP, np.zeros(0)), plant_args(plant)
     comp = composition_for(effects)
@@ -138,7 +161,17 @@ def jit_stepper():
 
 
 def heave_at(t, sp, Z, DZ, DDZ):
-    """(z, dz, ddz) of the heave samples at time ``t`` [s] as the stepper interpolates them (quintic Hermite)."""
+    """(z, dz, ddz) of the heave samples at time ``t`` [s] as the stepper interpolates them (quintic Hermite).
+
+    Parameters
+    ----------
+    t : float [s]
+        Time (from the first sample).
+    sp : float [s]
+        Spacing of the samples (h/2 of the stepper).
+    Z, DZ, DDZ : (n,) array [m], [m/s], [m/s^2]
+        Heave displacement, velocity and acceleration samples.
+    """
     from heavecomp.simulate import _kernel
 
     return _kernel.heave_at(t, sp, Z, DZ, DDZ)
@@ -146,7 +179,17 @@ def heave_at(t, sp, Z, DZ, DDZ):
 
 # ---------------------------------------------------------------------------- compile once
 def canonical_args(n_eff_states: int = 0, n_ep: int = 0, n_cols: int = NCH):
-    """Arguments of the canonical types of the stepper's signature (a call of no step)."""
+    """Arguments of the canonical types of the stepper's signature (a call of no step).
+
+    Parameters
+    ----------
+    n_eff_states : int
+        Number of effect states in the state vector (0: the nominal stepper).
+    n_ep : int
+        Number of effect parameters.
+    n_cols : int
+        Number of output columns (default :data:`NCH`, the channels).
+    """
     state = np.zeros(4 + n_eff_states + 1)
     mode_dir = np.array([float(STUCK), 1.0])
     z = np.zeros(8)
@@ -188,7 +231,19 @@ class compiling:
     """Context manager: when what it wraps runs longer than ``notice_after`` seconds (a compile,
     not a load from the cache), log one line saying so, then a heartbeat every ``every`` seconds.
 
-    Logged at WARNING on ``heavecomp.simulate.stepper`` (the CLI prints it to stderr)."""
+    Logged at WARNING on ``heavecomp.simulate.stepper`` (the CLI prints it to stderr).
+
+    Parameters
+    ----------
+    what : str
+        What is being compiled, for the message (``"the stick-slip stepper"``).
+    notice_after : float [s]
+        Wall time after which the first line is logged.
+    every : float [s]
+        Wall time between heartbeat lines.
+    estimate_s : float [s]
+        CPU time the message quotes for the compile.
+    """
 
     def __init__(self, what: str, notice_after: float = 1.0, every: float = 15.0, estimate_s: float = 60.0):
         self.what, self.notice_after, self.every, self.estimate_s = what, notice_after, every, estimate_s
@@ -220,8 +275,13 @@ def compile_all(progress=None) -> list[str]:
     with the campaign's batch: :func:`heavecomp.campaign.batch.compile_batch`).
 
     The nominal stepper (simulate, closed loop), :func:`heave_at` and the stepper of the library's
-    effect composition (``simulate(effects=...)``, the diagnosis).  Returns the names compiled;
-    ``progress(name)`` is called before each."""
+    effect composition (``simulate(effects=...)``, the diagnosis).  Returns the names compiled.
+
+    Parameters
+    ----------
+    progress : callable or None
+        Called as ``progress(name)`` before each compile (None: not called).
+    """
     from heavecomp.simulate import _kernel
 
     steps = [("nominal stepper", lambda: _jit_kernel(None)),
