@@ -68,3 +68,14 @@ def test_simulates_with_input_output_response():
     df = r.to_pandas()
     assert {"time", "wob", "heave", "stroke"} <= set(df.columns)
     assert np.isfinite(df["wob"]).all() and df["wob"].std() > 0
+
+
+def test_linearize_keeps_signal_names_with_copy_names():
+    """The documented door: ``ct.linearize(..., copy_names=True)`` keeps the nlsys' signal names (without it
+    python-control names them generically, which is why the docs say to pass it)."""
+    p = paper_a("none")
+    op = L.linearise_details(p, friction="none").op
+    sys = cmc_nlsys(p)
+    lin = ct.linearize(sys, op.x, op.u, copy_names=True)
+    assert lin.input_labels == sys.input_labels and lin.output_labels == sys.output_labels
+    assert "wob" in lin.output_labels and "heave" in lin.input_labels

@@ -4,7 +4,9 @@ The right-hand side and the outputs are the casadi model of :func:`heavecomp.eff
 (the plant equations written once), evaluated numerically: nothing is restated here.  Use it to
 simulate with ``control.input_output_response``, to interconnect with your own controller
 (``control.interconnect`` by signal name) or to linearise with ``control.linearize``; the latter
-agrees with :func:`heavecomp.analysis.linearise` (tested).
+agrees with :func:`heavecomp.analysis.linearise` (tested).  ``control.linearize`` names the linear
+system's signals generically unless told otherwise: pass ``copy_names=True`` to keep ``heave``,
+``wob``, ... (``ct.linearize(sys, x0, u0, copy_names=True)``; tested).
 
 >>> from heavecomp.params import paper_a
 >>> from heavecomp.analysis.nonlinear_system import cmc_nlsys

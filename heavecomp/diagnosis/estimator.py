@@ -43,6 +43,7 @@ from heavecomp.diagnosis import fitting as F
 from heavecomp.diagnosis import joint as J
 from heavecomp.diagnosis import replay as R
 from heavecomp.diagnosis import screen as S
+from heavecomp.diagnosis import structure as ST
 from heavecomp.diagnosis import verdict as V
 from heavecomp.diagnosis import where as W
 from heavecomp.diagnosis.fitting import at_bounds  # noqa: F401 - public here since issue 14.3
@@ -153,7 +154,7 @@ class GapDiagnoser(GapEstimator):
             get(n)
         self.candidates = names
         if not 0.2 <= split <= 0.9:
-            raise InputError(f"--split must be between 0.2 and 0.9, got {split}")
+            raise InputError(f"split must be between 0.2 and 0.9, got {split}", option="split")
         self.split = split
         self.settle = settle
         self.penalty = penalty
@@ -204,6 +205,8 @@ class GapDiagnoser(GapEstimator):
     def _fit(self, run):
         t_wall = time.perf_counter()
         P = self.verdict_policy()
+        # the log's sensor set (contract schema 3: heave required; the reader asks for all four today)
+        self.sensors_ = tuple(c for c in ST.CHANNELS if c in run.columns and np.isfinite(run[c]).any())
         self._report(0.02, "replaying the nominal model")
         ctx = R.prepare(run, self.nominal, split=self.split, settle=self.settle, stuck_speed=self.stuck_speed,
                         segment=self.segment, reinit=self.reinit, input_draws=self.input_draws,
@@ -335,12 +338,29 @@ class GapDiagnoser(GapEstimator):
             self.progress(frac, msg)
 
     # ---------------------------------------------------------------- output
+    def isolability(self) -> dict:
+        """What the log's sensor set can tell apart (contract schema 3, ``isolability``): the candidates
+        it can detect and the groups it cannot tell apart, from the model's structure
+        (:func:`heavecomp.diagnosis.structure.isolability`, level ``"shape"``: which equation each
+        effect enters and which measured signals its term depends on)."""
+        iso = ST.isolability(self.sensors_, self.candidates, level="shape")
+        return {"detectable": iso["detectable"], "groups": iso["groups"], "level": iso["level"]}
+
     def to_json(self) -> dict:
-        """The ``diagnosis.json`` content (contract schema 2: schema 1's keys, plus ``verdict.component``,
-        ``verdict.discovered``, ``gap.where.components``, ``initial_state``, ``warnings``; extras:
-        ``prescreen``)."""
+        """The ``diagnosis.json`` content (contract schema 3: schema 1's keys, plus ``verdict.component``,
+        ``verdict.discovered``, ``gap.where.components``, ``initial_state``, ``warnings`` (schema 2),
+        ``sensors``, ``isolability`` and ``verdict.group`` (schema 3; the ``calibrated`` block is added by
+        the command that writes ``calibrated.toml``); extras: ``prescreen``)."""
         v = dict(self.verdict_)
-        return {"schema": 2,
+        iso = self.isolability()
+        named = v.get("effect")
+        if named not in ("none", "inconclusive", "discovered", None):
+            channel = (v.get("parameters") or {}).get("channel")
+            group = ST.group_of(f"{named}:{channel}" if channel else named, iso)
+            v["group"] = group if group else [named]
+        return {"schema": 3,
+                "sensors": list(self.sensors_),
+                "isolability": iso,
                 "verdict": v,
                 "gap": self.gap_,
                 "candidates": self.candidates_,

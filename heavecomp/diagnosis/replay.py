@@ -322,7 +322,7 @@ def split_of(run, split, settle) -> dict:
     T_end = float(run.t[-1])
     settle = settle if settle is not None else min(30.0, 0.1 * T_end)
     if not 0 <= settle < 0.5 * T_end:
-        raise InputError(f"--settle {settle:g} s must be >= 0 and shorter than half the run ({T_end:g} s)")
+        raise InputError(f"settle {settle:g} s must be >= 0 and shorter than half the run ({T_end:g} s)", option="settle")
     t_split = split * T_end
     return {"fit": [0.0, t_split], "validate": [t_split, T_end], "settle": settle}
 

@@ -12,7 +12,7 @@ import numpy as np
 from heavecomp.diagnosis.where import residual_spectrum
 from heavecomp.report.figures import _plt, save
 from heavecomp.report.scenario import md_table
-from heavecomp.report.provenance import stamp, stamp_report
+from heavecomp.report.provenance import declare_units, stamp, stamp_report
 from heavecomp.simulate.core import CHANNEL_UNITS
 from heavecomp.report.scenario import _clean as clean
 from heavecomp.effects import CANDIDATES
@@ -57,9 +57,36 @@ def _clean(x):
 
 
 def write_json(diag, path) -> Path:
+    """Write ``diagnosis.json`` with the unit of every fitted parameter declared where it is made.
+
+    Parameters
+    ----------
+    diag : GapDiagnoser
+        A fitted diagnoser.
+    path : str or Path
+        The file to write.
+    """
     path = Path(path)
-    path.write_text(json.dumps(_clean(diag.to_json()), indent=2) + "\n")
+    d = diag.to_json()
+    for block in _parameter_blocks(d):  # the effect's own metadata, the channel's unit for a channel effect
+        if isinstance(block.get("parameters"), dict) and isinstance(block.get("effect"), str):
+            units = _effect_units(block["effect"], block["parameters"])
+            own = {k: u for k, u in units.items() if k in block["parameters"]}
+            if own:
+                declare_units(block["parameters"], own)
+                block["parameter_units"] = own  # beside the values: a key name cannot pick the wrong unit
+    path.write_text(json.dumps(_clean(d), indent=2) + "\n")
     return path
+
+
+def _parameter_blocks(d: dict) -> list:
+    """The blocks of a ``diagnosis.json`` dict that carry an ``effect`` and its fitted ``parameters``."""
+    v = d.get("verdict", {})
+    blocks = [v, *d.get("candidates", [])]
+    if isinstance(v.get("second_effect"), dict):
+        blocks.append(v["second_effect"])
+    blocks += [c for c in v.get("second_candidates", []) or [] if isinstance(c, dict)]
+    return blocks
 
 
 def fig_where(diag):
@@ -285,11 +312,39 @@ def write_report(diag, out_dir, *, title="Sim-to-real gap diagnosis") -> dict:
               "", f"Split: fit {diag.split_['fit'][0]:.0f}-{diag.split_['fit'][1]:.0f} s, held out "
                   f"{diag.split_['validate'][0]:.0f}-{diag.split_['validate'][1]:.0f} s; first "
                   f"{diag.split_['settle']:.0f} s excluded (start-up).",
+              "", "## What this sensor set can tell apart", "", *_isolability_lines(diag),
               "", "## Before / after", "", "![overlay](overlay.png)", ""]
     (out / "report.md").write_text("\n".join(lines))
 
     stamp_report(out / "report.md", stamp())
     return diag.to_json()
+
+
+def _isolability_lines(diag) -> list:
+    """The isolability of the log's sensor set (``diagnosis.json`` ``isolability``) as Markdown lines.
+
+    Parameters
+    ----------
+    diag : GapDiagnoser
+        A fitted diagnoser.
+    """
+    iso = diag.isolability()
+    groups = [g for g in iso["groups"] if len(g) > 1]
+    alone = [g[0] for g in iso["groups"] if len(g) == 1]
+    lines = [f"Sensors: {', '.join(diag.sensors_)}. From the model's structure (which equation each effect "
+             "enters, which measured signals its term depends on), the candidates this sensor set can tell "
+             "apart alone: " + (", ".join(f"`{a}`" for a in alone) or "none") + "."]
+    if groups:
+        lines += ["", "Groups it cannot tell apart by structure (the replay fit decides between them; a verdict "
+                  "in one names its group, `verdict.group`):", "",
+                  *[f"- {', '.join(f'`{m}`' for m in g)}" for g in groups]]
+    v = diag.verdict_
+    if v.get("effect") not in ("none", "inconclusive", "discovered"):
+        group = diag.to_json()["verdict"].get("group", [v["effect"]])
+        if len(group) > 1:
+            lines += ["", f"The verdict `{v['effect']}` lies in the group {', '.join(f'`{m}`' for m in group)}: "
+                      "it fitted best among effects this sensor set cannot tell apart by structure."]
+    return lines
 
 
 def fig_confusion(summary):
