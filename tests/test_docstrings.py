@@ -44,10 +44,8 @@ PENDING = {
     "heavecomp/controllers/registry.py",
     "heavecomp/diagnosis/components.py",
     "heavecomp/diagnosis/data.py",
-    "heavecomp/diagnosis/equation_error.py",
 
     "heavecomp/diagnosis/stepper.py",
-    "heavecomp/diagnosis/where.py",
     "heavecomp/effects/base.py",
     "heavecomp/effects/candidates.py",
     "heavecomp/effects/features.py",
