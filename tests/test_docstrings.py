@@ -42,7 +42,6 @@ PACKAGE = ROOT / "heavecomp"
 PENDING = {
     "heavecomp/closed_loop/loop.py",
     "heavecomp/controllers/registry.py",
-    "heavecomp/diagnosis/components.py",
     "heavecomp/diagnosis/data.py",
 
     "heavecomp/diagnosis/stepper.py",
