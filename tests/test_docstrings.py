@@ -44,7 +44,6 @@ PENDING = {
     "heavecomp/controllers/registry.py",
     "heavecomp/diagnosis/data.py",
 
-    "heavecomp/effects/registry.py",
     "heavecomp/report/diagnosis.py",
 }
 
