@@ -42,7 +42,6 @@ PACKAGE = ROOT / "heavecomp"
 PENDING = {
     "heavecomp/diagnosis/data.py",
 
-    "heavecomp/report/diagnosis.py",
 }
 
 _ENTRY = re.compile(r"^(?P<names>\*{0,2}\w+(?:\s*,\s*\*{0,2}\w+)*)(?:\s+:\s*(?P<type>\S.*))?$")
