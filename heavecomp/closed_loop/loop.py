@@ -118,11 +118,12 @@ def simulate_closed_loop(params, controller="passive", duration: float = 120.0, 
 
     Parameters
     ----------
-    params : CMCParams
-        Plant parameters; ``[active]`` gives u_max, rate_max and the control rate.
+    params : heavecomp.params.CMCParams
+        Plant parameters; ``[active]`` gives u_max [N], rate_max [N/s] and the control rate [Hz].
     controller : str or Controller
         ``passive``, ``pid``, ``linear-mpc``, ``nonlinear-mpc`` or an instance.
     duration : float [s]
+        Simulated time.
     dt : float [s], optional
         RK4 step (default: the plant's, made a divisor of the control interval).
     heave : HeaveSamples or (t, z), optional
@@ -132,6 +133,11 @@ def simulate_closed_loop(params, controller="passive", duration: float = 120.0, 
     preview : {"predicted", "perfect"}
         ``predicted``: the controller predicts heave from its measurements (AR);
         ``perfect``: it is given the true future heave (an upper bound).
+    stats_start : float [s], optional
+        Start of the span the metrics are computed on; None: the end of the heave ramp-in (0 for a
+        given ``heave``), at most half the run.
+    progress : callable(fraction), optional
+        Called with the fraction done every 200 control steps and at the end.
     effects : sequence, optional
         The true plant's effects (:mod:`heavecomp.effects`: instances, names or ``(name, values)``;
         None: the plant effects of ``params``' ``[[effects]]``): plant effects act at its hooks; a
@@ -143,7 +149,7 @@ def simulate_closed_loop(params, controller="passive", duration: float = 120.0, 
         its plant effects enter the prediction, its channel effects how it reads the measurement
         (the calibrated correction of a sensor fault).  None: the plant effects of ``params``'
         ``[[effects]]`` (``passive`` and ``pid`` have no model).
-    options
+    **options : dict
         :class:`~heavecomp.controllers.ControllerConfig` overrides (when
         ``controller`` is a name).
 
@@ -323,7 +329,15 @@ def _preview_error(previews, hs, sp, Tc, heave_at) -> dict:
 
 
 def output_every(rate: float | None, control_rate: float) -> int:
-    """Rows per written row for an output ``rate`` [Hz] (None: the control rate)."""
+    """Rows per written row for an output ``rate`` [Hz] (None: the control rate).
+
+    Parameters
+    ----------
+    rate : float [Hz] or None
+        Output rate asked for; None: the control rate.
+    control_rate : float [Hz]
+        The loop's control rate (``[active].control_rate``).
+    """
     if rate is None:
         return 1
     ratio = control_rate / rate if rate > 0 else math.inf

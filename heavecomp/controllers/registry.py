@@ -31,12 +31,24 @@ CONTROLLERS = {
 
 
 def is_controller(obj) -> bool:
-    """True if ``obj`` follows the loop contract: it has a callable ``step``."""
+    """True if ``obj`` follows the loop contract: it has a callable ``step``.
+
+    Parameters
+    ----------
+    obj : object
+        Any object.
+    """
     return callable(getattr(obj, "step", None))
 
 
 def takes_effects(name) -> bool:
-    """True if the registered controller ``name`` has a model that can hold effects (the MPCs)."""
+    """True if the registered controller ``name`` has a model that can hold effects (the MPCs).
+
+    Parameters
+    ----------
+    name : str or object
+        A registered controller name (any other object: False).
+    """
     return isinstance(name, str) and name in CONTROLLERS and "effects" in inspect.signature(CONTROLLERS[name]).parameters
 
 
@@ -48,15 +60,17 @@ def make(name, params, config: ControllerConfig | None = None, *, effects=None, 
     name : str or object
         A registered name, or any object with ``step(t, measurement, preview=None) -> u``
         (returned as it is; ``options`` then do not apply).
-    params : CMCParams
+    params : heavecomp.params.CMCParams
+        Parameter set of the plant the controller acts on (its ``[active]`` limits).
     config : ControllerConfig, optional
+        Controller settings; None: :meth:`ControllerConfig.from_params` with ``options``.
     effects : sequence, optional
         Effects the controller's model knows (:mod:`heavecomp.effects`: instances, names or
         ``(name, values)``; None: the plant effects of the parameter file's ``[[effects]]``).  Plant
         effects enter its prediction model, a channel effect (``sensor_gain``, ``sensor_offset``) the way it reads its
         measurement.  Only the MPCs have a model; ``passive`` and ``pid`` take none (ParameterError
         for a non-empty ``effects``).
-    options
+    **options : dict
         :class:`ControllerConfig` overrides (limits default to ``params``' ``[active]`` table).
     """
     if not isinstance(name, str):

@@ -95,10 +95,22 @@ def equations(t, heave, stroke, pressure, wob, params, heave_reference=0.0, cuto
 
     Parameters
     ----------
-    t : array [s]; heave, stroke [m]; pressure [Pa] (gauge); wob [N]
-    params : CMCParams (nominal)
+    t : numpy.ndarray [s]
+        Sample times.
+    heave : numpy.ndarray [m]
+        Measured heave.
+    stroke : numpy.ndarray [m]
+        Measured compensator stroke.
+    pressure : numpy.ndarray [Pa]
+        Measured gas pressure (gauge).
+    wob : numpy.ndarray [N]
+        Measured weight on bit.
+    params : heavecomp.params.CMCParams
+        Nominal parameters.
     heave_reference : float [m]
         The heave of the operating point (``InitialState.heave_reference``).
+    cutoff : float [Hz]
+        Zero-phase low-pass of every channel before the equations.
 
     Returns
     -------
@@ -303,6 +315,10 @@ def residuals(run, params, *, heave_reference=None, noise=None, mask=None, cutof
 
     Parameters
     ----------
+    run : heavecomp.diagnosis.data.MeasuredRun
+        The measured run (heave, stroke, pressure and wob columns).
+    params : heavecomp.params.CMCParams
+        Nominal parameters.
     heave_reference : float [m], optional
         Heave of the operating point (default: the first filtered heave sample).
     noise : {channel: sigma}, optional
@@ -312,6 +328,10 @@ def residuals(run, params, *, heave_reference=None, noise=None, mask=None, cutof
     floor_channels : {stroke, pressure, wob: array}, optional
         The nominal model's replay at the run's times (driven by the measured heave): its component
         z-values are the floor subtracted from the run's (:attr:`ComponentResiduals.floor`).
+    cutoff : float [Hz]
+        Zero-phase low-pass of every channel before the equations.
+    seed : int
+        Seed of the measurement-noise draws that measure each equation's noise.
     """
 
     t = run.t
@@ -415,7 +435,17 @@ def channel_features(y, sigma, motion=None) -> dict:
     indicator times the motion, the part of the load the reading no longer follows), ``play*`` (a
     reading through a play of :data:`PLAY_WIDTHS` x std, minus the reading).
 
-    Returns {name: (array, readable expression)} in the channel's unit."""
+    Returns {name: (array, readable expression)} in the channel's unit.
+
+    Parameters
+    ----------
+    y : numpy.ndarray [unit of the channel]
+        The channel's (gap-filled) reading.
+    sigma : float [unit of the channel]
+        The channel's measurement noise.
+    motion : numpy.ndarray [m], optional
+        The string top's position ``z_h + s`` (adds the ``*_motion`` features); None: none.
+    """
     y = np.asarray(y, float)
     d = y - float(np.median(y))
     hi, lo = np.quantile(y, [0.99, 0.01])
@@ -496,6 +526,13 @@ def channel_search(cr, fit, validate) -> dict | None:
     Returns the best consistent term (by stacked held-out shrink): {``component``: "sensors",
     ``channel``, ``term``, ``features``, ``coefficients`` [-, per noise], ``shrink`` (stacked,
     held out), ``equations`` {e: {``seen`` [noise variances], ``shrink``}}}, or None.
+
+    Parameters
+    ----------
+    cr : ComponentResiduals
+        Component residuals of the run (:func:`residuals`; its ``inputs`` re-evaluate the equations).
+    fit, validate : numpy.ndarray of bool
+        Samples to fit on / to score on (held out).
     """
     inp = cr.inputs
     if not inp:

@@ -165,6 +165,20 @@ def check_run(t, columns: dict, *, params=None, source="<array>", rows=None) -> 
 
     ``rows`` (optional) gives the file line of each sample, for messages (default: header on
     line 1, one sample per line).
+
+    Parameters
+    ----------
+    t : array_like [s]
+        Sample times (strictly increasing, else DataError).
+    columns : dict
+        {column: array} in SI: ``heave``, ``stroke`` [m], ``pressure`` [Pa] (gauge), ``wob`` [N],
+        optionally ``pitch`` [rad].
+    params : heavecomp.params.CMCParams, optional
+        Nominal parameters; given, the channel magnitudes are checked against them (:func:`check_units`).
+    source : str
+        Name of the data's origin, for messages.
+    rows : sequence of int, optional
+        File line of each sample, for messages; None: header on line 1, one sample per line.
     """
 
     t = np.asarray(t, dtype=float)
@@ -258,6 +272,13 @@ def check_units(run: MeasuredRun, params) -> None:
     Pressure: the mean gauge pressure should be near p_0 (cmc-reference.md); a mean near
     p_0 + p_atm adds a warning (absolute pressure?) to ``run.warnings``;
     WOB: its mean near W_0; stroke: its spread comparable to the heave's.
+
+    Parameters
+    ----------
+    run : MeasuredRun
+        The measured run.
+    params : heavecomp.params.CMCParams
+        Nominal parameters (p_0 [Pa], the WOB set-point W_0 [N]).
     """
     src = run.source
     p0 = params.p0
@@ -285,7 +306,15 @@ def check_units(run: MeasuredRun, params) -> None:
 
 
 def fill_gaps(t, y):
-    """Linear interpolation over NaN samples (for the replay input)."""
+    """Linear interpolation over NaN samples (for the replay input).
+
+    Parameters
+    ----------
+    t : numpy.ndarray [s]
+        Sample times (increasing; may be non-uniform).
+    y : numpy.ndarray [unit of the channel]
+        The channel's samples (NaN: missing).
+    """
     ok = np.isfinite(y)
     if ok.all():
         return y
@@ -293,7 +322,17 @@ def fill_gaps(t, y):
 
 
 def uniform(t, y, dt=None):
-    """Resample (t, y) to a uniform grid of spacing ``dt`` (default: median interval); NaNs bridged."""
+    """Resample (t, y) to a uniform grid of spacing ``dt`` (default: median interval); NaNs bridged.
+
+    Parameters
+    ----------
+    t : numpy.ndarray [s]
+        Sample times (increasing; may be non-uniform).
+    y : numpy.ndarray [unit of the channel]
+        The channel's samples (NaN: missing).
+    dt : float [s], optional
+        Grid spacing; None: the median interval.
+    """
     dt = float(np.median(np.diff(t))) if dt is None else dt
     tu = np.arange(t[0], t[-1] + 1e-9 * dt, dt)
     return tu, np.interp(tu, t, fill_gaps(t, y))
@@ -312,6 +351,15 @@ def zero_phase_lowpass(y, dt, cutoff=HEAVE_CUTOFF):
     band-limits the channel below the filter: the channel is returned unchanged and this is
     logged (documented in ``docs/diagnosis.md``; until 2026-11 the skip was silent).  A run too
     short for the full filter gets the longest filter it can carry (a wider transition band).
+
+    Parameters
+    ----------
+    y : array_like [unit of the channel]
+        Uniformly sampled channel.
+    dt : float [s]
+        Sample spacing.
+    cutoff : float [Hz]
+        Cut-off frequency.
     """
 
     fs = 1.0 / dt
@@ -328,7 +376,15 @@ def zero_phase_lowpass(y, dt, cutoff=HEAVE_CUTOFF):
 def heave_filtered(run: MeasuredRun, cutoff=HEAVE_CUTOFF):
     """The replay's heave before its reference is removed: gap-filled, uniformly resampled,
     zero-phase FIR low-passed (``cutoff`` [Hz]); a cubic spline of it (callable t -> z [m],
-    ``.derivative()`` for dz_h, ddz_h)."""
+    ``.derivative()`` for dz_h, ddz_h).
+
+    Parameters
+    ----------
+    run : MeasuredRun
+        The measured run.
+    cutoff : float [Hz]
+        Cut-off of the zero-phase low-pass.
+    """
     from scipy.interpolate import CubicSpline
 
     tu, zu = uniform(run.t, run["heave"])
@@ -343,6 +399,21 @@ def heave_samples(run: MeasuredRun, h: float, n_steps: int, cutoff=HEAVE_CUTOFF,
     :func:`heavecomp.diagnosis.start.estimate` for a log that starts anywhere); default the first
     filtered sample (cmc-reference.md: a run that starts at rest at the operating point).
     ``spline``: the run's :func:`heave_filtered` at ``cutoff`` when already made (it is not made again).
+
+    Parameters
+    ----------
+    run : MeasuredRun
+        The measured run.
+    h : float [s]
+        Stepper step (the samples are spaced h/2).
+    n_steps : int
+        Stepper steps.
+    cutoff : float [Hz]
+        Cut-off of the zero-phase low-pass.
+    reference : float [m], optional
+        Heave of the operating point; None: the first filtered sample.
+    spline : scipy.interpolate.CubicSpline, optional
+        The run's :func:`heave_filtered` at ``cutoff`` when already made; None: made here.
     """
 
     cs = heave_filtered(run, cutoff) if spline is None else spline
@@ -374,7 +445,17 @@ def _angle_reference(run, ca, reference) -> float:
 
 def lowpass_zero_phase(t, y, cutoff):
     """A channel zero-phase FIR low-passed (linear interpolation back to the original times ``t``),
-    and its velocity and acceleration by spline differentiation of the same filtered samples."""
+    and its velocity and acceleration by spline differentiation of the same filtered samples.
+
+    Parameters
+    ----------
+    t : numpy.ndarray [s]
+        Sample times (increasing; may be non-uniform).
+    y : numpy.ndarray [unit of the channel]
+        The channel's samples (NaN: missing).
+    cutoff : float [Hz]
+        Cut-off of the zero-phase low-pass.
+    """
     from scipy.interpolate import CubicSpline
 
     tu, yu = uniform(t, y)
@@ -385,7 +466,17 @@ def lowpass_zero_phase(t, y, cutoff):
 
 def derivative_zero_phase(t, y, cutoff):
     """Velocity and acceleration of a channel by zero-phase FIR filtering and spline differentiation,
-    returned at the original times ``t`` (:func:`lowpass_zero_phase`)."""
+    returned at the original times ``t`` (:func:`lowpass_zero_phase`).
+
+    Parameters
+    ----------
+    t : numpy.ndarray [s]
+        Sample times (increasing; may be non-uniform).
+    y : numpy.ndarray [unit of the channel]
+        The channel's samples (NaN: missing).
+    cutoff : float [Hz]
+        Cut-off of the zero-phase low-pass.
+    """
     return lowpass_zero_phase(t, y, cutoff)[1:]
 
 
@@ -402,6 +493,13 @@ def noise_floor(y, t=None) -> float:
     Second differences alone (until 2026-11) hold at 50-100 Hz but read the waves as noise at 10 Hz
     (1.8x too high for 2 mm on a 2.5 m sea, 6x for 0.5 mm); from 10 to 100 Hz this estimate is within
     a few % (``tests/test_diagnosis_preprocessing.py``).  A non-uniform ``t`` is resampled first.
+
+    Parameters
+    ----------
+    y : array_like [unit of the channel]
+        The channel's samples (non-finite ones are dropped).
+    t : numpy.ndarray [s], optional
+        Sample times of a non-uniformly sampled channel (resampled first); None: uniform.
     """
     from scipy.special import comb
 

@@ -53,7 +53,13 @@ def _ms(x):
 
 def effective_n(r) -> float:
     """Number of independent samples of an autocorrelated residual, n (1 - rho) / (1 + rho), rho the
-    lag-1 autocorrelation (a filtered residual has far fewer than n; BIC with n would accept noise)."""
+    lag-1 autocorrelation (a filtered residual has far fewer than n; BIC with n would accept noise).
+
+    Parameters
+    ----------
+    r : numpy.ndarray
+        Residual samples (any unit).
+    """
     n = r.size
     if n < 4 or np.std(r) == 0:
         return float(n)
@@ -147,6 +153,23 @@ def rank_effects(r, sig, effects, fit, validate, base=None, component="") -> lis
     Returns a list, best first, of {``effect``, ``component``, ``shape``, ``coefficients``,
     ``shrink``, ``bic``, ``delta_bic``, ``rms_before``, ``rms_after``}; effects without an
     equation-error form here (``features`` returns None) are left out.
+
+    Parameters
+    ----------
+    r : numpy.ndarray [unit of the component]
+        Component residual.
+    sig : dict
+        Measured signals of the component ({``t`` [s], ``v`` [m/s], ``x`` [m], ``p`` [Pa], ...}:
+        :meth:`heavecomp.diagnosis.components.ComponentResiduals.signals_for`).
+    effects : iterable of type
+        Effect classes (:class:`heavecomp.effects.base.Effect` subclasses).
+    fit, validate : numpy.ndarray of bool
+        Samples to fit on / to score on (held out).
+    base : dict, optional
+        {name: array} columns refitted with every candidate and in the reference (nominal linear
+        parameters).
+    component : str
+        Component name reported for every row; empty: each class's own :meth:`Effect.component`.
     """
     out = []
     for cls in effects:
@@ -173,6 +196,12 @@ def library(sig: dict) -> dict:
     spring [m], ``still`` boolean at rest).
 
     Returns {name: (array, readable expression)}.  A feature whose signal is missing is left out.
+
+    Parameters
+    ----------
+    sig : dict
+        Measured signals of the component ({``t`` [s], ``v`` [m/s], ``x`` [m], ``p`` [Pa], ...}:
+        :meth:`heavecomp.diagnosis.components.ComponentResiduals.signals_for`). Optional ``rel`` [m] and ``still`` (bool) add their features.
     """
     t = np.asarray(sig["t"], float)
     L = {"const": (np.ones(t.size), "1"), "t": (t - t[0], "(t - t0)")}
@@ -223,7 +252,19 @@ def library(sig: dict) -> dict:
 def stlsq(X, y, threshold, iters=10):
     """Sequentially thresholded least squares on standardised columns: refit on the surviving
     columns, drop those whose standardised coefficient is below ``threshold`` x std(y).
-    Returns the boolean support."""
+    Returns the boolean support.
+
+    Parameters
+    ----------
+    X : numpy.ndarray
+        Feature columns (n samples x k).
+    y : numpy.ndarray
+        Target (the component residual on the fit part).
+    threshold : float [-]
+        Smallest standardised coefficient kept, relative to std(y).
+    iters : int
+        Maximum thresholding rounds.
+    """
     Z = X / _scales(X)
     keep = np.ones(X.shape[1], bool)
     sy = float(np.std(y)) or 1.0
@@ -251,6 +292,26 @@ def open_search(r, sig, fit, validate, *, base=None, component="", max_terms=3, 
 
     Returns {``term``: readable sum of coefficient x feature, SI; ``features``: names; ``coefficients``;
     ``shrink``: held-out; ``component``; ``bic``, ``delta_bic``, ``rms_before``, ``rms_after``} or None.
+
+    Parameters
+    ----------
+    r : numpy.ndarray [unit of the component]
+        Component residual.
+    sig : dict
+        Measured signals of the component ({``t`` [s], ``v`` [m/s], ``x`` [m], ``p`` [Pa], ...}:
+        :meth:`heavecomp.diagnosis.components.ComponentResiduals.signals_for`).
+    fit, validate : numpy.ndarray of bool
+        Samples to fit on / to score on (held out).
+    base : dict, optional
+        {name: array} columns refitted in every model and in the reference.
+    component : str
+        Component name reported.
+    max_terms : int
+        Most terms of the chosen model.
+    min_shrink : float [-]
+        Held-out shrink the chosen model must reach.
+    features : dict, optional
+        {name: (array, readable expression)} searched instead of :func:`library`.
     """
     lib = features if features is not None else library(sig)
     r = np.asarray(r, float)

@@ -107,7 +107,17 @@ class CandidateFit:
 
 
 def public(nominal, name, values) -> dict:
-    """A candidate's parameters as reported (parameter_mismatch: the nominal's values it stands for)."""
+    """A candidate's parameters as reported (parameter_mismatch: the nominal's values it stands for).
+
+    Parameters
+    ----------
+    nominal : heavecomp.params.CMCParams
+        Nominal parameters (the values a parameter_mismatch multiplies).
+    name : str
+        Candidate effect name (:func:`heavecomp.effects.candidates.get`).
+    values : dict
+        Fitted parameter values [SI] of the candidate.
+    """
     if name == "parameter_mismatch":
         return ParameterMismatch.named_values(nominal, values)
     return dict(values)
@@ -119,6 +129,15 @@ def at_bounds(name, values, tol=VerdictPolicy.bound_tol) -> list:
     not those whose bounds are the ends of their physical range (``cls.fit.limits``: a share of 0 or 1).
 
     Returns a list of {parameter, value, side ("lower" | "upper"), bound}.
+
+    Parameters
+    ----------
+    name : str
+        Candidate effect name.
+    values : dict
+        Fitted parameter values [SI] of the candidate.
+    tol : float [-]
+        Share of the search range (on the fit's scale) counted as at a bound.
     """
     cls = get(name)
     lo, hi = cls.bounds_x()
@@ -141,14 +160,34 @@ def at_bounds(name, values, tol=VerdictPolicy.bound_tol) -> list:
 
 
 def channel_scores(mse_b, mse_a) -> dict:
-    """Held-out rms before and after, and shrink, per channel."""
+    """Held-out rms before and after, and shrink, per channel.
+
+    Parameters
+    ----------
+    mse_b, mse_a : dict
+        Held-out mean squares per channel [SI^2] before (nominal) and after (candidate).
+    """
     return {c: {"rms_before": math.sqrt(mse_b[c]), "rms_after": math.sqrt(mse_a[c]),
                 "shrink": 1.0 - math.sqrt(mse_a[c] / mse_b[c]) if mse_b[c] > 0 else 0.0} for c in CH}
 
 
 def score(ctx, name, fitted: Fit, pred, pred_pert) -> CandidateFit:
     """The held-out record of candidate ``name`` fitted as ``fitted``, from its replay ``pred`` and its
-    replays on the heave-noise draws ``pred_pert``."""
+    replays on the heave-noise draws ``pred_pert``.
+
+    Parameters
+    ----------
+    ctx : heavecomp.diagnosis.replay.ReplayContext
+        The prepared run (:func:`heavecomp.diagnosis.replay.prepare`).
+    name : str
+        Candidate effect name.
+    fitted : Fit
+        The candidate's fit on the fit part.
+    pred : dict
+        Its whole replay ({channel: array} [SI], :meth:`ReplayContext.simulate`).
+    pred_pert : list of dict
+        Its replays on the heave-noise draws (:attr:`ReplayContext.hs_pert`).
+    """
     P = ctx.policy
     mse_a = ctx.mse(pred, ctx.valmask)
     expl_plain = ctx.explained(ctx.mse_before, mse_a)
@@ -168,12 +207,30 @@ def score(ctx, name, fitted: Fit, pred, pred_pert) -> CandidateFit:
 
 def candidate_class(ctx, name) -> type:
     """The class fitted for candidate ``name`` on this run (``Effect.for_input``: heave_reference
-    without a logged angle fits g and t_d only)."""
+    without a logged angle fits g and t_d only).
+
+    Parameters
+    ----------
+    ctx : heavecomp.diagnosis.replay.ReplayContext
+        The prepared run (:func:`heavecomp.diagnosis.replay.prepare`).
+    name : str
+        Candidate effect name.
+    """
     return get(name).for_input(ctx.replay.hs)
 
 
 def n_params(ctx, name, fitted: Fit) -> int:
-    """Parameters a fit used (optional ones held at null are not counted)."""
+    """Parameters a fit used (optional ones held at null are not counted).
+
+    Parameters
+    ----------
+    ctx : heavecomp.diagnosis.replay.ReplayContext
+        The prepared run (:func:`heavecomp.diagnosis.replay.prepare`).
+    name : str
+        Candidate effect name.
+    fitted : Fit
+        The candidate's fit (its ``n_params``, None: all the class's parameters).
+    """
     return candidate_class(ctx, name).n_params() if fitted.n_params is None else fitted.n_params
 
 
@@ -183,7 +240,15 @@ def fit_cost(ctx, name) -> float:
     replays on the library stepper (~1.5x the plain one) ~40 times (grid + Nelder-Mead), weighted
     2.7 per replay (the order bench_600s was measured with; 1.5 measured the same under load); the
     six-parameter refit ~100 times on the plain stepper (least squares + rescan); an output
-    candidate a few times.  The order changes no result (every fit is independent)."""
+    candidate a few times.  The order changes no result (every fit is independent).
+
+    Parameters
+    ----------
+    ctx : heavecomp.diagnosis.replay.ReplayContext
+        The prepared run (:func:`heavecomp.diagnosis.replay.prepare`).
+    name : str
+        Candidate effect name.
+    """
     cls = candidate_class(ctx, name)
     if cls.kind == "output":
         return 1.0
@@ -194,7 +259,23 @@ def fit_cost(ctx, name) -> float:
 def fit(ctx, name, start=None, fixed=(), *, search=Search(), hint=None) -> Fit:
     """Fit candidate ``name`` (optionally jointly after the ``fixed`` configurations) on the fit part,
     from ``start`` (parameter values; None: the default start, the coarse grid and the equation-error
-    start ``hint``, a fit vector) with the strategy its kind asks for."""
+    start ``hint``, a fit vector) with the strategy its kind asks for.
+
+    Parameters
+    ----------
+    ctx : heavecomp.diagnosis.replay.ReplayContext
+        The prepared run (:func:`heavecomp.diagnosis.replay.prepare`).
+    name : str
+        Candidate effect name.
+    start : dict, optional
+        Start parameter values [SI]; None: the default start (coarse grid, equation-error ``hint``).
+    fixed : sequence of (str, dict)
+        Configurations ``(effect name, values)`` already fitted and held in the model (a joint fit).
+    search : Search
+        Search effort (evaluations, grid and scan points, threads).
+    hint : numpy.ndarray, optional
+        Equation-error start as a fit vector (``cls.to_x``); None: none.
+    """
     cls = candidate_class(ctx, name)
     t0 = time.perf_counter()
     if cls.kind == "output" and cls.fit.linear:
@@ -208,7 +289,23 @@ def fit(ctx, name, start=None, fixed=(), *, search=Search(), hint=None) -> Fit:
 
 # ------------------------------------------------------------------ through the replay
 def fit_replayed(ctx, cls, start=None, fixed=(), *, search=Search(), hint=None) -> Fit:
-    """A plant or nominal candidate fitted through the replay (see the module docstring)."""
+    """A plant or nominal candidate fitted through the replay (see the module docstring).
+
+    Parameters
+    ----------
+    ctx : heavecomp.diagnosis.replay.ReplayContext
+        The prepared run (:func:`heavecomp.diagnosis.replay.prepare`).
+    cls : type
+        The candidate's effect class (:func:`candidate_class`).
+    start : dict, optional
+        Start parameter values [SI]; None: the default start (coarse grid, equation-error ``hint``).
+    fixed : sequence of (str, dict)
+        Configurations ``(effect name, values)`` already fitted and held in the model (a joint fit).
+    search : Search
+        Search effort (evaluations, grid and scan points, threads).
+    hint : numpy.ndarray, optional
+        Equation-error start as a fit vector (``cls.to_x``); None: none.
+    """
     P = ctx.policy
     t_end = ctx.split["fit"][1]
     x0 = cls.to_x(start) if start else cls.x0()
@@ -268,7 +365,21 @@ def _least_squares_has_workers() -> bool:
 
 
 def least_squares(fun, x0, lo, hi, budget, n_jobs=1):
-    """Bounded least squares on the decimated fit residual (``budget`` evaluations)."""
+    """Bounded least squares on the decimated fit residual (``budget`` evaluations).
+
+    Parameters
+    ----------
+    fun : callable
+        Residual vector of a fit vector ``x`` (weighted, decimated).
+    x0 : numpy.ndarray
+        Start fit vector.
+    lo, hi : numpy.ndarray
+        Bounds of the fit vector.
+    budget : int
+        Maximum number of residual evaluations.
+    n_jobs : int
+        Threads for the finite-difference Jacobian (scipy >= 1.16; otherwise serial).
+    """
     from scipy.optimize import least_squares as ls
 
     opts = dict(bounds=(lo, hi), diff_step=0.03, max_nfev=budget, x_scale=1.0, xtol=1e-3, ftol=1e-4, gtol=1e-6)
@@ -287,7 +398,23 @@ def rescan(cls, fun, r, lo, hi, nominal, search=Search()):
     points, 10-90 % of the range, the others at the fit, clipped ones as the model uses them:
     ``cls.effective``); when the best scanned point costs less
     than the fit, the fit restarts from it; the lower fit cost wins (fit part only: the held-out
-    data play no part in the choice).  At most ``scan`` evaluations + one more fit per parameter."""
+    data play no part in the choice).  At most ``scan`` evaluations + one more fit per parameter.
+
+    Parameters
+    ----------
+    cls : type
+        The candidate's effect class (its ``fit.rugged`` parameters are rescanned).
+    fun : callable
+        Residual vector of a fit vector ``x``.
+    r : scipy.optimize.OptimizeResult
+        The least-squares fit to improve on.
+    lo, hi : numpy.ndarray
+        Bounds of the fit vector.
+    nominal : heavecomp.params.CMCParams
+        Nominal parameters (for ``cls.effective``, the clipped model).
+    search : Search
+        Search effort (``scan`` points per parameter, ``max_nfev`` and ``n_jobs`` of the refit).
+    """
     best, nfev = r, int(r.nfev)
     names = [f.name for f in cls.fields()]
     for p in cls.fit.rugged:
@@ -315,7 +442,19 @@ def rescan(cls, fun, r, lo, hi, nominal, search=Search()):
 def nelder_mead(fun, x0, lo, hi, budget):
     """Derivative-free refinement (Nelder-Mead on the clipped parameters; stick-slip costs are
     piecewise smooth, so finite-difference gradients mislead), then a forward-difference
-    Jacobian at the optimum for the uncertainty.  Returns an object like least_squares'."""
+    Jacobian at the optimum for the uncertainty.  Returns an object like least_squares'.
+
+    Parameters
+    ----------
+    fun : callable
+        Residual vector of a fit vector ``x``.
+    x0 : numpy.ndarray
+        Start fit vector.
+    lo, hi : numpy.ndarray
+        Bounds of the fit vector (the parameters are clipped to them).
+    budget : int
+        Maximum number of cost evaluations of the simplex search.
+    """
     from scipy.optimize import minimize
 
     def cost(x):
@@ -339,7 +478,15 @@ def nelder_mead(fun, x0, lo, hi, budget):
 
 
 def sigma(cls, r) -> dict:
-    """1-sigma of the fitted parameters from the Jacobian, inflated for correlated residuals."""
+    """1-sigma of the fitted parameters from the Jacobian, inflated for correlated residuals.
+
+    Parameters
+    ----------
+    cls : type
+        The candidate's effect class (its ``fit.log`` parameters are fitted in log).
+    r : scipy.optimize.OptimizeResult or types.SimpleNamespace
+        A fit with ``x``, residual ``fun`` and Jacobian ``jac``.
+    """
     J = r.jac
     m, k = J.shape
     res = r.fun
@@ -361,7 +508,17 @@ def fit_delay_output(ctx, cls, fixed=()) -> Fit:
     """A channel effect with one nonlinear parameter (sensor_delay): per channel, a scan of the
     parameter over its bounds (``delay_scan`` points of the policy) refined by a bounded scalar search,
     the channel reading made by the effect's own ``apply`` from the replay's grid (no re-simulation);
-    the channel whose fit leaves the smallest weighted residual wins."""
+    the channel whose fit leaves the smallest weighted residual wins.
+
+    Parameters
+    ----------
+    ctx : heavecomp.diagnosis.replay.ReplayContext
+        The prepared run (:func:`heavecomp.diagnosis.replay.prepare`).
+    cls : type
+        The candidate's effect class (one parameter, e.g. sensor_delay's delay [s]).
+    fixed : sequence of (str, dict)
+        Configurations ``(effect name, values)`` already fitted and held in the model.
+    """
     from scipy.optimize import minimize_scalar
 
     (field,) = cls.fields()
@@ -394,7 +551,17 @@ def fit_linear_output(ctx, cls, fixed=()) -> Fit:
     channel's fit residual by at least :data:`heavecomp.diagnosis.equation_error.MIN_SHRINK`;
     ``n_params`` counts the parameters used.  On stroke and WOB, which also set the replay's start
     (:meth:`~heavecomp.diagnosis.replay.Replay.start_for`), the fit is refined through the replay
-    (:func:`_refine_reading`)."""
+    (:func:`_refine_reading`).
+
+    Parameters
+    ----------
+    ctx : heavecomp.diagnosis.replay.ReplayContext
+        The prepared run (:func:`heavecomp.diagnosis.replay.prepare`).
+    cls : type
+        The candidate's effect class (affine reading, e.g. sensor_gain, sensor_offset).
+    fixed : sequence of (str, dict)
+        Configurations ``(effect name, values)`` already fitted and held in the model.
+    """
     t_end = ctx.split["fit"][1]
     base0 = ctx.simulate(list(fixed), t_end)
     names = [f.name for f in cls.fields()]

@@ -27,7 +27,21 @@ class SecondSearch:
 def partners(fits, shares, prescreened, n_second, policy) -> list:
     """The runners-up fitted jointly with the best: the ``n_second`` best-ranked, plus the best candidate
     of each other component holding ``second_share`` of the equation-error gap (``shares``).  Any pair
-    works except two output candidates (one transport delay per configuration)."""
+    works except two output candidates (one transport delay per configuration).
+
+    Parameters
+    ----------
+    fits : list of heavecomp.diagnosis.fitting.CandidateFit
+        The replayed candidates' fits, best first.
+    shares : dict
+        Equation-error share of the gap [-] per component (``where.components``).
+    prescreened : dict
+        :func:`heavecomp.diagnosis.screen.prescreen` result (each candidate's component).
+    n_second : int
+        Best-ranked runners-up tried jointly.
+    policy : heavecomp.diagnosis.policy.VerdictPolicy
+        Decision thresholds (``second_share``).
+    """
     best = fits[0]
     best_output = get(best.effect).kind == "output"
     allowed = [r for r in fits[1:] if not (best_output and get(r.effect).kind == "output")]
@@ -49,7 +63,23 @@ def search(ctx, fits, shares, prescreened, n_second, search=F.Search()) -> Secon
     ``second_effect``.  The ranking alone is a poor guide to the partner (alone, a candidate may mimic
     the dominant effect's remainder or distort to absorb it), so the components' shares add the
     partners they see without replaying them.  Default 4 + those: the joint fits were half of the
-    diagnosis' time with every runner-up tried (bench_600s)."""
+    diagnosis' time with every runner-up tried (bench_600s).
+
+    Parameters
+    ----------
+    ctx : heavecomp.diagnosis.replay.ReplayContext
+        The prepared run (:func:`heavecomp.diagnosis.replay.prepare`).
+    fits : list of heavecomp.diagnosis.fitting.CandidateFit
+        The replayed candidates' fits, best first.
+    shares : dict
+        Equation-error share of the gap [-] per component (``where.components``).
+    prescreened : dict
+        :func:`heavecomp.diagnosis.screen.prescreen` result (each candidate's component).
+    n_second : int
+        Best-ranked runners-up tried jointly (:func:`partners`).
+    search : heavecomp.diagnosis.fitting.Search
+        Search effort of each joint fit.
+    """
     P = ctx.policy
     best = fits[0]
     fixed = [(best.effect, best.values)]

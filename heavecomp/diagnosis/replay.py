@@ -136,7 +136,13 @@ class Replay:
 
 
 def output_noise(run) -> dict:
-    """Output-noise standard deviation of every channel [SI] (second-difference estimate)."""
+    """Output-noise standard deviation of every channel [SI] (second-difference estimate).
+
+    Parameters
+    ----------
+    run : heavecomp.diagnosis.data.MeasuredRun
+        The measured run.
+    """
     return {c: noise_floor(run[c], run.t if not run.uniform else None) for c in CH}
 
 
@@ -144,7 +150,23 @@ def build(run, nominal, *, stuck_speed=S.STUCK_SPEED, segment=None, reinit=1.5, 
     """The :class:`Replay` of ``run`` under the ``nominal`` parameters: the stepper grid (refused up front
     beyond the diagnosis budget), the heave spline (made once), the initial state estimated from the
     first seconds (:func:`heavecomp.diagnosis.start.estimate`, ``noise``: output noise per channel) and
-    the heave samples from the reference it found; with ``segment`` [s], multiple-shooting segments."""
+    the heave samples from the reference it found; with ``segment`` [s], multiple-shooting segments.
+
+    Parameters
+    ----------
+    run : heavecomp.diagnosis.data.MeasuredRun
+        The measured run.
+    nominal : heavecomp.params.CMCParams
+        Nominal parameters.
+    stuck_speed : float [m/s]
+        The start is stuck when the measured stroke speed is below this.
+    segment : float [s] or None
+        Multiple-shooting segment length; None: one segment.
+    reinit : float [s]
+        Start of each restarted segment left out of the residuals.
+    noise : dict, optional
+        Output-noise standard deviation per channel [SI] (:func:`output_noise`) for the start estimate.
+    """
     h, n_steps = grid(run, nominal)
     spline = heave_filtered(run)
     initial = S.estimate(run, nominal, spline, stuck_speed=stuck_speed, noise=noise)
@@ -159,7 +181,15 @@ def build(run, nominal, *, stuck_speed=S.STUCK_SPEED, segment=None, reinit=1.5, 
 
 def grid(run, nominal) -> tuple:
     """The replay's step [s] and number of steps; a log over the diagnosis budget is refused (before any
-    work: the diagnosis replays the log hundreds of times)."""
+    work: the diagnosis replays the log hundreds of times).
+
+    Parameters
+    ----------
+    run : heavecomp.diagnosis.data.MeasuredRun
+        The measured run.
+    nominal : heavecomp.params.CMCParams
+        Nominal parameters. (the replay step, :func:`heavecomp.diagnosis.stepper.replay_dt`).
+    """
     h = replay_dt(nominal)
     n_steps = int(math.ceil(run.t[-1] / h - 1e-9))
     if n_steps > MAX_REPLAY_STEPS:
@@ -170,7 +200,15 @@ def grid(run, nominal) -> tuple:
 
 
 def start_warnings(initial, nominal) -> list:
-    """A warning when the log does not start at rest at the operating point (issue 12: start anywhere)."""
+    """A warning when the log does not start at rest at the operating point (issue 12: start anywhere).
+
+    Parameters
+    ----------
+    initial : heavecomp.diagnosis.start.InitialState
+        The initial state estimated from the first seconds of the log.
+    nominal : heavecomp.params.CMCParams
+        Nominal parameters. (the WOB set-point [N] of the operating point).
+    """
     st = initial
     if st.at_rest:
         return []
@@ -299,7 +337,17 @@ class ReplayContext:
 
 
 def mse(y, pred, mask) -> dict:
-    """Mean square of ``pred`` minus the measured ``y`` per channel on ``mask`` (finite samples)."""
+    """Mean square of ``pred`` minus the measured ``y`` per channel on ``mask`` (finite samples).
+
+    Parameters
+    ----------
+    y : dict
+        Measured channels {channel: array} [SI].
+    pred : dict
+        Predicted channels {channel: array} [SI] (may be shorter than ``y``).
+    mask : numpy.ndarray of bool
+        Samples compared.
+    """
     out = {}
     for c in CH:
         yc = y[c][: pred[c].size]
@@ -310,7 +358,17 @@ def mse(y, pred, mask) -> dict:
 
 
 def parallel_map(fn, items, n_jobs) -> list:
-    """``[fn(x) for x in items]``, on ``n_jobs`` threads."""
+    """``[fn(x) for x in items]``, on ``n_jobs`` threads.
+
+    Parameters
+    ----------
+    fn : callable
+        Function of one item.
+    items : sequence
+        Items mapped.
+    n_jobs : int
+        Threads (1: serial).
+    """
     if n_jobs > 1 and len(items) > 1:
         with cf.ThreadPoolExecutor(n_jobs) as ex:
             return list(ex.map(fn, items))
@@ -318,7 +376,17 @@ def parallel_map(fn, items, n_jobs) -> list:
 
 
 def split_of(run, split, settle) -> dict:
-    """The fit / validate intervals and the settling window [s]; bad settings refused."""
+    """The fit / validate intervals and the settling window [s]; bad settings refused.
+
+    Parameters
+    ----------
+    run : heavecomp.diagnosis.data.MeasuredRun
+        The measured run.
+    split : float [-]
+        Fraction of the run in the fit part.
+    settle : float [s] or None
+        Settling window left out at the start; None: min(30 s, 10 % of the run).
+    """
     T_end = float(run.t[-1])
     settle = settle if settle is not None else min(30.0, 0.1 * T_end)
     if not 0 <= settle < 0.5 * T_end:
@@ -331,9 +399,32 @@ def prepare(run, nominal, *, split=0.67, settle=None, stuck_speed=S.STUCK_SPEED,
             input_draws=8, decimate=1, n_jobs=1, policy=None) -> ReplayContext:
     """Prepare ``run`` once for the diagnosis (see the module docstring); returns the frozen context.
 
-    Parameters are the :class:`heavecomp.diagnosis.GapDiagnoser` settings of the same names (``split``
-    a fraction of the run, ``settle`` and ``reinit`` [s], ``stuck_speed`` [m/s]); ``policy``: the
-    :class:`~heavecomp.diagnosis.policy.VerdictPolicy` (its heave-noise draws and pre-filter ratio).
+    The settings are the :class:`heavecomp.diagnosis.GapDiagnoser` settings of the same names.
+
+    Parameters
+    ----------
+    run : heavecomp.diagnosis.data.MeasuredRun
+        The measured run.
+    nominal : heavecomp.params.CMCParams
+        Nominal parameters.
+    split : float [-]
+        Fraction of the run in the fit part.
+    settle : float [s] or None
+        Settling window left out at the start; None: min(30 s, 10 % of the run).
+    stuck_speed : float [m/s]
+        The start (and a restarted segment) is stuck when the stroke speed is below this.
+    segment : float [s] or None
+        Multiple-shooting segment length; None: one segment.
+    reinit : float [s]
+        Start of each restarted segment left out of the residuals.
+    input_draws : int
+        Heave-noise draws of the input-noise envelope.
+    decimate : int
+        Decimation of the fit residual (every ``decimate``-th sample).
+    n_jobs : int
+        Threads for the replays.
+    policy : heavecomp.diagnosis.policy.VerdictPolicy, optional
+        Decision thresholds (its heave-noise draws and pre-filter ratio); None: the defaults.
     """
     policy = policy or VerdictPolicy()
     sp = split_of(run, split, settle)

@@ -36,7 +36,21 @@ def prescreen(cr, shares, fitmask, valmask, names, policy) -> dict:
     their residual sees, ``Effect.fit.screened``) and whose equation-error columns shrink nothing held out
     (< :data:`heavecomp.diagnosis.equation_error.MIN_SHRINK`) is not.  Output and nominal candidates
     (a channel delay, the six-parameter refit) are always replayed, and so is every candidate when
-    none would be.  ``shares``: the equation-error shares of the gap (``where.components``)."""
+    none would be.  ``shares``: the equation-error shares of the gap (``where.components``).
+
+    Parameters
+    ----------
+    cr : heavecomp.diagnosis.components.ComponentResiduals
+        Component residuals of the run (equation error from the measured signals).
+    shares : dict
+        Equation-error share of the gap [-] per component (``where.components``).
+    fitmask, valmask : numpy.ndarray of bool
+        Samples of the fit and held-out parts (:class:`~heavecomp.diagnosis.replay.ReplayContext`).
+    names : sequence of str
+        Candidate effect names.
+    policy : heavecomp.diagnosis.policy.VerdictPolicy
+        Decision thresholds (``prescreen_gap``, ``prescreen_share``).
+    """
     gap = cr.gap()
     fm, vm = fitmask & cr.mask, valmask & cr.mask
     out = {}
@@ -61,7 +75,17 @@ def prescreen(cr, shares, fitmask, valmask, names, policy) -> dict:
 
 def equation_error_start(cr, pre, cls):
     """The fit vector candidate ``cls``'s equation-error fit (``pre``: its :func:`prescreen` entry)
-    stands for (:meth:`heavecomp.effects.base.Effect.from_equation_error`), or None."""
+    stands for (:meth:`heavecomp.effects.base.Effect.from_equation_error`), or None.
+
+    Parameters
+    ----------
+    cr : heavecomp.diagnosis.components.ComponentResiduals
+        Component residuals of the run (equation error from the measured signals).
+    pre : dict or None
+        The candidate's :func:`prescreen` entry.
+    cls : type
+        The candidate's effect class.
+    """
     pre = pre or {}
     ee, comp = pre.get("equation_error"), pre.get("component")
     if ee is None or comp not in cr.residual:
@@ -73,7 +97,23 @@ def equation_error_start(cr, pre, cls):
 def skipped_row(name, pre, shares, rms_before, n_params, policy) -> dict:
     """The candidates row of a candidate the pre-screen did not replay (contract fields; its
     held-out prediction is the nominal's: shrink and explained 0, score the parsimony penalty).
-    ``pre``: its :func:`prescreen` entry; ``rms_before``: the held-out wob rms of the nominal [N]."""
+    ``pre``: its :func:`prescreen` entry; ``rms_before``: the held-out wob rms of the nominal [N].
+
+    Parameters
+    ----------
+    name : str
+        Candidate effect name.
+    pre : dict
+        Its :func:`prescreen` entry.
+    shares : dict
+        Equation-error share of the gap [-] per component.
+    rms_before : float [N]
+        Held-out WOB rms of the nominal replay.
+    n_params : int
+        The candidate's number of parameters (its parsimony penalty).
+    policy : heavecomp.diagnosis.policy.VerdictPolicy
+        Decision thresholds (``penalty``).
+    """
     return {"effect": name, "parameters": {}, "rms_before": rms_before, "rms_after": rms_before, "shrink": 0.0,
             "score": -policy.penalty * n_params, "explained": 0.0, "n_params": n_params,
             "at_bound": [], "fit_wall_time": pre["wall_time"],
@@ -85,7 +125,13 @@ def skipped_row(name, pre, shares, rms_before, n_params, policy) -> dict:
 
 
 def moved_most(values) -> str:
-    """Component of the nominal parameter a parameter_mismatch moved most (|log multiplier|)."""
+    """Component of the nominal parameter a parameter_mismatch moved most (|log multiplier|).
+
+    Parameters
+    ----------
+    values : dict
+        Fitted parameter_mismatch multipliers [-] by parameter.
+    """
     names = {f.name: table for f, (_, table, _) in zip(ParameterMismatch.fields(), MISMATCH_KEYS)}
     k = max(values, key=lambda n: abs(math.log(max(values[n], 1e-12))))
     return TABLE_COMPONENT.get(names.get(k, ""), "")
@@ -93,7 +139,17 @@ def moved_most(values) -> str:
 
 def candidate_component(effect, values, prescreened) -> str:
     """The component a fitted candidate lives in (parameter_mismatch: that of the parameter that moved
-    most; ``values`` its fitted parameters, ``prescreened`` the :func:`prescreen` result)."""
+    most; ``values`` its fitted parameters, ``prescreened`` the :func:`prescreen` result).
+
+    Parameters
+    ----------
+    effect : str
+        Candidate effect name.
+    values : dict
+        Its fitted parameters [SI].
+    prescreened : dict
+        :func:`prescreen` result.
+    """
     if effect == "parameter_mismatch":
         return moved_most(values)
     return prescreened.get(effect, {}).get("component") or get(effect).component()
@@ -105,7 +161,17 @@ def discover(cr, fitmask, valmask, policy):
     A misreading of one channel consistent across the equations that read it
     (:func:`heavecomp.diagnosis.components.channel_search`) comes first: a single component's term
     explains one equation, while the same misreading seen in two is a sensor (a saturating WOB channel
-    read as string_formation before; docs/diagnosis.md)."""
+    read as string_formation before; docs/diagnosis.md).
+
+    Parameters
+    ----------
+    cr : heavecomp.diagnosis.components.ComponentResiduals
+        Component residuals of the run (equation error from the measured signals).
+    fitmask, valmask : numpy.ndarray of bool
+        Samples of the fit and held-out parts (:class:`~heavecomp.diagnosis.replay.ReplayContext`).
+    policy : heavecomp.diagnosis.policy.VerdictPolicy
+        Decision thresholds (``discover_components``).
+    """
     fm, vm = fitmask & cr.mask, valmask & cr.mask
     sensor = CR.channel_search(cr, fm, vm)
     if sensor is not None:

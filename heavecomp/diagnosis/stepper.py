@@ -41,7 +41,17 @@ NCH = len(CHANNELS)
 
 def smooth_fx(plant, comp, EP) -> bool:
     """True when neither the friction law nor an active effect has a part that jumps with sign(v):
-    the stepper then integrates one smooth system, as :func:`heavecomp.simulate.simulate` does."""
+    the stepper then integrates one smooth system, as :func:`heavecomp.simulate.simulate` does.
+
+    Parameters
+    ----------
+    plant : heavecomp.plants.cmc.PlantVectors
+        :func:`heavecomp.plants.cmc.plant_vectors` of the parameter set.
+    comp : heavecomp.effects.compose.Composition
+        The effect composition.
+    EP : numpy.ndarray
+        Its effect parameters (:meth:`Composition.ep`).
+    """
     return not (plant.has_stiction or comp.adds_stiction(EP))
 
 
@@ -60,6 +70,16 @@ def run_fx(plant, comp, EP, hs, h, n_steps, out_every=1, *, u_active=0.0, progre
         Heave samples spaced ``h/2``.
     h : float [s]
         RK4 step.
+    n_steps : int
+        Steps to run.
+    out_every : int
+        Steps between output rows.
+    u_active : float [N]
+        Constant active actuator force.
+    progress : callable(fraction), optional
+        Called after each chunk (:func:`heavecomp.simulate.core.drive`).
+    chunk_steps : int
+        Steps per chunk between ``progress`` calls.
 
     Returns
     -------
@@ -88,6 +108,13 @@ def replay_dt(params, rate: float | None = None) -> float:
     candidates and the withheld-effect generator must all integrate on a step whose error is far
     below the measurement noise, or the discretisation error itself shows up as a gap.
     ``lambda_max`` is :func:`heavecomp.plants.cmc.eigen_rate`.
+
+    Parameters
+    ----------
+    params : heavecomp.params.CMCParams
+        Parameter set (its fastest eigen-rate bounds the step).
+    rate : float [Hz], optional
+        Output rate the step must divide; None: any step.
     """
 
     h = min(0.01, 0.25 / eigen_rate(params))
@@ -103,6 +130,23 @@ def simulate_fx(params, duration, effects=(), *, rate=50.0, heave=None, dt=None,
     :func:`heavecomp.effects.compose.composition_for` the effects).
 
     Returns a dict channel -> array sampled at ``rate`` [Hz].
+
+    Parameters
+    ----------
+    params : heavecomp.params.CMCParams
+        Parameter set.
+    duration : float [s]
+        Simulated time.
+    effects : iterable
+        Effects on: instances, names or ``(name, values)`` (:func:`heavecomp.effects.registry.resolve`).
+    rate : float [Hz]
+        Output rate.
+    heave : tuple of numpy.ndarray, optional
+        Measured heave ``(t [s], z [m])`` driving the run; None: the parameter set's ``[heave]`` table.
+    dt : float [s], optional
+        RK4 step; None: :func:`replay_dt`.
+    comp : heavecomp.effects.compose.Composition, optional
+        The composition to run; None: :func:`heavecomp.effects.compose.composition_for` the effects.
     """
     h = dt if dt is not None else replay_dt(params, rate)
     out_every = max(1, int(round(1.0 / (rate * h))))
@@ -129,6 +173,26 @@ def run_segments(plant, comp, EP, hs, h, bounds, starts, n_out):
     from the end of the previous segment), the dwell time from 0.
 
     Returns the output rows on the stepper grid (row i at t = i h), shape (n_out, NCH).
+
+    Parameters
+    ----------
+    plant : heavecomp.plants.cmc.PlantVectors
+        :func:`heavecomp.plants.cmc.plant_vectors` of the parameter set.
+    comp : heavecomp.effects.compose.Composition
+        The effect composition.
+    EP : numpy.ndarray
+        Its effect parameters (:meth:`Composition.ep`).
+    hs : heavecomp.simulate.excitation.HeaveSamples
+        Heave samples spaced ``h/2``.
+    h : float [s]
+        RK4 step.
+    bounds : list of (int, int)
+        Grid steps (i0, i1) of each segment.
+    starts : list of tuple or None
+        Start state (s [m], v [m/s], y_b [m], v_b [m/s], stuck) of each segment; None: rest at the
+        operating point.
+    n_out : int
+        Output rows (grid steps + 1).
     """
     advance = S.kernel_for(comp)
     args = S.plant_args(plant, EP, smooth_fx(plant, comp, EP))

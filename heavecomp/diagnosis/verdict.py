@@ -87,7 +87,21 @@ class Verdict:
 def assess(fits, gap, floors, envelope, policy) -> Assessment:
     """Gap ratios, margin and its input-noise spread, shrink channel and the ``none`` test (see
     :class:`Assessment`).  ``gap``: per channel {rms_validate} [SI]; ``floors``, ``envelope``: noise
-    floor and input-noise envelope per channel [SI]."""
+    floor and input-noise envelope per channel [SI].
+
+    Parameters
+    ----------
+    fits : list of heavecomp.diagnosis.fitting.CandidateFit
+        The replayed candidates' fits, best score first.
+    gap : dict
+        Per channel {rms_validate: held-out rms of the nominal replay [SI]}.
+    floors : dict
+        Noise floor per channel [SI] (output noise and replay floor).
+    envelope : dict
+        Input-noise envelope per channel [SI].
+    policy : heavecomp.diagnosis.policy.VerdictPolicy
+        Decision thresholds.
+    """
     P = policy
     best = fits[0]
     runner = fits[1] if len(fits) > 1 else None
@@ -111,19 +125,56 @@ def assess(fits, gap, floors, envelope, policy) -> Assessment:
 
 
 def wants_second(fits, a: Assessment, policy) -> bool:
-    """Whether the verdict reads a second-effect search (:func:`heavecomp.diagnosis.joint.search`)."""
+    """Whether the verdict reads a second-effect search (:func:`heavecomp.diagnosis.joint.search`).
+
+    Parameters
+    ----------
+    fits : list of heavecomp.diagnosis.fitting.CandidateFit
+        The replayed candidates' fits, best score first.
+    a : Assessment
+        The :func:`assess` result of ``fits``.
+    policy : heavecomp.diagnosis.policy.VerdictPolicy
+        Decision thresholds. (``min_explained``, ``second_below``).
+    """
     best = fits[0].explained
     return not a.is_none and (best < policy.min_explained or best < policy.second_below)
 
 
 def wants_discovery(fits, a: Assessment, policy) -> bool:
-    """Whether the verdict reads the open search (:func:`heavecomp.diagnosis.screen.discover`)."""
+    """Whether the verdict reads the open search (:func:`heavecomp.diagnosis.screen.discover`).
+
+    Parameters
+    ----------
+    fits : list of heavecomp.diagnosis.fitting.CandidateFit
+        The replayed candidates' fits, best score first.
+    a : Assessment
+        The :func:`assess` result of ``fits``.
+    policy : heavecomp.diagnosis.policy.VerdictPolicy
+        Decision thresholds. (``min_explained``).
+    """
     return not a.is_none and fits[0].explained < policy.min_explained
 
 
 def decide(fits, gap, floors, envelope, policy, evidence: Evidence) -> Verdict:
     """The verdict on ``fits`` (:class:`~heavecomp.diagnosis.fitting.CandidateFit`, best score first);
-    see the module docstring.  Pure: the same arguments give the same verdict."""
+    see the module docstring.  Pure: the same arguments give the same verdict.
+
+    Parameters
+    ----------
+    fits : list of heavecomp.diagnosis.fitting.CandidateFit
+        The replayed candidates' fits, best score first.
+    gap : dict
+        Per channel {rms_validate: held-out rms of the nominal replay [SI]}.
+    floors : dict
+        Noise floor per channel [SI] (output noise and replay floor).
+    envelope : dict
+        Input-noise envelope per channel [SI].
+    policy : heavecomp.diagnosis.policy.VerdictPolicy
+        Decision thresholds.
+    evidence : Evidence
+        What else the diagnosis found: equation-error shares, pre-screen, second-effect search, open
+        search and stationarity.
+    """
     a = assess(fits, gap, floors, envelope, policy)
     best = fits[0]
     v = {"effect": best.effect, "confidence": "low", "parameters": best.parameters,

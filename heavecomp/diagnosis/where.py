@@ -16,13 +16,27 @@ SEGMENT_LENGTH = 5.0    #: s, window of the rolling residual power for "segments
 
 
 def eigenfrequencies(params) -> list[float]:
-    """Undamped eigenfrequencies [Hz] of the plant's linear model (:func:`heavecomp.plants.cmc.eigenfrequencies`)."""
+    """Undamped eigenfrequencies [Hz] of the plant's linear model (:func:`heavecomp.plants.cmc.eigenfrequencies`).
+
+    Parameters
+    ----------
+    params : heavecomp.params.CMCParams
+        Nominal parameters.
+    """
 
     return _eigenfrequencies(params)
 
 
 def wave_band(t, z) -> tuple[float, float]:
-    """Frequencies [Hz] holding the central 90 % of the heave variance (5 %..95 %)."""
+    """Frequencies [Hz] holding the central 90 % of the heave variance (5 %..95 %).
+
+    Parameters
+    ----------
+    t : numpy.ndarray [s]
+        Sample times (may be non-uniform, with dropouts).
+    z : numpy.ndarray [m]
+        Measured heave.
+    """
     from scipy.signal import welch
 
     tu, zu = uniform(t, z)
@@ -34,6 +48,16 @@ def wave_band(t, z) -> tuple[float, float]:
 
 
 def band_edges(run, params):
+    """The frequency bands of "where" [Hz]: below the wave band, the wave band, the resonance (up to
+    1.3 x the top eigenfrequency, at least 1.5 x the wave band's top) and above.
+
+    Parameters
+    ----------
+    run : heavecomp.diagnosis.data.MeasuredRun
+        The measured run (its heave sets the wave band).
+    params : heavecomp.params.CMCParams
+        Nominal parameters (their eigenfrequencies set the resonance band).
+    """
     lo, hi = wave_band(run.t, run["heave"])
     fe = eigenfrequencies(params)
     res = [hi, max(1.3 * max(fe), 1.5 * hi)]  # contiguous: wave | resonance (up to 1.3 x the top mode) | above
@@ -41,7 +65,15 @@ def band_edges(run, params):
 
 
 def residual_spectrum(t, r):
-    """Welch PSD of a residual [unit^2/Hz] on a uniform resampling (dropouts bridged)."""
+    """Welch PSD of a residual [unit^2/Hz] on a uniform resampling (dropouts bridged).
+
+    Parameters
+    ----------
+    t : numpy.ndarray [s]
+        Sample times.
+    r : numpy.ndarray [unit]
+        Residual.
+    """
     from scipy.signal import welch
 
     tu, ru = uniform(t, r)
@@ -59,6 +91,13 @@ def level_shares(t, r) -> dict:
     ``TREND_DEGREE`` in time adds beyond the mean (a drift over the whole run: a gas charge that
     leaks, a gas that warms under cycling, a sensor zero that drifts); ``fluctuation`` = the rest,
     which the band spectrum splits.  Also returns the detrended residual.
+
+    Parameters
+    ----------
+    t : numpy.ndarray [s]
+        Sample times.
+    r : numpy.ndarray [unit]
+        Residual (finite samples).
     """
     ms = float(np.mean(r * r))
     if ms <= 0 or r.size < TREND_DEGREE + 2:
@@ -84,6 +123,19 @@ def locate(run, nom, params, mask, channel="wob") -> dict:
     Regimes come from the replayed nominal model (noise-free): stuck; breakaway
     (the first ``BREAKAWAY_WINDOW`` s after a stuck -> sliding transition); sliding
     with |v| growing (v a > 0) or shrinking.
+
+    Parameters
+    ----------
+    run : heavecomp.diagnosis.data.MeasuredRun
+        The measured run.
+    nom : dict
+        The nominal replay ({channel: array} [SI], ``stuck``, ``stroke_velocity`` [m/s]) at the run's times.
+    params : heavecomp.params.CMCParams
+        Nominal parameters.
+    mask : numpy.ndarray of bool
+        Samples counted (e.g. after the settling window).
+    channel : str
+        Channel whose residual (nominal minus measured) is located.
     """
     t = run.t
     y = run[channel]

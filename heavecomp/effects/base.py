@@ -107,6 +107,12 @@ class Effect:
     mirrored as read-only class attributes of the same names (``cls.log``, ``cls.feature_grid``, ...)
     for older readers; set them on ``fit``.  An instance carries parameter values:
     ``FlowLoss(resistance=2e5)``.
+
+    Parameters
+    ----------
+    **values : float
+        Parameter values [SI; each field's ``unit`` metadata] by field name of ``Params``;
+        an unknown name raises :class:`heavecomp.errors.ParameterError`.
     """
 
     name: str = ""
@@ -267,7 +273,15 @@ class ChannelEffect(Effect):
     """Base of an effect on one measured channel (hook ``channel``, ``kind = "output"``): the plant is
     nominal, the recorded channel misreads.  ``apply(t, tg, y, *prm)`` gives the recorded channel at
     times ``t`` [s] from the true one ``y`` on the grid ``tg`` [s]; an instance names its channel
-    (:data:`SENSOR_CHANNELS`): ``SensorGain(channel="wob", factor=1.08)``."""
+    (:data:`SENSOR_CHANNELS`): ``SensorGain(channel="wob", factor=1.08)``.
+
+    Parameters
+    ----------
+    channel : str
+        The measured channel that misreads (one of :data:`SENSOR_CHANNELS`).
+    **values : float
+        Parameter values [SI] by field name of ``Params``.
+    """
 
     hook = "channel"
     kind = "output"

@@ -134,7 +134,13 @@ EFFECT_NAMES = tuple(CANDIDATES)
 
 def get(name: str) -> type:
     """The class of an effect the diagnosis can fit, by name: a candidate, or any other registered effect
-    (:mod:`heavecomp.effects.registry`, e.g. ``charge_drift``); ParameterError naming the known ones."""
+    (:mod:`heavecomp.effects.registry`, e.g. ``charge_drift``); ParameterError naming the known ones.
+
+    Parameters
+    ----------
+    name : str
+        Effect name (e.g. ``"dwell_stiction"``, ``"parameter_mismatch"``).
+    """
     known = {**CANDIDATES, **library()}
     try:
         return known[name]

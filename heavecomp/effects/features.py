@@ -52,7 +52,15 @@ def first_order_lag(t, x, tau: float, y0: float = 0.0) -> np.ndarray:
 def rest_durations(t, still) -> tuple[np.ndarray, np.ndarray]:
     """Time at rest so far (0 while moving) and the duration of the last rest, held while moving
     (0 before the first rest) [s]; ``still`` is a boolean array (at rest).  A rest that ends at sample
-    i lasted t[i] - t[start]."""
+    i lasted t[i] - t[start].
+
+    Parameters
+    ----------
+    t : numpy.ndarray [s]
+        Sample times.
+    still : numpy.ndarray of bool
+        At rest, per sample.
+    """
     t = np.asarray(t, dtype=float)
     still = np.asarray(still, dtype=bool)
     before = np.r_[False, still[:-1]]
@@ -65,7 +73,17 @@ def rest_durations(t, still) -> tuple[np.ndarray, np.ndarray]:
 
 
 def dwell_time(t, v, dead_band: float) -> np.ndarray:
-    """Time at rest so far [s]: grows while |v| <= ``dead_band`` [m/s], 0 while sliding."""
+    """Time at rest so far [s]: grows while |v| <= ``dead_band`` [m/s], 0 while sliding.
+
+    Parameters
+    ----------
+    t : numpy.ndarray [s]
+        Sample times.
+    v : numpy.ndarray [m/s]
+        Stroke velocity.
+    dead_band : float [m/s]
+        Speed at or under which the stroke counts as at rest.
+    """
     return rest_durations(t, np.abs(np.asarray(v, dtype=float)) <= dead_band)[0]
 
 
@@ -75,6 +93,15 @@ def breakaway_dwell(t, dwell, window: float) -> np.ndarray:
 
     ``dwell`` is the time at rest so far (:func:`dwell_time`): a sliding sample has dwell 0, and the
     rest before it ended at the last sample with dwell > 0.
+
+    Parameters
+    ----------
+    t : numpy.ndarray [s]
+        Sample times.
+    dwell : numpy.ndarray [s]
+        Time at rest so far (:func:`dwell_time`).
+    window : float [s]
+        Length of the start of each sliding phase that carries the preceding rest's length.
     """
     t = np.asarray(t, dtype=float)
     dwell = np.asarray(dwell, dtype=float)
@@ -92,5 +119,13 @@ def breakaway_dwell(t, dwell, window: float) -> np.ndarray:
 
 
 def need(sig: dict, *names) -> bool:
-    """True when every signal of ``names`` is in ``sig``."""
+    """True when every signal of ``names`` is in ``sig``.
+
+    Parameters
+    ----------
+    sig : dict
+        Signals by name.
+    *names : str
+        Signal names needed.
+    """
     return all(n in sig for n in names)

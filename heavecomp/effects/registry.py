@@ -41,7 +41,13 @@ def library() -> dict:
 
 
 def effect_class(name: str) -> type:
-    """The registered effect class of ``name`` (ParameterError naming the known ones)."""
+    """The registered effect class of ``name`` (ParameterError naming the known ones).
+
+    Parameters
+    ----------
+    name : str
+        Registered effect name (e.g. ``"dwell_stiction"``).
+    """
     lib = library()
     try:
         return lib[name]
@@ -51,7 +57,14 @@ def effect_class(name: str) -> type:
 
 def resolve(effects) -> list:
     """Effect instances from a list of instances, names (default parameters) or
-    ``(name, {parameter: value})`` pairs."""
+    ``(name, {parameter: value})`` pairs.
+
+    Parameters
+    ----------
+    effects : iterable or None
+        Effect instances, names or classes (default parameters), or ``(name or class, {parameter:
+        value [SI]})`` pairs; None: no effect.
+    """
 
     out = []
     for e in effects or ():
@@ -71,7 +84,13 @@ def resolve(effects) -> list:
 def split_effects(effects):
     """``(plant, heave, sensor)`` effects of the instances ``effects``: terms at the plant's hooks
     (the stepper), the heave the plant sees (``kind = "heave"``), the recorded channels
-    (``kind = "output"``).  A nominal refit (``parameter_mismatch``) is no submodel: ParameterError."""
+    (``kind = "output"``).  A nominal refit (``parameter_mismatch``) is no submodel: ParameterError.
+
+    Parameters
+    ----------
+    effects : iterable of heavecomp.effects.base.Effect
+        Effect instances.
+    """
     out = {"plant": [], "heave": [], "output": []}
     for e in effects:
         if e.kind not in out:

@@ -24,7 +24,13 @@ MODE_NAMES = ("sliding, low mode (top mass on the gas spring)", "sliding, high m
 
 
 def named_modes(freqs_hz) -> str:
-    """Eigenfrequencies sorted by frequency, each named by its mode: ``"0.44 Hz (sliding, ...)"``."""
+    """Eigenfrequencies sorted by frequency, each named by its mode: ``"0.44 Hz (sliding, ...)"``.
+
+    Parameters
+    ----------
+    freqs_hz : sequence of float [Hz]
+        Eigenfrequencies in the order of :func:`heavecomp.diagnosis.where.eigenfrequencies`.
+    """
     names = MODE_NAMES if len(freqs_hz) == len(MODE_NAMES) else [f"mode {i + 1}" for i in range(len(freqs_hz))]
     return ", ".join(f"{f:.2f} Hz ({n})" for f, n in sorted(zip(freqs_hz, names)))
 
@@ -90,7 +96,13 @@ def _parameter_blocks(d: dict) -> list:
 
 
 def fig_where(diag):
-    """Residual over stroke velocity x acceleration (nominal replay), coloured by |WOB residual|."""
+    """Residual over stroke velocity x acceleration (nominal replay), coloured by |WOB residual|.
+
+    Parameters
+    ----------
+    diag : heavecomp.diagnosis.GapDiagnoser
+        A fitted diagnoser (its ``verdict_``, ``where_``, ``traces_``, ``split_``, ...).
+    """
     plt = _plt()
     tr = diag.traces_
     t = tr["t"]
@@ -127,7 +139,13 @@ def fig_where(diag):
 
 
 def fig_spectra(diag):
-    """Residual spectra per channel before (nominal) and after (best candidate), with the band edges."""
+    """Residual spectra per channel before (nominal) and after (best candidate), with the band edges.
+
+    Parameters
+    ----------
+    diag : heavecomp.diagnosis.GapDiagnoser
+        A fitted diagnoser (its ``verdict_``, ``where_``, ``traces_``, ``split_``, ...).
+    """
     plt = _plt()
     tr = diag.traces_
     t = tr["t"]
@@ -154,7 +172,15 @@ def fig_spectra(diag):
 
 
 def fig_overlay(diag, span=40.0):
-    """Measured vs nominal vs best candidate on held-out data around the worst held-out segment."""
+    """Measured vs nominal vs best candidate on held-out data around the worst held-out segment.
+
+    Parameters
+    ----------
+    diag : heavecomp.diagnosis.GapDiagnoser
+        A fitted diagnoser (its ``verdict_``, ``where_``, ``traces_``, ``split_``, ...).
+    span : float [s]
+        Time shown, around the worst held-out segment.
+    """
     plt = _plt()
     tr = diag.traces_
     t = tr["t"]
@@ -190,7 +216,15 @@ def fig_overlay(diag, span=40.0):
 
 
 def overlay_title(v, best) -> str:
-    """The overlay's title, by what the verdict ``v`` says (``best``: the best candidate drawn)."""
+    """The overlay's title, by what the verdict ``v`` says (``best``: the best candidate drawn).
+
+    Parameters
+    ----------
+    v : dict
+        The verdict (``diagnosis.json``'s ``verdict``).
+    best : str
+        The best candidate's effect name (the one drawn).
+    """
     eff = v["effect"]
     if eff == "none":
         return "Held-out data, verdict none: the nominal replay agrees with the measurement within the noise"
@@ -253,7 +287,17 @@ def _skipped_lines(diag) -> list:
 
 
 def write_report(diag, out_dir, *, title="Sim-to-real gap diagnosis") -> dict:
-    """Write diagnosis.json, report.md and where.png / spectra.png / overlay.png into ``out_dir``."""
+    """Write diagnosis.json, report.md and where.png / spectra.png / overlay.png into ``out_dir``.
+
+    Parameters
+    ----------
+    diag : heavecomp.diagnosis.GapDiagnoser
+        A fitted diagnoser (its ``verdict_``, ``where_``, ``traces_``, ``split_``, ...).
+    out_dir : str or pathlib.Path
+        Folder written (created if missing).
+    title : str
+        Title of report.md.
+    """
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     write_json(diag, out / "diagnosis.json")
@@ -348,7 +392,14 @@ def _isolability_lines(diag) -> list:
 
 
 def fig_confusion(summary):
-    """Confusion matrix of the withheld-effect benchmark (rows: withheld effect, columns: verdict)."""
+    """Confusion matrix of the withheld-effect benchmark (rows: withheld effect, columns: verdict).
+
+    Parameters
+    ----------
+    summary : dict
+        The withheld-effect benchmark's summary: ``confusion`` {withheld effect: {verdict: count}},
+        ``n_runs``, ``accuracy`` [-].
+    """
     plt = _plt()
     cm = summary["confusion"]
     truths = list(cm)
