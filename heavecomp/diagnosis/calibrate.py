@@ -136,30 +136,16 @@ def calibrate(nominal, diagnosis: dict) -> Calibrated:
     """
     v = diagnosis["verdict"]
     eff = v["effect"]
-    specs = list(nominal.effects)
     out = Calibrated(nominal, verdict=eff, expected_shrink=float(v.get("shrink", 0.0)))
+    if eff in ("none", "inconclusive"):
+        out.why.append(_unchanged(v))
+        out.expected_shrink = 0.0
+        return out
+    specs = list(nominal.effects)
 
     def add(name, values):
-        spec, ch = _effect_change(name, values)
-        same = [i for i, (n, vals) in enumerate(specs)
-                if n == name and vals.get("channel") == spec[1].get("channel")]
-        if same:  # the file had this effect: the diagnosis refitted it
-            specs[same[0]] = spec
-        else:
-            specs.append(spec)
-        out.changes.append(ch)
+        _add_effect(specs, out, name, values)
 
-    if eff == "none":
-        out.why.append("diagnosis verdict: none -- the log agrees with this model within the measurement noise "
-                       "(and the replay's response to the heave noise); nothing to change: this is the nominal file")
-        out.expected_shrink = 0.0
-        return out
-    if eff == "inconclusive":
-        out.why.append(f"diagnosis verdict: inconclusive -- {v.get('note', 'no candidate explains the gap')}; "
-                       "nothing is changed: this is the nominal file"
-                       + (f" (the gap lives in {v['component']})" if v.get("component") else ""))
-        out.expected_shrink = 0.0
-        return out
     params = nominal
     if eff == "parameter_mismatch":
         params, changes = _mismatch(nominal, v.get("parameters", {}))
@@ -168,23 +154,7 @@ def calibrate(nominal, diagnosis: dict) -> Calibrated:
                        "their tables: " + (", ".join(f"{c['name']} {c['from']:.6g} -> {c['to']:.6g}"
                                                      for c in changes) or "none moved"))
     elif eff == "discovered":
-        d = v.get("discovered") or {}
-        feats = list(d.get("features", []))
-        if d.get("component") == DISCOVERED_COMPONENT and feats and all(f in DISCOVERED_FEATURES for f in feats):
-            add("discovered_term", {f: float(d["coefficients"][f]) for f in feats})
-            out.changes[-1]["component_shrink"] = float(d.get("shrink", 0.0))
-            # verdict.shrink is the best *named* candidate's; the term's own replay shrink is unknown until
-            # replayed (replay_shrink): nothing is promised for it
-            out.expected_shrink = 0.0
-            out.why.append(f"diagnosis verdict: discovered -- the open search's term on the friction residual, "
-                           f"{d.get('term', '')}, carried as effect discovered_term (it shrinks the held-out friction "
-                           f"residual by {d.get('shrink', 0.0):.2f}; its replay shrink is not known until replayed)")
-        else:
-            out.why.append(f"diagnosis verdict: discovered -- the open search's term on the "
-                           f"{d.get('component', '?')} residual, {d.get('term', '')}, has no model form at its hook "
-                           f"(discovered_term carries the friction features {', '.join(DISCOVERED_FEATURES)}); "
-                           "nothing is changed: this is the nominal file")
-            out.expected_shrink = 0.0
+        if not _add_discovered(out, v.get("discovered") or {}, add):
             return out
     else:
         add(eff, v.get("parameters", {}))
@@ -193,19 +163,112 @@ def calibrate(nominal, diagnosis: dict) -> Calibrated:
                        + ("a sensor that misreads: the [[effects]] entry corrects how a log is read (the plant is "
                           "unchanged)" if role == "reading" else "the effect is added at its hook with the fitted "
                                                                  "values"))
-    se = v.get("second_effect")
-    if se and se.get("parameters") is not None:
-        if se["effect"] == "parameter_mismatch":
-            params, changes = _mismatch(params, se["parameters"])
-            out.changes += changes
-        else:
-            add(se["effect"], se["parameters"])
-        out.why.append(f"second effect {se['effect']} (fitted jointly with the first, added "
-                       f"{100 * se.get('added_explained', 0.0):.0f} % of the held-out gap)")
-        if "shrink_joint" in se:
-            out.expected_shrink = float(se["shrink_joint"])
+    params = _add_second(out, v.get("second_effect"), params, add)
     out.params = params.replace(effects=specs) if specs != list(params.effects) else params
     return out
+
+
+def _unchanged(v: dict) -> str:
+    """Why a ``none`` or ``inconclusive`` verdict leaves the nominal file as it is.
+
+    Parameters
+    ----------
+    v : dict
+        The diagnosis' verdict.
+    """
+    if v["effect"] == "none":
+        return ("diagnosis verdict: none -- the log agrees with this model within the measurement noise "
+                "(and the replay's response to the heave noise); nothing to change: this is the nominal file")
+    return (f"diagnosis verdict: inconclusive -- {v.get('note', 'no candidate explains the gap')}; "
+            "nothing is changed: this is the nominal file"
+            + (f" (the gap lives in {v['component']})" if v.get("component") else ""))
+
+
+def _add_effect(specs: list, out: Calibrated, name: str, values: dict) -> None:
+    """Add (or replace, when the file had it) the effect ``name`` with ``values`` in ``specs``.
+
+    Parameters
+    ----------
+    specs : list
+        The ``[[effects]]`` entries so far, ``(name, values)``; changed in place.
+    out : Calibrated
+        The calibrated model so far; its ``changes`` are extended.
+    name : str
+        Effect name.
+    values : dict
+        Its fitted parameters [SI] (a channel effect's ``channel`` included).
+    """
+    spec, ch = _effect_change(name, values)
+    same = [i for i, (n, vals) in enumerate(specs) if n == name and vals.get("channel") == spec[1].get("channel")]
+    if same:  # the file had this effect: the diagnosis refitted it
+        specs[same[0]] = spec
+    else:
+        specs.append(spec)
+    out.changes.append(ch)
+
+
+def _add_discovered(out: Calibrated, d: dict, add) -> bool:
+    """Carry the open search's term as ``discovered_term`` when it has a model form at its hook.
+
+    Parameters
+    ----------
+    out : Calibrated
+        The calibrated model so far (extended in place).
+    d : dict
+        The verdict's ``discovered`` block: ``component``, ``features``, ``coefficients``, ``term``, ``shrink``.
+    add : callable
+        ``add(name, values)``: adds an effect entry.
+
+    Returns
+    -------
+    bool
+        False when the term has no model form (the nominal file is kept).
+    """
+    feats = list(d.get("features", []))
+    if d.get("component") == DISCOVERED_COMPONENT and feats and all(f in DISCOVERED_FEATURES for f in feats):
+        add("discovered_term", {f: float(d["coefficients"][f]) for f in feats})
+        out.changes[-1]["component_shrink"] = float(d.get("shrink", 0.0))
+        # verdict.shrink is the best *named* candidate's; the term's own replay shrink is unknown until
+        # replayed (replay_shrink): nothing is promised for it
+        out.expected_shrink = 0.0
+        out.why.append(f"diagnosis verdict: discovered -- the open search's term on the friction residual, "
+                       f"{d.get('term', '')}, carried as effect discovered_term (it shrinks the held-out friction "
+                       f"residual by {d.get('shrink', 0.0):.2f}; its replay shrink is not known until replayed)")
+        return True
+    out.why.append(f"diagnosis verdict: discovered -- the open search's term on the "
+                   f"{d.get('component', '?')} residual, {d.get('term', '')}, has no model form at its hook "
+                   f"(discovered_term carries the friction features {', '.join(DISCOVERED_FEATURES)}); "
+                   "nothing is changed: this is the nominal file")
+    out.expected_shrink = 0.0
+    return False
+
+
+def _add_second(out: Calibrated, se, params, add):
+    """Add the verdict's second effect (fitted jointly with the first); returns the parameters.
+
+    Parameters
+    ----------
+    out : Calibrated
+        The calibrated model so far (extended in place).
+    se : dict or None
+        The verdict's ``second_effect``.
+    params : CMCParams
+        The parameters so far (a second parameter mismatch refits them).
+    add : callable
+        ``add(name, values)``: adds an effect entry.
+    """
+    if not se or se.get("parameters") is None:
+        return params
+    if se["effect"] == "parameter_mismatch":
+        params, changes = _mismatch(params, se["parameters"])
+        out.changes += changes
+    else:
+        add(se["effect"], se["parameters"])
+    out.why.append(f"second effect {se['effect']} (fitted jointly with the first, added "
+                   f"{100 * se.get('added_explained', 0.0):.0f} % of the held-out gap)")
+    if "shrink_joint" in se:
+        out.expected_shrink = float(se["shrink_joint"])
+    return params
 
 
 def to_toml(cal: Calibrated, source: str = "") -> str:

@@ -294,8 +294,32 @@ def assess(run, params=None, *, rows=None) -> Quality:
     t = np.asarray(run.t, dtype=float)
     q = Quality()
     cols = {c: np.array(run[c], dtype=float) for c in CHANNELS}
+    t, cols = _torn_and_spikes(q, t, cols, line)
+    T_wave = mean_period(t, cols["heave"])
+    _frozen(q, t, cols, T_wave, line, src)
+    _magnitudes(q, cols, params, src)
+    _time_base(q, t, cols["wob"], T_wave, params)
+    _clock_skew(q, t, cols)
+    q.exclude = {c: np.array(sorted(s), dtype=int) for c, s in q.exclude.items() if s}
+    return q
+
+
+def _torn_and_spikes(q: Quality, t, cols: dict, line) -> tuple:
+    """A torn last row (dropped) and spikes (excluded) in every channel; returns ``(t, cols)`` without the
+    dropped row and with the spikes as NaN.
+
+    Parameters
+    ----------
+    q : Quality
+        The findings so far, extended in place.
+    t : numpy.ndarray
+        Times [s].
+    cols : dict
+        Channel -> samples [SI] (copies: changed in place).
+    line : callable
+        Sample index -> the file's line number, for messages.
+    """
     n = t.size
-    # ---- torn last row, spikes
     for c in CHANNELS:
         hit, torn = spikes(cols[c])
         if torn:
@@ -314,8 +338,28 @@ def assess(run, params=None, *, rows=None) -> Quality:
         t = t[:-1]
         cols = {c: y[:-1] for c, y in cols.items()}
         q.exclude = {c: {i for i in s if i < last} for c, s in q.exclude.items()}
-    # ---- dominant period, frozen stretches
-    T_wave = mean_period(t, cols["heave"])
+    return t, cols
+
+
+def _frozen(q: Quality, t, cols: dict, T_wave: float, line, src: str) -> None:
+    """Frozen stretches (a value repeated exactly over more than ``FROZEN_PERIODS`` wave periods):
+    excluded with confidence low, or refused for the heave or beyond ``MAX_MISSING``.
+
+    Parameters
+    ----------
+    q : Quality
+        The findings so far, extended in place.
+    t : numpy.ndarray
+        Times [s].
+    cols : dict
+        Channel -> samples [SI] (frozen stretches set to NaN in place).
+    T_wave : float
+        The heave's mean period [s] (NaN when unknown).
+    line : callable
+        Sample index -> the file's line number, for messages.
+    src : str
+        The log's name, for messages.
+    """
     dt = float(np.median(np.diff(t)))
     per = T_wave if math.isfinite(T_wave) else WAVE_PERIOD[1]
     min_len = int(math.ceil(max(FROZEN_MIN_S, FROZEN_PERIODS * min(max(per, WAVE_PERIOD[0]), WAVE_PERIOD[1])) / dt))
@@ -337,7 +381,22 @@ def assess(run, params=None, *, rows=None) -> Quality:
             cols[c][a:b] = np.nan
         _issue(q, "frozen", c, f"frozen: {what} (a live channel changes within {FROZEN_PERIODS:g} wave periods): "
                                "excluded, confidence low")
-    # ---- impossible magnitudes
+
+
+def _magnitudes(q: Quality, cols: dict, params, src: str) -> None:
+    """Channel magnitudes no rig makes (refused), and a WOB mean far from the set-point (confidence low).
+
+    Parameters
+    ----------
+    q : Quality
+        The findings so far, extended in place.
+    cols : dict
+        Channel -> samples [SI].
+    params : CMCParams or None
+        The nominal parameters (the checks against the operating point need them).
+    src : str
+        The log's name, for messages.
+    """
     z, s, p, w = cols["heave"], cols["stroke"], cols["pressure"], cols["wob"]
     if np.nanmax(z) - np.nanmin(z) > 2 * HEAVE_MAX:
         raise DataError(f"{src}: column 'heave': range {np.nanmax(z) - np.nanmin(z):.4g} m is more than a platform heaves "
@@ -347,28 +406,47 @@ def assess(run, params=None, *, rows=None) -> Quality:
                         f"compensator's stroke (at most {STROKE_MAX:g} m, 25 ft) — wrong unit (cm, in)?")
     if np.nanmin(p) < -P_ATM:
         raise DataError(f"{src}: column 'pressure': {np.nanmin(p):.4g} Pa (gauge) is below vacuum (-{P_ATM:g} Pa)")
-    if params is not None:
-        c_, ds, op = params.compensator, params.drill_string, params.operating_point
-        p0, W0 = params.p0, op.wob_setpoint
-        if np.nanmax(p) > MAX_PRESSURE_RATIO * p0:
-            raise DataError(f"{src}: column 'pressure': {np.nanmax(p):.4g} Pa is over {MAX_PRESSURE_RATIO:g} x the "
-                            f"operating pressure p_0 = {p0:.4g} Pa (the gas spring cannot compress that far)")
-        weight = (c_.moving_mass + ds.lower_mass) * G
-        if np.nanmax(np.abs(w)) > MAX_WOB_RATIO * weight:
-            raise DataError(f"{src}: column 'wob': |WOB| reaches {np.nanmax(np.abs(w)):.4g} N, over {MAX_WOB_RATIO:g} x "
-                            f"the suspended weight (M_c + m_b) g = {weight:.4g} N")
-        wm = float(np.nanmean(w))
-        mbg = ds.lower_mass * G
-        if wm >= mbg or wm <= 0:
-            raise DataError(f"{src}: column 'wob': mean {wm:.4g} N is "
-                            + (f"above the lower mass's weight m_b g = {mbg:.4g} N (the drill string would push; "
-                               f"nominal W_0 = {W0:.4g} N) — wrong unit or unit declaration (kN as t?)" if wm > 0 else
-                               "not positive (the bit is off bottom; nominal W_0 = {W0:.4g} N)")
-                            + " or wrong parameter file?")
-        if not W0 / WOB_MEAN_FACTOR <= wm <= W0 * WOB_MEAN_FACTOR:
-            _issue(q, "wob_setpoint", "wob", f"mean {wm:.4g} N is {wm / W0:.2f} x the set-point W_0 = {W0:.4g} N: "
-                                            "another operating point than the parameter file's (or a unit): confidence low")
-    # ---- time base
+    if params is None:
+        return
+    c_, ds, op = params.compensator, params.drill_string, params.operating_point
+    p0, W0 = params.p0, op.wob_setpoint
+    if np.nanmax(p) > MAX_PRESSURE_RATIO * p0:
+        raise DataError(f"{src}: column 'pressure': {np.nanmax(p):.4g} Pa is over {MAX_PRESSURE_RATIO:g} x the "
+                        f"operating pressure p_0 = {p0:.4g} Pa (the gas spring cannot compress that far)")
+    weight = (c_.moving_mass + ds.lower_mass) * G
+    if np.nanmax(np.abs(w)) > MAX_WOB_RATIO * weight:
+        raise DataError(f"{src}: column 'wob': |WOB| reaches {np.nanmax(np.abs(w)):.4g} N, over {MAX_WOB_RATIO:g} x "
+                        f"the suspended weight (M_c + m_b) g = {weight:.4g} N")
+    wm = float(np.nanmean(w))
+    mbg = ds.lower_mass * G
+    if wm >= mbg or wm <= 0:
+        raise DataError(f"{src}: column 'wob': mean {wm:.4g} N is "
+                        + (f"above the lower mass's weight m_b g = {mbg:.4g} N (the drill string would push; "
+                           f"nominal W_0 = {W0:.4g} N) — wrong unit or unit declaration (kN as t?)" if wm > 0 else
+                           "not positive (the bit is off bottom; nominal W_0 = {W0:.4g} N)")
+                        + " or wrong parameter file?")
+    if not W0 / WOB_MEAN_FACTOR <= wm <= W0 * WOB_MEAN_FACTOR:
+        _issue(q, "wob_setpoint", "wob", f"mean {wm:.4g} N is {wm / W0:.2f} x the set-point W_0 = {W0:.4g} N: "
+                                        "another operating point than the parameter file's (or a unit): confidence low")
+
+
+def _time_base(q: Quality, t, w, T_wave: float, params) -> None:
+    """A time base at the wrong scale: the heave's period outside the sea states', or the WOB resonating
+    off every mode of the rig (confidence low).
+
+    Parameters
+    ----------
+    q : Quality
+        The findings so far, extended in place.
+    t : numpy.ndarray
+        Times [s].
+    w : numpy.ndarray
+        WOB samples [N].
+    T_wave : float
+        The heave's mean period [s].
+    params : CMCParams or None
+        The nominal parameters (the rig's modes).
+    """
     if not WAVE_PERIOD[0] <= T_wave <= WAVE_PERIOD[1]:
         _issue(q, "time_base", "t", f"the heave's mean period is {T_wave:.3g} s, outside the {WAVE_PERIOD[0]:g}-"
                                     f"{WAVE_PERIOD[1]:g} s of sea states: time base wrong (scale, unit)? confidence low")
@@ -380,11 +458,25 @@ def assess(run, params=None, *, rows=None) -> Quality:
             _issue(q, "time_base", "t", f"the WOB resonates at {f_pk:.3g} Hz, {f_pk / near:.2f} x the nearest of the rig's "
                                         f"modes ({', '.join(f'{f:.3g}' for f in modes)} Hz from the parameter file): time "
                                         "base at the wrong scale (or the wrong parameter file)? confidence low")
-    # ---- clock skew: stroke and pressure follow the heave through the gas spring
+
+
+def _clock_skew(q: Quality, t, cols: dict) -> None:
+    """Clock skew between channels: stroke and pressure follow the heave through the gas spring, so a
+    cross-correlation peak far from zero lag is a clock offset (confidence low).
+
+    Parameters
+    ----------
+    q : Quality
+        The findings so far, extended in place.
+    t : numpy.ndarray
+        Times [s].
+    cols : dict
+        Channel -> samples [SI].
+    """
     max_lag = min(30.0, 0.25 * float(t[-1] - t[0]))
     lags = {}
     for c in ("stroke", "pressure"):
-        lag, r, r0 = _lag(t, z, cols[c], max_lag)
+        lag, r, r0 = _lag(t, cols["heave"], cols[c], max_lag)
         if r >= MIN_CORRELATION and r0 < ZERO_LAG_SHARE * r:  # a periodic heave correlates at half periods too
             lags[c] = lag
     far = {c: g for c, g in lags.items() if abs(g) > MAX_SKEW_S}
@@ -393,8 +485,6 @@ def assess(run, params=None, *, rows=None) -> Quality:
         shown = ", ".join(f"{c} {g:+.2f} s" for c, g in lags.items())
         _issue(q, "clock_skew", col, f"clock skew? offset from the heave by {shown} (cross-correlation peak), more "
                                      f"than any sensor lag ({MAX_SKEW_S:g} s): confidence low")
-    q.exclude = {c: np.array(sorted(s), dtype=int) for c, s in q.exclude.items() if s}
-    return q
 
 
 def cleaned(run, q: Quality):
