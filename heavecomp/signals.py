@@ -11,23 +11,34 @@ Hamming window) applied with ``scipy.signal.filtfilt`` (forward and backward:
 zero phase, squared magnitude response), central differences for the
 derivatives, and the filter applied again after each differentiation.
 
-It is the package's one home for zero-phase filtering (issue 11.5): the diagnosis'
-heave and channel pre-filter (:func:`design_flat_lowpass`, a Kaiser-window FIR whose
-pass band is flat to 0.1 % after the forward-backward pass) and the identification's
-forward-backward Butterworth (:func:`butterworth_zero_phase`) live here too; the
-callers (``heavecomp.diagnosis.data``, ``heavecomp.identification.filtering``) only
-choose their filter.  No function here skips filtering silently: a cut-off at or above
-the Nyquist frequency, or a signal too short for the filter, raises
-:class:`~heavecomp.errors.InputError`.
+It is the package's one home for zero-phase filtering (issue 11.5).  Three low-passes, one
+signature ``(x, fs, cutoff, ...)``, named by how they differ:
+
+- :func:`hamming_zero_phase`: paper B's Hamming-window FIR (:func:`differentiate`,
+  :func:`friction_from_motion`);
+- :func:`flat_zero_phase`: the diagnosis' heave and channel pre-filter, a Kaiser-window FIR
+  whose pass band is flat to 0.04 % after the forward-backward pass;
+- :func:`butterworth_zero_phase`: the identification's forward-backward Butterworth.
+
+No function here skips filtering silently: a cut-off at or above the Nyquist frequency, or a
+signal too short for the filter, raises :class:`~heavecomp.errors.InputError`, except
+:func:`flat_zero_phase`, which returns a channel whose sampling already band-limits it below the
+filter unchanged and logs that.
 """
 
 from __future__ import annotations
+
+import logging
 
 import numpy as np
 
 from heavecomp.errors import DataError, InputError
 from heavecomp.errors import ParameterError
 
+log = logging.getLogger(__name__)
+
+FLAT_TRANSITION = 0.75  #: transition band of :func:`flat_zero_phase` as a fraction of its cut-off [-] (0.5-1.1 Hz for the heave)
+FLAT_RIPPLE = 2e-4  #: pass-band ripple of one pass of :func:`flat_zero_phase` [-] (forward-backward: 0.04 %)
 
 def sample_rate(t, *, name: str = "t", rtol: float = 1e-3) -> float:
     """Sampling rate [Hz] of a uniformly sampled time vector ``t`` [s].
@@ -153,8 +164,8 @@ def filtfilt_fir(x, b) -> np.ndarray:
     return y[::-1][n:-n]
 
 
-def zero_phase_lowpass(x, fs: float, cutoff: float, numtaps: int | None = None) -> np.ndarray:
-    """Filter ``x`` forward and backward with the FIR low-pass: no phase shift (paper B).
+def hamming_zero_phase(x, fs: float, cutoff: float, numtaps: int | None = None) -> np.ndarray:
+    """Filter ``x`` forward and backward with the Hamming FIR low-pass: no phase shift (paper B).
 
     The signal must be longer than 3 filter lengths (``filtfilt`` padding);
     otherwise InputError.
@@ -175,6 +186,43 @@ def zero_phase_lowpass(x, fs: float, cutoff: float, numtaps: int | None = None) 
     if x.shape[-1] <= 3 * b.size:
         raise InputError(f"signal of {x.shape[-1]} samples is too short for a {b.size}-tap filter "
                          f"(cutoff {cutoff:g} Hz at {fs:g} Hz): raise the cutoff or record longer")
+    return filtfilt_fir(x, b)
+
+
+def flat_zero_phase(x, fs: float, cutoff: float, transition: float = FLAT_TRANSITION,
+                    ripple: float = FLAT_RIPPLE) -> np.ndarray:
+    """Zero-phase FIR low-pass with a flat pass band: :func:`design_flat_lowpass` (Kaiser window,
+    transition band ``transition`` x cut-off centred on it, pass-band ripple ``ripple`` per pass) run
+    forward and backward (:func:`filtfilt_fir`); the diagnosis' heave and channel pre-filter.
+
+    Below the transition band the response is flat to 2 ``ripple`` (0.04 %): the heave's wave band
+    passes unchanged (the Hamming FIR used until 2026-11 amplified 0.1-0.4 Hz by 0.5-1 %).
+
+    When the stop edge lies at or above the Nyquist frequency ``fs/2`` the sampling itself
+    band-limits the channel below the filter: the channel is returned unchanged and this is
+    logged (documented in ``docs/diagnosis.md``; until 2026-11 the skip was silent).  A signal too
+    short for the full filter gets the longest filter it can carry (a wider transition band).
+
+    Parameters
+    ----------
+    x : array
+        Signal sampled at ``fs``, filtered along its last axis.
+    fs : float [Hz]
+        Sampling rate.
+    cutoff : float [Hz]
+        Centre of the transition band (-6 dB of one pass).
+    transition : float [-]
+        Width of the transition band as a fraction of ``cutoff``.
+    ripple : float [-]
+        Pass-band ripple of one pass.
+    """
+    width = transition * cutoff
+    if cutoff + 0.5 * width >= 0.5 * fs:
+        log.info("zero-phase low-pass at %g Hz skipped: sampling at %g Hz already band-limits below %g Hz",
+                 cutoff, fs, 0.5 * fs)
+        return np.asarray(x, dtype=float)
+    x = np.asarray(x, dtype=float)
+    b = design_flat_lowpass(fs, cutoff, width, ripple, max_taps=max(3, (x.size - 1) // 3 - 1))
     return filtfilt_fir(x, b)
 
 
@@ -236,11 +284,11 @@ def differentiate(t, x, cutoff: float, *, order: int = 2, numtaps: int | None = 
     if not np.all(np.isfinite(x)):
         raise DataError(f"column {name}: contains NaN or inf")
     dt = 1.0 / fs
-    xf = zero_phase_lowpass(x, fs, cutoff, numtaps)
+    xf = hamming_zero_phase(x, fs, cutoff, numtaps)
     out = [xf]
     y = xf
     for _ in range(order):
-        y = zero_phase_lowpass(np.gradient(y, dt), fs, cutoff, numtaps)
+        y = hamming_zero_phase(np.gradient(y, dt), fs, cutoff, numtaps)
         out.append(y)
     return tuple(out)
 
@@ -268,5 +316,5 @@ def friction_from_motion(t, x, drive_force, mass: float, cutoff: float, *, numta
     if F.shape != np.shape(t):
         raise DataError(f"column drive_force: length {F.size} differs from the time column ({np.size(t)})")
     _, v, a = differentiate(t, x, cutoff, numtaps=numtaps)
-    Ff = zero_phase_lowpass(F, fs, cutoff, numtaps) - mass * a
+    Ff = hamming_zero_phase(F, fs, cutoff, numtaps) - mass * a
     return {"velocity": v, "acceleration": a, "friction": Ff}

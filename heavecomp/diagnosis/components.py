@@ -18,7 +18,7 @@ gas law                 Pa     measured pressure minus ``gas_pressure(s)`` at th
 ======================  =====  ==================================================================
 
 Derivatives and the values themselves come through the same zero-phase FIR low-pass
-(:data:`CUTOFF`; :func:`heavecomp.diagnosis.data.zero_phase_lowpass`), so linear terms see one
+(:data:`CUTOFF`; :func:`heavecomp.signals.flat_zero_phase`), so linear terms see one
 frequency response.  Each equation residual is split by a joint least-squares regression (on the
 whole analysed span) into the parts other components explain:
 

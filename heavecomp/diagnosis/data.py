@@ -34,7 +34,7 @@ from heavecomp.errors import DataError
 from heavecomp.simulate.excitation import HeaveSamples
 from heavecomp.io.series import MAX_DT_S, gaps
 from heavecomp.io.series import UNITS as SOURCE_UNITS, check_spec, read_series
-from heavecomp.signals import design_flat_lowpass, filtfilt_fir
+from heavecomp.signals import flat_zero_phase
 
 P_ATM = 101325.0  #: atmospheric pressure [Pa] (cmc-reference.md)
 
@@ -52,8 +52,6 @@ MAX_MISSING = 0.2  #: largest tolerated fraction of missing samples per column
 MAX_GAP = 2.0      #: longest heave dropout (or hole in the time column) bridged by interpolation [s]
 MIN_SAMPLES = 50   #: fewest samples of a run
 HEAVE_CUTOFF = 0.8  #: zero-phase FIR low-pass cut-off for the heave [Hz] (paper B's method; waves < 0.7 Hz)
-TRANSITION = 0.75  #: transition band of the pre-filter as a fraction of its cut-off [-] (0.5-1.1 Hz for the heave)
-RIPPLE = 2e-4  #: pass-band ripple of one pass of the pre-filter [-] (forward-backward: 0.04 %)
 
 
 @dataclasses.dataclass
@@ -338,41 +336,6 @@ def uniform(t, y, dt=None):
     return tu, np.interp(tu, t, fill_gaps(t, y))
 
 
-def zero_phase_lowpass(y, dt, cutoff=HEAVE_CUTOFF):
-    """Zero-phase FIR low-pass of a uniformly sampled channel (spacing ``dt`` [s], ``cutoff`` [Hz]):
-    :func:`heavecomp.signals.design_flat_lowpass` (Kaiser window, transition band
-    ``TRANSITION`` x cut-off centred on it, pass-band ripple ``RIPPLE`` per pass) run forward and
-    backward (:func:`heavecomp.signals.filtfilt_fir`; paper B's zero-phase filtering).
-
-    Below the transition band the response is flat to 2 ``RIPPLE`` (0.04 %): the heave's wave band
-    passes unchanged (the Hamming FIR used until 2026-11 amplified 0.1-0.4 Hz by 0.5-1 %).
-
-    When the stop edge lies at or above the Nyquist frequency ``1/(2 dt)`` the sampling itself
-    band-limits the channel below the filter: the channel is returned unchanged and this is
-    logged (documented in ``docs/diagnosis.md``; until 2026-11 the skip was silent).  A run too
-    short for the full filter gets the longest filter it can carry (a wider transition band).
-
-    Parameters
-    ----------
-    y : array_like [unit of the channel]
-        Uniformly sampled channel.
-    dt : float [s]
-        Sample spacing.
-    cutoff : float [Hz]
-        Cut-off frequency.
-    """
-
-    fs = 1.0 / dt
-    width = TRANSITION * cutoff
-    if cutoff + 0.5 * width >= 0.5 * fs:
-        log.info("zero-phase low-pass at %g Hz skipped: sampling at %g Hz already band-limits below %g Hz",
-                 cutoff, fs, 0.5 * fs)
-        return np.asarray(y, dtype=float)
-    y = np.asarray(y, dtype=float)
-    b = design_flat_lowpass(fs, cutoff, width, RIPPLE, max_taps=max(3, (y.size - 1) // 3 - 1))
-    return filtfilt_fir(y, b)
-
-
 def heave_filtered(run: MeasuredRun, cutoff=HEAVE_CUTOFF):
     """The replay's heave before its reference is removed: gap-filled, uniformly resampled,
     zero-phase FIR low-passed (``cutoff`` [Hz]); a cubic spline of it (callable t -> z [m],
@@ -388,7 +351,7 @@ def heave_filtered(run: MeasuredRun, cutoff=HEAVE_CUTOFF):
     from scipy.interpolate import CubicSpline
 
     tu, zu = uniform(run.t, run["heave"])
-    return CubicSpline(tu, zero_phase_lowpass(zu, tu[1] - tu[0], cutoff))
+    return CubicSpline(tu, flat_zero_phase(zu, 1.0 / (tu[1] - tu[0]), cutoff))
 
 
 def heave_samples(run: MeasuredRun, h: float, n_steps: int, cutoff=HEAVE_CUTOFF, reference=None, spline=None):
@@ -459,25 +422,9 @@ def lowpass_zero_phase(t, y, cutoff):
     from scipy.interpolate import CubicSpline
 
     tu, yu = uniform(t, y)
-    yf = zero_phase_lowpass(yu, tu[1] - tu[0], cutoff)
+    yf = flat_zero_phase(yu, 1.0 / (tu[1] - tu[0]), cutoff)
     cs = CubicSpline(tu, yf)
     return np.interp(t, tu, yf), cs(t, 1), cs(t, 2)
-
-
-def derivative_zero_phase(t, y, cutoff):
-    """Velocity and acceleration of a channel by zero-phase FIR filtering and spline differentiation,
-    returned at the original times ``t`` (:func:`lowpass_zero_phase`).
-
-    Parameters
-    ----------
-    t : numpy.ndarray [s]
-        Sample times (increasing; may be non-uniform).
-    y : numpy.ndarray [unit of the channel]
-        The channel's samples (NaN: missing).
-    cutoff : float [Hz]
-        Cut-off of the zero-phase low-pass.
-    """
-    return lowpass_zero_phase(t, y, cutoff)[1:]
 
 
 NOISE_ORDERS = (2, 3, 4, 5, 6)  #: difference orders of the noise estimate

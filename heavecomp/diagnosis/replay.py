@@ -19,8 +19,8 @@ import math
 import numpy as np
 
 from heavecomp.diagnosis import start as S
-from heavecomp.diagnosis.data import (ANGLES, HEAVE_CUTOFF, MeasuredRun, derivative_zero_phase, heave_filtered,
-                                      heave_samples, noise_floor, uniform, zero_phase_lowpass)
+from heavecomp.diagnosis.data import (ANGLES, HEAVE_CUTOFF, MeasuredRun, heave_filtered, heave_samples,
+                                      lowpass_zero_phase, noise_floor, uniform)
 from heavecomp.diagnosis.policy import VerdictPolicy
 from heavecomp.effects.candidates import ParameterMismatch, get
 from heavecomp.diagnosis.stepper import CHANNELS as SC, replay_dt, run_segments
@@ -29,6 +29,7 @@ from heavecomp.effects.spec import plant_effects
 from heavecomp.errors import InputError
 from heavecomp.params.budget import MAX_REPLAY_STEPS
 from heavecomp.plants.cmc import D0, KF, plant_vectors
+from heavecomp.signals import flat_zero_phase
 
 #: the measured channels a replay is compared on (wob first: the primary channel)
 CH = ("wob", "stroke", "pressure")
@@ -227,10 +228,10 @@ def _segments(run, h, n_steps, PP, length, reinit_s, stuck_speed):
     n_seg = max(1, int(math.floor(t[-1] / length)))
     bounds, starts = [], []
     tu, su = uniform(t, run["stroke"])
-    sf = zero_phase_lowpass(su, tu[1] - tu[0], 1.0)
-    vs, _ = derivative_zero_phase(t, run["stroke"], 1.0)
-    wf_u = zero_phase_lowpass(uniform(t, run["wob"])[1], tu[1] - tu[0], 3.0)
-    dw, _ = derivative_zero_phase(t, run["wob"], 3.0)
+    sf = flat_zero_phase(su, 1.0 / (tu[1] - tu[0]), 1.0)
+    _, vs, _ = lowpass_zero_phase(t, run["stroke"], 1.0)
+    wf_u = flat_zero_phase(uniform(t, run["wob"])[1], 1.0 / (tu[1] - tu[0]), 3.0)
+    _, dw, _ = lowpass_zero_phase(t, run["wob"], 3.0)
     reinit = np.zeros(t.size, bool)
     for k in range(n_seg):
         i0 = int(round(k * length / h))

@@ -7,24 +7,12 @@ import math
 import numpy as np
 
 from heavecomp.diagnosis.data import uniform
-from heavecomp.plants.cmc import eigenfrequencies as _eigenfrequencies
+from heavecomp.plants.cmc import eigenfrequencies  # the plant's linear model; used here and re-exported
 
 REGIMES = ("stuck", "breakaway", "sliding_accelerating", "sliding_decelerating")
 BANDS = ("below_wave", "wave", "resonance", "above")
 BREAKAWAY_WINDOW = 0.3  #: s after a stuck -> sliding transition counted as "breakaway"
 SEGMENT_LENGTH = 5.0    #: s, window of the rolling residual power for "segments"
-
-
-def eigenfrequencies(params) -> list[float]:
-    """Undamped eigenfrequencies [Hz] of the plant's linear model (:func:`heavecomp.plants.cmc.eigenfrequencies`).
-
-    Parameters
-    ----------
-    params : heavecomp.params.CMCParams
-        Nominal parameters.
-    """
-
-    return _eigenfrequencies(params)
 
 
 def wave_band(t, z) -> tuple[float, float]:

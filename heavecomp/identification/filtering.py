@@ -17,24 +17,6 @@ from heavecomp.errors import ParameterError
 from heavecomp.signals import butterworth_zero_phase
 
 
-def zero_phase_lowpass(x, fs: float, cutoff: float, order: int = 4) -> np.ndarray:
-    """Forward-backward Butterworth low-pass: :func:`heavecomp.signals.butterworth_zero_phase`
-    (the package's one signal-processing module); kept under this name for the identification.
-
-    Parameters
-    ----------
-    x : array
-        Signal sampled at ``fs`` (filtered along its first axis).
-    fs : float [Hz]
-        Sampling rate.
-    cutoff : float [Hz]
-        -3 dB frequency of the single-pass Butterworth filter.
-    order : int
-        Butterworth order (the forward-backward pass doubles it).
-    """
-    return butterworth_zero_phase(x, fs, cutoff, order)
-
-
 def derivatives(q, fs: float, cutoff: float, order: int = 4):
     """Filtered position, velocity and acceleration by central differences.
 
@@ -54,7 +36,7 @@ def derivatives(q, fs: float, cutoff: float, order: int = 4):
     q_f, dq, ddq : ndarray
         [m], [m/s], [m/s^2] at the input rate.
     """
-    q_f = zero_phase_lowpass(q, fs, cutoff, order)
+    q_f = butterworth_zero_phase(q, fs, cutoff, order)
     h = 1.0 / fs
     dq = np.gradient(q_f, h)
     ddq = np.gradient(dq, h)

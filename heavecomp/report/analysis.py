@@ -17,15 +17,10 @@ import numpy as np
 
 from heavecomp.analysis.frequency import WAVE_BAND
 from heavecomp.analysis.summary import analyse
-from heavecomp.report.figures import _plt as plt_, save
-from heavecomp.report.provenance import _clean as c
-from heavecomp.report.provenance import round_floats, stamp, stamp_report
+from heavecomp.report.figures import _plt, save
+from heavecomp.report.provenance import _clean, round_floats, stamp, stamp_report
 
 log = logging.getLogger(__name__)
-
-
-def _plt():
-    return plt_()
 
 
 def _band(ax, axis="x"):
@@ -196,10 +191,6 @@ def df_figure(rows: list[dict], *, title: str = ""):
                  fontsize=10)
     fig.tight_layout()
     return fig
-
-
-def _clean(x):
-    return c(x)
 
 
 def write_analysis(params, out, *, source: str = "", **kw) -> dict:

@@ -12,7 +12,7 @@ import numpy as np
 from heavecomp.report.figures import REGIME_COLORS, REGIME_LABELS, _plt, save
 from heavecomp.campaign.tables import check_parquet, export_parquet
 from heavecomp.campaign.execute import read_table, run_campaign
-from heavecomp.report.provenance import declare_units, stamp, stamp_report
+from heavecomp.report.provenance import _clean, declare_units, stamp, stamp_report
 
 log = logging.getLogger(__name__)
 
@@ -266,21 +266,6 @@ def _variant_lines(campaign):
         d = dict(v.overrides)
         lines.append(f"| {v.name} | " + " | ".join(f"{d[k]:.6g}" for k in keys) + " |")
     return lines + [""]
-
-
-def _clean(x, digits=None):
-    """JSON-safe: nan/inf -> null, numpy scalars -> python; optionally round to ``digits`` significant digits."""
-    if isinstance(x, np.generic):
-        x = x.item()
-    if isinstance(x, float):
-        if not math.isfinite(x):
-            return None
-        return float(f"{x:.{digits}g}") if digits else x
-    if isinstance(x, dict):
-        return {k: _clean(v, digits) for k, v in x.items()}
-    if isinstance(x, (list, tuple)):
-        return [_clean(v, digits) for v in x]
-    return x
 
 
 def run_and_report(campaign, out_dir, **kw):

@@ -12,9 +12,8 @@ import numpy as np
 from heavecomp.diagnosis.where import residual_spectrum
 from heavecomp.report.figures import _plt, save
 from heavecomp.report.scenario import md_table
-from heavecomp.report.provenance import declare_units, stamp, stamp_report
+from heavecomp.report.provenance import _clean, declare_units, stamp, stamp_report
 from heavecomp.simulate.core import CHANNEL_UNITS
-from heavecomp.report.scenario import _clean as clean
 from heavecomp.effects import CANDIDATES
 
 CH_UNITS = {"wob": ("kN", 1e-3), "stroke": ("mm", 1e3), "pressure": ("kPa", 1e-3)}
@@ -55,11 +54,6 @@ def _with_unit(name: str, val, sigma=None, units=None) -> str:
     u = (units or {}).get(name)
     pm = f" ± {sigma:.2g}" if isinstance(sigma, float) and math.isfinite(sigma) else ""
     return f"{name} = {val:.4g}{pm}" + (f" {u}" if u and u != "-" else "")
-
-
-def _clean(x):
-
-    return clean(x)
 
 
 def write_json(diag, path) -> Path:

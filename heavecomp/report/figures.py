@@ -17,6 +17,8 @@ REGIME_COLORS = {"none": "tab:green", "rotating_eq7": "tab:orange", "rotating_eq
 
 
 def _plt():
+    """matplotlib.pyplot with the non-interactive Agg backend (unless one is already chosen), imported
+    on first use; the report package's one pyplot import (also public as :func:`pyplot`)."""
     import matplotlib
 
     matplotlib.use("Agg", force=False)
@@ -25,9 +27,7 @@ def _plt():
     return plt
 
 
-def pyplot():
-    """matplotlib.pyplot with the non-interactive Agg backend (unless one is already chosen)."""
-    return _plt()
+pyplot = _plt
 
 
 def save(fig, path, dpi: int = 110, tight: bool = True) -> Path:

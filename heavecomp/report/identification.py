@@ -6,12 +6,8 @@ from __future__ import annotations
 import numpy as np
 
 from heavecomp.plants.axis import BASE_NAMES, EMPS_PUBLISHED, EMPS_UNITS
-from heavecomp.report.figures import _plt as plt
+from heavecomp.report.figures import _plt
 from heavecomp.report.scenario import md_table, write_report
-
-
-def _plt():
-    return plt()
 
 
 def emps_overlay(t, measured, model_before, model_after, label_after: str):

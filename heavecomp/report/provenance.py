@@ -413,17 +413,33 @@ def split_timings(obj):
     return obj, None
 
 
-def _clean(x):
-    """JSON-ready copy: NaN/inf -> None, numpy scalars -> Python, keys -> str."""
-    if isinstance(x, float) and not math.isfinite(x):
-        return None
+def _clean(x, digits: int | None = None):
+    """JSON-ready copy: NaN/inf -> None, numpy scalars -> Python, tuples -> lists, keys -> str;
+    the report package's one JSON cleaner.
+
+    Parameters
+    ----------
+    x : dict, list, tuple or scalar
+        A JSON-like value, possibly holding numpy scalars.
+    digits : int, optional
+        Round every finite float to this many significant digits (none: floats kept exact).
+
+    Returns
+    -------
+    dict, list or scalar
+    """
+    if isinstance(x, float):
+        if not math.isfinite(x):
+            return None
+        if digits:
+            return float(f"{x:.{digits}g}")
     if isinstance(x, dict):
-        return {str(k): _clean(v) for k, v in x.items()}
+        return {str(k): _clean(v, digits) for k, v in x.items()}
     if isinstance(x, (list, tuple)):
-        return [_clean(v) for v in x]
+        return [_clean(v, digits) for v in x]
     if hasattr(x, "item") and not isinstance(x, (str, bytes)):
         try:
-            return _clean(x.item())
+            return _clean(x.item(), digits)
         except (ValueError, AttributeError):
             pass
     return x
