@@ -70,7 +70,7 @@ def run(args) -> int:
     from heavecomp.effects.spec import load  # the file with its [[effects]] checked
 
     _check(args)
-    params = load(args.params)
+    params = load(args.params, heave_file=False)  # the analysis takes no heave from the file
     s = write_analysis(params, args.out, source=f"({Path(args.params).name})", n_points=args.points,
                        omega_min=args.omega_min, omega_max=args.omega_max, sliding_velocity=args.sliding_velocity)
     from heavecomp.report.provenance import finish
