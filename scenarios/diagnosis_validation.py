@@ -454,9 +454,36 @@ def write_corrupted(out: Path, rows, summary, settings, digest, quick, candidate
         + ("all" if candidates is None else ", ".join(candidates)) + ". "
         "A run is *confident* when it is corrupted, not refused and its confidence is medium or high.",
         "## Goals", goals, "## By class", kinds,
+        "## Not as expected", _failures(rows),
         "## Runs", "expect (heavecomp.benchmark.corruption): refuse = refused naming the column; refuse_or_low = "
         "that, or confidence low with a warning naming the column; dropped = a torn-row warning naming the column and "
         "the clean run's verdict; clean = no data-quality issue (and the clean verdict).", table])
+
+
+def _failures(rows) -> str:
+    """One line per corrupted or clean run not answered as expected: what it got instead."""
+    out = []
+    for r in rows:
+        if "error" in r or r["judged"]["pass"]:
+            continue
+        col = r["column"]
+        if r["outcome"] == "refused":
+            got = f"refused without naming column '{col}': {r['message']}"
+        elif r["outcome"] == "crashed":
+            got = f"crashed: {r['message']}"
+        elif r["kind"] == "clean":
+            got = "data-quality issues on a clean run: " + ", ".join(f"{q['kind']} ({q['column']})" for q in r["quality"])
+        else:
+            named = [w for w in r["warnings"] if f"column '{col}'" in w]
+            got = (f"verdict {r['verdict']} ({r['confidence']})"
+                   + ("" if named else f"; no warning names column '{col}'")
+                   + (f"; data-quality issues found: {', '.join(q['kind'] + ' (' + q['column'] + ')' for q in r['quality'])}"
+                      if r["quality"] else "; no data-quality issue found")
+                   + ("; the confidence is low for the diagnosis' own reasons, not the data's"
+                      if r["confidence"] == "low" and not r["quality"] else ""))
+        detail = ", ".join(f"{k} {v:.3g}" if isinstance(v, float) else f"{k} {v}" for k, v in r["detail"].items())
+        out.append(f"- {r['base']} (seed {r['seed']}), {r['kind']}" + (f" ({detail})" if detail else "") + f": {got}")
+    return "\n".join(out) or "None."
 
 
 def _log_corrupted(rows, t0):
