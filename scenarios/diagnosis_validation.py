@@ -11,6 +11,15 @@ starting mid-operation, a long soft string and a soft formation, effects near th
 effects outside every name, the six schema-2 effects in forms of the generator's own).
 The diagnoser's settings are frozen on the tuning set: their hash is recorded in its report, and
 the scoring run refuses to run when the settings differ from the committed tuning report's.
+
+The corrupted set (issue 21 item 4) is its own category: a few clean generated runs (seeds 170000+,
+used by no other set nor the fuzz run), each corrupted once by every class of
+heavecomp.benchmark.corruption (frozen channel, spike, time base, clock skew, torn value, non-finite
+cell, WOB set-point, impossible magnitude), read as load_run reads a log (check_run, then the
+data-quality checks) and diagnosed. The goal: no confident verdict on corrupted data -- each is
+refused naming the corrupted column, or diagnosed with confidence low and a warning naming it (a torn
+last row: dropped with a warning naming it and the clean run's verdict); the clean runs draw no
+data-quality warning.
 """
 
 from __future__ import annotations
@@ -28,9 +37,10 @@ from pathlib import Path
 
 import numpy as np
 
-from heavecomp.diagnosis import GapDiagnoser, load_run
+from heavecomp.diagnosis import GapDiagnoser, load_run, quality
+from heavecomp.diagnosis.data import check_run
 from heavecomp.errors import InputError
-from heavecomp.benchmark import generate, NEAR_NOISE, parameter_sets, validation_cases
+from heavecomp.benchmark import Case, corruption, generate, NEAR_NOISE, parameter_sets, validation_cases
 from heavecomp.params import load
 from heavecomp.report.provenance import write_params
 from heavecomp.report.scenario import ROOT, md_table, parse_args, run, write_metrics, write_report
@@ -262,7 +272,7 @@ def write(out: Path, which, rows, summary, settings, digest, frozen_note, quick)
     missing = sum(1 for r in rows if "full" in r and r["full"]["component"] is None and r["full"]["verdict"] != "none")
     s = summary
     write_report(out, f"Diagnosis validation: the {which} set", [
-        __doc__.split("\n\n", 1)[1],
+        __doc__.split("\n\n")[1],
         f"**Thresholds: {frozen_note}.** Settings (GapDiagnoser.get_params(), less {', '.join(NOT_FROZEN)}): "
         + ", ".join(f"`{k}={v}`" for k, v in settings.items()) + ".",
         f"{s['n_generated']} of {s['n_cases']} cases generated"
@@ -284,10 +294,240 @@ def write(out: Path, which, rows, summary, settings, digest, frozen_note, quick)
         "verdict's shrink channel.", runs])
 
 
+# ------------------------------------------------------------------------------ corrupted set
+#: first seed of the corrupted set's clean runs (tuning 20000+, scoring 50000-111000, monitor 30000+ and
+#: 130000-151000, benchmark 1000+, fuzz 21: none used here)
+CORRUPTED_SEED0 = 170000
+#: the clean runs the corrupted set corrupts: (label, category, parameter set)
+CORRUPTED_BASES = (("none", "none", "paper_a"), ("flow_loss", "named", "paper_a"),
+                   ("gas_leak", "named", "soft_formation"), ("string_damping", "named", "light_friction"))
+CORRUPTED_DURATION = 150.0  #: s of each clean run (short: the set is about refusals and caps, not accuracy)
+
+
+def corrupted_cases(quick=False):
+    """The clean cases of the corrupted set (:data:`CORRUPTED_BASES`, seeds :data:`CORRUPTED_SEED0` +)."""
+    cases = [Case(lab, CORRUPTED_SEED0 + i, cat, duration=CORRUPTED_DURATION, params=ps)
+             for i, (lab, cat, ps) in enumerate(CORRUPTED_BASES)]
+    return [dataclasses.replace(c, duration=90.0) for c in cases[:1]] if quick else cases
+
+
+def _outcome(t, cols, nominal, source, candidates, n_jobs) -> dict:
+    """Read arrays as load_run does (check_run, then quality.checked) and diagnose: refused/verdict."""
+    try:
+        run = quality.checked(check_run(t, cols, params=nominal, source=source), nominal)
+        d = GapDiagnoser(nominal, candidates, n_jobs=n_jobs).fit(run)
+    except InputError as exc:  # the command would exit 2 with this one line
+        return {"outcome": "refused", "message": str(exc), "verdict": None, "confidence": None, "warnings": [],
+                "quality": []}
+    v = d.verdict_
+    q = getattr(run, "quality", None)
+    return {"outcome": "verdict", "message": None, "verdict": v["effect"], "confidence": v["confidence"],
+            "warnings": list(d.warnings_), "quality": [{"kind": i["kind"], "column": i["column"]}
+                                                       for i in (q.issues if q is not None else [])]}
+
+
+def judge_corrupted(row, clean_verdict) -> dict:
+    """Pass/fail of one corrupted (or clean) run by its ``expect`` (heavecomp.benchmark.corruption):
+
+    - ``refuse``: refused, the message naming the column;
+    - ``low`` / ``refuse_or_low``: refused naming the column, or confidence low with a warning naming it;
+    - ``dropped``: a torn-row warning naming the column and the clean run's verdict;
+    - ``clean`` (a clean run, or a torn cut that changed nothing): no data-quality issue and, for a
+      corrupted one, the clean run's verdict.
+
+    ``confident`` marks a verdict with confidence medium or high on corrupted data (the goal: none).
+    """
+    col, exp = row["column"], row["expect"]
+    named = (lambda s: s is not None and f"column '{col}'" in s)
+    refused = row["outcome"] == "refused"
+    warned = any(named(w) for w in row["warnings"])
+    low = row["confidence"] == "low"
+    if exp == "clean":
+        ok = not refused and not row["quality"] and (row["kind"] == "clean" or row["verdict"] == clean_verdict)
+    elif exp == "refuse":
+        ok = refused and named(row["message"])
+    elif exp in ("low", "refuse_or_low"):
+        ok = (refused and named(row["message"])) or (not refused and low and warned)
+    elif exp == "dropped":
+        ok = (not refused and row["verdict"] == clean_verdict
+              and any("torn" in w and named(w) for w in row["warnings"]))
+    else:
+        raise ValueError(f"unknown expectation {exp!r}")
+    # a torn row dropped with its warning leaves a clean run: its verdict may be confident
+    torn_dropped = exp == "dropped" and any("torn" in w and named(w) for w in row["warnings"])
+    confident = row["kind"] != "clean" and exp != "clean" and not refused and not low and not torn_dropped
+    return {"pass": bool(ok), "confident": bool(confident)}
+
+
+def run_corrupted_base(case, n_jobs=1, candidates=None, kinds=corruption.CLASSES) -> list:
+    """One clean case: its clean run and one corruption of every class in ``kinds``, each diagnosed and
+    judged; the rows of the report (the clean run first)."""
+    t0 = time.perf_counter()
+    try:
+        tr = generate(case)
+    except RuntimeError as exc:  # a sea that cannot carry the effect: reported, never hidden
+        return [{"base": case.label, "seed": case.seed, "kind": "clean", "error": str(exc)}]
+    nominal = tr.nominal
+    base = {"base": case.label, "seed": case.seed, "params": case.params}
+    clean = dict(base, kind="clean", column=None, expect="clean", detail={},
+                 **_outcome(tr.t, tr.columns, nominal, f"clean:{case.label}", candidates, n_jobs))
+    clean["judged"] = judge_corrupted(clean, None)
+    clean["wall_time"] = time.perf_counter() - t0
+    rows = [clean]
+    for j, kind in enumerate(kinds):
+        t1 = time.perf_counter()
+        rng = np.random.default_rng([case.seed, j])  # each class's draw reproducible from the seed alone
+        try:
+            t, cols, desc = corruption.corrupt(kind, tr.t, tr.columns, rng, nominal)
+            row = dict(base, kind=kind, column=desc["column"], expect=desc["expect"],
+                       detail={k: v for k, v in desc.items() if k not in ("class", "column", "expect")},
+                       **_outcome(t, cols, nominal, f"{kind}:{case.label}", candidates, n_jobs))
+            row["judged"] = judge_corrupted(row, clean["verdict"])
+        except Exception as exc:  # noqa: BLE001 - a crash is a failure of the set, reported, not hidden
+            log.exception("%s (seed %s) %s: the diagnosis crashed", case.label, case.seed, kind)
+            row = dict(base, kind=kind, column=None, expect=None, detail={}, outcome="crashed", message=repr(exc),
+                       verdict=None, confidence=None, warnings=[], quality=[],
+                       judged={"pass": False, "confident": False})
+        row["wall_time"] = time.perf_counter() - t1
+        rows.append(row)
+    return rows
+
+
+def summarize_corrupted(rows) -> dict:
+    """Counts of the corrupted set: confident verdicts on corrupted data, passes, false alarms."""
+    done = [r for r in rows if "error" not in r]
+    bad = [r for r in done if r["kind"] != "clean"]
+    clean = [r for r in done if r["kind"] == "clean"]
+    by_kind = {k: {"n": sum(r["kind"] == k for r in bad), "pass": sum(r["judged"]["pass"] for r in bad if r["kind"] == k),
+                   "confident": sum(r["judged"]["confident"] for r in bad if r["kind"] == k),
+                   "refused": sum(r["outcome"] == "refused" for r in bad if r["kind"] == k)}
+               for k in corruption.CLASSES if any(r["kind"] == k for r in bad)}
+    n_conf = sum(r["judged"]["confident"] for r in bad)
+    n_pass = sum(r["judged"]["pass"] for r in bad)
+    alarms = sum(not r["judged"]["pass"] for r in clean)
+    goals = [{"goal": "no confident verdict on corrupted data", "measured": n_conf, "n_runs": len(bad),
+              "result": "n/a" if not bad else ("PASS" if n_conf == 0 else "FAIL")},
+             {"goal": "every corrupted run refused or warned about by column as expected", "measured": n_pass,
+              "n_runs": len(bad), "result": "n/a" if not bad else ("PASS" if n_pass == len(bad) else "FAIL")},
+             {"goal": "no false alarm on the clean runs", "measured": alarms, "n_runs": len(clean),
+              "result": "n/a" if not clean else ("PASS" if alarms == 0 else "FAIL")}]
+    return {"n_corrupted": len(bad), "n_clean": len(clean), "confident_on_corrupted": n_conf, "passed": n_pass,
+            "false_alarms": alarms, "refused": sum(r["outcome"] == "refused" for r in bad),
+            "crashed": sum(r["outcome"] == "crashed" for r in bad),
+            "not_generated": [f"{r['base']} ({r['seed']})" for r in rows if "error" in r],
+            "by_kind": by_kind, "goals": goals}
+
+
+def write_corrupted(out: Path, rows, summary, settings, digest, quick, candidates):
+    write_metrics(out, {"set": "corrupted", "quick": quick, "settings": settings, "settings_hash": digest,
+                        "candidates": "all" if candidates is None else list(candidates),
+                        "seed0": CORRUPTED_SEED0, "duration_s": CORRUPTED_DURATION if not quick else 90.0,
+                        "summary": summary, "runs": rows})
+    s = summary
+    goals = md_table(["goal (issue 21 item 4)", "measured", "runs", "result"],
+                     [[g["goal"], g["measured"], g["n_runs"], g["result"]] for g in s["goals"]])
+    kinds = md_table(["class", "runs", "refused", "confident verdicts", "pass"],
+                     [[k, d["n"], d["refused"], d["confident"], d["pass"]] for k, d in s["by_kind"].items()])
+
+    def said(r):
+        txt = r["message"] if r["outcome"] != "verdict" else "; ".join(
+            w for w in r["warnings"] if r["column"] and f"column '{r['column']}'" in w) or "-"
+        return txt.replace("|", "/")[:140]
+
+    table = md_table(["base", "seed", "class", "column", "expect", "outcome", "verdict", "confidence", "pass",
+                      "what it said (first 140 characters)"],
+                     [[r["base"], r["seed"], r["kind"], r["column"] or "-", r["expect"], r["outcome"],
+                       r["verdict"] or "-", r["confidence"] or "-", "yes" if r["judged"]["pass"] else "**no**", said(r)]
+                      for r in rows if "error" not in r])
+    write_report(out, "Diagnosis validation: the corrupted set", [
+        __doc__.split("\n\n")[2],
+        f"**Confident verdicts on corrupted data: {s['confident_on_corrupted']} of {s['n_corrupted']}** "
+        f"({s['refused']} refused naming a column, {s['passed']} of {s['n_corrupted']} answered as expected; "
+        f"false alarms on the clean runs: {s['false_alarms']} of {s['n_clean']})."
+        + (" — **quick mode: one short run, not a validation**" if quick else ""),
+        f"Clean runs: seeds {CORRUPTED_SEED0}+, {len(CORRUPTED_BASES)} cases "
+        f"({', '.join(f'{b[0]} on {b[2]}' for b in CORRUPTED_BASES)}), "
+        f"{CORRUPTED_DURATION if not quick else 90.0:g} s at 50 Hz under a JONSWAP sea; each class's size drawn "
+        "by heavecomp.benchmark.corruption.corrupt from numpy.random.default_rng([seed, class index]). "
+        "Read as load_run reads a file (check_run, then heavecomp.diagnosis.quality.checked) and diagnosed by "
+        f"GapDiagnoser with its default settings (settings hash `{digest}`), candidates: "
+        + ("all" if candidates is None else ", ".join(candidates)) + ". "
+        "A run is *confident* when it is corrupted, not refused and its confidence is medium or high.",
+        "## Goals", goals, "## By class", kinds,
+        "## Not as expected", _failures(rows),
+        "## Runs", "expect (heavecomp.benchmark.corruption): refuse = refused naming the column; refuse_or_low = "
+        "that, or confidence low with a warning naming the column; dropped = a torn-row warning naming the column and "
+        "the clean run's verdict; clean = no data-quality issue (and the clean verdict).", table])
+
+
+def _failures(rows) -> str:
+    """One line per corrupted or clean run not answered as expected: what it got instead."""
+    out = []
+    for r in rows:
+        if "error" in r or r["judged"]["pass"]:
+            continue
+        col = r["column"]
+        if r["outcome"] == "refused":
+            got = f"refused without naming column '{col}': {r['message']}"
+        elif r["outcome"] == "crashed":
+            got = f"crashed: {r['message']}"
+        elif r["kind"] == "clean":
+            got = "data-quality issues on a clean run: " + ", ".join(f"{q['kind']} ({q['column']})" for q in r["quality"])
+        else:
+            named = [w for w in r["warnings"] if f"column '{col}'" in w]
+            got = (f"verdict {r['verdict']} ({r['confidence']})"
+                   + ("" if named else f"; no warning names column '{col}'")
+                   + (f"; data-quality issues found: {', '.join(q['kind'] + ' (' + q['column'] + ')' for q in r['quality'])}"
+                      if r["quality"] else "; no data-quality issue found")
+                   + ("; the confidence is low for the diagnosis' own reasons, not the data's"
+                      if r["confidence"] == "low" and not r["quality"] else ""))
+        detail = ", ".join(f"{k} {v:.3g}" if isinstance(v, float) else f"{k} {v}" for k, v in r["detail"].items())
+        out.append(f"- {r['base']} (seed {r['seed']}), {r['kind']}" + (f" ({detail})" if detail else "") + f": {got}")
+    return "\n".join(out) or "None."
+
+
+def _log_corrupted(rows, t0):
+    for r in rows:
+        if "error" in r:
+            log.info("[%5.0f s] %s (%s): not generated (%s)", time.perf_counter() - t0, r["base"], r["seed"], r["error"])
+            continue
+        log.info("[%5.0f s] %s (%s) %s %s -> %s %s %s (%s)%s", time.perf_counter() - t0, r["base"], r["seed"], r["kind"],
+                 r["column"] or "", r["outcome"], r["verdict"] or "", r["confidence"] or "",
+                 "pass" if r["judged"]["pass"] else "FAIL", " CONFIDENT" if r["judged"]["confident"] else "")
+
+
+def main_corrupted(args, nominal, settings, digest) -> int:
+    """``--set corrupted``: every corruption class on each clean case, in ``args.jobs`` processes."""
+    cases = corrupted_cases(args.quick)
+    t0 = time.perf_counter()
+    groups = [None] * len(cases)
+    if args.jobs == 1:
+        for i, c in enumerate(cases):
+            groups[i] = run_corrupted_base(c, n_jobs=2)
+            _log_corrupted(groups[i], t0)
+    else:
+        import multiprocessing as mp
+
+        with cf.ProcessPoolExecutor(args.jobs, mp_context=mp.get_context("spawn")) as ex:
+            futs = {ex.submit(run_corrupted_base, c, 1): i for i, c in enumerate(cases)}
+            for f in cf.as_completed(futs):
+                groups[futs[f]] = f.result()
+                _log_corrupted(groups[futs[f]], t0)
+    rows = [r for g in groups for r in g]
+    summary = summarize_corrupted(rows)
+    summary["wall_time_s"] = time.perf_counter() - t0
+    write_corrupted(args.out, rows, summary, settings, digest, args.quick, None)
+    log.info("corrupted set: confident verdicts on corrupted data: %d of %d; passed %d; false alarms %d of %d "
+             "(%.0f s) -> %s", summary["confident_on_corrupted"], summary["n_corrupted"], summary["passed"],
+             summary["false_alarms"], summary["n_clean"], summary["wall_time_s"], args.out)
+    return 0
+
+
 def main(argv=None) -> int:
     def extra(p):
-        p.add_argument("--set", dest="which", choices=("tuning", "scoring"), required=True,
-                       help="the tuning set (freezes the settings) or the scoring set (needs them frozen)")
+        p.add_argument("--set", dest="which", choices=("tuning", "scoring", "corrupted"), required=True,
+                       help="the tuning set (freezes the settings), the scoring set (needs them frozen) or the "
+                            "corrupted set (corrupted logs: refused or diagnosed with confidence low)")
         p.add_argument("--jobs", type=int, default=2, help="runs diagnosed in parallel processes (default 2)")
         p.add_argument("--runs", default=None, help="keep the generated CSV runs in this folder (default: "
                                                      "a temporary folder, deleted)")
@@ -301,10 +541,12 @@ def main(argv=None) -> int:
     if args.out == ROOT / "reports" / "diagnosis_validation":
         args.out = args.out / args.which
         args.out.mkdir(parents=True, exist_ok=True)
-    cases = validation_cases(args.which, quick=args.quick)
     nominal = parameter_sets()["paper_a"]
     settings = frozen_settings(nominal)
     digest = frozen_digest(nominal, settings)
+    if args.which == "corrupted":
+        return main_corrupted(args, nominal, settings, digest)
+    cases = validation_cases(args.which, quick=args.quick)
     ok, note = _settings_check(args.which, digest)
     if not ok and not args.allow_unfrozen:
         print(f"diagnosis_validation: {note} (--allow-unfrozen scores anyway, flagged)", file=sys.stderr)

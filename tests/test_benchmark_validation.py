@@ -173,3 +173,48 @@ def test_validation_machinery_on_a_tiny_set(tmp_path):
     assert len(m["runs"]) == 3
     assert {g["result"] for g in m["summary"]["goals"]} <= {"PASS", "FAIL", "n/a"}
     assert "## Calibration" in (tmp_path / "report.md").read_text() and (tmp_path / "report.html").is_file()
+
+
+# --------------------------------------------------------------------------- corrupted set (issue 21 item 4)
+def _crow(kind, expect, outcome, confidence=None, warnings=(), message=None, verdict="none", column="wob"):
+    return {"kind": kind, "column": column, "expect": expect, "outcome": outcome, "message": message,
+            "verdict": None if outcome == "refused" else verdict, "confidence": confidence,
+            "warnings": list(warnings), "quality": []}
+
+
+def test_corrupted_set_judges_by_the_named_column():
+    """The corrupted set's pass rule: a refusal or a low verdict counts only when it names the
+    corrupted column; a medium verdict on corrupted data is confident; a torn row dropped by name
+    with the clean verdict passes."""
+    judge = _scenario().judge_corrupted
+    said = "column 'wob': 1 spike(s)"
+    assert judge(_crow("spike", "refuse_or_low", "verdict", "low", [said]), "none") == {"pass": True, "confident": False}
+    assert judge(_crow("spike", "refuse_or_low", "verdict", "medium", [said]), "none") == {"pass": False, "confident": True}
+    assert not judge(_crow("spike", "refuse_or_low", "verdict", "low", ["column 'stroke': 1 spike(s)"]), "none")["pass"]
+    assert not judge(_crow("non_finite", "refuse", "refused", message="run: column 'heave', row 9: non-finite"),
+                     "none")["pass"]
+    torn = "column 'wob': row 7502 (the last) reads 9 against ... torn: dropped"
+    assert judge(_crow("torn", "dropped", "verdict", "high", [torn]), "none") == {"pass": True, "confident": False}
+    assert not judge(_crow("torn", "dropped", "verdict", "high", [torn], verdict="flow_loss"), "none")["pass"]
+    assert judge(_crow("torn", "dropped", "verdict", "high", []), "none") == {"pass": False, "confident": True}
+
+
+def test_corrupted_set_refuses_two_tiny_runs_by_column():
+    """Two tiny corrupted runs (an inf cell, a stroke in cm read as m) read as load_run reads a file:
+    refused naming the column, judged as passes and counted as no confident verdict."""
+    mod = _scenario()
+    from heavecomp.benchmark import corruption
+
+    tr = generate(Case("none", mod.CORRUPTED_SEED0, "none", duration=40.0))
+    rows = []
+    for t, cols, d in (corruption.non_finite(tr.t, tr.columns, "pressure", 100),
+                       corruption.scaled(tr.t, tr.columns, "stroke", 100.0, "magnitude")):
+        row = dict(kind=d["class"], column=d["column"], expect="refuse", base="none", seed=tr.truth["case"]["seed"],
+                   **mod._outcome(t, cols, tr.nominal, "tiny", None, 1))
+        row["judged"] = mod.judge_corrupted(row, None)
+        rows.append(row)
+    assert [r["outcome"] for r in rows] == ["refused", "refused"]
+    assert "column 'pressure'" in rows[0]["message"] and "column 'stroke'" in rows[1]["message"]
+    s = mod.summarize_corrupted(rows)
+    assert (s["n_corrupted"], s["passed"], s["confident_on_corrupted"], s["refused"]) == (2, 2, 0, 2)
+    assert s["goals"][0]["result"] == "PASS" and s["goals"][2]["result"] == "n/a"
