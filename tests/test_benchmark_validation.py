@@ -169,7 +169,7 @@ def test_validation_machinery_on_a_tiny_set(tmp_path):
     mod = _scenario()
     assert mod.main(["--set", "tuning", "--quick", "--jobs", "1", "--out", str(tmp_path)]) == 0
     m = json.loads((tmp_path / "metrics.json").read_text())
-    assert m["settings_hash"] == mod.frozen_digest(G.validation_parameter_sets()["paper_a"], m["settings"])
+    assert m["settings_hash"] == mod.frozen_digest(B.parameter_sets()["paper_a"], m["settings"])
     assert len(m["runs"]) == 3
     assert {g["result"] for g in m["summary"]["goals"]} <= {"PASS", "FAIL", "n/a"}
     assert "## Calibration" in (tmp_path / "report.md").read_text() and (tmp_path / "report.html").is_file()

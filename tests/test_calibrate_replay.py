@@ -27,14 +27,14 @@ CASES = ("string_damping", "parameter_mismatch", "sensor_gain", "none")
 
 @pytest.fixture(scope="module")
 def runs():
-    """case -> a generated run (the one import of the generator: it moves to heavecomp/benchmark/)."""
-    from heavecomp.diagnosis import generator as G
+    """case -> a generated run (the benchmark's generator, :mod:`heavecomp.benchmark`)."""
+    from heavecomp.benchmark import benchmark_case, Case, generate
 
     def make(case):
         if case == "sensor_gain":
-            return G.generate_case(G._case("sensor_gain", 13, "named", duration=DURATION, variant="wob"))
-        return G.generate(case, seed={"string_damping": 11, "parameter_mismatch": 12, "none": 14}[case],
-                          duration=DURATION)
+            return generate(Case("sensor_gain", 13, "named", duration=DURATION, variant="wob"))
+        return generate(benchmark_case(case, seed={"string_damping": 11, "parameter_mismatch": 12, "none": 14}[case],
+                                       duration=DURATION))
 
     return make
 
