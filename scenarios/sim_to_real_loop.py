@@ -26,7 +26,8 @@ from heavecomp.benchmark.truth import TRUTH
 from heavecomp.benchmark.truth.sensor_gain import sensor_gain as truth_sensor_gain
 from heavecomp.closed_loop.loop import Noise, simulate_closed_loop
 from heavecomp.controllers import make
-from heavecomp.diagnosis.calibrate import calibrate, diagnoser
+from heavecomp.diagnosis.calibrate import calibrate
+from heavecomp.diagnosis.estimator import GapDiagnoser
 from heavecomp.effects.spec import check
 from heavecomp.effects.sensor_gain import SensorGain
 from heavecomp.report.figures import save
@@ -121,7 +122,7 @@ def loop_one(name: str, *, seed: int, log_duration: float, loop_duration: float,
     nominal = tr.nominal
     planted = tr.truth["parameters"][name]
     # diagnose, as the command does: the gap diagnosis, then calibrated.toml's model (calibrate)
-    d = diagnoser(nominal, None, n_jobs=1)
+    d = GapDiagnoser(nominal, None, n_jobs=1)
     d.fit(tr.to_run())
     v = d.verdict_
     cal = calibrate(nominal, d.to_json())

@@ -38,7 +38,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 def run(args) -> int:
     """Run ``heavecomp diagnose``: the measured run read and checked against the nominal parameter
-    file, the gap diagnosed (:func:`heavecomp.diagnosis.calibrate.diagnoser`), ``diagnosis.json``,
+    file, the gap diagnosed (:class:`heavecomp.diagnosis.GapDiagnoser`, which replays the file's plant effects too), ``diagnosis.json``,
     ``report.md`` and ``calibrated.toml`` written to ``--out`` and the verdict printed on one line.
 
     Parameters
@@ -62,7 +62,7 @@ def run(args) -> int:
     from pathlib import Path
 
     from heavecomp.diagnosis.data import load_run
-    from heavecomp.diagnosis.calibrate import diagnoser
+    from heavecomp.diagnosis.estimator import GapDiagnoser
     from heavecomp.report.diagnosis import write_report
     from heavecomp.errors import InputError
     from heavecomp.io.series import check_spec, parse_mapping
@@ -90,7 +90,7 @@ def run(args) -> int:
         if not args.quiet:
             print(f"[{time.perf_counter() - t0:6.1f} s {100 * frac:3.0f} %] {msg}", file=sys.stderr, flush=True)
 
-    d = diagnoser(params, cands, split=args.split, settle=args.settle, n_jobs=args.jobs, progress=progress)
+    d = GapDiagnoser(params, cands, split=args.split, settle=args.settle, n_jobs=args.jobs, progress=progress)
     d.fit(run_)
     write_report(d, args.out, title=f"Sim-to-real gap diagnosis — {run_.source}")
     _record_measurement(Path(args.out) / "diagnosis.json", run_.measurement)

@@ -314,26 +314,10 @@ def write(nominal, diagnosis: dict, out_dir, source: str = "") -> Calibrated:
 
 
 # ------------------------------------------------------------------------------------ replay
-def diagnoser(params, *args, **kw) -> GapDiagnoser:
-    """The gap diagnoser of ``params`` (:class:`GapDiagnoser`: its replays run the file's plant effects,
-    ``[[effects]]``, at their hooks; a candidate of the same effect refits it).
-
-    Parameters
-    ----------
-    params : CMCParams
-        The nominal parameters (with their ``[[effects]]``).
-    *args : tuple
-        Passed on to the diagnoser's constructor (:class:`GapDiagnoser`'s arguments).
-    **kw : dict
-        Passed on likewise (keyword arguments such as ``split``, ``n_jobs``).
-    """
-    return GapDiagnoser(params, *args, **kw)
-
-
 def _replay(params, run):
     """The diagnosis' replay of ``run`` (a :class:`~heavecomp.diagnosis.data.MeasuredRun`) with the model
     ``params`` (its plant effects included): channel -> array at the run's times."""
-    d = diagnoser(params)  # its settings: the replay's grid, heave and start estimated from the log, as in fit()
+    d = GapDiagnoser(params)  # its settings: the replay's grid, heave and start estimated from the log, as in fit()
     rp = R.build(run, params, stuck_speed=d.stuck_speed, segment=d.segment, reinit=d.reinit, noise=R.output_noise(run))
     return rp.simulate([])
 
@@ -391,4 +375,4 @@ def replay_shrink(path, calibrated, nominal, diagnosis: dict, *, columns=None, u
             "agreement": agree}
 
 
-__all__ = ["Calibrated", "calibrate", "diagnoser", "replay_shrink", "to_toml", "write"]
+__all__ = ["Calibrated", "calibrate", "replay_shrink", "to_toml", "write"]
