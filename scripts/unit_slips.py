@@ -49,6 +49,7 @@ def slips():
     """Yield (label, key, factor, value, message or None) for every slip."""
     from heavecomp.errors import ParameterError
     from heavecomp.params import from_dict
+    from heavecomp.params.plausibility import check_file
 
     for label, base in variants():
         for table, keys in base.items():
@@ -60,8 +61,8 @@ def slips():
                 for factor in FACTORS:
                     d = {t: dict(v) for t, v in base.items()}
                     d[table][key] = value * factor
-                    try:
-                        from_dict(d)
+                    try:  # what reading a parameter file runs (params.loads: from_dict, then the file checks)
+                        check_file(from_dict(d))
                         msg = None
                     except ParameterError as exc:
                         msg = str(exc)

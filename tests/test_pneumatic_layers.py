@@ -15,7 +15,8 @@ WING = {"heavecomp.pneumatic.friction": 1, "heavecomp.pneumatic.plant": 1, "heav
         "heavecomp.test_rig.plant": 1}
 #: what a wing module may import from the rest of the package, with the layer it sits in
 OUTSIDE = {"heavecomp.errors": 0, "heavecomp.params": 0, "heavecomp.signals": 0, "heavecomp.friction": 1,
-           "heavecomp.plants": 1, "heavecomp.simulate._kernel": 2, "heavecomp.analysis.linear": 5}
+           "heavecomp.plants": 1, "heavecomp.simulate._kernel": 2, "heavecomp.simulate.cache": 2,
+           "heavecomp.analysis.linear": 5}
 
 
 def _imports(path: Path):

@@ -374,7 +374,9 @@ def loads(text_: str, *, base_dir: Path | None = None, source: str = "<string>")
     except RecursionError:  # tomllib parses nested inline tables / arrays recursively
         raise ParameterError(f"{source}: not valid TOML for a parameter file: tables or arrays nested too deep "
                              "(a parameter file is one level of tables)") from None
-    return from_dict(data, base_dir=base_dir)
+    p = from_dict(data, base_dir=base_dir)
+    plausibility.check_file(p)  # what only a file can get wrong (a unit slip of the heave)
+    return p
 
 
 def load(path: str | Path, *, heave_file: bool = True) -> CMCParams:

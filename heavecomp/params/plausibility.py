@@ -203,15 +203,30 @@ def _get(p, dotted: str) -> float:
     return getattr(getattr(p, table), key)
 
 
-def _check_sea(h) -> None:
-    """The heave's size: not below :data:`HEAVE_MIN` unless 0, and its largest crest to trough within the
-    longest stroke (:data:`STROKE_MAX`)."""
+def check_file(p) -> None:
+    """Checks of what a parameter *file* says (``heavecomp.params.load``/``loads``), beyond :func:`check`:
+    a non-zero heave under :data:`HEAVE_MIN` is a unit slip there (1 mm written for 1 m).  A set built in
+    code for a study may go lower (the CMC stick map scans breakout amplitudes of a few millimetres).
+
+    Parameters
+    ----------
+    p : CMCParams
+        The parameter set read from the file.
+    """
+    h = p.heave
     if h is None or h.kind == "file":
         return
     key, x = ("heave.amplitude", h.amplitude) if h.kind == "sine" else ("heave.hs", h.hs)
     if 0 < x < HEAVE_MIN:
         raise ParameterError(f"{key} = {_g(x)} m is under {100 * HEAVE_MIN:g} cm: no sea moves a drilling unit that "
                              "little and no motion sensor resolves it (write 0 for no heave), or a unit slip by 1000?")
+
+
+def _check_sea(h) -> None:
+    """The heave's largest crest to trough within the longest stroke (:data:`STROKE_MAX`)."""
+    if h is None or h.kind == "file":
+        return
+    key, x = ("heave.amplitude", h.amplitude) if h.kind == "sine" else ("heave.hs", h.hs)
     span, how = (2 * x, "2 x heave.amplitude") if h.kind == "sine" else (HMAX_PER_HS * x, f"the largest wave, {HMAX_PER_HS:g} x heave.hs")
     if span > STROKE_MAX:
         raise ParameterError(f"{key} = {_g(x)} m: {how} = {_g(span)} m crest to trough is longer than any compensator's "

@@ -9,6 +9,7 @@ from pathlib import Path
 
 from heavecomp.diagnosis.calibrate import FILE, Calibrated, write
 from heavecomp.effects.spec import field_units
+from heavecomp.report.provenance import strip_declared
 
 
 #: a refitted parameter that moved less than this share is listed as refit noise, not as a change to make
@@ -100,7 +101,9 @@ def write_calibrated(params, out_dir, *, run_path: str, params_path: str) -> Cal
     out = Path(out_dir)
     jpath = out / "diagnosis.json"
     d = json.loads(jpath.read_text(encoding="utf-8"))
-    cal = write(params, d, out, source=f"{run_path} against {params_path}")
+    # the fitted values without the unit declarations the writer put beside them (provenance strips those
+    # when the run folder is finished, after this)
+    cal = write(params, strip_declared(d), out, source=f"{run_path} against {params_path}")
     d["calibrated"] = cal.block(FILE)
     jpath.write_text(json.dumps(d, indent=2) + "\n", encoding="utf-8")
     md = out / "report.md"
