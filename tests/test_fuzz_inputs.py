@@ -293,7 +293,8 @@ def check_run_promise(tab: Table, expected, tmp: Path, capsys):
     path = write_table(tab, tmp / "run.csv")
     argv = ["diagnose", str(path), "--params", str(nominal), "--out", str(tmp / "out"), "--quiet", *tab.argv]
     t0 = time.perf_counter()
-    with mock.patch("heavecomp.diagnosis.estimator.GapDiagnoser", _Probe):
+    # the command builds its diagnoser through calibrate.diagnoser (the file's effects in every replay)
+    with mock.patch("heavecomp.diagnosis.calibrate.GapDiagnoser", _Probe):
         try:
             rc = main(argv)
             run = None
