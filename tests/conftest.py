@@ -1,3 +1,4 @@
+import inspect
 from pathlib import Path
 import subprocess
 import sys
@@ -34,3 +35,25 @@ def diagnose_cli(tmp_path):
                                "--out", str(tmp_path / "o"), *extra], capture_output=True, text=True)
 
     return run
+
+
+@pytest.fixture(scope="session")
+def once():
+    """``once(make, *args, **kwargs)``: ``make(*args, **kwargs)``, computed on first use and shared
+    by every test of the session that asks for the same call.
+
+    For the planted runs of the diagnosis tests: a maker that generates a run and diagnoses it runs once
+    per distinct call (keyed by the maker's qualified name and the ``repr`` of its bound arguments,
+    defaults filled in), so tests that check different things about one diagnosed run fit it once.
+    The result is shared: a test only reads it.  Under ``pytest -n`` each worker has its own session."""
+    done = {}
+
+    def get(make, *args, **kwargs):
+        call = inspect.signature(make).bind(*args, **kwargs)
+        call.apply_defaults()  # a default written out or left out is the same call
+        key = (make.__module__, make.__qualname__, repr(sorted(call.arguments.items())))
+        if key not in done:
+            done[key] = make(*args, **kwargs)
+        return done[key]
+
+    return get

@@ -17,6 +17,8 @@ from heavecomp.simulate import excitation
 from heavecomp.diagnosis.stepper import replay_dt
 
 DUR = 90.0
+#: the truth of the parameter-mismatch run: gas spring and string stiffness moved
+MISMATCH = paper_a().replace(compensator={"gas_stiffness": 60e3}, drill_string={"stiffness": 1.2e6})
 
 
 def _planted(name, values, *, amplitude_hs=2.5, seed=4, params=None):
@@ -43,6 +45,13 @@ def _planted(name, values, *, amplitude_hs=2.5, seed=4, params=None):
     return nominal, check_run(t, cols, params=nominal)
 
 
+def _diagnosed(name, values, *, amplitude_hs=2.5, params=None):
+    """A run planted with ``name``'s own law, fitted with that candidate alone (shared through the
+    session fixture ``once``: tests reading the same planted run fit it once)."""
+    nominal, run = _planted(name, values, amplitude_hs=amplitude_hs, params=params)
+    return nominal, run, GapDiagnoser(nominal, [name], n_jobs=1, second=0, settle=10.0).fit(run)
+
+
 CASES = [
     ("friction_lag", {"lag_time": 0.5, "drop_time": 0.5}, 0.3),
     ("dwell_stiction", {"gain": 1e4, "exponent": 0.5}, 0.3),  # calm sea (H_s 1 m): long dwells
@@ -60,9 +69,8 @@ CASES = [
 
 
 @pytest.mark.parametrize("name,values,rtol", CASES, ids=[c[0] for c in CASES])
-def test_candidate_recovers_planted_parameters(name, values, rtol):
-    nominal, run = _planted(name, values, amplitude_hs=1.0 if name == "dwell_stiction" else 2.5)
-    d = GapDiagnoser(nominal, [name], n_jobs=1, second=0, settle=10.0).fit(run)
+def test_candidate_recovers_planted_parameters(name, values, rtol, once):
+    _, _, d = once(_diagnosed, name, values, amplitude_hs=1.0 if name == "dwell_stiction" else 2.5)
     got = d.candidates_[0]["parameters"]
     for k, v in values.items():
         if isinstance(v, str):
@@ -73,11 +81,8 @@ def test_candidate_recovers_planted_parameters(name, values, rtol):
 
 
 @pytest.mark.slow
-def test_parameter_mismatch_names_what_moved():
-    nominal = paper_a()
-    truth = nominal.replace(compensator={"gas_stiffness": 60e3}, drill_string={"stiffness": 1.2e6})
-    nominal, run = _planted("parameter_mismatch", {}, params=truth)
-    d = GapDiagnoser(nominal, ["parameter_mismatch"], n_jobs=1, second=0, settle=10.0).fit(run)
+def test_parameter_mismatch_names_what_moved(once):
+    _, _, d = once(_diagnosed, "parameter_mismatch", {}, params=MISMATCH)
     got = d.candidates_[0]["parameters"]
     assert got["compensator.gas_stiffness"] == pytest.approx(60e3, rel=0.1)
     assert got["drill_string.stiffness"] == pytest.approx(1.2e6, rel=0.15)
@@ -85,16 +90,14 @@ def test_parameter_mismatch_names_what_moved():
 
 
 @pytest.mark.slow
-def test_parameter_mismatch_rescan_leaves_the_stick_slip_side_minimum():
+def test_parameter_mismatch_rescan_leaves_the_stick_slip_side_minimum(once):
     """The side minimum a local fit reached on another kernel (F_S 12.5 kN against 23 kN, F_C's
     multiplier clipped): started there, the plain fit stays; the rescan of the rugged static
     force finds the truth's basin, on the fit part's cost alone."""
     from heavecomp.diagnosis import fitting as F
     from heavecomp.effects.candidates import ParameterMismatch as PM
 
-    truth = paper_a().replace(compensator={"gas_stiffness": 60e3}, drill_string={"stiffness": 1.2e6})
-    nominal, run = _planted("parameter_mismatch", {}, params=truth)
-    d = GapDiagnoser(nominal, ["parameter_mismatch"], n_jobs=1, second=0, settle=10.0).fit(run)
+    nominal, _, d = once(_diagnosed, "parameter_mismatch", {}, params=MISMATCH)
     t_end = d.split_["fit"][1]
     lo, hi = PM.bounds_x()
 
@@ -116,30 +119,29 @@ def test_parameter_mismatch_rescan_leaves_the_stick_slip_side_minimum():
     assert got["drill_string.stiffness"] == pytest.approx(1.2e6, rel=0.15)
 
 
-def test_constant_offset_is_not_charged_for_a_drift():
+def test_constant_offset_is_not_charged_for_a_drift(once):
     """An absolute-instead-of-gauge pressure (a constant offset) is fitted with its drift held at 0
     and one parameter counted, so the parsimony penalty does not favour a calibration gain, which
     reads the same when the pressure swings little about its mean; a drifting offset keeps both."""
-    nominal, run = _planted("sensor_offset", {"channel": "pressure", "offset": 101325.0}, amplitude_hs=2.5)
-    row = GapDiagnoser(nominal, ["sensor_offset"], n_jobs=1, second=0, settle=10.0).fit(run).candidates_[0]
+    row = once(_diagnosed, "sensor_offset", {"channel": "pressure", "offset": 101325.0})[2].candidates_[0]
     assert row["parameters"]["offset"] == pytest.approx(101325.0, rel=0.05)
     assert row["parameters"]["drift"] == 0.0 and row["n_params"] == 1
-    nominal, run = _planted("sensor_offset", {"channel": "pressure", "offset": 1e5, "drift": 100.0}, amplitude_hs=2.5)
-    row = GapDiagnoser(nominal, ["sensor_offset"], n_jobs=1, second=0, settle=10.0).fit(run).candidates_[0]
+    # the run of test_candidate_recovers_planted_parameters[sensor_offset], fitted once
+    row = once(_diagnosed, "sensor_offset", {"channel": "pressure", "offset": 1e5, "drift": 100.0},
+               amplitude_hs=2.5)[2].candidates_[0]
     assert row["n_params"] == 2 and row["parameters"]["drift"] == pytest.approx(100.0, rel=0.05)
 
 
 @pytest.mark.parametrize("name,values", [("sensor_offset", {"channel": "stroke", "offset": 0.03}),
                                          ("sensor_gain", {"channel": "wob", "factor": 1.08})],
                          ids=["stroke_offset", "wob_gain"])
-def test_misread_start_channel_is_recovered(name, values):
+def test_misread_start_channel_is_recovered(name, values, once):
     """Stroke and WOB also set the replay's start and heave reference: a stroke read 3 cm off (or a WOB
     read 8 % high) starts the nominal replay off by as much, so the channel itself follows the log and
     the misreading shows in the other channels.  The reading is fitted through the replay it starts:
     the planted value back within 5 % and most of the gap explained (the start from the misread channel
     left 0.62 explained and the wrong channel on a validation run)."""
-    nominal, run = _planted(name, dict(values, **({"drift": 0.0} if name == "sensor_offset" else {})))
-    d = GapDiagnoser(nominal, [name], n_jobs=1, second=0, settle=10.0).fit(run)
+    _, _, d = once(_diagnosed, name, dict(values, **({"drift": 0.0} if name == "sensor_offset" else {})))
     row = d.candidates_[0]
     assert row["parameters"]["channel"] == values["channel"]
     key = "offset" if name == "sensor_offset" else "factor"

@@ -293,7 +293,8 @@ def check_run_promise(tab: Table, expected, tmp: Path, capsys):
     path = write_table(tab, tmp / "run.csv")
     argv = ["diagnose", str(path), "--params", str(nominal), "--out", str(tmp / "out"), "--quiet", *tab.argv]
     t0 = time.perf_counter()
-    with mock.patch("heavecomp.diagnosis.estimator.GapDiagnoser", _Probe):
+    # the command builds its diagnoser through calibrate.diagnoser (the file's effects in every replay)
+    with mock.patch("heavecomp.diagnosis.calibrate.GapDiagnoser", _Probe):
         try:
             rc = main(argv)
             run = None
@@ -490,9 +491,9 @@ def test_fuzz_heave_files_long(case, tmp_path_factory, capsys, warm):
 # ---------------------------------------------------------------- as a user runs it: subprocesses
 @pytest.mark.parametrize("content", [
     b"\x89PNG\r\n\x1a\n" + bytes(range(256)) * 8,
-    gzip.compress(b"t;heave;stroke;pressure;wob\n0;0,1;0;2,4;98\n"),
+    gzip.compress(b"t;heave;stroke;pressure;wob\n0;0,1;0;2,4;98\n", mtime=0),
     "t,heave,stroke,pressure,wob\n".encode("utf-16"),
-])
+], ids=["binary", "gzip_semicolons", "utf16"])  # ids, not the bytes (gzip's header held the time of collection)
 def test_subprocess_odd_logs_one_line(tmp_path, content):
     f = tmp_path / "log.csv"
     f.write_bytes(content)
