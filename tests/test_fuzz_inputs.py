@@ -294,7 +294,7 @@ def check_run_promise(tab: Table, expected, tmp: Path, capsys):
     argv = ["diagnose", str(path), "--params", str(nominal), "--out", str(tmp / "out"), "--quiet", *tab.argv]
     t0 = time.perf_counter()
     # the command builds its diagnoser through calibrate.diagnoser (the file's effects in every replay)
-    with mock.patch("heavecomp.diagnosis.calibrate.GapDiagnoser", _Probe):
+    with mock.patch("heavecomp.diagnosis.estimator.GapDiagnoser", _Probe):  # diagnose builds it at call time
         try:
             rc = main(argv)
             run = None
