@@ -48,7 +48,7 @@ def _ends(cls):
     return out
 
 
-def _states(comp, cls):
+def _states(comp):
     """Effect-state values to sample: 0 and a spread of positive and negative memories."""
     n = comp.n_states
     if not n:
@@ -67,7 +67,7 @@ def test_effect_dissipates_at_both_ends_of_its_bounds(name, model):
     checked = 0
     for values in _ends(cls):
         EP = comp.ep([cls(**values)])
-        for mem, s, v, p in itertools.product(_states(comp, cls), STROKES, VELOCITIES, PRESSURES):
+        for mem, s, v, p in itertools.product(_states(comp), STROKES, VELOCITIES, PRESSURES):
             X = (s, v, 0.0, 0.0) + tuple(mem)
             Xm = (s, -v, 0.0, 0.0) + tuple(mem)
             if cls.hook == "seal_friction":

@@ -346,6 +346,23 @@ class GapDiagnoser(GapEstimator):
         iso = ST.isolability(self.sensors_, self.candidates, level="shape")
         return {"detectable": iso["detectable"], "groups": iso["groups"], "level": iso["level"]}
 
+    def verdict_group(self, iso=None):
+        """The isolability group of a named verdict (``verdict.group``; the effect alone when it is
+        isolable), or None for ``none``, ``inconclusive`` and ``discovered``.
+
+        Parameters
+        ----------
+        iso : dict, optional
+            :meth:`isolability`'s answer (computed when not given).
+        """
+        v = self.verdict_
+        named = v.get("effect")
+        if named in ("none", "inconclusive", "discovered", None):
+            return None
+        channel = (v.get("parameters") or {}).get("channel")
+        group = ST.group_of(f"{named}:{channel}" if channel else named, self.isolability() if iso is None else iso)
+        return group if group else [named]
+
     def to_json(self) -> dict:
         """The ``diagnosis.json`` content (contract schema 3: schema 1's keys, plus ``verdict.component``,
         ``verdict.discovered``, ``gap.where.components``, ``initial_state``, ``warnings`` (schema 2),
@@ -353,11 +370,9 @@ class GapDiagnoser(GapEstimator):
         the command that writes ``calibrated.toml``); extras: ``prescreen``)."""
         v = dict(self.verdict_)
         iso = self.isolability()
-        named = v.get("effect")
-        if named not in ("none", "inconclusive", "discovered", None):
-            channel = (v.get("parameters") or {}).get("channel")
-            group = ST.group_of(f"{named}:{channel}" if channel else named, iso)
-            v["group"] = group if group else [named]
+        group = self.verdict_group(iso)
+        if group is not None:
+            v["group"] = group
         return {"schema": 3,
                 "sensors": list(self.sensors_),
                 "isolability": iso,

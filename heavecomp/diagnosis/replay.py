@@ -56,6 +56,8 @@ class Replay:
     spline: object
     initial: S.InitialState
     stuck_speed: float
+    #: the parameter file's own plant effects (``[[effects]]``), resolved once: part of every replay
+    file_effects: tuple = ()
     #: segment starts per stroke/WOB reading (:meth:`start_for`), filled as configurations ask
     cache: dict = dataclasses.field(default_factory=dict, compare=False, repr=False)
 
@@ -73,7 +75,7 @@ class Replay:
         plant = self.plant
         # the parameter file's own plant effects ([[effects]], e.g. a calibrated model) are part of the
         # model in every replay; a candidate of the same effect refits it
-        file_fx = plant_effects(self.nominal)
+        file_fx = self.file_effects
         effects, sensors = list(file_fx), []
         # a channel that misreads also misled the start estimate: start from its true reading
         shift, starts = self.start_for([(n, v) for n, v in config if get(n).kind == "output"])
@@ -177,7 +179,8 @@ def build(run, nominal, *, stuck_speed=S.STUCK_SPEED, segment=None, reinit=1.5, 
     if segment:
         bounds, starts, rein = _segments(run, h, n_steps, plant.PP, segment, reinit, stuck_speed)
         starts[0] = initial.start()
-    return Replay(run, nominal, h, n_steps, hs, plant, bounds, starts, rein, spline, initial, stuck_speed)
+    return Replay(run, nominal, h, n_steps, hs, plant, bounds, starts, rein, spline, initial, stuck_speed,
+                  tuple(plant_effects(nominal)))
 
 
 def grid(run, nominal) -> tuple:

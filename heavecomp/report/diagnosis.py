@@ -377,11 +377,10 @@ def _isolability_lines(diag) -> list:
                   "in one names its group, `verdict.group`):", "",
                   *[f"- {', '.join(f'`{m}`' for m in g)}" for g in groups]]
     v = diag.verdict_
-    if v.get("effect") not in ("none", "inconclusive", "discovered"):
-        group = diag.to_json()["verdict"].get("group", [v["effect"]])
-        if len(group) > 1:
-            lines += ["", f"The verdict `{v['effect']}` lies in the group {', '.join(f'`{m}`' for m in group)}: "
-                      "it fitted best among effects this sensor set cannot tell apart by structure."]
+    group = diag.verdict_group(iso)
+    if group is not None and len(group) > 1:
+        lines += ["", f"The verdict `{v['effect']}` lies in the group {', '.join(f'`{m}`' for m in group)}: "
+                  "it fitted best among effects this sensor set cannot tell apart by structure."]
     return lines
 
 
