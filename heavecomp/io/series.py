@@ -486,7 +486,7 @@ def _mat_table(data: bytes, src: str):
 
 # ---------------------------------------------------------------- streamed reading
 #: decompressed text parsed per chunk [bytes]: with the float arrays of the columns, the reader's memory
-CHUNK_BYTES = 8 << 20
+CHUNK_BYTES = 4 << 20
 #: the first chunk [bytes] (the header is sniffed from it; it takes the checked, cell-by-cell path)
 FIRST_CHUNK_BYTES = 256 << 10
 #: rows per chunk of a Parquet file
@@ -591,17 +591,23 @@ def _decoded(dec, raw: bytes, offset: int, final: bool) -> str:
 _NA_PARSER = sorted({v for x in NA for v in (x, x.upper(), x.title())})
 
 
-def _fast_chunk(raw: bytes, text: str, nlines: int, sep, decimal, n: int, kinds: list):
+#: line breaks other than LF and CRLF (``str.splitlines`` splits at them; the C parser does not)
+_ODD_BREAKS = ("\x0b", "\x0c", "\x1c", "\x1d", "\x1e", "\x85", "\u2028", "\u2029")
+
+
+def _fast_chunk(raw: bytes, text: str, sep, decimal, n: int, kinds: list, encoding: str):
     """Parse a clean chunk without Python strings (pandas' C parser, float64): every line a data row of
     exactly ``n`` fields, no quote, no comment, no blank line.  Otherwise, or on any parser complaint,
     None: the chunk takes the checked path, which names the row of every problem.  ``kinds`` per column:
-    ``"float"``, ``"text"`` (ISO time) or ``"drop"`` (a text column carried nowhere)."""
-    if sep is None or n < 2 or '"' in text or "#" in text:
+    ``"float"``, ``"text"`` (ISO time) or ``"drop"`` (a text column carried nowhere).  Returns
+    ``(columns, rows)``."""
+    if sep is None or n < 2 or '"' in text or "#" in text or text.count("\r") != text.count("\r\n") \
+            or any(c in text for c in _ODD_BREAKS):
         return None
     b = np.frombuffer(raw, dtype=np.uint8)
     nl = np.flatnonzero(b == 10)
     rows = nl.size + (1 if raw[-1:] != b"\n" else 0)
-    if rows != nlines or rows == 0:  # another line break (a lone CR, form feed...) splitlines counts
+    if rows == 0:
         return None
     ends = np.append(nl, b.size) if rows > nl.size else nl
     seps = np.flatnonzero(b == ord(sep))
@@ -613,7 +619,7 @@ def _fast_chunk(raw: bytes, text: str, nlines: int, sep, decimal, n: int, kinds:
 
     use = [j for j, k in enumerate(kinds) if k != "drop"]
     try:
-        df = pd.read_csv(io.StringIO(text), sep=sep, header=None, names=list(range(n)), usecols=use,
+        df = pd.read_csv(io.BytesIO(raw), encoding="utf-8" if encoding == "utf-8-sig" else encoding, sep=sep, header=None, names=list(range(n)), usecols=use,
                          dtype={j: (np.float64 if kinds[j] == "float" else object) for j in use},
                          decimal=decimal, keep_default_na=False, na_values=_NA_PARSER, engine="c",
                          skip_blank_lines=False, quoting=csv.QUOTE_NONE)
@@ -623,7 +629,7 @@ def _fast_chunk(raw: bytes, text: str, nlines: int, sep, decimal, n: int, kinds:
         return None
     return [None if kinds[j] == "drop" else
             df[j].to_numpy(dtype=np.float64) if kinds[j] == "float" else df[j].astype(str).tolist()
-            for j in range(n)]
+            for j in range(n)], rows
 
 
 def _checked_chunk(lines, base: int, sep, n: int, src: str, skip_first: bool = False):
@@ -661,13 +667,16 @@ def _csv_chunks(stream, src: str, info: dict, comp, encoding: str, kinds: list):
         yield _checked_chunk(lines, base, sep, n, src, skip_first=has_header)
         base += len(lines)
         for raw_k, text_k in chunks:
-            lines_k = text_k.splitlines()
-            cols = _fast_chunk(raw_k, text_k, len(lines_k), sep, decimal, n, kinds) if kinds else None
-            if cols is not None:
-                yield cols, base + 1 + np.arange(len(lines_k))
+            got = _fast_chunk(raw_k, text_k, sep, decimal, n, kinds, encoding) if kinds else None
+            if got is not None:
+                cols, count = got
+                yield cols, base + 1 + np.arange(count)
             else:
+                lines_k = text_k.splitlines()
+                count = len(lines_k)
                 yield _checked_chunk(lines_k, base, sep, n, src)
-            base += len(lines_k)
+                del lines_k
+            base += count
 
     return header, rows()
 
@@ -807,9 +816,13 @@ def read_series(path, required=("t",), *, optional=(), columns=None, units=None,
             break
         except _NotUTF8 as exc:
             byte = exc.byte
-    out = {k: (v[0] if len(v) == 1 else np.concatenate(v)) for k, v in parts.items()}
-    del parts
+    out = {}
+    for k in list(parts):  # one column at a time, its chunks freed as it is joined
+        v = parts.pop(k)
+        out[k] = v[0] if len(v) == 1 else np.concatenate(v)
+        del v
     lines = rows[0] if len(rows) == 1 else np.concatenate(rows)
+    del rows
     info = meta.measurement
     if "t" in out:
         _check_time_unit(out["t"], info.get("_t_declared", False), meta.source, info["columns"]["t"])
