@@ -52,6 +52,7 @@ from heavecomp.diagnosis.replay import CH
 from heavecomp.effects.candidates import CANDIDATES, get
 from heavecomp.errors import InputError
 from heavecomp.estimator import GapEstimator
+from heavecomp.params.budget import check_diagnosis_memory
 from heavecomp.diagnosis.quality import apply_quality
 
 log = logging.getLogger(__name__)
@@ -207,6 +208,10 @@ class GapDiagnoser(GapEstimator):
         P = self.verdict_policy()
         # the log's sensor set (contract schema 3: heave required; the reader asks for all four today)
         self.sensors_ = tuple(c for c in ST.CHANNELS if c in run.columns and np.isfinite(run[c]).any())
+        # the whole diagnosis' memory, estimated before any replay: refused by name when it cannot fit
+        _h, n_steps = R.grid(run, self.nominal)  # over the replay budget: refused naming the log's length
+        check_diagnosis_memory(run.t.size, n_steps, jobs=self.n_jobs, duration=run.duration, rate=1.0 / run.dt,
+                               source=run.source)
         self._report(0.02, "replaying the nominal model")
         ctx = R.prepare(run, self.nominal, split=self.split, settle=self.settle, stuck_speed=self.stuck_speed,
                         segment=self.segment, reinit=self.reinit, input_draws=self.input_draws,
