@@ -66,7 +66,7 @@ def run(args) -> int:
     from pathlib import Path
 
     from heavecomp.diagnosis.data import load_run
-    from heavecomp.diagnosis.estimator import GapDiagnoser
+    from heavecomp.diagnosis.estimator import GapDiagnoser, check_memory
     from heavecomp.report.diagnosis import write_report
     from heavecomp.errors import InputError
     from heavecomp.io.series import check_spec, parse_mapping
@@ -93,9 +93,9 @@ def run(args) -> int:
                          f"{MIN_DURATION:g} s (a fitted and a held-out part of several wave periods each)")
     span = SP.choose(run_.duration, wanted, min_duration=MIN_DURATION)
     run_ = SP.cut(run_, span)  # the whole log's arrays are dropped here
-    # GapDiagnoser.fit estimates the whole diagnosis' memory before any replay (refused by name)
-    if not span.whole and not args.quiet:
-        print(f"diagnose: {span.reason}", file=sys.stderr, flush=True)
+    check_memory(run_, params, args.jobs)  # the whole diagnosis' memory (fit checks it too): refused in one line
+    if not span.whole:  # never silent, --quiet or not
+        print(f"diagnose: {span.reason} (--span START:END names another)", file=sys.stderr, flush=True)
     t0 = time.perf_counter()
 
     def progress(frac, msg):
