@@ -60,3 +60,31 @@ def test_the_cut_restarts_the_clock_and_says_why():
     assert cut.warnings[-1].startswith("analysed span: the log is 3000 s long: the diagnosis analyses its last 600 s")
     assert SP.cut(run, SP.choose(run.duration, (0.0, None))) is not run
     assert SP.cut(cut, SP.choose(cut.duration)) is cut  # whole: unchanged
+
+
+@pytest.mark.slow
+def test_diagnose_names_the_span_of_a_long_log_in_every_result(tmp_path, capsys):
+    """A 1500 s log: the last 600 s are diagnosed, and stderr, diagnosis.json and the report say so."""
+    import json
+
+    from heavecomp.benchmark.long_logs import long_log
+    from heavecomp.cli import main
+    from heavecomp.params import dumps
+
+    run = long_log([], seed=3, duration=1500.0, rate=10.0)
+    log = tmp_path / "long.csv"
+    cols = ("heave", "stroke", "pressure", "wob")
+    np.savetxt(log, np.column_stack([run.t] + [run.columns[c] for c in cols]), delimiter=",",
+               header="t," + ",".join(cols), comments="", fmt="%.10g")
+    nominal = tmp_path / "nominal.toml"
+    nominal.write_text(dumps(run.nominal))
+    out = tmp_path / "out"
+    rc = main(["diagnose", str(log), "--params", str(nominal), "--out", str(out), "--quiet",
+               "--candidates", "flow_loss"])
+    err = capsys.readouterr().err
+    assert rc == 0, err
+    assert "diagnose: the log is 1500 s long: the diagnosis analyses its last 600 s" in err and "--span" in err
+    d = json.loads((out / "diagnosis.json").read_text())
+    assert d["span"]["rule"] == "last" and d["span"]["start_s"] == 900.0 and d["span"]["end_s"] == 1500.0
+    assert abs(d["split"]["validate"][1] - 600.0) < 0.2  # the diagnosis' clock is the span's
+    assert "analysed span: the log is 1500 s long" in (out / "report.md").read_text()
