@@ -1,5 +1,7 @@
 """A log too long to replay is refused before any work, in one line (the run-size budget)."""
 
+import re
+
 import numpy as np
 import pytest
 
@@ -82,3 +84,27 @@ def test_the_command_refuses_before_any_replay(tmp_path, capsys, monkeypatch):
     assert rc == 2 and len(err.splitlines()) == 1 and "Traceback" not in err, err
     # the default span of a 3000 s log is its last 600 s: that is what the estimate is about
     assert "the diagnosis of 600 s would take" in err and "--span" in err and "--jobs" in err, err
+
+
+def test_a_log_too_long_to_read_is_refused_before_reading(tmp_path, capsys, monkeypatch):
+    from heavecomp.cli import main
+    from heavecomp.diagnosis import data
+    from heavecomp.params import dumps
+
+    nominal = tmp_path / "nominal.toml"
+    nominal.write_text(dumps(paper_a()))
+    log = tmp_path / "log.csv"
+    log.write_text("t,heave,stroke,pressure,wob\n" + "".join(f"{0.1 * k:.1f},0.1,0.1,1e7,2e5\n" for k in range(20000)))
+
+    def no_read(*a, **k):
+        raise AssertionError("the log was read before the memory check")
+
+    monkeypatch.setattr(data, "load_run", no_read)
+    monkeypatch.setattr(B, "available_bytes", lambda: (1e6, "the memory available on this machine", 0.0))
+    rc = main(["diagnose", str(log), "--params", str(nominal), "--out", str(tmp_path / "out"), "--quiet"])
+    err = capsys.readouterr().err.strip()
+    assert rc == 2 and len(err.splitlines()) == 1, err
+    assert re.search(r"reading and checking the log's 2(\.\d+)?e\+04 rows \(estimated from its size\) would take", err)
+    assert "cut the log into parts" in err
+    # rows not known before reading (bzip2): nothing is refused up front
+    assert B.check_read_memory(None, source="x.csv.bz2", available=(0.0, "", 0.0)) == 0.0

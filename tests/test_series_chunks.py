@@ -132,3 +132,21 @@ def test_too_many_samples_are_refused_by_name(tmp_path, small_chunks, monkeypatc
         S.read_series(_write(tmp_path / "log.csv", _table()), COLS)
     msg = str(e.value)
     assert "MB of samples by row" in msg and "cut the log into parts" in msg and "\n" not in msg
+
+
+def test_the_rows_are_estimated_from_the_size_before_reading(tmp_path):
+    import bz2
+
+    data = _table(5000)
+    plain = _write(tmp_path / "log.csv", data)
+    gz = _write(tmp_path / "log.csv.gz", data)
+    for f in (plain, gz):
+        assert abs(S.estimate_rows(f) - 5000) < 250, f
+    (tmp_path / "log.csv.bz2").write_bytes(bz2.compress(plain.read_bytes()))
+    assert S.estimate_rows(tmp_path / "log.csv.bz2") is None  # bzip2 does not record its size
+    assert S.estimate_rows(tmp_path / "missing.csv") is None  # the reader names what is wrong
+    pa = pytest.importorskip("pyarrow")
+    import pyarrow.parquet as pq
+
+    pq.write_table(pa.table({c: data[:, j] for j, c in enumerate(COLS)}), tmp_path / "log.parquet")
+    assert S.estimate_rows(tmp_path / "log.parquet") == 5000

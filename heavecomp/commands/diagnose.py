@@ -87,6 +87,10 @@ def run(args) -> int:
     from heavecomp.diagnosis import span as SP
 
     wanted = SP.parse(args.span)  # a malformed span fails before the log is read
+    from heavecomp.io.series import estimate_rows, short
+    from heavecomp.params.budget import check_read_memory
+
+    check_read_memory(estimate_rows(args.run), source=short(args.run))  # the whole-log pass, before reading
     run_ = load_run(args.run, params, columns=columns, units=units)  # read in chunks, checked whole
     if run_.duration < MIN_DURATION:
         raise InputError(f"{run_.source}: column 't': the run spans {run_.duration:.3g} s; diagnose needs at least "

@@ -179,6 +179,37 @@ DIAGNOSIS_STEP_BYTES = 3500.0
 DIAGNOSIS_JOB_STEP_BYTES = 500.0
 
 
+#: per row of the whole log read and checked [bytes]: its float64 columns and line numbers, the
+#: contract checks and the data-quality pass's working arrays (measured 238-347 B on the long-log
+#: benchmark's logs, gzip CSV and Parquet; benchmarks/longlog/README.md)
+LOAD_ROW_BYTES = 400.0
+
+
+def check_read_memory(rows, *, source: str, available=None) -> float:
+    """Refuse, before a log is read, one whose reading and whole-log checks (:data:`LOAD_ROW_BYTES` a
+    row) do not fit what the process may still take (:func:`available_bytes`): one line naming the
+    rows.  ``rows`` None (not known before reading: bzip2, xz) passes; the reader then refuses at
+    the row where its arrays exceed its own cap.  Returns the estimate [bytes].
+
+    Parameters
+    ----------
+    rows : int or None
+        The log's rows, estimated from its size (:func:`heavecomp.io.series.estimate_rows`).
+    source : str
+        The log's name, at the start of the message.
+    available : tuple (room, what, resident) or None
+        As :func:`check_diagnosis_memory`.
+    """
+    if rows is None:
+        return 0.0
+    need = LOAD_ROW_BYTES * rows
+    room, what, _resident = available_bytes() if available is None else available
+    if need <= room:
+        return need
+    raise InputError(f"{source}: reading and checking the log's {rows:.3g} rows (estimated from its size) would "
+                     f"take {_gb(need)}, over the {_gb(room)} that {what} leaves; cut the log into parts")
+
+
 def diagnosis_bytes(n_samples: int, n_steps: int, jobs: int) -> dict:
     """Estimated peak resident memory of a gap diagnosis, by part [bytes].
 
