@@ -99,7 +99,7 @@ def run(args) -> int:
     run_ = SP.cut(run_, span)  # the whole log's arrays are dropped here
     check_memory(run_, params, args.jobs)  # the whole diagnosis' memory (fit checks it too): refused in one line
     if not span.whole:  # never silent, --quiet or not
-        print(f"diagnose: {span.reason} (--span START:END names another)", file=sys.stderr, flush=True)
+        print(f"diagnose: {span.reason}; --span START:END names another", file=sys.stderr, flush=True)
     t0 = time.perf_counter()
 
     def progress(frac, msg):
