@@ -32,6 +32,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--split", type=float, default=0.67, metavar="F", help="fraction of the run fitted (default 0.67)")
     p.add_argument("--settle", type=float, default=None, metavar="S",
                    help="start-up window left out of the residuals [s] (default min(30 s, 10 %% of the run))")
+    p.add_argument("--span", default=None, metavar="START:END",
+                   help="the stretch of the log diagnosed, in s from its first sample (e.g. 3600:4200; either end "
+                        "may be left out). Default: a log up to 1200 s whole, a longer one its last 600 s, said in "
+                        "the report and diagnosis.json; heavecomp monitor follows the whole log")
     p.add_argument("--jobs", type=int, default=2, metavar="N", help="candidates fitted concurrently (default 2)")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress output")
 
@@ -62,7 +66,7 @@ def run(args) -> int:
     from pathlib import Path
 
     from heavecomp.diagnosis.data import load_run
-    from heavecomp.diagnosis.estimator import GapDiagnoser
+    from heavecomp.diagnosis.estimator import GapDiagnoser, check_memory
     from heavecomp.report.diagnosis import write_report
     from heavecomp.errors import InputError
     from heavecomp.io.series import check_spec, parse_mapping
@@ -80,10 +84,22 @@ def run(args) -> int:
             get(c)  # unknown names fail before any work
     if args.jobs < 1:
         raise InputError(f"--jobs must be >= 1, got {args.jobs}")
-    run_ = load_run(args.run, params, columns=columns, units=units)
+    from heavecomp.diagnosis import span as SP
+
+    wanted = SP.parse(args.span)  # a malformed span fails before the log is read
+    from heavecomp.io.series import estimate_rows, short
+    from heavecomp.params.budget import check_read_memory
+
+    check_read_memory(estimate_rows(args.run), source=short(args.run))  # the whole-log pass, before reading
+    run_ = load_run(args.run, params, columns=columns, units=units)  # read in chunks, checked whole
     if run_.duration < MIN_DURATION:
         raise InputError(f"{run_.source}: column 't': the run spans {run_.duration:.3g} s; diagnose needs at least "
                          f"{MIN_DURATION:g} s (a fitted and a held-out part of several wave periods each)")
+    span = SP.choose(run_.duration, wanted, min_duration=MIN_DURATION)
+    run_ = SP.cut(run_, span)  # the whole log's arrays are dropped here
+    check_memory(run_, params, args.jobs)  # the whole diagnosis' memory (fit checks it too): refused in one line
+    if not span.whole:  # never silent, --quiet or not
+        print(f"diagnose: {span.reason}; --span START:END names another", file=sys.stderr, flush=True)
     t0 = time.perf_counter()
 
     def progress(frac, msg):
@@ -93,7 +109,7 @@ def run(args) -> int:
     d = GapDiagnoser(params, cands, split=args.split, settle=args.settle, n_jobs=args.jobs, progress=progress)
     d.fit(run_)
     write_report(d, args.out, title=f"Sim-to-real gap diagnosis — {run_.source}")
-    _record_measurement(Path(args.out) / "diagnosis.json", run_.measurement)
+    _record_measurement(Path(args.out) / "diagnosis.json", run_.measurement, span.to_json())
     from heavecomp.report.calibrated import write_calibrated  # calibrated.toml, its json block, "What next"
 
     cal = write_calibrated(params, args.out, run_path=args.run, params_path=args.params)
@@ -109,12 +125,16 @@ def run(args) -> int:
     return 0
 
 
-def _record_measurement(path: Path, measurement: dict) -> None:
-    """Add how the run was read (format, columns, units, conversions) to diagnosis.json."""
+def _record_measurement(path: Path, measurement: dict, span: dict | None = None) -> None:
+    """Add how the run was read (format, columns, units, conversions) and which span of it was analysed
+    (:mod:`heavecomp.diagnosis.span`) to diagnosis.json."""
     import json
 
-    if not measurement or not path.is_file():
+    if not (measurement or span) or not path.is_file():
         return
     d = json.loads(path.read_text(encoding="utf-8"))
-    d["measurement"] = measurement
+    if measurement:
+        d["measurement"] = measurement
+    if span:
+        d["span"] = span
     path.write_text(json.dumps(d, indent=2) + "\n", encoding="utf-8")

@@ -52,9 +52,30 @@ from heavecomp.diagnosis.replay import CH
 from heavecomp.effects.candidates import CANDIDATES, get
 from heavecomp.errors import InputError
 from heavecomp.estimator import GapEstimator
+from heavecomp.params.budget import check_diagnosis_memory
 from heavecomp.diagnosis.quality import apply_quality
 
 log = logging.getLogger(__name__)
+
+
+def check_memory(run, nominal, n_jobs: int) -> dict:
+    """Refuse, before any replay, a run the diagnosis cannot hold: over the replay budget
+    (:func:`heavecomp.diagnosis.replay.grid`, naming the log's length) or over the memory the process may
+    still take (:func:`heavecomp.params.budget.check_diagnosis_memory`: the estimated peak of the whole
+    diagnosis, its samples and its replays on ``n_jobs`` threads).  Returns the estimate [bytes].
+
+    Parameters
+    ----------
+    run : heavecomp.diagnosis.data.MeasuredRun
+        The run (span) about to be diagnosed.
+    nominal : heavecomp.params.CMCParams
+        Nominal parameters (the replay step).
+    n_jobs : int
+        Candidates fitted concurrently.
+    """
+    _h, n_steps = R.grid(run, nominal)
+    return check_diagnosis_memory(run.t.size, n_steps, jobs=n_jobs, duration=run.duration, rate=1.0 / run.dt,
+                                  source=run.source)
 
 
 class GapDiagnoser(GapEstimator):
@@ -207,6 +228,7 @@ class GapDiagnoser(GapEstimator):
         P = self.verdict_policy()
         # the log's sensor set (contract schema 3: heave required; the reader asks for all four today)
         self.sensors_ = tuple(c for c in ST.CHANNELS if c in run.columns and np.isfinite(run[c]).any())
+        check_memory(run, self.nominal, self.n_jobs)  # before any replay
         self._report(0.02, "replaying the nominal model")
         ctx = R.prepare(run, self.nominal, split=self.split, settle=self.settle, stuck_speed=self.stuck_speed,
                         segment=self.segment, reinit=self.reinit, input_draws=self.input_draws,

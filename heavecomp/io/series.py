@@ -15,6 +15,15 @@ Formats, recognised by content (magic bytes), not by the file name:
 - the same compressed: gzip, bzip2, xz, zip (one member);
 - Parquet (pyarrow), MATLAB .mat up to v7 (scipy.io; v7.3/HDF5 is refused with a hint).
 
+Logs of any length are read in chunks (:func:`iter_chunks`; :func:`read_series` joins them): CSV,
+plain or compressed, is decompressed and parsed :data:`CHUNK_BYTES` at a time, Parquet by row
+groups.  The reader's memory is the float64 arrays of the columns and one chunk, never the file's
+text.  A clean chunk (every line a row of the header's field count, no quote, comment or blank line,
+counted on its bytes) is parsed by pandas' C parser straight into floats; any other chunk, and any
+chunk the C parser complains about, takes the checked path that splits cells in Python and names the
+row of every problem, so the messages and row numbers are those of a file read whole.  MATLAB files,
+compressed Parquet and UTF-16 text are read whole (at most :data:`MAX_BYTES`).
+
 Time may be seconds, milliseconds (declared) or ISO 8601 timestamps.  Heavy libraries
 (pandas, pyarrow, scipy.io) are imported only when a file needs them.
 
@@ -340,22 +349,20 @@ def split_header(name: str) -> tuple[str, str | None]:
     return base, (unit or None)
 
 
-def _text_table(text: str, src: str):
-    """Header names, raw string columns (one list per column), line numbers, delimiter, decimal."""
-    lines = text.splitlines()
-    idx = [i for i, ln in enumerate(lines) if ln.strip() and not ln.lstrip().startswith("#")]
-    if not idx:
-        raise DataError(f"{src}: empty file (no header, no data)")
-    content = [lines[i] for i in idx]
+def _head(content: list, src: str):
+    """(delimiter, decimal mark, header names, whether the first content line is a header) from the
+    first content lines (non-blank, not ``#``)."""
     sep, decimal = _sniff(content)
     first = [c.strip().strip('"') for c in _split(content[0], sep)]
     has_header = not all(_is_number(c) for c in first if c)
-    if has_header:
-        header, body, body_idx = first, content[1:], idx[1:]
-    else:
-        header, body, body_idx = [str(i + 1) for i in range(len(first))], content, idx
-    n = len(header)
-    if sep is not None and '"' in text:  # quoted cells may hold the delimiter: let csv split them
+    header = first if has_header else [str(i + 1) for i in range(len(first))]
+    return sep, decimal, header, has_header
+
+
+def _cells(body: list, body_lines, sep, n: int, src: str, quoted: bool) -> list:
+    """Rows split into cells; a row of another field count than the header is a DataError naming its
+    line (``body_lines``: the file line of each row)."""
+    if sep is not None and quoted:  # quoted cells may hold the delimiter: let csv split them
         import csv
 
         cells = [next(csv.reader([ln], delimiter=sep)) for ln in body]
@@ -363,14 +370,29 @@ def _text_table(text: str, src: str):
         cells = [_split(ln, sep) for ln in body]
     for k, row in enumerate(cells):
         if len(row) != n:
-            line = body_idx[k] + 1
+            line = body_lines[k]
             extra = ("a stray delimiter or a decimal comma in a comma-separated file?" if len(row) > n
                      else "a cell or delimiter missing?")
             shown = repr(sep) if sep else "whitespace"
             raise DataError(f"{src}: row {line} has {len(row)} fields, the header has {n} ({shown} separated; "
                             f"{extra})")
+    return cells
+
+
+def _text_table(text: str, src: str):
+    """Header names, raw string columns (one list per column), line numbers, delimiter, decimal."""
+    lines = text.splitlines()
+    idx = [i for i, ln in enumerate(lines) if ln.strip() and not ln.lstrip().startswith("#")]
+    if not idx:
+        raise DataError(f"{src}: empty file (no header, no data)")
+    content = [lines[i] for i in idx]
+    sep, decimal, header, has_header = _head(content, src)
+    body, body_idx = (content[1:], idx[1:]) if has_header else (content, idx)
+    n = len(header)
+    body_lines = np.asarray(body_idx, dtype=int) + 1
+    cells = _cells(body, body_lines, sep, n, src, '"' in text)
     cols = [[row[j] for row in cells] for j in range(n)]
-    return header, cols, np.asarray(body_idx, dtype=int) + 1, sep, decimal
+    return header, cols, body_lines, sep, decimal
 
 
 def _to_float(values, name, lines, src, decimal, required):
@@ -398,7 +420,7 @@ def _to_float(values, name, lines, src, decimal, required):
 
 
 def _time_from_strings(values, name, lines, src):
-    """ISO 8601 timestamps -> seconds from the first sample, or None if they are not timestamps."""
+    """ISO 8601 timestamps -> ns since the epoch (UTC, int64), or None if they are not timestamps."""
     import pandas as pd
 
     s = pd.Series(values, dtype="string").str.strip()
@@ -412,7 +434,7 @@ def _time_from_strings(values, name, lines, src):
     if not ok.all():
         k = int(np.flatnonzero(~ok)[0])
         raise DataError(f"{src}: column '{name}', row {lines[k]}: not a timestamp: {str(values[k])[:40]!r}")
-    return (ts - ts.iloc[0]).dt.total_seconds().to_numpy(dtype=float)
+    return ts.to_numpy(dtype="datetime64[ns]").astype("int64")
 
 
 def _parquet_table(data: bytes, src: str):
@@ -462,9 +484,287 @@ def _mat_table(data: bytes, src: str):
     return header, [vecs[k] for k in header], {k: v for k, v in mat.items() if not k.startswith("__")}
 
 
+# ---------------------------------------------------------------- streamed reading
+#: decompressed text parsed per chunk [bytes]: with the float arrays of the columns, the reader's memory
+CHUNK_BYTES = 4 << 20
+#: the first chunk [bytes] (the header is sniffed from it; it takes the checked, cell-by-cell path)
+FIRST_CHUNK_BYTES = 256 << 10
+#: rows per chunk of a Parquet file
+PARQUET_ROWS = 200_000
+#: largest float arrays the reader builds [bytes] (rows x (columns + 1 line number) x 8)
+MAX_ARRAY_BYTES = 1 << 30
+
+
+def _open(path: Path, src: str):
+    """(binary stream of the file's decompressed content, compression method or None, first raw bytes)."""
+    import bz2
+    import gzip
+    import lzma
+    import zipfile
+
+    try:
+        if not path.is_file():
+            raise DataError(f"{src}: file not found" if not path.exists() else f"{src}: not a file")
+        with path.open("rb") as fh:
+            magic = fh.read(32)
+        if magic[:2] == b"\x1f\x8b":
+            return gzip.open(path, "rb"), "gzip", magic
+        if magic[:3] == b"BZh":
+            return bz2.open(path, "rb"), "bzip2", magic
+        if magic[:6] == b"\xfd7zXZ\x00":
+            return lzma.open(path, "rb"), "xz", magic
+        if magic[:4] == b"PK\x03\x04":
+            try:
+                zf = zipfile.ZipFile(path)
+                names = [n for n in zf.namelist() if not n.endswith("/")]
+            except (zipfile.BadZipFile, EOFError, ValueError) as exc:
+                raise DataError(f"{src}: corrupt compressed file ({type(exc).__name__})") from None
+            if any(n.startswith("xl/") for n in names):
+                raise DataError(f"{src}: an Excel workbook; export the sheet as CSV")
+            if len(names) != 1:
+                raise DataError(f"{src}: zip archive with {len(names)} files; expected exactly one CSV")
+            return zf.open(names[0]), "zip", magic
+        return path.open("rb"), None, magic
+    except OSError as exc:
+        raise DataError(f"{src}: cannot read ({exc.strerror or type(exc).__name__})") from None
+
+
+def _read(stream, size: int, src: str, comp) -> bytes:
+    """``stream.read(size)``; a decompressor's or the file system's exception is one DataError line."""
+    import lzma
+    import zipfile
+    import zlib
+
+    try:
+        return stream.read(size)
+    except EOFError:
+        raise DataError(f"{src}: corrupt compressed file (truncated)") from None
+    except (lzma.LZMAError, zlib.error, zipfile.BadZipFile, ValueError) as exc:
+        raise DataError(f"{src}: corrupt compressed file ({type(exc).__name__})") from None
+    except OSError as exc:
+        if comp and not exc.strerror:  # gzip's BadGzipFile
+            raise DataError(f"{src}: corrupt compressed file ({type(exc).__name__})") from None
+        raise DataError(f"{src}: cannot read ({exc.strerror or type(exc).__name__})") from None
+
+
+class _NotUTF8(Exception):
+    """The text is not UTF-8 (``byte``: the first bad byte of the decompressed file): read it as Latin-1."""
+
+    def __init__(self, byte):
+        super().__init__(byte)
+        self.byte = byte
+
+
+def _text_chunks(stream, src: str, encoding: str, comp):
+    """Yield ``(raw, text)`` chunks of whole lines, about :data:`CHUNK_BYTES` each (``raw`` the bytes,
+    ``text`` decoded); the file is never held whole."""
+    import codecs
+
+    dec = codecs.getincrementaldecoder(encoding)()
+    rest, offset = b"", 0
+    size = FIRST_CHUNK_BYTES  # the first chunk (header, sniffing) takes the checked path: keep it small
+    while True:
+        block = _read(stream, size, src, comp)
+        size = CHUNK_BYTES
+        data = rest + block
+        if not block:
+            if data:
+                yield data, _decoded(dec, data, offset, True)
+            return
+        cut = data.rfind(b"\n") + 1
+        if cut == 0:
+            rest = data
+            continue
+        raw, rest = data[:cut], data[cut:]
+        yield raw, _decoded(dec, raw, offset, False)
+        offset += len(raw)
+
+
+def _decoded(dec, raw: bytes, offset: int, final: bool) -> str:
+    try:
+        return dec.decode(raw, final)
+    except UnicodeDecodeError as exc:
+        raise _NotUTF8(offset + exc.start) from None
+
+
+#: NA spellings given to the C parser (the checked path compares in lower case, after stripping)
+_NA_PARSER = sorted({v for x in NA for v in (x, x.upper(), x.title())})
+
+
+#: line breaks other than LF and CRLF (``str.splitlines`` splits at them; the C parser does not)
+_ODD_BREAKS = ("\x0b", "\x0c", "\x1c", "\x1d", "\x1e", "\x85", "\u2028", "\u2029")
+
+
+def _fast_chunk(raw: bytes, text: str, sep, decimal, n: int, kinds: list, encoding: str):
+    """Parse a clean chunk without Python strings (pandas' C parser, float64): every line a data row of
+    exactly ``n`` fields, no quote, no comment, no blank line.  Otherwise, or on any parser complaint,
+    None: the chunk takes the checked path, which names the row of every problem.  ``kinds`` per column:
+    ``"float"``, ``"text"`` (ISO time) or ``"drop"`` (a text column carried nowhere).  Returns
+    ``(columns, rows)``."""
+    if sep is None or n < 2 or '"' in text or "#" in text or text.count("\r") != text.count("\r\n") \
+            or any(c in text for c in _ODD_BREAKS):
+        return None
+    b = np.frombuffer(raw, dtype=np.uint8)
+    nl = np.flatnonzero(b == 10)
+    rows = nl.size + (1 if raw[-1:] != b"\n" else 0)
+    if rows == 0:
+        return None
+    ends = np.append(nl, b.size) if rows > nl.size else nl
+    seps = np.flatnonzero(b == ord(sep))
+    per_line = np.diff(np.searchsorted(seps, np.concatenate([[0], ends])))
+    if not (per_line == n - 1).all():
+        return None
+    import csv
+    import pandas as pd
+
+    use = [j for j, k in enumerate(kinds) if k != "drop"]
+    try:
+        df = pd.read_csv(io.BytesIO(raw), encoding="utf-8" if encoding == "utf-8-sig" else encoding, sep=sep, header=None, names=list(range(n)), usecols=use,
+                         dtype={j: (np.float64 if kinds[j] == "float" else object) for j in use},
+                         decimal=decimal, keep_default_na=False, na_values=_NA_PARSER, engine="c",
+                         skip_blank_lines=False, quoting=csv.QUOTE_NONE)
+    except (ValueError, TypeError, OverflowError, pd.errors.ParserError):
+        return None
+    if len(df) != rows:
+        return None
+    return [None if kinds[j] == "drop" else
+            df[j].to_numpy(dtype=np.float64) if kinds[j] == "float" else df[j].astype(str).tolist()
+            for j in range(n)], rows
+
+
+def _checked_chunk(lines, base: int, sep, n: int, src: str, skip_first: bool = False):
+    """The checked path of one chunk: cells split in Python, a ragged row named by its line
+    (``base``: lines of the file before the chunk)."""
+    idx = [i for i, ln in enumerate(lines) if ln.strip() and not ln.lstrip().startswith("#")]
+    if skip_first:
+        idx = idx[1:]
+    body = [lines[i] for i in idx]
+    body_lines = base + 1 + np.asarray(idx, dtype=int)
+    cells = _cells(body, body_lines, sep, n, src, any('"' in ln for ln in body))
+    return [[row[j] for row in cells] for j in range(n)], body_lines
+
+
+def _csv_chunks(stream, src: str, info: dict, comp, encoding: str, kinds: list):
+    """``(header, iterator of (cols, lines))`` of (compressed) CSV text read in chunks.  ``cols``: per column
+    a float64 array (a clean chunk, :func:`_fast_chunk`) or a list of cell strings; ``lines``: the file
+    line of each row.  ``kinds`` is filled by the caller after the first chunk (see :func:`_fast_chunk`)."""
+    chunks = _text_chunks(stream, src, encoding, comp)
+    base = 0
+    for raw, text in chunks:
+        lines = text.splitlines()
+        content = [ln for ln in lines if ln.strip() and not ln.lstrip().startswith("#")]
+        if content:
+            break
+        base += len(lines)
+    else:
+        raise DataError(f"{src}: empty file (no header, no data)")
+    sep, decimal, header, has_header = _head(content, src)
+    info.update(delimiter="whitespace" if sep is None else sep, decimal=decimal)
+    n = len(header)
+
+    def rows():
+        nonlocal base
+        yield _checked_chunk(lines, base, sep, n, src, skip_first=has_header)
+        base += len(lines)
+        for raw_k, text_k in chunks:
+            got = _fast_chunk(raw_k, text_k, sep, decimal, n, kinds, encoding) if kinds else None
+            if got is not None:
+                cols, count = got
+                yield cols, base + 1 + np.arange(count)
+            else:
+                lines_k = text_k.splitlines()
+                count = len(lines_k)
+                yield _checked_chunk(lines_k, base, sep, n, src)
+                del lines_k
+            base += count
+
+    return header, rows()
+
+
+def _parquet_chunks(path: Path, src: str):
+    """``(header, iterator of (cols, lines))`` of a Parquet file read :data:`PARQUET_ROWS` rows at a time."""
+    try:
+        import pyarrow as pa
+        import pyarrow.parquet as pq
+    except ImportError:  # pragma: no cover - pyarrow is a dependency
+        raise DataError(f"{src}: Parquet needs pyarrow (pip install pyarrow)") from None
+    try:
+        pf = pq.ParquetFile(path)
+        header = list(pf.schema_arrow.names)
+    except Exception as exc:  # noqa: BLE001 - pyarrow raises several types for a bad file
+        raise DataError(f"{src}: unreadable Parquet file ({type(exc).__name__})") from None
+
+    def rows():
+        done = 0
+        try:
+            for batch in pf.iter_batches(batch_size=PARQUET_ROWS):
+                yield [_arrow_column(batch.column(j), pa) for j in range(len(header))], done + 1 + np.arange(batch.num_rows)
+                done += batch.num_rows
+        except Exception as exc:  # noqa: BLE001 - pyarrow raises several types for a bad file
+            raise DataError(f"{src}: unreadable Parquet file ({type(exc).__name__})") from None
+        if done == 0:
+            yield [np.zeros(0) for _ in header], np.zeros(0, dtype=int)
+
+    return header, rows()
+
+
+def _arrow_column(col, pa):
+    """One pyarrow column as the reader's column: datetime64[ns], float64, or a list of strings."""
+    if pa.types.is_timestamp(col.type) or pa.types.is_date(col.type):
+        return np.asarray(col.cast(pa.timestamp("ns")).to_numpy(zero_copy_only=False)).astype("datetime64[ns]")
+    if pa.types.is_integer(col.type) or pa.types.is_floating(col.type) or pa.types.is_boolean(col.type):
+        return np.asarray(col.to_numpy(zero_copy_only=False), dtype=float)
+    return [None if v is None else str(v) for v in col.to_pylist()]
+
+
+def _table(path: Path, src: str, info: dict, warnings: list, kinds: list, encoding: str = "utf-8-sig"):
+    """``(header, iterator of (cols, lines), MATLAB scalars)`` of any supported file (a streamed CSV's
+    open stream under ``"_stream"`` in the third, for the caller to close): Parquet and
+    (compressed) CSV streamed in chunks; MATLAB, compressed Parquet and UTF-16 text read whole (one chunk)."""
+    stream, comp, magic = _open(path, src)
+    with stream:
+        head = _read(stream, 65536, src, comp)
+    if magic[:4] == b"PAR1":
+        info["format"] = "parquet"
+        header, it = _parquet_chunks(path, src)
+        return header, it, {}
+    if magic[:19] == b"MATLAB 5.0 MAT-file" or magic[:4] == b"\x89HDF" or path.suffix.lower() == ".mat":
+        info["format"] = "mat"
+        header, cols, scalars = _mat_table(_read_bytes(path, src), src)
+        return header, iter([(cols, np.arange(cols[0].size) + 1)]), scalars
+    if comp:
+        info["compression"] = comp
+    if head[:4] == b"PAR1" or b"\x00" in head:  # compressed Parquet, UTF-16 or binary: read whole
+        raw, _ = _decompress(_read_bytes(path, src), src)
+        if raw[:4] == b"PAR1":
+            info["format"] = "parquet"
+            header, cols = _parquet_table(raw, src)
+            return header, iter([(cols, np.arange(len(cols[0]) if cols else 0) + 1)]), {}
+        header, cols, lines, sep, decimal = _text_table(_decode(raw, src, warnings), src)
+        info.update(delimiter="whitespace" if sep is None else sep, decimal=decimal)
+        return header, iter([(cols, lines)]), {}
+    if encoding == "latin-1":
+        text = head.decode("latin-1")
+        ctrl = sum(1 for c in text if ord(c) < 32 and c not in "\r\n\t")
+        if ctrl > 0.01 * min(len(text), 65536):
+                raise DataError(f"{src}: binary file, not a recognised format (CSV text, gzip/bz2/xz/zip CSV, "
+                            "Parquet, MATLAB .mat)")
+    stream, comp, _ = _open(path, src)
+    try:
+        header, it = _csv_chunks(stream, src, info, comp, encoding, kinds)
+    except BaseException:
+        stream.close()
+        raise
+    return header, it, {"_stream": stream}
+
+
 # ---------------------------------------------------------------- table -> Series
 def read_series(path, required=("t",), *, optional=(), columns=None, units=None, what="measured series") -> Series:
     """Read a measured series from a file in any supported format (see the module docstring).
+
+    CSV (plain or compressed) and Parquet are read in chunks (:data:`CHUNK_BYTES` of text,
+    :data:`PARQUET_ROWS` rows): the memory is the float64 arrays of the columns (8 bytes per value,
+    plus 8 per row for its line number) and one chunk, never the file's text.
 
     Parameters
     ----------
@@ -494,32 +794,197 @@ def read_series(path, required=("t",), *, optional=(), columns=None, units=None,
     path = Path(path)
     src = short(path)
     columns, units = check_spec(columns, units, "measurement")
-    warnings: list[str] = []
-    data = _read_bytes(path, src)
+    byte = None
+    for encoding in ("utf-8-sig", "latin-1"):  # text not UTF-8 past the first chunk: read again as Latin-1
+        warnings: list[str] = [] if byte is None else [f"not UTF-8 (byte {byte}); read as Latin-1"]
+        parts, rows, meta = {}, [], None
+        total = 0
+        try:
+            for s in _chunks(path, src, tuple(required), tuple(optional), columns, units, encoding, warnings):
+                meta = s
+                for k in list(parts):
+                    if k not in s.columns:  # a carried column that turned out to hold text: dropped whole
+                        del parts[k]
+                for k, v in s.columns.items():
+                    parts.setdefault(k, []).append(v)
+                rows.append(s.rows)
+                total += s.rows.size
+                need = 8 * total * (len(s.columns) + 1)
+                if need > MAX_ARRAY_BYTES:
+                    raise DataError(f"{s.source}: more than {MAX_ARRAY_BYTES >> 20} MB of samples by row "
+                                    f"{int(s.rows[-1])} ({len(s.columns)} columns); cut the log into parts")
+            break
+        except _NotUTF8 as exc:
+            byte = exc.byte
+    out = {}
+    for k in list(parts):  # one column at a time, its chunks freed as it is joined
+        v = parts.pop(k)
+        out[k] = v[0] if len(v) == 1 else np.concatenate(v)
+        del v
+    lines = rows[0] if len(rows) == 1 else np.concatenate(rows)
+    del rows
+    info = meta.measurement
+    if "t" in out:
+        _check_time_unit(out["t"], info.get("_t_declared", False), meta.source, info["columns"]["t"])
+    info.pop("_t_declared", None)
+    return Series(columns=out, source=meta.source, measurement=info, warnings=meta.warnings, rows=np.asarray(lines))
+
+
+def iter_chunks(path, required=("t",), *, optional=(), columns=None, units=None, what="measured series",
+                check_time=True):
+    """Read a measured series chunk by chunk: :func:`read_series`'s reading, checks and messages, one
+    :class:`Series` per chunk (consecutive rows; ``t`` of timestamps from the file's first sample; every
+    chunk's ``measurement`` the same dict, complete once the file is read).
+
+    For a pass over a log of any length in bounded memory (``heavecomp monitor``): only one chunk's
+    arrays are held.  A carried (non-contract) column that holds text in a later chunk is left out from
+    there on.
+
+    Parameters
+    ----------
+    path : str or Path
+        The file.
+    required : tuple of str
+        Contract names that must be present (as :func:`read_series`).
+    optional : tuple of str
+        Contract names used when present.
+    columns : dict, optional
+        Contract name -> header of the source column.
+    units : dict, optional
+        Contract name -> unit of the source column.
+    what : str
+        What the file is, for messages.
+    check_time : bool
+        Check on the first chunk that undeclared time does not look like milliseconds (interval and
+        span; :func:`read_series` checks the whole column instead).
+
+    Yields
+    ------
+    Series
+        The next rows, contract columns in SI units, ``rows`` their file lines.
+    """
+    path = Path(path)
+    src = short(path)
+    columns, units = check_spec(columns, units, "measurement")
+    byte = None
+    for encoding in ("utf-8-sig", "latin-1"):
+        warnings: list[str] = [] if byte is None else [f"not UTF-8 (byte {byte}); read as Latin-1"]
+        started = False
+        try:
+            for s in _chunks(path, src, tuple(required), tuple(optional), columns, units, encoding, warnings):
+                if check_time and not started and "t" in s.columns:
+                    _check_time_unit(s.columns["t"], s.measurement["_t_declared"], src, s.measurement["columns"]["t"])
+                started = True
+                yield s
+            return
+        except _NotUTF8 as exc:
+            if started:  # the caller holds rows read as UTF-8 already: they cannot be read again
+                raise DataError(f"{src}: not UTF-8 at byte {exc.byte}, after rows read as UTF-8; save the file "
+                                "as UTF-8 (or read it whole)") from None
+            byte = exc.byte
+
+
+def _chunks(path, src, required, optional, columns, units, encoding, warnings):
+    """The Series of each chunk (see :func:`iter_chunks`)."""
     info = {"format": "csv"}
-    scalars = {}
-    if data[:4] == b"PAR1":
-        header, cols = _parquet_table(data, src)
-        lines = np.arange(len(cols[0]) if cols else 0) + 1
-        info["format"] = "parquet"
-    elif data[:19] == b"MATLAB 5.0 MAT-file" or data[:4] == b"\x89HDF" or path.suffix.lower() == ".mat":
-        header, cols, scalars = _mat_table(data, src)
-        lines = np.arange(cols[0].size) + 1
-        info["format"] = "mat"
-    else:
-        raw, comp = _decompress(data, src)
-        if comp:
-            info["compression"] = comp
-            if raw[:4] == b"PAR1":
-                header, cols = _parquet_table(raw, src)
-                lines = np.arange(len(cols[0]) if cols else 0) + 1
-                info["format"] = "parquet"
-        if info["format"] == "csv":
-            text = _decode(raw, src, warnings)
-            header, cols, lines, sep, decimal = _text_table(text, src)
-            info.update(delimiter="whitespace" if sep is None else sep, decimal=decimal)
+    kinds: list = []
+    header, chunks, scalars = _table(path, src, info, warnings, kinds, encoding)
+    stream = scalars.pop("_stream", None)
+    try:
+        yield from _converted(header, chunks, scalars, info, src, required, optional, columns, units, warnings,
+                              kinds)
+    finally:
+        if stream is not None:
+            stream.close()
+
+
+def _converted(header, chunks, scalars, info, src, required, optional, columns, units, warnings, kinds):
+    """The chunks' columns mapped, converted to SI and checked (see :func:`iter_chunks`)."""
     decimal = info.get("decimal", ".")
-    # duplicate names
+    chosen, norm = _choose(header, required, optional, columns, src)
+    used_units, conversions, scale = _units(header, norm, chosen, units, src)
+    carried = [j for j, h in enumerate(header) if j not in chosen.values() and str(h) not in chosen]
+    info["columns"] = {name: str(header[j]) for name, j in chosen.items()}
+    info["units"] = used_units
+    info["conversions"] = conversions
+    if scalars:
+        info["mat_scalars"] = sorted(k for k, v in scalars.items()
+                                     if isinstance(v, np.ndarray) and v.size == 1 and v.dtype.kind in "iuf")
+    if warnings:
+        for w in warnings:
+            log.warning("%s: %s", src, w)
+    origin = None  # the first timestamp [ns]
+    dropped: set = set()
+    first = True
+    for cols, lines in chunks:
+        out: dict[str, np.ndarray] = {}
+        for name, j in chosen.items():
+            vals, kind = cols[j], None
+            if isinstance(vals, np.ndarray) and vals.dtype.kind == "M":
+                if name != "t":
+                    raise DataError(f"{src}: column '{name}': timestamps, expected numbers")
+                ns = vals.astype("int64")
+                kind = "timestamps -> s from the first sample"
+            elif isinstance(vals, np.ndarray):
+                arr = np.asarray(vals, dtype=float)
+            else:
+                ns = None
+                if name == "t" and (used_units.get("t") == "timestamp" if not first else
+                                    not all(_is_number(str(v)) or str(v).strip().lower() in NA for v in vals[:20])):
+                    ns = _time_from_strings(vals, header[j], lines, src)
+                    if ns is None and not first:
+                        raise DataError(f"{src}: column '{header[j]}', row {lines[0]}: not a timestamp: "
+                                        f"{str(vals[0])[:40]!r}")
+                    kind = "ISO 8601 timestamps -> s from the first sample"
+                if ns is None:
+                    kind = None
+                    label = f"'{name}'" if str(header[j]) == name else f"'{name}' ({str(header[j])!r})"
+                    arr = _to_float(vals, label, lines, src, decimal, True)
+            if kind is not None:
+                if origin is None and ns.size:
+                    origin = int(ns[0])
+                arr = (ns - (origin or 0)) / 1e9
+                if first:  # a unit in the header of a timestamp column converts nothing
+                    conversions[:] = [c for c in conversions if not c.startswith("t: ")]
+                    conversions.insert(0, f"t: {kind}")
+                    used_units["t"] = "timestamp"
+            elif name in scale:
+                factor, offset = scale[name]
+                arr = arr * factor + offset
+            out[name] = arr
+        for j in carried:
+            if j in dropped:
+                continue
+            vals = cols[j]
+            if isinstance(vals, np.ndarray):
+                arr = np.asarray(vals, dtype=float) if vals.dtype.kind != "M" else None
+            elif vals is None:
+                arr = None
+            else:
+                arr = _to_float(vals, repr(str(header[j])), lines, src, decimal, False)
+            if arr is None:
+                dropped.add(j)
+                continue
+            out[str(header[j])] = arr
+        if first:
+            for name in list(used_units):
+                if used_units[name] is None:
+                    used_units[name] = f"{SI[KINDS[name]]} (assumed)"
+            info["_t_declared"] = "t" in chosen and ("t" in units or norm[chosen["t"]][1] is not None
+                                                    or used_units["t"] == "timestamp")
+            kinds[:] = ["drop"] * len(header)
+            for name, j in chosen.items():
+                kinds[j] = "text" if (name == "t" and used_units["t"] == "timestamp") else "float"
+            for j in carried:
+                if j not in dropped:
+                    kinds[j] = "float"
+            first = False
+        yield Series(columns=out, source=src, measurement=info, warnings=warnings, rows=np.asarray(lines))
+
+
+def _choose(header, required, optional, columns, src):
+    """Which source column is each contract column: ``({name: index}, normalised headers)``; duplicate
+    headers, unknown mappings and ambiguous or missing columns are DataErrors."""
     seen = {}
     for j, h in enumerate(header):
         key = str(h).strip()
@@ -527,7 +992,6 @@ def read_series(path, required=("t",), *, optional=(), columns=None, units=None,
             raise DataError(f"{src}: column '{key}' appears twice in the header (columns {seen[key] + 1} and {j + 1}); "
                             "rename one")
         seen[key] = j
-    # which source column is which contract column
     norm = [split_header(h) for h in header]
     chosen: dict[str, int] = {}
     for name in tuple(required) + tuple(optional):
@@ -560,11 +1024,16 @@ def read_series(path, required=("t",), *, optional=(), columns=None, units=None,
                                 example=f"{name}=NAME")
             continue
         chosen[name] = hits[0]
-    out: dict[str, np.ndarray] = {}
-    used_units: dict[str, str] = {}
+    return chosen, norm
+
+
+def _units(header, norm, chosen, units, src):
+    """Each chosen column's unit (declared or from its header), checked before any value is read:
+    ``(units used, conversions, {name: (factor, offset)} of the columns scaled to SI)``."""
+    used_units: dict = {}
     conversions: list[str] = []
+    scale: dict = {}
     for name, j in chosen.items():
-        vals = cols[j]
         head_unit = norm[j][1]
         decl = units.get(name)
         if decl and head_unit and UNITS.get(head_unit.lower(), (None,))[0] == KINDS[name] \
@@ -579,57 +1048,66 @@ def read_series(path, required=("t",), *, optional=(), columns=None, units=None,
         if unit is not None and UNITS[unit.lower()][0] != KINDS[name]:
             raise DataError(f"{src}: column '{name}' ({header[j]!r}): unit {unit!r} is a "
                             f"{UNITS[unit.lower()][0]} unit, '{name}' is a {KINDS[name]}")
-        if isinstance(vals, np.ndarray) and vals.dtype.kind == "M":
-            ns = vals.astype("int64")
-            arr = (ns - ns[0]) * 1e-9
-            if name != "t":
-                raise DataError(f"{src}: column '{name}': timestamps, expected numbers")
-            conversions.append("t: timestamps -> s from the first sample")
-            unit = "timestamp"
-        elif isinstance(vals, np.ndarray):
-            arr = np.asarray(vals, dtype=float)
-        else:
-            arr = None
-            if name == "t" and not all(_is_number(str(v)) or str(v).strip().lower() in NA for v in vals[:20]):
-                arr = _time_from_strings(vals, header[j], lines, src)
-                if arr is not None:
-                    conversions.append("t: ISO 8601 timestamps -> s from the first sample")
-                    unit = "timestamp"
-            if arr is None:
-                label = f"'{name}'" if str(header[j]) == name else f"'{name}' ({str(header[j])!r})"
-                arr = _to_float(vals, label, lines, src, decimal, True)
-        if unit is not None and unit != "timestamp":
+        used_units[name] = unit
+        if unit is not None:
             kind, factor, offset = UNITS[unit.lower()]
             if factor != 1.0 or offset != 0.0:
-                arr = arr * factor + offset
+                scale[name] = (factor, offset)
                 conversions.append(f"{name}: {unit} -> {SI[kind]} (x {factor:g}"
                                    + (f", {offset:+g} {SI[kind]} absolute -> gauge" if offset else "") + ")")
-        used_units[name] = unit if unit is not None else f"{SI[KINDS[name]]} (assumed)"
-        out[name] = arr
-    # other columns carried along (numeric only)
-    for j, h in enumerate(header):
-        if j in chosen.values() or str(h) in out:
-            continue
-        vals = cols[j]
-        if isinstance(vals, np.ndarray):
-            arr = np.asarray(vals, dtype=float) if vals.dtype.kind != "M" else None
-        else:
-            arr = _to_float(vals, repr(str(h)), lines, src, decimal, False)
-        if arr is not None:
-            out[str(h)] = arr
-    info["columns"] = {name: str(header[j]) for name, j in chosen.items()}
-    info["units"] = used_units
-    info["conversions"] = conversions
-    if scalars:
-        info["mat_scalars"] = sorted(k for k, v in scalars.items()
-                                     if isinstance(v, np.ndarray) and v.size == 1 and v.dtype.kind in "iuf")
-    if warnings:
-        for w in warnings:
-            log.warning("%s: %s", src, w)
-    if "t" in out:
-        _check_time_unit(out["t"], "t" in units or (norm[chosen["t"]][1] is not None)
-                         or used_units["t"] == "timestamp", src, header[chosen["t"]])
-    return Series(columns=out, source=src, measurement=info, warnings=warnings, rows=np.asarray(lines))
+    return used_units, conversions, scale
+
+
+def estimate_rows(path) -> int | None:
+    """About how many rows a file holds, from its size, before it is read: Parquet exactly (its
+    metadata); plain and zip CSV from the (uncompressed) size over the mean length of its first
+    lines; gzip from the uncompressed size its trailer records (one member under 4 GiB).  None where
+    the size is not known in advance (bzip2, xz, MATLAB, an unreadable file).
+
+    Parameters
+    ----------
+    path : str or Path
+        The file.
+    """
+    import zipfile
+
+    path = Path(path)
+    try:
+        size = path.stat().st_size
+        with path.open("rb") as fh:
+            magic = fh.read(4)
+            if magic == b"PAR1":
+                import pyarrow.parquet as pq
+
+                return int(pq.ParquetFile(path).metadata.num_rows)
+            if magic[:2] == b"\x1f\x8b":
+                fh.seek(-4, 2)
+                full = int.from_bytes(fh.read(4), "little")
+                if full < size:  # over 4 GiB (the field wraps) or several members: unknown
+                    return None
+                import gzip
+
+                with gzip.open(path, "rb") as g:
+                    head = g.read(65536)
+            elif magic == b"PK\x03\x04":
+                with zipfile.ZipFile(path) as zf:
+                    names = [n for n in zf.namelist() if not n.endswith("/")]
+                    if len(names) != 1:
+                        return None
+                    full = zf.getinfo(names[0]).file_size
+                    with zf.open(names[0]) as m:
+                        head = m.read(65536)
+            elif magic[:3] == b"BZh" or magic[:4] in (b"\xfd7zX", b"MATL", b"\x89HDF"):
+                return None
+            else:
+                fh.seek(0)
+                head, full = fh.read(65536), size
+    except Exception:  # noqa: BLE001 - an estimate: the reader names what is wrong with the file
+        return None
+    lines = head.count(b"\n")
+    if lines < 2:
+        return None
+    return int(full / (len(head) / lines))
 
 
 def _hdr(header) -> str:
@@ -678,5 +1156,5 @@ def gaps(t, max_gap: float, factor: float = 3.0):
     return np.flatnonzero(d > lim)
 
 
-__all__ = ["Series", "read_series", "read_text", "parse_mapping", "check_spec", "split_header", "UNITS", "KINDS", "short",
+__all__ = ["Series", "read_series", "iter_chunks", "estimate_rows", "read_text", "parse_mapping", "check_spec", "split_header", "UNITS", "KINDS", "short",
            "gaps"]

@@ -16,6 +16,11 @@ Budgets (module constants, per run):
   stepper; 24 h of paper A at its default 25 ms step is 3.5e6);
 - :data:`MAX_BYTES` = 4 GiB for heave samples plus output rows;
 - :data:`MAX_REPLAY_STEPS` = 1e7 steps of one replay of the gap diagnosis (checked before any replay).
+
+The gap diagnosis' whole run (issue 23.1): :func:`check_diagnosis_memory` estimates its peak resident
+memory from the analysed span's samples, its replay steps and the concurrent jobs
+(:func:`diagnosis_bytes`, coefficients measured on the long-log benchmark) and refuses, before any
+replay, what would not fit the memory the process may still take (:func:`available_bytes`).
 """
 
 from __future__ import annotations
@@ -155,3 +160,143 @@ def check_default_step(params, h: float, rate_fn: Callable) -> None:
         f"{drivers[0].split(' = ')[0] if drivers else 'parameters'}: the default time step would be {h:.3g} s "
         f"(set by {', '.join(drivers) or 'the plant'}), below {MIN_DEFAULT_STEP:g} s: an hour would need "
         f"{3600 / h:.3g} RK4 steps (budget {MAX_STEPS:.3g}); check those values")
+
+
+# ---------------------------------------------------------------- the gap diagnosis' memory
+# Coefficients measured (benchmarks/longlog/README.md): peak RSS of `heavecomp diagnose` on the generated
+# 3 h at 50 Hz and 24 h at 10 Hz logs, spans of 600 s and 1200 s, --jobs 1 and 2 (714, 1054, 648, 688 MB),
+# solved for the four terms and rounded up by ~5-10 %.
+#: resident memory of the diagnosis' process besides its span [bytes]: interpreter, numpy/scipy/pandas,
+#: the compiled stepper, the whole log as read and checked (up to 24 h at 10 Hz)
+DIAGNOSIS_BASE_BYTES = 400e6
+#: per sample of the analysed span [bytes]: the measured channels and their masks, the equation
+#: error's feature matrices, every fit's predicted channels kept for the verdict and the report
+DIAGNOSIS_SAMPLE_BYTES = 3000.0
+#: per replay step of the analysed span [bytes]: the heave samples (nominal and perturbed draws) and the
+#: stepper output every kept replay holds (``_grid``: 16 channels x 8 bytes a step, tens of replays)
+DIAGNOSIS_STEP_BYTES = 3500.0
+#: per replay step and concurrent job [bytes]: the replays in flight on each thread
+DIAGNOSIS_JOB_STEP_BYTES = 500.0
+
+
+#: per row of the whole log read and checked [bytes]: its float64 columns and line numbers, the
+#: contract checks and the data-quality pass's working arrays (measured 238-347 B on the long-log
+#: benchmark's logs, gzip CSV and Parquet; benchmarks/longlog/README.md)
+LOAD_ROW_BYTES = 400.0
+
+
+def check_read_memory(rows, *, source: str, available=None) -> float:
+    """Refuse, before a log is read, one whose reading and whole-log checks (:data:`LOAD_ROW_BYTES` a
+    row) do not fit what the process may still take (:func:`available_bytes`): one line naming the
+    rows.  ``rows`` None (not known before reading: bzip2, xz) passes; the reader then refuses at
+    the row where its arrays exceed its own cap.  Returns the estimate [bytes].
+
+    Parameters
+    ----------
+    rows : int or None
+        The log's rows, estimated from its size (:func:`heavecomp.io.series.estimate_rows`).
+    source : str
+        The log's name, at the start of the message.
+    available : tuple (room, what, resident) or None
+        As :func:`check_diagnosis_memory`.
+    """
+    if rows is None:
+        return 0.0
+    need = LOAD_ROW_BYTES * rows
+    room, what, _resident = available_bytes() if available is None else available
+    if need <= room:
+        return need
+    raise InputError(f"{source}: reading and checking the log's {rows:.3g} rows (estimated from its size) would "
+                     f"take {_gb(need)}, over the {_gb(room)} that {what} leaves; cut the log into parts")
+
+
+def diagnosis_bytes(n_samples: int, n_steps: int, jobs: int) -> dict:
+    """Estimated peak resident memory of a gap diagnosis, by part [bytes].
+
+    Parameters
+    ----------
+    n_samples : int
+        Samples of the analysed span.
+    n_steps : int
+        Replay steps of the analysed span (its duration over the replay step).
+    jobs : int
+        Candidates fitted concurrently.
+
+    Returns
+    -------
+    dict
+        ``base``, ``samples``, ``replays`` and ``total`` [bytes].
+    """
+    parts = {"base": DIAGNOSIS_BASE_BYTES, "samples": DIAGNOSIS_SAMPLE_BYTES * n_samples,
+             "replays": (DIAGNOSIS_STEP_BYTES + DIAGNOSIS_JOB_STEP_BYTES * jobs) * n_steps}
+    parts["total"] = sum(parts.values())
+    return parts
+
+
+def available_bytes() -> tuple:
+    """``(room, what limits it, resident)`` [bytes]: the memory this process may still take (the smallest
+    of the system's available memory, ``MemAvailable``, and what the address-space and data limits,
+    ``ulimit -v`` / ``-d``, leave above the process' present size), and its present resident size.
+    ``(inf, "", 0)`` where none is known (not Linux)."""
+    import os
+    import resource
+
+    room, what = math.inf, ""
+    try:
+        with open("/proc/meminfo", encoding="ascii") as fh:
+            for line in fh:
+                if line.startswith("MemAvailable:"):
+                    room, what = float(line.split()[1]) * 1024.0, "the memory available on this machine"
+    except OSError:
+        pass
+    size = resident = 0.0
+    try:
+        with open(f"/proc/{os.getpid()}/statm", encoding="ascii") as fh:
+            fields = fh.read().split()
+        page = os.sysconf("SC_PAGE_SIZE")
+        size, resident = float(fields[0]) * page, float(fields[1]) * page
+    except (OSError, ValueError, IndexError):
+        pass
+    for lim, name in ((resource.RLIMIT_AS, "the address-space limit (ulimit -v)"),
+                      (resource.RLIMIT_DATA, "the data-size limit (ulimit -d)")):
+        soft = resource.getrlimit(lim)[0]
+        if soft != resource.RLIM_INFINITY and soft - size < room:
+            room, what = max(0.0, soft - size), name
+    return room, what, resident
+
+
+def check_diagnosis_memory(n_samples: int, n_steps: int, *, jobs: int, duration: float, rate: float,
+                           source: str, available=None) -> dict:
+    """Refuse, before any replay, a gap diagnosis whose estimated peak memory (:func:`diagnosis_bytes`)
+    does not fit what the process may take (:func:`available_bytes`): one line naming what would not fit
+    (the span's samples and its replays with the jobs) and what to change.  Returns the estimate.
+
+    Parameters
+    ----------
+    n_samples : int
+        Samples of the analysed span.
+    n_steps : int
+        Replay steps of the analysed span.
+    jobs : int
+        Candidates fitted concurrently.
+    duration : float [s]
+        Length of the analysed span (for the message).
+    rate : float [Hz]
+        Its sampling rate (for the message).
+    source : str
+        The log's name, at the start of the message.
+    available : tuple (room, what, resident) or None
+        The memory the process may still take, what limits it, and its present resident size [bytes];
+        None: :func:`available_bytes`.
+    """
+    need = diagnosis_bytes(n_samples, n_steps, jobs)
+    room, what, resident = available_bytes() if available is None else available
+    # the base (and the span's arrays) are resident already: the growth is what must fit the room
+    grow = need["total"] - min(resident, DIAGNOSIS_BASE_BYTES)
+    if grow <= room:
+        return need
+    detail = (f"its {n_samples:.3g} samples ({duration:.4g} s at {rate:.3g} Hz) need {_gb(need['samples'])}, its "
+              f"replays ({n_steps:.3g} steps, {jobs} job{'s' if jobs != 1 else ''}) {_gb(need['replays'])}")
+    fix = "a shorter span" + (" or fewer jobs" if jobs > 1 else "")
+    raise InputError(f"{source}: the diagnosis of {duration:.4g} s would take {_gb(grow)} more, over the "
+                     f"{_gb(room)} that {what} leaves: {detail}; diagnose {fix}", option=("span", "jobs"))
