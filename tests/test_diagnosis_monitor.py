@@ -14,7 +14,7 @@ from heavecomp.params.sets import paper_a
 def test_cusum_finds_a_step_after_it_and_not_noise():
     rng = np.random.default_rng(3)
     u = rng.normal(size=3000)
-    assert M.cusum(u) is None  # 3000 blocks (8 h) of white noise: no alarm at h = 12
+    assert M.cusum(u) is None  # 3000 blocks (8 h) of white noise: no alarm at the committed threshold
     u[1500:] += 2.0
     b, j, onset, size = M.cusum(u)
     # a 2-sigma step: the sum grows by ~1.5 sigma per block past the allowance, crossing 12 in ~8 blocks
@@ -29,6 +29,32 @@ def test_cusum_skips_gaps_and_names_the_column():
     u[100:120, :] = np.nan
     b, j, onset, _ = M.cusum(u)
     assert j == 1 and 400 <= b < 420
+
+
+def test_shewhart_rule_alarms_a_large_step_a_block_before_the_clipped_cusum():
+    rng = np.random.default_rng(6)
+    u = rng.normal(0.0, 0.3, 200)
+    u[100:] += 12.0
+    b, _, onset, _ = M.cusum(u)
+    # two blocks of >= JUMP sigmas: alarmed in the second; the clipped sum alone adds CLIP - DRIFT per block
+    assert (b, onset) == (100 + M.JUMP_BLOCKS - 1, 100)
+    b_sum, _, _, _ = M.cusum(u, jump=math.inf)
+    assert b_sum == 100 + math.ceil(M.THRESHOLD / (M.CLIP - M.DRIFT)) - 1 > b
+
+
+def test_null_sigma_keeps_heavy_tails_from_raising_alarms():
+    # a quiet bulk with 5 % bursts of either sign (stick-slip in a block, a poorly conditioned block):
+    # standardised by the bulk's MAD the CUSUM alarms within a day of blocks; by null_sigma it does not
+    rng = np.random.default_rng(7)
+    x = rng.normal(0.0, 1.0, 8640)
+    burst = rng.random(x.size) < 0.05
+    x[burst] += rng.choice([-30.0, 30.0], burst.sum())
+    assert abs(M.robust_sigma(x) - 1.0) < 0.3 < 3.0 < M.null_sigma(x)
+    assert M.cusum(x / M.robust_sigma(x)) is not None
+    assert M.cusum(x / M.null_sigma(x)) is None
+    # a normal series: both scales agree
+    y = rng.normal(0.0, 2.0, 8640)
+    assert abs(M.null_sigma(y) / M.robust_sigma(y) - 1.0) < 0.1
 
 
 def test_robust_sigma_ignores_a_step():
