@@ -102,6 +102,28 @@ def test_monitor_finds_a_seal_friction_onset_on_a_generated_log(tmp_path):
     assert d["schema"] == 1 and set(d["changes"][0]) >= {"t", "component", "size_to_noise", "kind"}
     assert set(d["segments"][0]) >= {"start", "end", "operating_point", "gap_to_noise"}
     assert math.isclose(d["segments"][-1]["end"], tr.t[-1], rel_tol=1e-9)
+    # without the WOB channel the two balances that read it are left out and said so; the seal friction
+    # enters the top-mass balance alone (structure), so nothing is left to see it
+    from heavecomp.diagnosis.data import MeasuredRun
+
+    run = tr.to_run()
+    res = M.monitor(MeasuredRun(run.t, {k: v for k, v in run.columns.items() if k != "wob"}, source="no wob"),
+                    tr.nominal)
+    assert res.skipped["equations"] == {"lower_mass": ["wob"], "top_mass": ["wob"]} and "wob" not in res.sensors
+    assert not [c for c in res.changes if c["component"] == "friction"] and res.to_json()["skipped"]
+
+
+def test_missing_channels_leave_out_the_equations_that_read_them():
+    assert M.usable_equations(["heave", "stroke", "pressure"]) == (("gas",), {"lower_mass": ["wob"],
+                                                                           "top_mass": ["wob"]})
+    assert M.usable_equations(["heave", "stroke", "pressure", "wob"])[1] == {}
+    from heavecomp.diagnosis.data import MeasuredRun
+    from heavecomp.errors import DataError
+
+    t = np.arange(0.0, 600.0, 0.1)
+    run = MeasuredRun(t, {"heave": np.sin(t), "wob": np.full(t.size, 1e5)}, source="heave+wob")
+    with pytest.raises(DataError, match="'stroke', 'pressure' missing"):  # before any work: nothing computable
+        M.monitor(run, paper_a("stribeck"))
 
 
 def test_cli_bad_input_is_one_line(tmp_path, capsys):

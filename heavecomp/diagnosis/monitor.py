@@ -78,7 +78,9 @@ import numpy as np
 from heavecomp.diagnosis import components as CR
 from heavecomp.diagnosis.data import MeasuredRun, noise_floor
 from heavecomp.diagnosis.estimator import GapDiagnoser
+from heavecomp.diagnosis.structure import equation_channels
 from heavecomp.effects.base import COMPONENTS
+from heavecomp.errors import DataError
 
 log = logging.getLogger(__name__)
 
@@ -149,6 +151,8 @@ class MonitorResult:
     segments : list of dict  (``start``, ``end``, ``operating_point``, ``gap_to_noise``)
     noise : {channel: sigma [SI]}
     sensors : list of channels the log had
+    skipped : dict  what a missing channel left out: ``equations`` {equation: [missing channels it reads]},
+        ``operating_point`` (why set-point changes are not detected or not checked by the load balance)
     """
 
     t_blocks: np.ndarray
@@ -161,9 +165,11 @@ class MonitorResult:
     noise: dict
     sensors: list
     duration: float
+    skipped: dict = dataclasses.field(default_factory=dict)
 
     def to_json(self) -> dict:
-        return {"schema": SCHEMA, "changes": self.changes, "segments": self.segments,
+        extra = {"skipped": self.skipped} if self.skipped else {}
+        return {**extra, "schema": SCHEMA, "changes": self.changes, "segments": self.segments,
                 "sensors": list(self.sensors), "block_s": self.block, "duration_s": self.duration,
                 "noise": self.noise,
                 "method": {"statistic": "log of the block mean square of each equation residual over its noise "
@@ -364,10 +370,14 @@ def operating_changes(op, block_t, block, params, *, threshold=THRESHOLD_OP, lea
         pb, pa = p[max(onset - learn, 0):onset], p[onset + 1:min(onset + 1 + learn, w.size)]
         dW = float(np.nanmedian(after) - np.nanmedian(before)) if after.size and before.size else math.nan
         dp = float(np.nanmedian(pa) - np.nanmedian(pb)) if pa.size and pb.size else math.nan
-        operating = math.isfinite(dW) and math.isfinite(dp) and abs(dW + params.area * dp) <= CONSISTENT * abs(dW)
+        checked = bool(np.isfinite(p).any())
+        operating = not checked or (math.isfinite(dW) and math.isfinite(dp)
+                                    and abs(dW + params.area * dp) <= CONSISTENT * abs(dW))
         out.append({"t": float(block_t[b] + block), "component": "operating_point" if operating else "sensors",
                     "size_to_noise": size, "kind": "operating" if operating else "effect",
-                    "onset": float(block_t[onset]), "wob_step": dW, "pressure_step": dp})
+                    "onset": float(block_t[onset]), "wob_step": dW, "pressure_step": dp if checked else None})
+        if not checked:
+            out[-1]["load_balance"] = "unchecked: no pressure channel"
         if operating:
             bounds.append(onset)
         start = b + 1
@@ -450,6 +460,28 @@ class BlockSums:
         return out
 
 
+def _stand_in(channel, params, n) -> np.ndarray:
+    """A constant in place of a channel the log lacks (its nominal static value: the WOB set-point, the
+    charge pressure, mid-stroke 0), read only by equations the monitor leaves out [SI]."""
+    v = {"wob": params.operating_point.wob_setpoint, "pressure": params.p0}.get(channel, 0.0)
+    return np.full(n, float(v))
+
+
+def usable_equations(sensors) -> tuple:
+    """(equations every channel of which the log has, {left-out equation: [missing channels it reads]})
+    from the model's structure (:func:`heavecomp.diagnosis.structure.equation_channels`).
+
+    Parameters
+    ----------
+    sensors : sequence of str
+        The channels the log has.
+    """
+    eqc = equation_channels()
+    use = tuple(e for e, chs in eqc.items() if all(c in sensors for c in chs))
+    skip = {e: [c for c in chs if c not in sensors] for e, chs in eqc.items() if e not in use}
+    return use, skip
+
+
 def coefficient_features() -> dict:
     """{equation: ((component, feature), ...)}: the features whose block coefficients the monitor follows
     (the equation's own split, :data:`heavecomp.diagnosis.components.SPLIT`, less :data:`NOT_PER_BLOCK`;
@@ -466,7 +498,7 @@ def coefficient_features() -> dict:
 
 
 def component_blocks(run, params, edges, op_bounds, op, noise, *, block=BLOCK, chunk=CHUNK, pad=PAD,
-                     progress=None) -> BlockSums:
+                     progress=None, equations=None) -> BlockSums:
     """Block sums of the equation residuals and their component parts (pass 2), chunk by chunk, each
     operating segment with its own operating point.
 
@@ -489,6 +521,9 @@ def component_blocks(run, params, edges, op_bounds, op, noise, *, block=BLOCK, c
     pad : float [s]
         Extra samples on each side of a chunk.
     progress : callable (fraction, message), optional
+    equations : sequence of str, optional
+        The equations to follow (default: every one); a channel the log lacks is given a constant
+        stand-in (:func:`_stand_in`) that only the equations left out read.
     """
     nb = edges.size - 1
     t = run.t
@@ -500,7 +535,7 @@ def component_blocks(run, params, edges, op_bounds, op, noise, *, block=BLOCK, c
     for s0, s1 in zip(seg_edges[:-1], seg_edges[1:]):
         if s1 <= s0:
             continue
-        w0 = float(np.nanmedian(op["wob"][s0:s1]))
+        w0 = float(np.nanmedian(op["wob"][s0:s1])) if np.isfinite(op["wob"][s0:s1]).any() else math.nan
         prm = params if not (w0 > 0) else params.replace(operating_point={"wob_setpoint": w0})
         zref = float(np.nanmedian(op["heave"][s0:s1]))
         for a, b in _chunks(s0, s1, per):
@@ -509,11 +544,14 @@ def component_blocks(run, params, edges, op_bounds, op, noise, *, block=BLOCK, c
             j1 = int(np.searchsorted(t, t[i1 - 1] + pad, side="right"))
             if j1 - j0 < 50:
                 continue
-            sub = MeasuredRun(t[j0:j1], {k: run[k][j0:j1] for k in OP_CHANNELS}, source=run.source)
+            sub = MeasuredRun(t[j0:j1], {k: run[k][j0:j1] if k in run.columns else _stand_in(k, params, j1 - j0)
+                                         for k in OP_CHANNELS}, source=run.source)
             cr = CR.residuals(sub, prm, heave_reference=zref, noise=noise)
+            if equations is not None:
+                cr.equations = {e: r for e, r in cr.equations.items() if e in equations}
             if sums is None:
                 sums = BlockSums({e: np.zeros(nb) for e in cr.equations}, {}, {e: np.zeros(nb) for e in cr.equations},
-                                 dict(cr.noise))
+                                 {e: cr.noise[e] for e in cr.equations})
                 for e in cr.equations:
                     m = len(feats.get(e, ()))
                     sums.xtx[e], sums.xtr[e] = np.zeros((nb, m, m)), np.zeros((nb, m))
@@ -752,9 +790,8 @@ def segments(changes, block_t, block, op, sums, duration) -> list:
         a = int(np.searchsorted(block_t, s))
         b = max(int(np.searchsorted(block_t, e)), a + 1)
         sl = slice(a, b)
-        opp = {"wob_setpoint": float(np.nanmedian(op["wob"][sl])),
-               "static_stroke": float(np.nanmedian(op["stroke"][sl])),
-               "static_pressure": float(np.nanmedian(op["pressure"][sl]))}
+        opp = {k: (float(np.nanmedian(op[c][sl])) if np.isfinite(op[c][sl]).any() else None)
+               for k, c in (("wob_setpoint", "wob"), ("static_stroke", "stroke"), ("static_pressure", "pressure"))}
         out.append({"start": float(s), "end": float(e), "operating_point": opp,
                     "gap_to_noise": _segment_gap(sums, a, b)})
     return out
@@ -786,23 +823,45 @@ def monitor(run, params, *, block=BLOCK, chunk=CHUNK, threshold=THRESHOLD, thres
     -------
     MonitorResult
     """
+    sensors = _sensors(run)
+    use, skip = usable_equations(sensors)
+    missing = [c for c in OP_CHANNELS if c not in sensors]
+    if not use:
+        raise DataError(f"{run.source}: column(s) {', '.join(repr(c) for c in missing)} missing: no equation residual "
+                        f"can be computed from {', '.join(sensors)} (the gas law needs stroke and pressure, the "
+                        "lower-mass balance heave, stroke and WOB)")
+    skipped = {}
+    if skip:
+        skipped["equations"] = skip
+        log.warning("%s: without %s the monitor leaves out %s", run.source, ", ".join(missing),
+                    "; ".join(f"the {e} residual (reads {', '.join(c)})" for e, c in skip.items()))
+    if "wob" not in sensors:
+        skipped["operating_point"] = "no WOB channel: set-point changes are not detected"
+    elif "pressure" not in sensors:
+        skipped["operating_point"] = ("no pressure channel: a WOB step is reported as an operating change, "
+                                      "unchecked by the load balance (a WOB misreading reads the same)")
     t = run.t
     edges = _block_edges(t, block)
     block_t = t[edges[:-1]]
-    op = {k: _block_means(run[k], edges) for k in OP_CHANNELS}
+    nan = np.full(edges.size - 1, np.nan)
+    op = {k: _block_means(run[k], edges) if k in sensors else nan.copy() for k in OP_CHANNELS}
     if noise is None:
         first = t <= t[0] + chunk
-        noise = {k: noise_floor(run[k][first]) for k in OP_CHANNELS}
+        noise = {k: noise_floor(run[k][first]) if k in sensors else 1.0 for k in OP_CHANNELS}
     if progress:
         progress(0.0, f"{edges.size - 1} blocks of {block:g} s; operating point")
-    op_changes, op_bounds = operating_changes(op, block_t, block, params, threshold=threshold_op, learn=learn)
-    sums = component_blocks(run, params, edges, op_bounds, op, noise, block=block, chunk=chunk, progress=progress)
+    if "wob" in sensors:
+        op_changes, op_bounds = operating_changes(op, block_t, block, params, threshold=threshold_op, learn=learn)
+    else:
+        op_changes, op_bounds = [], []
+    sums = component_blocks(run, params, edges, op_bounds, op, noise, block=block, chunk=chunk, progress=progress,
+                            equations=use)
     eff = [e for e in component_changes(sums, block_t, block, op_bounds, threshold=threshold, learn=learn)
            if not absorbed(e, op_changes)]
     changes = sorted(op_changes + eff, key=lambda c: c["t"])
     segs = segments(changes, block_t, block, op, sums, run.duration)
     return MonitorResult(block_t, block, sums.stats(), op, sums, changes, segs,
-                         {k: float(v) for k, v in noise.items()}, _sensors(run), run.duration)
+                         {k: float(v) for k, v in noise.items() if k in sensors}, sensors, run.duration, skipped)
 
 
 # ---------------------------------------------------------------------------- --diagnose: one verdict per segment
