@@ -18,9 +18,11 @@ Three passes, each streaming over the log (peak memory set by :data:`CHUNK`, not
    median block-mean WOB, the heave reference from its median block-mean heave), so a new
    operating point does not read as a gap; blocks within :data:`BLANK` of an operating change are
    left out (the filters straddle it);
-3. **changes**: a two-sided, self-starting, clipped CUSUM with a Shewhart rule beside it
-   (:func:`cusum`: :data:`JUMP_BLOCKS` blocks in a row beyond :data:`JUMP` sigmas alarm at once) on
-   every monitored series (:func:`columns`): per equation, log(1 + block statistic), standardised by
+3. **changes**: a two-sided, self-starting, clipped CUSUM (:func:`cusum`; threshold :data:`THRESHOLD`
+   on the block coefficients, :data:`THRESHOLD_EQ` on the equations' mean squares) with, on the block
+   coefficients, a Shewhart rule beside it (:data:`JUMP_BLOCKS` blocks in a row beyond :data:`JUMP`
+   sigmas alarm at once) on every monitored series (:func:`columns`): per equation, log(1 + block
+   statistic), standardised by
    :func:`null_sigma` (the larger of the robust block-to-block noise, 1.4826 MAD of first differences
    / sqrt 2, and the tail scale that puts the :data:`TAIL_Q` quantile of the |first differences|
    where a normal series has it: a heavy-tailed series is not scaled by its quiet bulk alone; floored
@@ -100,11 +102,16 @@ COEF_MOVED = 1.0  #: a block coefficient that moved less than this [sigmas] does
 OP_SLACK = 120.0  #: s around an operating change within which an effect alarm is the operating change
 CLIP = 4.0  #: largest deviation one block adds to a CUSUM [block sigmas]
 DRIFT = 1.0  #: CUSUM allowance k [block sigmas]: shifts below it are not accumulated
-THRESHOLD = 9.0  #: CUSUM decision threshold h [block sigmas] (tuning set: scenarios/monitor_validation.py)
+THRESHOLD = 8.0  #: CUSUM decision threshold h of the block coefficients [block sigmas] (tuning set: scenarios/monitor_validation.py)
 #: Shewhart rule beside the CUSUM (a combined Shewhart-CUSUM scheme): an alarm as soon as JUMP_BLOCKS blocks in a
 #: row deviate from the reference by JUMP sigmas or more, the same sign: a large step is alarmed after two blocks,
-#: where the clipped CUSUM needs THRESHOLD / (CLIP - DRIFT) = 3 [block sigmas, -]
+#: where the clipped CUSUM needs THRESHOLD / (CLIP - DRIFT) = 3 (the block coefficients; JUMP_EQ for the mean squares)
 JUMP, JUMP_BLOCKS = 6.0, 2
+#: the CUSUM threshold for the equations' mean squares [block sigmas]: higher than the coefficients' (fourth method:
+#: every false alarm of the third method's scoring set came from the top-mass balance's mean square, whose stick
+#: events come in wave groups over several blocks)
+THRESHOLD_EQ = 12.0
+JUMP_EQ = math.inf  #: the Shewhart rule's deviation for the equations' mean squares: none (the same reason) [block sigmas]
 #: the standardising scale of a monitored series is at least the one that puts this quantile of its |first
 #: differences| / sqrt 2 where a normal series has it (:func:`null_sigma`): a heavy-tailed series (stick-slip
 #: bursts, a sea that changes) is not scaled by its quiet bulk alone [-]
@@ -176,7 +183,8 @@ class MonitorResult:
                                         "variance, and the block least-squares coefficients of each equation "
                                         "residual on its split's features",
                            "detector": "two-sided clipped CUSUM with a Shewhart rule", "drift_sigmas": DRIFT,
-                           "threshold_sigmas": THRESHOLD, "jump_sigmas": JUMP, "jump_blocks": JUMP_BLOCKS,
+                           "threshold_sigmas": THRESHOLD, "threshold_equation_sigmas": THRESHOLD_EQ,
+                           "jump_sigmas": JUMP, "jump_equation_sigmas": JUMP_EQ, "jump_blocks": JUMP_BLOCKS,
                            "threshold_op_sigmas": THRESHOLD_OP, "learn_blocks": LEARN, "chunk_s": CHUNK}}
 
 
@@ -262,16 +270,16 @@ def cusum(u, learn=LEARN, drift=DRIFT, threshold=THRESHOLD, start=0, window=WIND
         Finite blocks before any alarm [-].
     drift : float [sigmas]
         Allowance k.
-    threshold : float [sigmas]
-        Decision threshold h.
+    threshold : float or array (series,) [sigmas]
+        Decision threshold h, for all series or per series.
     start : int
         First block of the stretch.
     window : int
         Blocks of the reference before the change-point estimate.
     clip : float [sigmas]
         Largest deviation one block adds.
-    jump : float [sigmas]
-        Deviation of the Shewhart rule (``math.inf``: none).
+    jump : float or array (series,) [sigmas]
+        Deviation of the Shewhart rule, for all series or per series (``math.inf``: none).
     jump_blocks : int
         Blocks in a row of the Shewhart rule.
     """
@@ -279,6 +287,7 @@ def cusum(u, learn=LEARN, drift=DRIFT, threshold=THRESHOLD, start=0, window=WIND
     if u.ndim == 1:
         u = u[:, None]
     n, m = u.shape
+    jump = np.broadcast_to(np.asarray(jump, float), (m,))
     ok = np.isfinite(u[start:])
     v = np.where(ok, u[start:], 0.0)
     cs = np.vstack([np.zeros((1, m)), np.cumsum(v, axis=0)])   # prefix sums from ``start``
@@ -300,8 +309,8 @@ def cusum(u, learn=LEARN, drift=DRIFT, threshold=THRESHOLD, start=0, window=WIND
                 z_hi[j] = z_lo[j] = i + 1
                 continue
             d0 = row[j] - (cs[cut, j] - cs[w0, j]) / nref
-            r_hi[j] = r_hi[j] + 1 if d0 >= jump else 0
-            r_lo[j] = r_lo[j] + 1 if d0 <= -jump else 0
+            r_hi[j] = r_hi[j] + 1 if d0 >= jump[j] else 0
+            r_lo[j] = r_lo[j] + 1 if d0 <= -jump[j] else 0
             if max(r_hi[j], r_lo[j]) >= jump_blocks:
                 big[j] = abs(d0)
             d = min(max(d0, -clip), clip)
@@ -720,13 +729,15 @@ def component_changes(sums, block_t, block, op_bounds, *, threshold=THRESHOLD, l
         Blocks learnt at a stretch's start.
     """
     names, comps, eqs, u = columns(sums)
+    jumps = np.array([JUMP_EQ if c is None else JUMP for c in comps])
     out = []
     nb = u.shape[0]
     restarts = sorted(set(op_bounds) | {0})
     start = 0
     while start < nb:
         stop = next((r for r in restarts if r > start), nb)
-        hit = cusum(u[:stop], learn=learn if start in restarts else RELEARN, threshold=threshold, start=start)
+        hit = cusum(u[:stop], learn=learn if start in restarts else RELEARN, start=start,
+                    jump=jumps, threshold=np.array([THRESHOLD_EQ if c is None else threshold for c in comps]))
         if hit is None:
             start = stop
             continue
