@@ -234,3 +234,22 @@ def test_diagnose_segments_fits_each_effect_segment_on_its_own_slice(monkeypatch
     assert res.segments[1]["verdict"]["effect"] == "pressure_friction"
     assert res.segments[1]["verdict"]["span"] == [1000.0, 1000.0 + M.DIAGNOSE_SPAN]
     assert res.segments[2]["verdict"]["effect"] == "not_diagnosed"
+
+
+def test_scoring_refuses_settings_that_differ_from_the_tuning_report(monkeypatch, tmp_path, capsys):
+    """scenarios/monitor_validation.py --set scoring runs only with the settings the committed tuning
+    report froze (its settings hash): a changed threshold is refused, exit 2, before any log is read."""
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[1] / "scenarios" / "monitor_validation.py"
+    spec = importlib.util.spec_from_file_location("scenario_monitor_validation", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    frozen = json.loads(mod.TUNING_METRICS.read_text())["settings_hash"]
+    assert mod.settings_check("scoring", mod.settings_hash(mod.settings()))[0] == (mod.settings_hash(mod.settings())
+                                                                                  == frozen)
+    monkeypatch.setattr(M, "THRESHOLD", M.THRESHOLD + 1.0)
+    assert mod.main(["--set", "scoring", "--out", str(tmp_path), "--cache", str(tmp_path / "none")]) == 2
+    assert "differs from the tuning report's" in capsys.readouterr().err
+    assert not (tmp_path / "scoring" / "metrics.json").exists()
