@@ -14,7 +14,7 @@ from heavecomp.params.sets import paper_a
 def test_cusum_finds_a_step_after_it_and_not_noise():
     rng = np.random.default_rng(3)
     u = rng.normal(size=3000)
-    assert M.cusum(u) is None  # 3000 blocks (8 h) of white noise: no alarm at h = 12
+    assert M.cusum(u) is None  # 3000 blocks (8 h) of white noise: no alarm at the committed threshold
     u[1500:] += 2.0
     b, j, onset, size = M.cusum(u)
     # a 2-sigma step: the sum grows by ~1.5 sigma per block past the allowance, crossing 12 in ~8 blocks
@@ -29,6 +29,32 @@ def test_cusum_skips_gaps_and_names_the_column():
     u[100:120, :] = np.nan
     b, j, onset, _ = M.cusum(u)
     assert j == 1 and 400 <= b < 420
+
+
+def test_shewhart_rule_alarms_a_large_step_a_block_before_the_clipped_cusum():
+    rng = np.random.default_rng(6)
+    u = rng.normal(0.0, 0.3, 200)
+    u[100:] += 12.0
+    b, _, onset, _ = M.cusum(u)
+    # two blocks of >= JUMP sigmas: alarmed in the second; the clipped sum alone adds CLIP - DRIFT per block
+    assert (b, onset) == (100 + M.JUMP_BLOCKS - 1, 100)
+    b_sum, _, _, _ = M.cusum(u, jump=math.inf)
+    assert b_sum == 100 + math.ceil(M.THRESHOLD / (M.CLIP - M.DRIFT)) - 1 > b
+
+
+def test_null_sigma_keeps_heavy_tails_from_raising_alarms():
+    # a quiet bulk with 5 % bursts of either sign (stick-slip in a block, a poorly conditioned block):
+    # standardised by the bulk's MAD the CUSUM alarms within a day of blocks; by null_sigma it does not
+    rng = np.random.default_rng(7)
+    x = rng.normal(0.0, 1.0, 8640)
+    burst = rng.random(x.size) < 0.05
+    x[burst] += rng.choice([-30.0, 30.0], burst.sum())
+    assert abs(M.robust_sigma(x) - 1.0) < 0.3 < 3.0 < M.null_sigma(x)
+    assert M.cusum(x / M.robust_sigma(x)) is not None
+    assert M.cusum(x / M.null_sigma(x)) is None
+    # a normal series: both scales agree
+    y = rng.normal(0.0, 2.0, 8640)
+    assert abs(M.null_sigma(y) / M.robust_sigma(y) - 1.0) < 0.1
 
 
 def test_robust_sigma_ignores_a_step():
@@ -76,6 +102,28 @@ def test_monitor_finds_a_seal_friction_onset_on_a_generated_log(tmp_path):
     assert d["schema"] == 1 and set(d["changes"][0]) >= {"t", "component", "size_to_noise", "kind"}
     assert set(d["segments"][0]) >= {"start", "end", "operating_point", "gap_to_noise"}
     assert math.isclose(d["segments"][-1]["end"], tr.t[-1], rel_tol=1e-9)
+    # without the WOB channel the two balances that read it are left out and said so; the seal friction
+    # enters the top-mass balance alone (structure), so nothing is left to see it
+    from heavecomp.diagnosis.data import MeasuredRun
+
+    run = tr.to_run()
+    res = M.monitor(MeasuredRun(run.t, {k: v for k, v in run.columns.items() if k != "wob"}, source="no wob"),
+                    tr.nominal)
+    assert res.skipped["equations"] == {"lower_mass": ["wob"], "top_mass": ["wob"]} and "wob" not in res.sensors
+    assert not [c for c in res.changes if c["component"] == "friction"] and res.to_json()["skipped"]
+
+
+def test_missing_channels_leave_out_the_equations_that_read_them():
+    assert M.usable_equations(["heave", "stroke", "pressure"]) == (("gas",), {"lower_mass": ["wob"],
+                                                                           "top_mass": ["wob"]})
+    assert M.usable_equations(["heave", "stroke", "pressure", "wob"])[1] == {}
+    from heavecomp.diagnosis.data import MeasuredRun
+    from heavecomp.errors import DataError
+
+    t = np.arange(0.0, 600.0, 0.1)
+    run = MeasuredRun(t, {"heave": np.sin(t), "wob": np.full(t.size, 1e5)}, source="heave+wob")
+    with pytest.raises(DataError, match="'stroke', 'pressure' missing"):  # before any work: nothing computable
+        M.monitor(run, paper_a("stribeck"))
 
 
 def test_cli_bad_input_is_one_line(tmp_path, capsys):
@@ -186,3 +234,22 @@ def test_diagnose_segments_fits_each_effect_segment_on_its_own_slice(monkeypatch
     assert res.segments[1]["verdict"]["effect"] == "pressure_friction"
     assert res.segments[1]["verdict"]["span"] == [1000.0, 1000.0 + M.DIAGNOSE_SPAN]
     assert res.segments[2]["verdict"]["effect"] == "not_diagnosed"
+
+
+def test_scoring_refuses_settings_that_differ_from_the_tuning_report(monkeypatch, tmp_path, capsys):
+    """scenarios/monitor_validation.py --set scoring runs only with the settings the committed tuning
+    report froze (its settings hash): a changed threshold is refused, exit 2, before any log is read."""
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[1] / "scenarios" / "monitor_validation.py"
+    spec = importlib.util.spec_from_file_location("scenario_monitor_validation", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    frozen = json.loads(mod.TUNING_METRICS.read_text())["settings_hash"]
+    assert mod.settings_check("scoring", mod.settings_hash(mod.settings()))[0] == (mod.settings_hash(mod.settings())
+                                                                                  == frozen)
+    monkeypatch.setattr(M, "THRESHOLD", M.THRESHOLD + 1.0)
+    assert mod.main(["--set", "scoring", "--out", str(tmp_path), "--cache", str(tmp_path / "none")]) == 2
+    assert "differs from the tuning report's" in capsys.readouterr().err
+    assert not (tmp_path / "scoring" / "metrics.json").exists()

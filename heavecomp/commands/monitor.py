@@ -72,6 +72,8 @@ def run(args) -> int:
     write_report(res, args.out, source=run_.source, extra={"measurement": run_.measurement} if run_.measurement else None)
     write_segment_diagnoses(diagnoses, args.out)
     finish(args.out, params=params, json_files=("monitor.json",), heave_used=False, measured_run=str(Path(args.run).resolve()))
+    for e, chans in res.skipped.get("equations", {}).items():
+        print(f"left out the {e} residual: the log has no {', '.join(chans)} channel", file=sys.stderr)
     eff = [c for c in res.changes if c["kind"] == "effect"]
     ops = [c for c in res.changes if c["kind"] == "operating"]
     print(f"{len(eff)} effect change(s), {len(ops)} operating change(s), {len(res.segments)} segment(s)"

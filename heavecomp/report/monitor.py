@@ -105,7 +105,16 @@ def report_markdown(res, source="", figure="timeline.png") -> str:
              f"{res.duration / 3600:.2f} h of log, sensors {', '.join(res.sensors)}; statistic blocks of "
              f"{res.block:g} s. {sum(c['kind'] == 'effect' for c in res.changes)} effect change(s), "
              f"{sum(c['kind'] == 'operating' for c in res.changes)} operating change(s).", "",
-             f"![timeline]({figure})", "", "## Changes", ""]
+             f"![timeline]({figure})", ""]
+    sk = getattr(res, "skipped", None) or {}
+    if sk.get("equations"):
+        lines += ["**Channels missing:** left out " + "; ".join(
+            f"the {e} residual (reads {', '.join(c)})" for e, c in sk["equations"].items())
+            + " (the model's structure: an effect that enters only those equations cannot be seen; "
+              "docs/monitoring.md, isolability per sensor set).", ""]
+    if sk.get("operating_point"):
+        lines += [f"**Operating point:** {sk['operating_point']}.", ""]
+    lines += ["## Changes", ""]
     if res.changes:
         lines.append(md_table(["detected t [s]", "onset [s]", "component", "size [noise σ]", "kind"],
                               [[f"{c['t']:.0f}", f"{c['onset']:.0f}", c["component"], f"{c['size_to_noise']:.1f}",
@@ -118,8 +127,12 @@ def report_markdown(res, source="", figure="timeline.png") -> str:
               "A Δp = -ΔW); a WOB that moves alone is a misreading (`sensors`).", "", "## Segments", ""]
     hdr = ["start [s]", "end [s]", "WOB set-point [kN]", "static stroke [m]", "static pressure [MPa]"] + \
           [f"{c} gap/noise [-]" for c in COMPONENTS] + ["verdict"]
-    rows = [[f"{s['start']:.0f}", f"{s['end']:.0f}", f"{s['operating_point']['wob_setpoint'] * 1e-3:.1f}",
-             f"{s['operating_point']['static_stroke']:.3f}", f"{s['operating_point']['static_pressure'] * 1e-6:.3f}"]
+    def op(s, key, scale, fmt):
+        v = s["operating_point"][key]
+        return "-" if v is None else format(v * scale, fmt)
+
+    rows = [[f"{s['start']:.0f}", f"{s['end']:.0f}", op(s, "wob_setpoint", 1e-3, ".1f"),
+             op(s, "static_stroke", 1.0, ".3f"), op(s, "static_pressure", 1e-6, ".3f")]
             + [f"{s['gap_to_noise'][c]:.2f}" for c in COMPONENTS] + [_verdict(s)] for s in res.segments]
     lines += [md_table(hdr, rows), "",
               "gap/noise: per component, sqrt(1 + gap) over the segment: the rms of its residual parts over their "
