@@ -205,8 +205,11 @@ class GapDiagnoser(GapEstimator):
     def _fit(self, run):
         t_wall = time.perf_counter()
         P = self.verdict_policy()
-        # the log's sensor set (contract schema 3: heave required; the reader asks for all four today)
+        # the log's sensor set (contract schema 3: heave required, any of stroke, pressure and wob may be
+        # missing); a candidate the set cannot detect (by the model's structure) is not fitted
         self.sensors_ = tuple(c for c in ST.CHANNELS if c in run.columns and np.isfinite(run[c]).any())
+        self.undetectable_ = self.undetectable(self.sensors_)
+        fitted = [n for n in self.candidates if n not in self.undetectable_]
         self._report(0.02, "replaying the nominal model")
         ctx = R.prepare(run, self.nominal, split=self.split, settle=self.settle, stuck_speed=self.stuck_speed,
                         segment=self.segment, reinit=self.reinit, input_draws=self.input_draws,
@@ -215,18 +218,19 @@ class GapDiagnoser(GapEstimator):
         self._where(run, ctx)
         # ---- pre-screen: candidates whose component shows no gap are not replayed
         self.prescreen_ = S.prescreen(self.components_, self.where_["components"], ctx.fitmask, ctx.valmask,
-                                      self.candidates, P)
-        names = [n for n in self.candidates if self.prescreen_[n]["replay"]]
+                                      fitted, P)
+        names = [n for n in fitted if self.prescreen_[n]["replay"]]
         self.fits_ = self._fit_candidates(ctx, names)
         self._report(0.9, "verdict")
         self.verdict_ = self._decide(ctx, self.fits_, P)
-        skipped = [S.skipped_row(n, self.prescreen_[n], self.where_["components"], math.sqrt(ctx.mse_before["wob"]),
-                                 F.candidate_class(ctx, n).n_params(), P) for n in self.candidates if n not in names]
+        skipped = [S.skipped_row(n, self.prescreen_[n], self.where_["components"],
+                                 math.sqrt(ctx.mse_before[ctx.primary]), F.candidate_class(ctx, n).n_params(), P)
+                   for n in fitted if n not in names]
         # stable: fitted first at ties
         self.candidates_ = sorted([f.to_json() for f in self.fits_] + skipped, key=lambda r: -r["score"])
         nom, best = ctx.nominal_pred, self.fits_[0]
         best_pred = best.pred if self.verdict_["effect"] != "none" else nom
-        self.traces_ = {"t": run.t, "measured": {c: run[c] for c in CH}, "nominal": {c: nom[c] for c in CH},
+        self.traces_ = {"t": run.t, "measured": {c: run[c] for c in ctx.channels}, "nominal": {c: nom[c] for c in CH},
                         "best": {c: best_pred[c] for c in CH}, "best_effect": best.effect,
                         "stroke_velocity": nom["stroke_velocity"], "stuck": nom["stuck"]}
         self.wall_time_ = time.perf_counter() - t_wall
@@ -252,7 +256,7 @@ class GapDiagnoser(GapEstimator):
         from the measured signals; floor: the nominal replay)."""
         nom, allmask = ctx.nominal_pred, ctx.allmask
         self.gap_ = {"channels": {}}
-        for c in CH:
+        for c in ctx.channels:
             y = run[c]
             ok = allmask & np.isfinite(y)
             r = nom[c][ok] - y[ok]
@@ -260,7 +264,7 @@ class GapDiagnoser(GapEstimator):
             span = float(np.ptp(y[ok])) or 1.0
             self.gap_["channels"][c] = {"rms": rms, "nrmse": rms / span, "rms_validate": math.sqrt(ctx.mse_before[c]),
                                         "noise_floor": self.noise_floor_[c]}
-        self.where_ = W.locate(run, nom, self.nominal, allmask)
+        self.where_ = W.locate(run, nom, self.nominal, allmask, channel=ctx.primary)
         self.gap_["where"] = self.where_
         self._report(0.04, "component residuals (equation error)")
         self.components_ = CR.residuals(run, self.nominal, heave_reference=self.initial_.heave_reference,
@@ -268,6 +272,9 @@ class GapDiagnoser(GapEstimator):
                                         floor_channels=nom)
         self.where_["components"] = self.components_.shares()
         self.where_["component_table"] = self.components_.table()
+        seen = self.components_.observable()
+        if not all(seen.values()):  # components no computable equation carries: 0 share, as not observable
+            self.where_["not_observable"] = [c for c, ok in seen.items() if not ok]
 
     def _fit_candidates(self, ctx, names) -> list:
         """Every candidate in ``names`` fitted and scored (fits on ``n_jobs`` threads, the costliest
@@ -321,7 +328,8 @@ class GapDiagnoser(GapEstimator):
             return self.components_.stationarity(component, mask=mask, drift_sigmas=P.drift_sigmas,
                                                  drift_share=P.drift_share)
 
-        evidence = V.Evidence(shares, self.prescreen_, second, self.discovered_, stationarity)
+        evidence = V.Evidence(shares, self.prescreen_, second, self.discovered_, stationarity,
+                              tuple(self.where_.get("not_observable", ())))
         verdict = V.decide(fits, self.gap_["channels"], self.noise_floor_, self.input_envelope_, P, evidence)
         self.warnings_ += list(verdict.warnings)
         return verdict.to_json()
@@ -338,13 +346,31 @@ class GapDiagnoser(GapEstimator):
             self.progress(frac, msg)
 
     # ---------------------------------------------------------------- output
+    def undetectable(self, sensors) -> list:
+        """The candidates the sensor set ``sensors`` cannot detect by the model's structure
+        (:func:`heavecomp.diagnosis.structure.isolability`, level ``"structural"``): no residual computable
+        from those channels carries them.  A channel effect counts as detectable when it is on any channel
+        present.
+
+        Parameters
+        ----------
+        sensors : iterable of str
+            Channels the log has.
+        """
+        iso = ST.isolability(sensors, self.candidates)
+        det = {c.partition(":")[0] for c in iso["detectable"]}
+        return [n for n in self.candidates if n not in det]
+
     def isolability(self) -> dict:
         """What the log's sensor set can tell apart (contract schema 3, ``isolability``): the candidates
         it can detect and the groups it cannot tell apart, from the model's structure
         (:func:`heavecomp.diagnosis.structure.isolability`, level ``"shape"``: which equation each
         effect enters and which measured signals its term depends on)."""
         iso = ST.isolability(self.sensors_, self.candidates, level="shape")
-        return {"detectable": iso["detectable"], "groups": iso["groups"], "level": iso["level"]}
+        out = {"detectable": iso["detectable"], "groups": iso["groups"], "level": iso["level"]}
+        if iso["undetectable"]:
+            out["undetectable"] = iso["undetectable"]
+        return out
 
     def verdict_group(self, iso=None):
         """The isolability group of a named verdict (``verdict.group``; the effect alone when it is
@@ -386,4 +412,5 @@ class GapDiagnoser(GapEstimator):
                 "warnings": list(getattr(self, "warnings_", [])),
                 "initial_state": self.initial_.to_json(),
                 "prescreen": getattr(self, "prescreen_", {}),
+                "not_fitted": {"undetectable": list(getattr(self, "undetectable_", []))},
                 "wall_time_s": self.wall_time_}
