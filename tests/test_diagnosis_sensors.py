@@ -81,3 +81,4 @@ def test_diagnose_a_log_without_pressure(tmp_path):
         assert v["group"] in j["isolability"]["groups"] or v["group"] == [v["effect"]]
     md = (tmp_path / "report.md").read_text()
     assert "not observable" in md.lower() and "not measured" in md
+    assert "_units" not in md  # write_json declares units in the file only, not in the diagnoser's parameters

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import copy
 import json
 import math
 import re
@@ -67,7 +68,7 @@ def write_json(diag, path) -> Path:
         The file to write.
     """
     path = Path(path)
-    d = diag.to_json()
+    d = copy.deepcopy(diag.to_json())  # the declarations go into the file, not into the diagnoser's own results
     for block in _parameter_blocks(d):  # the effect's own metadata, the channel's unit for a channel effect
         if isinstance(block.get("parameters"), dict) and isinstance(block.get("effect"), str):
             units = _effect_units(block["effect"], block["parameters"])
