@@ -61,6 +61,7 @@ def test_stroke_pressure_and_wob_are_each_optional(tmp_path, header):
     r = load_run(_write(tmp_path / "r.csv", t, c, header=header), P)
     assert r.sensors == ("heave",) + tuple(k for k in ("stroke", "pressure", "wob") if k in header)
     assert set(r.columns) == set(header[1:])
+    assert sorted(w.split("'")[1] for w in r.warnings) == sorted(set(("stroke", "pressure", "wob")) - set(header))
     if "wob" in header:  # a WOB in kN is still caught without the pressure
         c2 = dict(c, wob=c["wob"] / 1e3)
         assert "wob=kN" in _err(tmp_path, t, c2, header=header)

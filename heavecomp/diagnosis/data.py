@@ -262,7 +262,9 @@ def check_run(t, columns: dict, *, params=None, source="<array>", rows=None) -> 
         i = hole[0]
         raise DataError(f"{source}: column 't', row {line(i + 1)}: {t[i + 1] - t[i]:.3g} s without samples "
                         f"({t[i]:g} -> {t[i + 1]:g} s; longest bridged gap {MAX_GAP:g} s)")
-    warnings = []
+    # a channel the log lacks (contract schema 3): diagnosed without it, said once, with the way to map it
+    warnings = [f"no column '{c}': diagnosed with the channels present (if the log has it under another name, map "
+                f"it, {c}=NAME)" for c in ("stroke", "pressure", "wob") if c not in columns]
     for col in checked:
         miss = ~np.isfinite(columns[col])
         frac = float(miss.mean())
