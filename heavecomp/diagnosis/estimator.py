@@ -14,8 +14,9 @@ Method
    dropouts; noise floor sigma_c from second differences plus what the heave noise and the heave
    pre-processing make of the replay.
 3. Each candidate is fitted (:mod:`heavecomp.diagnosis.fitting`: bounded, few parameters, decimated
-   residual) on the *fit* part [settle, t_split] and scored on the held-out part [t_split, end].  All
-   channels enter, each weighted by 1/rms_before_c^2 on the fit part.  Candidates whose model component
+   residual) on the *fit* part [settle, t_split] and scored on the held-out part [t_split, end].  Every
+   channel the log has enters (heave required; any of stroke, pressure, WOB may be missing: docs/diagnosis.md
+   "Sensor sets"), each weighted by 1/rms_before_c^2 on the fit part.  Candidates whose model component
    shows no equation-error gap are not replayed (:mod:`heavecomp.diagnosis.screen`).
 4. Explained share of the held-out gap above the noise floor, per channel
    ``e_c = (mse_before - mse_after) / (mse_before - sigma_c^2)``, averaged with the channels'
@@ -137,6 +138,8 @@ class GapDiagnoser(GapEstimator):
     second_tried_ : list every joint partner tried for a second effect
     context_ : ReplayContext  the prepared run (:mod:`heavecomp.diagnosis.replay`)
     fits_ : list         the replayed candidates as :class:`~heavecomp.diagnosis.fitting.CandidateFit`, best first
+    sensors_ : tuple     the channels the log has (heave, and those of stroke, pressure, wob present)
+    undetectable_ : list candidates the sensor set cannot detect by structure: not fitted (:meth:`undetectable`)
     """
 
     _ranking_attr, _choice_attr = "candidates_", "verdict_"  # GapEstimator's ranking_ and effect_
