@@ -343,8 +343,11 @@ def write_report(diag, out_dir, *, title="Sim-to-real gap diagnosis") -> dict:
     g = diag.gap_
     pc = diag.where_.get("channel", "wob")
     pu, ps = CH_UNITS[pc]
+    group = diag.verdict_group()
+    named = (f"**Verdict: one of {', '.join(f'`{m}`' for m in group)}** (this sensor set cannot tell them apart; "
+             f"`{v['effect']}` fitted best)" if group and len(group) > 1 else f"**Verdict: `{v['effect']}`**")
     lines = [f"# {title}", "",
-             f"**Verdict: `{v['effect']}`** (confidence {v['confidence']}); held-out shrink of the "
+             f"{named} (confidence {v['confidence']}); held-out shrink of the "
              f"{v.get('shrink_channel', 'wob')} residual {v['shrink']:.2f}."]
     if v.get("note"):
         lines.append(f"\n{v['note']}.")
