@@ -20,6 +20,17 @@ data-quality checks) and diagnosed. The goal: no confident verdict on corrupted 
 refused naming the corrupted column, or diagnosed with confidence low and a warning naming it (a torn
 last row: dropped with a warning naming it and the clean run's verdict); the clean runs draw no
 data-quality warning.
+
+The sensor-set scoring (issue 23 item 3, ``--set sensors``) diagnoses the same generated runs with
+the channels a rig may lack dropped before the diagnosis (the generator is untouched): all four; no
+stroke; no pressure; WOB and heave only (``--sensors``). The runs are the scoring set's first case of
+one effect per model component plus a no-effect run, with fresh seeds (230000+, used by no other set),
+at most 240 s long, each written as a CSV with only the set's columns and read by load_run as a rig log. Per sensor set: the
+named-effect rate (the planted effect named, held-out shrink real), the right-group rate (the planted
+effect in the verdict's isolability group, ``verdict.group``), and the confident-wrong count (a medium
+or high verdict whose group does not hold the planted effect). A planted effect that moves no channel
+of the set by the generator's own GAP_MIN x its noise is counted apart (not visible to that set: the
+honest answer is none or a low-confidence verdict). Thresholds are the frozen tuning settings.
 """
 
 from __future__ import annotations
@@ -523,11 +534,243 @@ def main_corrupted(args, nominal, settings, digest) -> int:
     return 0
 
 
+# ------------------------------------------------------------------------------ sensor sets
+#: the sensor sets scored (issue 23 item 3): name -> channels the diagnosed log keeps
+SENSOR_SETS = {"all": ("heave", "stroke", "pressure", "wob"), "no_stroke": ("heave", "pressure", "wob"),
+               "no_pressure": ("heave", "stroke", "wob"), "wob_heave": ("heave", "wob")}
+SENSORS_SEED0 = 230000  #: first seed of the sensor-set runs (tuning 20000+, scoring 50000-151000, corrupted 170000+)
+SENSORS_DURATION = 240.0  #: s of each sensor-set run (the scoring cases' own length when shorter)
+#: the scoring set's effects scored per sensor set: one in each model component (friction, gas spring, flow line,
+#: string and formation, a sensor, the heave input) and a no-effect run -- four diagnoses each, so the set finishes
+#: in the time a shared 2-core machine gives it
+SENSORS_LABELS = ("pressure_friction", "gas_leak", "flow_loss", "string_damping", "sensor_gain", "heave_reference",
+                  "none")
+
+
+def sensor_cases(quick=False):
+    """The sensor-set runs: the first scoring case of each of :data:`SENSORS_LABELS`, with fresh seeds
+    (:data:`SENSORS_SEED0` +), at most :data:`SENSORS_DURATION` long, no cut twin."""
+    seen, cases = set(), []
+    for c in validation_cases("scoring"):
+        if c.category not in ("named", "none") or c.label in seen or c.label not in SENSORS_LABELS:
+            continue
+        seen.add(c.label)
+        cases.append(dataclasses.replace(c, seed=SENSORS_SEED0 + len(cases), duration=min(c.duration, SENSORS_DURATION),
+                                         pair_cut=0.0))
+    if quick:
+        cases = [dataclasses.replace(c, duration=90.0, start=min(c.start, 30.0)) for c in cases[:1]]
+    return cases
+
+
+def _csv_of(tr, keep, path: Path) -> Path:
+    """The run as a contract CSV with only the channels ``keep`` (and ``t``, and a logged angle)."""
+    cols = [c for c in ("heave", "stroke", "pressure", "wob") if c in keep] + [a for a in ("pitch",) if a in tr.columns]
+    np.savetxt(path, np.column_stack([tr.t] + [tr.columns[c] for c in cols]), delimiter=",",
+               header=",".join(["t"] + cols), comments="", fmt="%.10g")
+    return path
+
+
+def _base(name):
+    return name.partition(":")[0]
+
+
+def judge_sensors(label, got, visible) -> dict:
+    """How one sensor-set verdict counts: ``named`` (the planted effect named with a real shrink; no-effect
+    runs: ``none``), ``group`` (the planted effect in the verdict's group, real shrink; no-effect: ``none``),
+    ``confident_wrong`` (medium/high, and the group does not hold the planted effect; no-effect: any
+    medium/high verdict but none).  ``visible``: the planted effect moves a channel of the set by
+    GAP_MIN x its noise; a run it is not visible to is right when it names nothing with confidence."""
+    eff, conf = got["verdict"], got["confidence"]
+    confident = conf in ("medium", "high")
+    named = eff not in NOT_NAMED and eff != "refused"
+    group = {_base(m) for m in (got.get("group") or ([eff] if named else []))}
+    real = got["shrink"] >= SHRINK_REAL
+    if label == "none":
+        ok = eff == "none"
+        return {"named": ok, "group": ok, "confident_wrong": eff != "none" and confident}
+    wrong = named and confident and label not in group
+    if not visible:
+        ok = not (named and confident)
+        return {"named": ok, "group": ok, "confident_wrong": wrong}
+    return {"named": eff == label and real, "group": named and label in group and real, "confident_wrong": wrong}
+
+
+def run_sensor_case(case, workdir, sets, n_jobs=1) -> dict:
+    """One run generated once, diagnosed from a CSV of each sensor set's channels; the row of the report."""
+    from heavecomp.benchmark.sizing import GAP_MIN
+
+    t0 = time.perf_counter()
+    row = {"case": dataclasses.asdict(case), "label": case.label, "category": case.category, "seed": case.seed}
+    try:
+        tr = generate(case)
+    except RuntimeError as exc:
+        row["error"] = str(exc)
+        return row
+    row["truth"] = {k: tr.truth[k] for k in ("component", "parameters", "gap_to_noise", "noise_floor", "sea")}
+    gaps = tr.truth.get("gap_channels", {}).get(case.label, {})
+    row["truth"]["gap_channels"] = gaps
+    row["sets"] = {}
+    for name in sets:
+        keep = SENSOR_SETS[name]
+        t1 = time.perf_counter()
+        stem = f"{case.seed}_{case.label}_{name}"
+        csv = _csv_of(tr, keep, Path(workdir) / f"{stem}.csv")
+        nominal = load(write_params(Path(workdir), tr.nominal, f"{stem}.toml"))
+        visible = case.label == "none" or max([gaps.get(c, 0.0) for c in keep if c != "heave"] or [0.0]) >= GAP_MIN
+        try:
+            d = GapDiagnoser(nominal, n_jobs=n_jobs).fit(load_run(csv, nominal))
+            j = d.to_json()
+            v = j["verdict"]
+            got = {"verdict": v["effect"], "confidence": v["confidence"], "group": v.get("group"),
+                   "component": v.get("component"), "shrink": float(v["shrink"]),
+                   "shrink_channel": v.get("shrink_channel"), "sensors": j["sensors"],
+                   "not_observable": j["gap"]["where"].get("not_observable", []),
+                   "not_fitted": j["not_fitted"]["undetectable"]}
+        except InputError as exc:
+            got = {"verdict": "refused", "confidence": "low", "group": None, "component": None, "shrink": 0.0,
+                   "refused": str(exc)}
+        except Exception as exc:  # noqa: BLE001 - a crash is reported, the set goes on
+            log.exception("%s (seed %s) %s: the diagnosis failed", case.label, case.seed, name)
+            got = {"verdict": "crashed", "confidence": "low", "group": None, "component": None, "shrink": 0.0,
+                   "crashed": repr(exc)}
+        got["visible"] = bool(visible)
+        got["judged"] = judge_sensors(case.label, got, visible)
+        got["wall_time"] = time.perf_counter() - t1
+        row["sets"][name] = got
+    row["wall_time"] = time.perf_counter() - t0
+    return row
+
+
+def summarize_sensors(rows, sets) -> dict:
+    """Per sensor set: runs, named-effect rate, right-group rate, confident-wrong count (effect runs the set
+    can see, no-effect runs, and runs it cannot see apart)."""
+    ok = [r for r in rows if "sets" in r]
+    out = {}
+    for name in sets:
+        got = [(r, r["sets"][name]) for r in ok]
+        vis = [(r, g) for r, g in got if r["label"] != "none" and g["visible"]]
+        invis = [(r, g) for r, g in got if r["label"] != "none" and not g["visible"]]
+        nones = [(r, g) for r, g in got if r["label"] == "none"]
+
+        def rate(items, key):
+            return _share(sum(g["judged"][key] for _, g in items), len(items))
+
+        out[name] = {"sensors": list(SENSOR_SETS[name]), "n_runs": len(got), "n_visible": len(vis),
+                     "named_rate": rate(vis, "named"), "group_rate": rate(vis, "group"),
+                     "confident_wrong": sum(g["judged"]["confident_wrong"] for _, g in got),
+                     "none_right": sum(g["judged"]["named"] for _, g in nones), "n_none": len(nones),
+                     "not_visible_right": sum(g["judged"]["named"] for _, g in invis), "n_not_visible": len(invis),
+                     "refused_or_crashed": sum(g["verdict"] in ("refused", "crashed") for _, g in got),
+                     "mean_group_size": _mean([len(g["group"]) for _, g in got if g.get("group")])}
+    return {"n_cases": len(rows), "n_generated": len(ok), "not_generated": [r["label"] for r in rows if "error" in r],
+            "per_set": out}
+
+
+def _mean(xs):
+    return float(np.mean(xs)) if xs else None
+
+
+def write_sensors(out: Path, rows, summary, sets, settings, digest, note, quick):
+    write_metrics(out, {"set": "sensors", "quick": quick, "settings": settings, "settings_hash": digest,
+                        "frozen": note, "seed0": SENSORS_SEED0, "shrink_real": SHRINK_REAL,
+                        "sensor_sets": {k: list(SENSOR_SETS[k]) for k in sets}, "summary": summary, "runs": rows})
+    ps = summary["per_set"]
+    table = md_table(["sensor set", "channels", "effect runs it sees", "named effect right", "right group",
+                      "confident wrong (all runs)", "no-effect runs none", "runs it cannot see: no confident verdict",
+                      "mean size of a named verdict's group", "refused / crashed"],
+                     [[k, ", ".join(d["sensors"]), d["n_visible"], _fmt(d["named_rate"], pct=True),
+                       _fmt(d["group_rate"], pct=True), d["confident_wrong"], f"{d['none_right']} of {d['n_none']}",
+                       f"{d['not_visible_right']} of {d['n_not_visible']}", _fmt(d["mean_group_size"]),
+                       d["refused_or_crashed"]]
+                      for k, d in ps.items()])
+
+    def cell(g):
+        grp = g.get("group")
+        txt = f"{g['verdict']} ({g['confidence']})"
+        if grp and len(grp) > 1:
+            txt += " in {" + ", ".join(grp) + "}"
+        return txt + ("" if g["visible"] else " [not visible]") + (" ✓" if g["judged"]["group"] else "")
+
+    runs = md_table(["true effect", "seed", "sea", "params", "rate [Hz]"] + list(sets),
+                    [[r["label"] + (f" ({r['case']['variant']})" if r["case"]["variant"] else ""), r["seed"],
+                      r["case"]["sea"], r["case"]["params"], f"{r['case']['rate']:g}"]
+                     + [cell(r["sets"][k]) for k in sets] for r in rows if "sets" in r])
+    write_report(out, "Diagnosis validation: per sensor set", [
+        __doc__.split("\n\n")[3],
+        f"**Thresholds: {note}.** {summary['n_generated']} of {summary['n_cases']} runs generated"
+        + (f" (not generated: {', '.join(summary['not_generated'])})" if summary["not_generated"] else "")
+        + (" — **quick mode: one short run, not a validation**" if quick else "") + ".",
+        "## Scores per sensor set", table,
+        "Named effect right and right group are shares of the effect runs the set sees (the planted effect moves one "
+        "of its channels by the generator's GAP_MIN x its noise). The isolability groups are the model's structure "
+        "(docs/diagnosis.md, 'Sensor sets'); a verdict in a group names the group, so the right-group rate says as "
+        "much as the groups are small (their mean size is in the table).",
+        "## Runs", "Each cell: verdict (confidence), its group when the sensor set cannot tell it apart; "
+        "[not visible]: the planted effect moves no channel of the set above GAP_MIN x noise; ✓: right group.", runs])
+
+
+def main_sensors(args, nominal, settings, digest) -> int:
+    """``--set sensors``: every sensor-set run diagnosed once per sensor set, in ``args.jobs`` processes."""
+    sets = [s.strip() for s in args.sensors.split(",") if s.strip()]
+    bad = [s for s in sets if s not in SENSOR_SETS]
+    if bad or not sets:
+        print(f"--sensors: unknown sensor set {bad[0] if bad else args.sensors!r}; known: {', '.join(SENSOR_SETS)}",
+              file=sys.stderr)
+        return 2
+    ok, note = _settings_check("scoring", digest)  # scored: the settings frozen by the tuning report
+    if not ok and not args.allow_unfrozen:
+        print(f"diagnosis_validation: {note} (--allow-unfrozen scores anyway, flagged)", file=sys.stderr)
+        return 2
+    if not ok:
+        note = f"NOT FROZEN — {note}"
+    cases = sensor_cases(args.quick)
+    workdir = Path(args.runs) if args.runs else Path(tempfile.mkdtemp(prefix="heavecomp_sensors_"))
+    workdir.mkdir(parents=True, exist_ok=True)
+    t0 = time.perf_counter()
+    rows = [None] * len(cases)
+
+    def done(i, row):
+        rows[i] = row
+        if "error" in row:
+            log.info("[%d/%d %5.0f s] %s: not generated (%s)", i + 1, len(cases), time.perf_counter() - t0,
+                     row["label"], row["error"])
+            return
+        log.info("[%d/%d %5.0f s] %s: %s", i + 1, len(cases), time.perf_counter() - t0, row["label"],
+                 "; ".join(f"{k} {g['verdict']} ({g['confidence']})" for k, g in row["sets"].items()))
+
+    try:
+        if args.jobs == 1:
+            for i, c in enumerate(cases):
+                done(i, run_sensor_case(c, workdir, sets, n_jobs=2))
+        else:
+            import multiprocessing as mp
+
+            with cf.ProcessPoolExecutor(args.jobs, mp_context=mp.get_context("spawn")) as ex:
+                futs = {ex.submit(run_sensor_case, c, workdir, sets, 1): i for i, c in enumerate(cases)}
+                for f in cf.as_completed(futs):
+                    done(futs[f], f.result())
+    finally:
+        if not args.runs:
+            shutil.rmtree(workdir, ignore_errors=True)
+    summary = summarize_sensors(rows, sets)
+    summary["wall_time_s"] = time.perf_counter() - t0
+    write_sensors(args.out, rows, summary, sets, settings, digest, note, args.quick)
+    log.info("sensor sets: %s (%.0f s) -> %s", "; ".join(
+        f"{k}: named {_fmt(d['named_rate'], pct=True)}, group {_fmt(d['group_rate'], pct=True)}, "
+        f"confident wrong {d['confident_wrong']}" for k, d in summary["per_set"].items()),
+        summary["wall_time_s"], args.out)
+    return 0
+
+
 def main(argv=None) -> int:
     def extra(p):
-        p.add_argument("--set", dest="which", choices=("tuning", "scoring", "corrupted"), required=True,
-                       help="the tuning set (freezes the settings), the scoring set (needs them frozen) or the "
-                            "corrupted set (corrupted logs: refused or diagnosed with confidence low)")
+        p.add_argument("--set", dest="which", choices=("tuning", "scoring", "corrupted", "sensors"), required=True,
+                       help="the tuning set (freezes the settings), the scoring set (needs them frozen), the "
+                            "corrupted set (corrupted logs: refused or diagnosed with confidence low) or the sensor-set "
+                            "scoring (fresh runs diagnosed with channels dropped, per --sensors)")
+        p.add_argument("--sensors", default=",".join(SENSOR_SETS),
+                       help="with --set sensors: the sensor sets scored, comma separated, of "
+                            f"{', '.join(SENSOR_SETS)} (default: all four)")
         p.add_argument("--jobs", type=int, default=2, help="runs diagnosed in parallel processes (default 2)")
         p.add_argument("--runs", default=None, help="keep the generated CSV runs in this folder (default: "
                                                      "a temporary folder, deleted)")
@@ -546,6 +789,8 @@ def main(argv=None) -> int:
     digest = frozen_digest(nominal, settings)
     if args.which == "corrupted":
         return main_corrupted(args, nominal, settings, digest)
+    if args.which == "sensors":
+        return main_sensors(args, nominal, settings, digest)
     cases = validation_cases(args.which, quick=args.quick)
     ok, note = _settings_check(args.which, digest)
     if not ok and not args.allow_unfrozen:

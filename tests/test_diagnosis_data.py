@@ -46,8 +46,49 @@ def test_good_run_loads(tmp_path):
 
 def test_missing_column(tmp_path):
     t, c = _good()
-    msg = _err(tmp_path, t, c, header=("t", "heave", "stroke", "wob"))
-    assert "missing column 'pressure'" in msg
+    msg = _err(tmp_path, t, c, header=("t", "stroke", "pressure", "wob"))
+    assert "missing column 'heave'" in msg
+    msg = _err(tmp_path, t, c, header=("t", "heave"))  # the heave alone: nothing to compare the model with
+    assert "'stroke', 'pressure', 'wob'" in msg
+
+
+@pytest.mark.parametrize("header", [("t", "heave", "stroke", "wob"), ("t", "heave", "pressure", "wob"),
+                                    ("t", "heave", "wob"), ("t", "heave", "stroke")])
+def test_stroke_pressure_and_wob_are_each_optional(tmp_path, header):
+    """Contract schema 3: heave is required, any of stroke, pressure and WOB may be missing; the run
+    says which it has, and the magnitudes of those present are still checked."""
+    t, c = _good()
+    r = load_run(_write(tmp_path / "r.csv", t, c, header=header), P)
+    assert r.sensors == ("heave",) + tuple(k for k in ("stroke", "pressure", "wob") if k in header)
+    assert set(r.columns) == set(header[1:])
+    assert sorted(w.split("'")[1] for w in r.warnings) == sorted(set(("stroke", "pressure", "wob")) - set(header))
+    if "wob" in header:  # a WOB in kN is still caught without the pressure
+        c2 = dict(c, wob=c["wob"] / 1e3)
+        assert "wob=kN" in _err(tmp_path, t, c2, header=header)
+
+
+def test_wob_from_hook_load_is_explicit_and_recorded(tmp_path):
+    """A log with a hook load and no WOB: W = string weight - hook load, the string weight from the
+    parameter file's [measurement] table (or the keyword), the conversion in the provenance; without a
+    string weight it is one line naming the column and the key."""
+    from heavecomp.params import load
+
+    t, c = _good()
+    W_s = 1.5e6
+    hl = dict(c, hook_load=(W_s - c["wob"]) / 1e3)  # logged in kN
+    f = _write(tmp_path / "r.csv", t, hl, header=("t", "heave", "stroke", "pressure", "hook_load"))
+    toml = tmp_path / "p.toml"
+    toml.write_text(dumps(P) + f"\n[measurement]\nunits = {{ hook_load = \"kN\" }}\nstring_weight = {W_s}\n")
+    r = load_run(f, load(toml))
+    np.testing.assert_allclose(r["wob"], c["wob"], rtol=1e-9)
+    assert r.measurement["wob_from"] == {"column": "hook_load", "string_weight_N": W_s,
+                                         "formula": "wob = string_weight - hook_load"}
+    assert any("hook_load" in x for x in r.measurement["conversions"])
+    r2 = load_run(f, P, units={"hook_load": "kN"}, string_weight=W_s)
+    np.testing.assert_allclose(r2["wob"], c["wob"], rtol=1e-9)
+    with pytest.raises(DataError) as e:
+        load_run(f, P, units={"hook_load": "kN"})
+    assert "'hook_load'" in str(e.value) and "string_weight" in str(e.value) and "\n" not in str(e.value)
 
 
 def test_non_numeric_cell_names_column_and_row(tmp_path):

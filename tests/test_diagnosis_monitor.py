@@ -136,10 +136,13 @@ def test_cli_bad_input_is_one_line(tmp_path, capsys):
     save(p, prm)
     t = np.arange(0.0, 300.0, 0.1)
     log = tmp_path / "log.csv"
-    log.write_text("t,heave,stroke,wob\n" + "\n".join(f"{x:.1f},0,0,{p.operating_point.wob_setpoint}" for x in t))
+    # heave and WOB only: the reader takes it (any of stroke, pressure, wob may be missing), but no equation
+    # the monitor follows can be computed without stroke and pressure -> refused in one line, before any work
+    log.write_text("t,heave,wob\n" + "\n".join(f"{x:.1f},{0.5 * np.sin(0.6 * x):.4f},{p.operating_point.wob_setpoint + 500 * np.sin(0.6 * x):.1f}"
+                                                for x in t))
     rc = main(["monitor", str(log), "--params", str(prm), "--out", str(tmp_path / "o")])
     err = capsys.readouterr().err.strip().splitlines()
-    assert rc == 2 and len(err) == 1 and "pressure" in err[0]
+    assert rc == 2 and len(err) == 1 and "pressure" in err[0] and "stroke" in err[0]
     assert not (tmp_path / "o" / "monitor.json").exists()
 
 

@@ -61,6 +61,7 @@ from heavecomp.diagnosis.data import ANGLES, fill_gaps, lowpass_zero_phase, nois
 from heavecomp.diagnosis.policy import VerdictPolicy
 from heavecomp.effects.base import COMPONENTS
 from heavecomp.effects.features import rest_durations
+from heavecomp.errors import DataError
 from heavecomp.friction.laws import friction_cont, friction_jump
 from heavecomp.plants.cmc import CF, D0, KF, MB, MC, G, gas_pressure, net_force, plant_vectors, tension
 
@@ -200,6 +201,12 @@ class ComponentResiduals:
     mask: np.ndarray
     floor: dict = dataclasses.field(default_factory=dict)
     inputs: dict = dataclasses.field(default_factory=dict)
+    #: the equations the log's channels cannot compute (:func:`unobservable`): their residuals are NaN
+    missing: tuple = ()
+
+    def observable(self) -> dict:
+        """{component: whether an equation that carries a part of it is computable from the log's channels}."""
+        return {c: any(e not in self.missing for e in self.parts.get(c, {})) for c in COMPONENTS}
 
     def z(self, mask=None) -> dict:
         """{component: {equation: mean square of its part / noise variance of the equation}} [-]."""
@@ -302,6 +309,7 @@ class ComponentResiduals:
             ok = m & np.isfinite(r)
             eqs = list(self.parts.get(c, {}))
             rows.append({"component": c, "share": sh[c], "gap_to_noise": gn[c],
+                         "observable": any(e not in self.missing for e in eqs),
                          "rms": float(np.sqrt(np.mean(r[ok] ** 2))) if ok.any() else 0.0,
                          "noise": float(math.sqrt(sum(self.noise[e] ** 2 for e in eqs) / max(len(eqs), 1))),
                          "unit": UNITS[c], "equations": eqs})
@@ -335,29 +343,54 @@ def residuals(run, params, *, heave_reference=None, noise=None, mask=None, cutof
     """
 
     t = run.t
-    ch = {k: fill_gaps(t, run[k]) for k in ("heave", "stroke", "pressure", "wob")}
+    lost = tuple(k for k in ("stroke", "pressure", "wob") if k not in run.columns)
+    if lost and floor_channels is None:
+        raise DataError(f"{run.source}: column '{lost[0]}' missing: the component residuals without it need the "
+                        "nominal replay in its place (the gap diagnosis gives it; floor_channels)")
+    # a missing channel: the nominal replay stands in so the arrays exist; every equation that reads it is
+    # not computable (:func:`unobservable`) and left out (NaN)
+    ch = {k: fill_gaps(t, run[k] if k in run.columns else np.asarray(floor_channels[k], float))
+          for k in ("heave", "stroke", "pressure", "wob")}
+    missing = unobservable(lost)
     if heave_reference is None:
         heave_reference = float(lowpass_zero_phase(t, ch["heave"], cutoff)[0][0])
     m = (t >= t[0] + EDGE) & (t <= t[-1] - EDGE)
     if mask is not None:
         m &= mask
-    noise = dict(noise) if noise else {k: noise_floor(run[k], None if run.uniform else t) for k in ch}
-    out = _split(t, ch, params, heave_reference, cutoff, noise, m, seed)
+    noise = dict(noise) if noise else {k: noise_floor(run[k], None if run.uniform else t) for k in ch if k not in lost}
+    noise = {k: noise.get(k, 0.0) for k in ch}
+    out = _split(t, ch, params, heave_reference, cutoff, noise, m, seed, missing=missing)
+    out.missing = missing
     for a in ANGLES:  # a logged vessel angle [rad], filtered as the heave (heave_reference's lever arm)
         if a in run.columns:
             out.signals[a] = lowpass_zero_phase(t, fill_gaps(t, run[a]), cutoff)[0]
     out.inputs = {"channels": ch, "params": params, "heave_reference": heave_reference, "cutoff": cutoff,
-                  "channel_noise": noise}
+                  "channel_noise": noise, "present": tuple(k for k in READS if k not in lost)}
     if floor_channels is not None:
         ref = dict(ch, **{k: fill_gaps(t, np.asarray(floor_channels[k], float)) for k in ("stroke", "pressure", "wob")})
-        nf = _split(t, ref, params, heave_reference, cutoff, None, m, seed, noise_of=out.noise)
+        nf = _split(t, ref, params, heave_reference, cutoff, None, m, seed, noise_of=out.noise, missing=missing)
         out.floor = nf.z()
     return out
 
 
-def _split(t, ch, params, heave_reference, cutoff, noise, m, seed, noise_of=None):
-    """Equation residuals of channels ``ch``, their noise (or ``noise_of``) and the attribution."""
+def unobservable(lost) -> tuple:
+    """The equations that read a channel of ``lost`` (:data:`READS`): not computable without it.
+
+    Parameters
+    ----------
+    lost : iterable of str
+        The output channels (stroke, pressure, wob) the log does not have.
+    """
+    lost = set(lost)
+    return tuple(e for e in SPLIT if any(e in READS[c] for c in lost))
+
+
+def _split(t, ch, params, heave_reference, cutoff, noise, m, seed, noise_of=None, missing=()):
+    """Equation residuals of channels ``ch`` (those in ``missing`` NaN: not computable), their noise (or
+    ``noise_of``) and the attribution."""
     eq, sig, _ = equations(t, ch["heave"], ch["stroke"], ch["pressure"], ch["wob"], params, heave_reference, cutoff)
+    for e in missing:
+        eq[e] = np.full(t.size, np.nan)
     if noise_of is not None:
         return _attribute(t, eq, sig, noise_of, m)
     # noise of each equation residual: the change when every channel gets its own noise again
@@ -397,9 +430,14 @@ def _attribute(t, eq, sig, sig_noise, m):
         resid[own] = rest
     # a component that only explains parts of other equations: its residual is the equation's (the one
     # where it is largest) with the other components' parts removed (what its candidates see)
+    def size(c, k):  # mean square over the noise of component c's part in equation k (-1: not computable)
+        v = parts[c][k][m]
+        v = v[np.isfinite(v)]
+        return float(np.mean(v * v)) / max(sig_noise[k], 1e-300) ** 2 if v.size else -1.0
+
     for c in COMPONENTS:
         if c not in resid:
-            e = max(parts[c], key=lambda k: np.nanmean(parts[c][k][m] ** 2) / max(sig_noise[k], 1e-300) ** 2)
+            e = max(parts[c], key=lambda k: size(c, k))
             resid[c] = parts[OWN[e]][e] + parts[c][e]
     return ComponentResiduals(t, eq, sig_noise, parts, resid, sig, m)
 
@@ -541,7 +579,11 @@ def channel_search(cr, fit, validate) -> dict | None:
     args = (inp["params"], inp["heave_reference"], inp["cutoff"])
     base_eq = cr.equations
     best = None
+    missing = set(cr.missing)
     for c, eqs in READS.items():
+        eqs = tuple(e for e in eqs if e not in missing)
+        if c not in inp.get("present", READS) or len(eqs) < 2:  # a channel the log lacks, or seen once: no test
+            continue
         sigma = float(inp["channel_noise"].get(c, 0.0)) or float(np.std(ch[c])) * 1e-3
         feats = channel_features(ch[c], sigma, cr.signals["zh"] + cr.signals["x"])
         lib = {}

@@ -40,7 +40,10 @@ P_ATM = 101325.0  #: atmospheric pressure [Pa] (cmc-reference.md)
 
 log = logging.getLogger(__name__)
 
-REQUIRED = ("t", "heave", "stroke", "pressure", "wob")
+#: columns every run must have (contract schema 3: heave is the model's input)
+REQUIRED = ("t", "heave")
+#: the measured outputs, each optional (contract schema 3: any of them may be missing); the diagnosis works
+#: on those present (:attr:`MeasuredRun.sensors`)
 CHANNELS = ("wob", "stroke", "pressure")
 UNITS = {"t": "s", "heave": "m", "stroke": "m", "pressure": "Pa", "wob": "N"}
 #: optional vessel-angle columns [rad] (``heave_reference``'s lever arm): unit-checked, gaps bridged like the heave
@@ -73,6 +76,11 @@ class MeasuredRun:
         return self.columns[name]
 
     @property
+    def sensors(self) -> tuple:
+        """The measured channels the run has, in contract order (``heave`` always; contract schema 3)."""
+        return ("heave",) + tuple(c for c in ("stroke", "pressure", "wob") if c in self.columns)
+
+    @property
     def duration(self) -> float:
         return float(self.t[-1] - self.t[0])
 
@@ -87,7 +95,7 @@ class MeasuredRun:
         return bool(np.ptp(d) <= 1e-6 * np.median(d))
 
 
-def load_run(path, params=None, *, columns=None, units=None) -> MeasuredRun:
+def load_run(path, params=None, *, columns=None, units=None, string_weight=None) -> MeasuredRun:
     """Read and check a measured run in any supported shape (``docs/contracts/measured-run.md``).
 
     The file is read by :func:`heavecomp.io.series.read_series` (CSV with any delimiter,
@@ -106,6 +114,9 @@ def load_run(path, params=None, *, columns=None, units=None) -> MeasuredRun:
     columns, units : dict, optional
         Contract name -> source column / unit; override ``[measurement]`` key by key
         (``--columns`` / ``--units``).
+    string_weight : float [N], optional
+        The string weight the WOB is derived from when the log has a hook load and no WOB
+        (:func:`wob_from_hook_load`); overrides ``[measurement] string_weight``.
 
     Raises
     ------
@@ -118,9 +129,11 @@ def load_run(path, params=None, *, columns=None, units=None) -> MeasuredRun:
     uns = {**(spec.units if spec else {}), **(units or {})}
     if hasattr(path, "columns") and hasattr(path, "index") and not isinstance(path, (str, bytes)):
         return _frame_run(path, params, cols, uns)
-    s = read_series(path, REQUIRED, optional=ANGLES, columns=cols, units=uns, what="measured run")
+    s = read_series(path, REQUIRED, optional=CHANNELS + ANGLES + (HOOK_LOAD,), columns=cols, units=uns,
+                    what="measured run")
     data = dict(s.columns)
     t = data.pop("t")
+    wob_from_hook_load(data, s, string_weight if string_weight is not None else getattr(spec, "string_weight", None))
     fixes = reading_effects(params) if params is not None else []
     if fixes:  # [[effects]] sensor effects: the log is read as the rig truly moved (docs/contracts/parameter-file.md)
         data, notes = correct(fixes, t, data)
@@ -130,13 +143,50 @@ def load_run(path, params=None, *, columns=None, units=None) -> MeasuredRun:
     return quality.checked(run, params, rows=s.rows)  # corruption: refused, or warned about with a confidence cap
 
 
+HOOK_LOAD = "hook_load"  #: optional column: the hook load [N], from which the WOB is derived when it is not logged
+
+
+def wob_from_hook_load(data: dict, series, string_weight) -> None:
+    """The WOB from the hook load when a log has no WOB column: W = string weight - hook load (the bit
+    carries what the hook no longer holds; cmc-reference.md's W is the force on the bit, positive).  In
+    place on ``data``; the conversion is recorded in ``series.measurement`` (``wob_from``) and its
+    ``conversions``.  A log with a WOB column keeps it (the hook load is carried along).
+
+    Parameters
+    ----------
+    data : dict
+        Contract name -> samples [SI], as read (``hook_load`` [N] among them when the log has one).
+    series : heavecomp.io.series.Series
+        The series read (its ``source`` names the file; its ``measurement`` records the conversion).
+    string_weight : float [N] or None
+        The string weight hanging from the hook off bottom (``[measurement] string_weight``).
+
+    Raises
+    ------
+    DataError
+        A hook load without a string weight, or a string weight that is not a positive number.
+    """
+    if "wob" in data or HOOK_LOAD not in data:
+        return
+    if string_weight is None:
+        raise DataError(f"{series.source}: column 'wob' missing and column 'hook_load' given: the WOB is the string "
+                        "weight minus the hook load; give the string weight [N] (measurement.string_weight)")
+    w = float(string_weight)
+    if not math.isfinite(w) or w <= 0:
+        raise DataError(f"{series.source}: measurement.string_weight: expected a positive force in N, got {string_weight!r}")
+    data["wob"] = w - data.pop(HOOK_LOAD)
+    m = series.measurement = dict(series.measurement or {})
+    m["wob_from"] = {"column": HOOK_LOAD, "string_weight_N": w, "formula": "wob = string_weight - hook_load"}
+    m["conversions"] = list(m.get("conversions", [])) + [f"wob: string weight {w:.6g} N - hook_load"]
+
+
 def _frame_run(df, params, columns: dict, units: dict) -> MeasuredRun:
     """:func:`load_run` of a pandas DataFrame: contract columns (or mapped ones), time as a column or the index."""
     columns, units = check_spec(columns, units, "measurement")
     src = "<DataFrame>"
     names = [str(c) for c in df.columns]
     data = {}
-    for name in REQUIRED + ANGLES:
+    for name in REQUIRED + CHANNELS + ANGLES:
         want = columns.get(name, name)
         if want in names:
             data[name] = np.asarray(df[df.columns[names.index(want)]], dtype=float)
@@ -181,14 +231,17 @@ def check_run(t, columns: dict, *, params=None, source="<array>", rows=None) -> 
 
     t = np.asarray(t, dtype=float)
     columns = {k: np.asarray(v, dtype=float) for k, v in columns.items()}
-    checked = REQUIRED[1:] + tuple(a for a in ANGLES if a in columns)
+    checked = ("heave",) + tuple(c for c in ("stroke", "pressure", "wob") if c in columns) \
+        + tuple(a for a in ANGLES if a in columns)
     line = (lambda i: int(rows[i])) if rows is not None else (lambda i: int(i) + 2)
     for col in checked:  # the contract: non-finite values are an error (an inf, e.g. 1e400, is no dropout)
         if col in columns and np.isinf(columns[col]).any():
             raise DataError(f"{source}: column '{col}', row {line(np.flatnonzero(np.isinf(columns[col]))[0])}: non-finite value")
-    for col in REQUIRED[1:]:
+    for col in REQUIRED[1:]:  # heave; any of stroke, pressure and wob may be missing (contract schema 3)
         if col not in columns:
             raise DataError(f"{source}: missing column '{col}'")
+    if not any(c in columns for c in CHANNELS):
+        raise DataError(f"{source}: no measured output: need at least one of columns 'stroke', 'pressure', 'wob'")
     if t.size < MIN_SAMPLES:
         raise DataError(f"{source}: column 't': need at least {MIN_SAMPLES} samples, got {t.size}")
     bad = np.flatnonzero(~np.isfinite(t))
@@ -209,7 +262,9 @@ def check_run(t, columns: dict, *, params=None, source="<array>", rows=None) -> 
         i = hole[0]
         raise DataError(f"{source}: column 't', row {line(i + 1)}: {t[i + 1] - t[i]:.3g} s without samples "
                         f"({t[i]:g} -> {t[i + 1]:g} s; longest bridged gap {MAX_GAP:g} s)")
-    warnings = []
+    # a channel the log lacks (contract schema 3): diagnosed without it, said once, with the way to map it
+    warnings = [f"no column '{c}': diagnosed with the channels present (if the log has it under another name, map "
+                f"it, {c}=NAME)" for c in ("stroke", "pressure", "wob") if c not in columns]
     for col in checked:
         miss = ~np.isfinite(columns[col])
         frac = float(miss.mean())
@@ -219,7 +274,8 @@ def check_run(t, columns: dict, *, params=None, source="<array>", rows=None) -> 
         if miss.any():
             warnings.append(f"column '{col}': {int(miss.sum())} missing samples "
                             + ("interpolated in the replay input" if col not in CHANNELS else "excluded from the residuals"))
-    for col in ("heave",) + checked[4:]:  # the replay's inputs: gaps bridged by interpolation
+    angles = tuple(a for a in ANGLES if a in columns)
+    for col in ("heave",) + angles:  # the replay's inputs: gaps bridged by interpolation
         miss = ~np.isfinite(columns[col])
         for a, b in _runs(miss) if miss.any() else ():
             lo = t[max(a - 1, 0)]
@@ -227,7 +283,7 @@ def check_run(t, columns: dict, *, params=None, source="<array>", rows=None) -> 
             if hi - lo > MAX_GAP:
                 raise DataError(f"{source}: column '{col}', row {line(a)}: dropout of {hi - lo:.3g} s "
                                 f"(longest bridged gap {MAX_GAP:g} s)")
-    for col in checked[4:]:
+    for col in angles:
         rms = float(np.sqrt(np.nanmean(columns[col] ** 2)))
         if rms > MAX_ANGLE_RMS:
             raise DataError(f"{source}: column '{col}': rms {rms:.4g} rad ({math.degrees(rms):.0f} deg) is no vessel "
@@ -281,16 +337,21 @@ def check_units(run: MeasuredRun, params) -> None:
     src = run.source
     p0 = params.p0
     W0 = params.operating_point.wob_setpoint
-    pm = float(np.nanmedian(run["pressure"]))
-    if abs(pm - p0 - P_ATM) < 0.3 * P_ATM < abs(pm - p0):
-        run.warnings.append(f"column 'pressure': mean {pm:.4g} Pa is p_0 + {(pm - p0) / 1e5:.2f} bar — absolute "
-                            "pressure? the contract is gauge; if so declare --units pressure=bara (or Pa_abs)")
-    _check_mean(run, src, "pressure", "Pa", "p_0", p0, (0.2, 5.0),
-                ((1e-5, "bar"), (1e-3, "kPa"), (1e-6, "MPa"), (1.45038e-4, "psi")),
-                "wrong unit, absolute pressure of another rig, or wrong parameter file?")
-    _check_mean(run, src, "wob", "N", "W_0", W0, (0.05, 20.0),
-                ((1e-3, "kN"), (1.0 / 9810.0, "tonnes"), (1.0 / 4448.22, "kip")),
-                "wrong unit or wrong parameter file?")
+    have = run.columns
+    if "pressure" in have:
+        pm = float(np.nanmedian(run["pressure"]))
+        if abs(pm - p0 - P_ATM) < 0.3 * P_ATM < abs(pm - p0):
+            run.warnings.append(f"column 'pressure': mean {pm:.4g} Pa is p_0 + {(pm - p0) / 1e5:.2f} bar — absolute "
+                                "pressure? the contract is gauge; if so declare --units pressure=bara (or Pa_abs)")
+        _check_mean(run, src, "pressure", "Pa", "p_0", p0, (0.2, 5.0),
+                    ((1e-5, "bar"), (1e-3, "kPa"), (1e-6, "MPa"), (1.45038e-4, "psi")),
+                    "wrong unit, absolute pressure of another rig, or wrong parameter file?")
+    if "wob" in have:
+        _check_mean(run, src, "wob", "N", "W_0", W0, (0.05, 20.0),
+                    ((1e-3, "kN"), (1.0 / 9810.0, "tonnes"), (1.0 / 4448.22, "kip")),
+                    "wrong unit or wrong parameter file?")
+    if "stroke" not in have:
+        return
     sz = float(np.nanstd(run["heave"]))
     ss = float(np.nanstd(run["stroke"]))
     if sz > 0 and ss > 100 * sz and ss > 1.0:

@@ -14,8 +14,9 @@ Method
    dropouts; noise floor sigma_c from second differences plus what the heave noise and the heave
    pre-processing make of the replay.
 3. Each candidate is fitted (:mod:`heavecomp.diagnosis.fitting`: bounded, few parameters, decimated
-   residual) on the *fit* part [settle, t_split] and scored on the held-out part [t_split, end].  All
-   channels enter, each weighted by 1/rms_before_c^2 on the fit part.  Candidates whose model component
+   residual) on the *fit* part [settle, t_split] and scored on the held-out part [t_split, end].  Every
+   channel the log has enters (heave required; any of stroke, pressure, WOB may be missing: docs/diagnosis.md
+   "Sensor sets"), each weighted by 1/rms_before_c^2 on the fit part.  Candidates whose model component
    shows no equation-error gap are not replayed (:mod:`heavecomp.diagnosis.screen`).
 4. Explained share of the held-out gap above the noise floor, per channel
    ``e_c = (mse_before - mse_after) / (mse_before - sigma_c^2)``, averaged with the channels'
@@ -158,6 +159,8 @@ class GapDiagnoser(GapEstimator):
     second_tried_ : list every joint partner tried for a second effect
     context_ : ReplayContext  the prepared run (:mod:`heavecomp.diagnosis.replay`)
     fits_ : list         the replayed candidates as :class:`~heavecomp.diagnosis.fitting.CandidateFit`, best first
+    sensors_ : tuple     the channels the log has (heave, and those of stroke, pressure, wob present)
+    undetectable_ : list candidates the sensor set cannot detect by structure: not fitted (:meth:`undetectable`)
     """
 
     _ranking_attr, _choice_attr = "candidates_", "verdict_"  # GapEstimator's ranking_ and effect_
@@ -226,9 +229,12 @@ class GapDiagnoser(GapEstimator):
     def _fit(self, run):
         t_wall = time.perf_counter()
         P = self.verdict_policy()
-        # the log's sensor set (contract schema 3: heave required; the reader asks for all four today)
+        # the log's sensor set (contract schema 3: heave required, any of stroke, pressure and wob may be
+        # missing); a candidate the set cannot detect (by the model's structure) is not fitted
         self.sensors_ = tuple(c for c in ST.CHANNELS if c in run.columns and np.isfinite(run[c]).any())
         check_memory(run, self.nominal, self.n_jobs)  # before any replay
+        self.undetectable_ = self.undetectable(self.sensors_)
+        fitted = [n for n in self.candidates if n not in self.undetectable_]
         self._report(0.02, "replaying the nominal model")
         ctx = R.prepare(run, self.nominal, split=self.split, settle=self.settle, stuck_speed=self.stuck_speed,
                         segment=self.segment, reinit=self.reinit, input_draws=self.input_draws,
@@ -237,18 +243,19 @@ class GapDiagnoser(GapEstimator):
         self._where(run, ctx)
         # ---- pre-screen: candidates whose component shows no gap are not replayed
         self.prescreen_ = S.prescreen(self.components_, self.where_["components"], ctx.fitmask, ctx.valmask,
-                                      self.candidates, P)
-        names = [n for n in self.candidates if self.prescreen_[n]["replay"]]
+                                      fitted, P)
+        names = [n for n in fitted if self.prescreen_[n]["replay"]]
         self.fits_ = self._fit_candidates(ctx, names)
         self._report(0.9, "verdict")
         self.verdict_ = self._decide(ctx, self.fits_, P)
-        skipped = [S.skipped_row(n, self.prescreen_[n], self.where_["components"], math.sqrt(ctx.mse_before["wob"]),
-                                 F.candidate_class(ctx, n).n_params(), P) for n in self.candidates if n not in names]
+        skipped = [S.skipped_row(n, self.prescreen_[n], self.where_["components"],
+                                 math.sqrt(ctx.mse_before[ctx.primary]), F.candidate_class(ctx, n).n_params(), P)
+                   for n in fitted if n not in names]
         # stable: fitted first at ties
         self.candidates_ = sorted([f.to_json() for f in self.fits_] + skipped, key=lambda r: -r["score"])
         nom, best = ctx.nominal_pred, self.fits_[0]
         best_pred = best.pred if self.verdict_["effect"] != "none" else nom
-        self.traces_ = {"t": run.t, "measured": {c: run[c] for c in CH}, "nominal": {c: nom[c] for c in CH},
+        self.traces_ = {"t": run.t, "measured": {c: run[c] for c in ctx.channels}, "nominal": {c: nom[c] for c in CH},
                         "best": {c: best_pred[c] for c in CH}, "best_effect": best.effect,
                         "stroke_velocity": nom["stroke_velocity"], "stuck": nom["stuck"]}
         self.wall_time_ = time.perf_counter() - t_wall
@@ -274,7 +281,7 @@ class GapDiagnoser(GapEstimator):
         from the measured signals; floor: the nominal replay)."""
         nom, allmask = ctx.nominal_pred, ctx.allmask
         self.gap_ = {"channels": {}}
-        for c in CH:
+        for c in ctx.channels:
             y = run[c]
             ok = allmask & np.isfinite(y)
             r = nom[c][ok] - y[ok]
@@ -282,7 +289,7 @@ class GapDiagnoser(GapEstimator):
             span = float(np.ptp(y[ok])) or 1.0
             self.gap_["channels"][c] = {"rms": rms, "nrmse": rms / span, "rms_validate": math.sqrt(ctx.mse_before[c]),
                                         "noise_floor": self.noise_floor_[c]}
-        self.where_ = W.locate(run, nom, self.nominal, allmask)
+        self.where_ = W.locate(run, nom, self.nominal, allmask, channel=ctx.primary)
         self.gap_["where"] = self.where_
         self._report(0.04, "component residuals (equation error)")
         self.components_ = CR.residuals(run, self.nominal, heave_reference=self.initial_.heave_reference,
@@ -290,6 +297,9 @@ class GapDiagnoser(GapEstimator):
                                         floor_channels=nom)
         self.where_["components"] = self.components_.shares()
         self.where_["component_table"] = self.components_.table()
+        seen = self.components_.observable()
+        if not all(seen.values()):  # components no computable equation carries: 0 share, as not observable
+            self.where_["not_observable"] = [c for c, ok in seen.items() if not ok]
 
     def _fit_candidates(self, ctx, names) -> list:
         """Every candidate in ``names`` fitted and scored (fits on ``n_jobs`` threads, the costliest
@@ -343,7 +353,8 @@ class GapDiagnoser(GapEstimator):
             return self.components_.stationarity(component, mask=mask, drift_sigmas=P.drift_sigmas,
                                                  drift_share=P.drift_share)
 
-        evidence = V.Evidence(shares, self.prescreen_, second, self.discovered_, stationarity)
+        evidence = V.Evidence(shares, self.prescreen_, second, self.discovered_, stationarity,
+                              tuple(self.where_.get("not_observable", ())))
         verdict = V.decide(fits, self.gap_["channels"], self.noise_floor_, self.input_envelope_, P, evidence)
         self.warnings_ += list(verdict.warnings)
         return verdict.to_json()
@@ -360,13 +371,31 @@ class GapDiagnoser(GapEstimator):
             self.progress(frac, msg)
 
     # ---------------------------------------------------------------- output
+    def undetectable(self, sensors) -> list:
+        """The candidates the sensor set ``sensors`` cannot detect by the model's structure
+        (:func:`heavecomp.diagnosis.structure.isolability`, level ``"structural"``): no residual computable
+        from those channels carries them.  A channel effect counts as detectable when it is on any channel
+        present.
+
+        Parameters
+        ----------
+        sensors : iterable of str
+            Channels the log has.
+        """
+        iso = ST.isolability(sensors, self.candidates)
+        det = {c.partition(":")[0] for c in iso["detectable"]}
+        return [n for n in self.candidates if n not in det]
+
     def isolability(self) -> dict:
         """What the log's sensor set can tell apart (contract schema 3, ``isolability``): the candidates
         it can detect and the groups it cannot tell apart, from the model's structure
         (:func:`heavecomp.diagnosis.structure.isolability`, level ``"shape"``: which equation each
         effect enters and which measured signals its term depends on)."""
         iso = ST.isolability(self.sensors_, self.candidates, level="shape")
-        return {"detectable": iso["detectable"], "groups": iso["groups"], "level": iso["level"]}
+        out = {"detectable": iso["detectable"], "groups": iso["groups"], "level": iso["level"]}
+        if iso["undetectable"]:
+            out["undetectable"] = iso["undetectable"]
+        return out
 
     def verdict_group(self, iso=None):
         """The isolability group of a named verdict (``verdict.group``; the effect alone when it is
@@ -408,4 +437,5 @@ class GapDiagnoser(GapEstimator):
                 "warnings": list(getattr(self, "warnings_", [])),
                 "initial_state": self.initial_.to_json(),
                 "prescreen": getattr(self, "prescreen_", {}),
+                "not_fitted": {"undetectable": list(getattr(self, "undetectable_", []))},
                 "wall_time_s": self.wall_time_}

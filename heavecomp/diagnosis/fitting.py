@@ -86,16 +86,21 @@ class CandidateFit:
     at_bound: tuple = ()
 
     @property
+    def primary(self) -> str:
+        """The primary channel: WOB, else the first of the replay's channels the run has."""
+        return next(c for c in CH if c in self.channels)
+
+    @property
     def rms_before(self) -> float:
-        return self.channels["wob"]["rms_before"]
+        return self.channels[self.primary]["rms_before"]
 
     @property
     def rms_after(self) -> float:
-        return self.channels["wob"]["rms_after"]
+        return self.channels[self.primary]["rms_after"]
 
     @property
     def shrink(self) -> float:
-        return self.channels["wob"]["shrink"]
+        return self.channels[self.primary]["shrink"]
 
     def to_json(self) -> dict:
         """The ``candidates`` row (contract fields first)."""
@@ -165,10 +170,11 @@ def channel_scores(mse_b, mse_a) -> dict:
     Parameters
     ----------
     mse_b, mse_a : dict
-        Held-out mean squares per channel [SI^2] before (nominal) and after (candidate).
+        Held-out mean squares per channel [SI^2] before (nominal) and after (candidate), on the channels
+        the run has.
     """
     return {c: {"rms_before": math.sqrt(mse_b[c]), "rms_after": math.sqrt(mse_a[c]),
-                "shrink": 1.0 - math.sqrt(mse_a[c] / mse_b[c]) if mse_b[c] > 0 else 0.0} for c in CH}
+                "shrink": 1.0 - math.sqrt(mse_a[c] / mse_b[c]) if mse_b[c] > 0 else 0.0} for c in CH if c in mse_b}
 
 
 def score(ctx, name, fitted: Fit, pred, pred_pert) -> CandidateFit:
@@ -527,7 +533,7 @@ def fit_delay_output(ctx, cls, fixed=()) -> Fit:
     grid = base["_grid"]
     best = None
     n_scan = ctx.policy.delay_scan
-    for c in CH:
+    for c in ctx.channels:
         def obj(x, c=c):
             pred = dict(base)
             pred[c] = cls.apply(base["t"], grid[:, 0], grid[:, SC.index(c)], x)
@@ -539,7 +545,7 @@ def fit_delay_output(ctx, cls, fixed=()) -> Fit:
                             options={"xatol": 1e-4})
         if best is None or r.fun < best[0]:
             best = (r.fun, c, float(r.x))
-    return Fit({"channel": best[1], field.name: best[2]}, {field.name: math.nan}, n_scan * len(CH), best[0])
+    return Fit({"channel": best[1], field.name: best[2]}, {field.name: math.nan}, n_scan * len(ctx.channels), best[0])
 
 
 def fit_linear_output(ctx, cls, fixed=()) -> Fit:
@@ -567,7 +573,7 @@ def fit_linear_output(ctx, cls, fixed=()) -> Fit:
     names = [f.name for f in cls.fields()]
     used = np.array([n not in cls.fit.optional for n in names])
     best = None
-    for c in CH:
+    for c in ctx.channels:
         got = _fit_channel(ctx, cls, base0, c, used)
         if c in ("stroke", "wob"):  # they also set the replay's start: Gauss-Newton on every channel
             got = _refine_reading(ctx, cls, fixed, t_end, c, got, used)

@@ -107,5 +107,5 @@ def search(ctx, fits, shares, prescreened, n_second, search=F.Search()) -> Secon
             mse_a = ctx.mse(pred, ctx.valmask)
             out = {"effect": r.effect, "parameters": F.public(ctx.replay.nominal, r.effect, fitted.values),
                    "added_explained": float(gain), "explained_joint": float(expl),
-                   "shrink_joint": 1.0 - math.sqrt(mse_a["wob"] / max(ctx.mse_before["wob"], 1e-30))}
+                   "shrink_joint": 1.0 - math.sqrt(mse_a[ctx.primary] / max(ctx.mse_before[ctx.primary], 1e-30))}
     return SecondSearch(out, tuple(tried))

@@ -293,12 +293,12 @@ def assess(run, params=None, *, rows=None) -> Quality:
     line = _liner(rows)
     t = np.asarray(run.t, dtype=float)
     q = Quality()
-    cols = {c: np.array(run[c], dtype=float) for c in CHANNELS}
+    cols = {c: np.array(run[c], dtype=float) for c in CHANNELS if c in run.columns}  # the channels the log has
     t, cols = _torn_and_spikes(q, t, cols, line)
     T_wave = mean_period(t, cols["heave"])
     _frozen(q, t, cols, T_wave, line, src)
     _magnitudes(q, cols, params, src)
-    _time_base(q, t, cols["wob"], T_wave, params)
+    _time_base(q, t, cols.get("wob"), T_wave, params)
     _clock_skew(q, t, cols)
     q.exclude = {c: np.array(sorted(s), dtype=int) for c, s in q.exclude.items() if s}
     return q
@@ -320,7 +320,7 @@ def _torn_and_spikes(q: Quality, t, cols: dict, line) -> tuple:
         Sample index -> the file's line number, for messages.
     """
     n = t.size
-    for c in CHANNELS:
+    for c in cols:
         hit, torn = spikes(cols[c])
         if torn:
             q.drop_last = True
@@ -363,7 +363,7 @@ def _frozen(q: Quality, t, cols: dict, T_wave: float, line, src: str) -> None:
     dt = float(np.median(np.diff(t)))
     per = T_wave if math.isfinite(T_wave) else WAVE_PERIOD[1]
     min_len = int(math.ceil(max(FROZEN_MIN_S, FROZEN_PERIODS * min(max(per, WAVE_PERIOD[0]), WAVE_PERIOD[1])) / dt))
-    for c in CHANNELS:
+    for c in cols:
         runs_ = frozen_runs(cols[c], min_len)
         if not runs_:
             continue
@@ -397,23 +397,25 @@ def _magnitudes(q: Quality, cols: dict, params, src: str) -> None:
     src : str
         The log's name, for messages.
     """
-    z, s, p, w = cols["heave"], cols["stroke"], cols["pressure"], cols["wob"]
+    z, s, p, w = (cols.get(c) for c in ("heave", "stroke", "pressure", "wob"))  # None: a channel the log lacks
     if np.nanmax(z) - np.nanmin(z) > 2 * HEAVE_MAX:
         raise DataError(f"{src}: column 'heave': range {np.nanmax(z) - np.nanmin(z):.4g} m is more than a platform heaves "
                         f"(at most {2 * HEAVE_MAX:g} m crest to trough)")
-    if np.nanmax(s) - np.nanmin(s) > STROKE_MAX:
+    if "stroke" in cols and np.nanmax(s) - np.nanmin(s) > STROKE_MAX:
         raise DataError(f"{src}: column 'stroke': range {np.nanmax(s) - np.nanmin(s):.4g} m is longer than any "
                         f"compensator's stroke (at most {STROKE_MAX:g} m, 25 ft) — wrong unit (cm, in)?")
-    if np.nanmin(p) < -P_ATM:
+    if "pressure" in cols and np.nanmin(p) < -P_ATM:
         raise DataError(f"{src}: column 'pressure': {np.nanmin(p):.4g} Pa (gauge) is below vacuum (-{P_ATM:g} Pa)")
     if params is None:
         return
     c_, ds, op = params.compensator, params.drill_string, params.operating_point
     p0, W0 = params.p0, op.wob_setpoint
-    if np.nanmax(p) > MAX_PRESSURE_RATIO * p0:
+    if "pressure" in cols and np.nanmax(p) > MAX_PRESSURE_RATIO * p0:
         raise DataError(f"{src}: column 'pressure': {np.nanmax(p):.4g} Pa is over {MAX_PRESSURE_RATIO:g} x the "
                         f"operating pressure p_0 = {p0:.4g} Pa (the gas spring cannot compress that far)")
     weight = (c_.moving_mass + ds.lower_mass) * G
+    if w is None:
+        return
     if np.nanmax(np.abs(w)) > MAX_WOB_RATIO * weight:
         raise DataError(f"{src}: column 'wob': |WOB| reaches {np.nanmax(np.abs(w)):.4g} N, over {MAX_WOB_RATIO:g} x "
                         f"the suspended weight (M_c + m_b) g = {weight:.4g} N")
@@ -450,7 +452,7 @@ def _time_base(q: Quality, t, w, T_wave: float, params) -> None:
     if not WAVE_PERIOD[0] <= T_wave <= WAVE_PERIOD[1]:
         _issue(q, "time_base", "t", f"the heave's mean period is {T_wave:.3g} s, outside the {WAVE_PERIOD[0]:g}-"
                                     f"{WAVE_PERIOD[1]:g} s of sea states: time base wrong (scale, unit)? confidence low")
-    elif params is not None:
+    elif params is not None and w is not None:
         modes = [float(f) for f in natural_frequencies(params)[0] if f > 0]
         f_pk = _mode_peak(t, w, modes[0], 1.0 / T_wave) if modes else None
         near = min(modes, key=lambda f: abs(math.log(f_pk / f))) if f_pk is not None else None
@@ -476,6 +478,8 @@ def _clock_skew(q: Quality, t, cols: dict) -> None:
     max_lag = min(30.0, 0.25 * float(t[-1] - t[0]))
     lags = {}
     for c in ("stroke", "pressure"):
+        if c not in cols:
+            continue
         lag, r, r0 = _lag(t, cols["heave"], cols[c], max_lag)
         if r >= MIN_CORRELATION and r0 < ZERO_LAG_SHARE * r:  # a periodic heave correlates at half periods too
             lags[c] = lag

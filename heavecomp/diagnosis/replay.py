@@ -31,7 +31,8 @@ from heavecomp.params.budget import MAX_REPLAY_STEPS
 from heavecomp.plants.cmc import D0, KF, plant_vectors
 from heavecomp.signals import flat_zero_phase
 
-#: the measured channels a replay is compared on (wob first: the primary channel)
+#: the measured channels a replay is compared on (wob first: the primary channel); a run compares those of
+#: them it has (:attr:`ReplayContext.channels`, :func:`present`)
 CH = ("wob", "stroke", "pressure")
 #: seed of the heave-noise draws of the input-noise envelope (the same draws on every run)
 NOISE_SEED = 12345
@@ -138,15 +139,26 @@ class Replay:
         return self.cache[key]
 
 
-def output_noise(run) -> dict:
-    """Output-noise standard deviation of every channel [SI] (second-difference estimate).
+def present(run) -> tuple:
+    """The output channels of :data:`CH` the run has, in that order (the first is the primary channel).
 
     Parameters
     ----------
     run : heavecomp.diagnosis.data.MeasuredRun
         The measured run.
     """
-    return {c: noise_floor(run[c], run.t if not run.uniform else None) for c in CH}
+    return tuple(c for c in CH if c in run.columns)
+
+
+def output_noise(run) -> dict:
+    """Output-noise standard deviation of every channel the run has [SI] (second-difference estimate).
+
+    Parameters
+    ----------
+    run : heavecomp.diagnosis.data.MeasuredRun
+        The measured run.
+    """
+    return {c: noise_floor(run[c], run.t if not run.uniform else None) for c in present(run)}
 
 
 def build(run, nominal, *, stuck_speed=S.STUCK_SPEED, segment=None, reinit=1.5, noise=None) -> Replay:
@@ -228,6 +240,10 @@ def _segments(run, h, n_steps, PP, length, reinit_s, stuck_speed):
     y_b = delta_0 - W/k_F, v_b = -dW/dt / k_F).  The first ``reinit_s`` s of every restarted segment
     are left out of the residuals."""
     t = run.t
+    for c in ("stroke", "wob"):
+        if c not in run.columns:
+            raise InputError(f"{run.source}: multiple-shooting segments start from the measured stroke and WOB; "
+                             f"column '{c}' is missing (diagnose without segments)", option="segment")
     n_seg = max(1, int(math.floor(t[-1] / length)))
     bounds, starts = [], []
     tu, su = uniform(t, run["stroke"])
@@ -283,10 +299,17 @@ class ReplayContext:
     policy: VerdictPolicy
     decimate: int = 1
     n_jobs: int = 1
+    #: the output channels the run has (:func:`present`): every loss, floor and share is on these only
+    channels: tuple = CH
 
     @property
     def run(self):
         return self.replay.run
+
+    @property
+    def primary(self) -> str:
+        """The primary channel: WOB, else the first of :data:`CH` the run has."""
+        return self.channels[0]
 
     def simulate(self, config, t_end=None, hs=None) -> dict:
         """:meth:`Replay.simulate`."""
@@ -294,7 +317,7 @@ class ReplayContext:
 
     def mse(self, pred, mask) -> dict:
         """Mean square of prediction minus measurement per channel on ``mask`` (finite samples)."""
-        return mse(self.y, pred, mask)
+        return mse(self.y, pred, mask, self.channels)
 
     def explained(self, mse_b, mse_a) -> float:
         """Explained share of the held-out gap above the noise floor: per channel
@@ -302,7 +325,7 @@ class ReplayContext:
         g_c = max(mse_b / sigma_c^2 - 1, 0) (the channel with the largest gap over its noise counts most)."""
         num = den = 0.0
         floor_share = self.policy.gap_floor_share
-        for c in CH:
+        for c in self.channels:
             f2 = max(self.noise_floor[c] ** 2, 1e-30)
             g = max(mse_b[c] / f2 - 1.0, 0.0)
             e = (mse_b[c] - mse_a[c]) / max(mse_b[c] - f2, floor_share * mse_b[c], 1e-300)
@@ -325,7 +348,7 @@ class ReplayContext:
         """The weighted, decimated fit-part residual of all channels (the fits' objective)."""
         m = self.fitmask[: pred["wob"].size]
         parts = []
-        for c in CH:
+        for c in self.channels:
             y = self.y[c][: m.size]
             ok = m & np.isfinite(y)
             parts.append((pred[c][ok] - y[ok])[:: self.decimate] * math.sqrt(self.weights[c]))
@@ -340,7 +363,7 @@ class ReplayContext:
         return parallel_map(fn, items, self.n_jobs)
 
 
-def mse(y, pred, mask) -> dict:
+def mse(y, pred, mask, channels=CH) -> dict:
     """Mean square of ``pred`` minus the measured ``y`` per channel on ``mask`` (finite samples).
 
     Parameters
@@ -351,9 +374,11 @@ def mse(y, pred, mask) -> dict:
         Predicted channels {channel: array} [SI] (may be shorter than ``y``).
     mask : numpy.ndarray of bool
         Samples compared.
+    channels : tuple of str
+        The channels compared (those the run has).
     """
     out = {}
-    for c in CH:
+    for c in channels:
         yc = y[c][: pred[c].size]
         m = mask[: pred[c].size] & np.isfinite(yc)
         r = pred[c][m] - yc[m]
@@ -441,19 +466,20 @@ def prepare(run, nominal, *, split=0.67, settle=None, stuck_speed=S.STUCK_SPEED,
     valmask = (t >= sp["fit"][1]) & keep
     allmask = (t >= sp["settle"]) & keep
     nom = rp.simulate([])
-    fl = _replay_floor(rp, nom, allmask, valmask, input_draws, n_jobs, policy)
-    floor = {c: math.hypot(noise[c], fl["replay_floor"][c]) for c in CH}
-    envelope = {c: max(math.hypot(noise[c], math.sqrt(fl["env_ms"][c])), floor[c]) for c in CH}
-    y = {c: run[c] for c in CH}
-    mse_fit = mse(y, nom, fitmask)
-    weights = {c: 1.0 / max(mse_fit[c], floor[c] ** 2, 1e-30) for c in CH}
+    chans = present(run)
+    fl = _replay_floor(rp, nom, allmask, valmask, input_draws, n_jobs, policy, chans)
+    floor = {c: math.hypot(noise[c], fl["replay_floor"][c]) for c in chans}
+    envelope = {c: max(math.hypot(noise[c], math.sqrt(fl["env_ms"][c])), floor[c]) for c in chans}
+    y = {c: run[c] for c in chans}
+    mse_fit = mse(y, nom, fitmask, chans)
+    weights = {c: 1.0 / max(mse_fit[c], floor[c] ** 2, 1e-30) for c in chans}
     return ReplayContext(rp, sp, y, fitmask, valmask, allmask, noise, fl["heave_noise"], fl["replay_floor"], floor,
-                         envelope, weights, nom, mse(y, nom, valmask), fl["hs_pert"],
-                         [mse(y, a, valmask) for a in fl["pert_preds"]], policy, max(1, int(decimate)),
-                         max(1, int(n_jobs)))
+                         envelope, weights, nom, mse(y, nom, valmask, chans), fl["hs_pert"],
+                         [mse(y, a, valmask, chans) for a in fl["pert_preds"]], policy, max(1, int(decimate)),
+                         max(1, int(n_jobs)), chans)
 
 
-def _replay_floor(rp, nom, mask, val, input_draws, n_jobs, policy) -> dict:
+def _replay_floor(rp, nom, mask, val, input_draws, n_jobs, policy, chans=CH) -> dict:
     """Residual an exact model would still show because the *input* is noisy: the nominal replay
     repeated with the heave perturbed by white noise of the heave's own noise level (second-difference
     estimate); rms difference per channel [SI] (``replay_floor``), with the sensitivity to the heave
@@ -476,7 +502,7 @@ def _replay_floor(rp, nom, mask, val, input_draws, n_jobs, policy) -> dict:
         return heave_samples(pert, rp.h, rp.n_steps, reference=ref)
 
     def ms(a, m):
-        return {c: float(np.mean((a[c][m] - nom[c][m]) ** 2)) for c in CH}
+        return {c: float(np.mean((a[c][m] - nom[c][m]) ** 2)) for c in chans}
 
     draws = [perturbed() for _ in range(max(1, int(input_draws)))]  # the noise drawn in order, replayed concurrently
     n_pert = policy.perturbed_draws
@@ -485,8 +511,9 @@ def _replay_floor(rp, nom, mask, val, input_draws, n_jobs, policy) -> dict:
     env = ms(alt, val)
     for o in others:
         other = ms(o, val)
-        env = {c: max(env[c], other[c]) for c in CH}
+        env = {c: max(env[c], other[c]) for c in chans}
     pre = ms(alt2, val)
     a, b = ms(alt, mask), ms(alt2, mask)
     return {"heave_noise": sz, "hs_pert": draws[:n_pert], "pert_preds": ([alt] + others)[:n_pert],
-            "env_ms": {c: env[c] + pre[c] for c in CH}, "replay_floor": {c: float(np.sqrt(a[c] + b[c])) for c in CH}}
+            "env_ms": {c: env[c] + pre[c] for c in chans},
+            "replay_floor": {c: float(np.sqrt(a[c] + b[c])) for c in chans}}

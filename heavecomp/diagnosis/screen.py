@@ -52,6 +52,7 @@ def prescreen(cr, shares, fitmask, valmask, names, policy) -> dict:
         Decision thresholds (``prescreen_gap``, ``prescreen_share``).
     """
     gap = cr.gap()
+    seen = cr.observable()  # a component no computable equation carries cannot be screened: it is replayed
     fm, vm = fitmask & cr.mask, valmask & cr.mask
     out = {}
     for n in names:
@@ -59,11 +60,12 @@ def prescreen(cr, shares, fitmask, valmask, names, policy) -> dict:
         cls = get(n)
         comp = cls.component() if cls.kind == "plant" else ("sensors" if cls.kind == "output" else "")
         ee = None
-        if comp in cr.residual:
+        if comp in cr.residual and seen.get(comp, True):
             ranked = EE.rank_effects(cr.residual[comp], cr.signals_for(comp), [cls], fm, vm, component=comp)
             ee = ranked[0] if ranked else None
         small = gap.get(comp, 0.0) <= policy.prescreen_gap or shares.get(comp, 0.0) < policy.prescreen_share
-        quiet = comp in CR.SCREENED and cls.fit.screened and small and (ee is None or ee["shrink"] < EE.MIN_SHRINK)
+        quiet = (comp in CR.SCREENED and seen.get(comp, True) and cls.fit.screened and small
+                 and (ee is None or ee["shrink"] < EE.MIN_SHRINK))
         replay = not (cls.kind == "plant" and quiet)
         out[n] = {"component": comp, "component_gap": float(gap.get(comp, math.nan)), "replay": replay,
                   "equation_error": ee, "wall_time": time.perf_counter() - t0}

@@ -23,6 +23,12 @@ stroke s, the pressure p and the WOB W; the rest follows from the operating poin
 At rest at the operating point every estimate is zero within its noise and z_ref is the
 first (filtered) heave sample: the replay of a log that does start at rest is the replay
 from rest.
+
+A log without a stroke or a WOB channel (contract schema 3): what that channel would tell is
+taken from the operating point and listed in ``assumed`` -- no stroke: s_0 = v_0 = 0, stuck (the
+static operating point), and s = 0 in the z_ref balance (over the window's waves the stroke
+averages near its static value); no WOB: W = W_0 (y_b = delta_0, v_b = 0) in the balance and at
+t = 0.
 """
 
 from __future__ import annotations
@@ -53,6 +59,8 @@ class InitialState:
     at_rest: bool
     window: float
     sigma: dict
+    #: what was taken from the operating point because its channel is missing (``stroke``, ``wob``)
+    assumed: tuple = ()
 
     def start(self):
         """The ``starts`` entry of :func:`heavecomp.diagnosis.stepper.run_segments`."""
@@ -63,7 +71,8 @@ class InitialState:
                 "lower_displacement": self.lower_displacement, "lower_velocity": self.lower_velocity,
                 "stuck": bool(self.stuck), "heave_reference": self.heave_reference, "wob": self.wob,
                 "at_rest": bool(self.at_rest), "window_s": self.window,
-                "standard_error": {k: float(v) for k, v in self.sigma.items()}}
+                "standard_error": {k: float(v) for k, v in self.sigma.items()},
+                **({"assumed_from_operating_point": list(self.assumed)} if self.assumed else {})}
 
 
 def _poly_at_zero(t, y, deg):
@@ -132,15 +141,21 @@ def estimate(run, params, heave_filtered, *, window=WINDOW, stuck_speed=STUCK_SP
         w = np.zeros(t.size, bool)
         w[: min(8, t.size)] = True
     tw = t[w] - t[0]
-    s = run["stroke"][w]
-    W = run["wob"][w]
+    ds, fo, op = params.drill_string, params.formation, params.operating_point
+    kds, kF, W0 = ds.stiffness, fo.stiffness, op.wob_setpoint
+    assumed = tuple(c for c in ("stroke", "wob") if c not in run.columns)
+    # a missing channel reads as its operating-point value (module docstring), with no noise
+    col = {c: (run[c] if c in run.columns else np.full(t.size, 0.0 if c == "stroke" else W0)) for c in ("stroke", "wob")}
+    s = col["stroke"][w]
+    W = col["wob"][w]
     noise = dict(noise or {})
     for c in ("stroke", "wob"):
         if c not in noise:
-            noise[c] = noise_floor(run[c], None if run.uniform else run.t)
-    s0, v0, stuck, se_s, used = _stroke_at_start(tw, s, noise["stroke"], stuck_speed)
-    ds, fo, op = params.drill_string, params.formation, params.operating_point
-    kds, kF, W0 = ds.stiffness, fo.stiffness, op.wob_setpoint
+            noise[c] = noise_floor(col[c], None if run.uniform else run.t) if c in run.columns else 0.0
+    if "stroke" in run.columns:
+        s0, v0, stuck, se_s, used = _stroke_at_start(tw, s, noise["stroke"], stuck_speed)
+    else:
+        s0, v0, stuck, se_s, used = 0.0, 0.0, True, 0.0, float(tw[-1])
     delta0 = W0 / kF
     # heave reference: a constant, so read from the string balance away from the filter's edge
     # (the first ZREF_WINDOW[0] s of the filtered heave carry its edge error) over ZREF_WINDOW
@@ -149,7 +164,7 @@ def estimate(run, params, heave_filtered, *, window=WINDOW, stuck_speed=STUCK_SP
     if wz.sum() < 8:
         wz = w
     tz = rel[wz]
-    Wz, sz = run["wob"][wz], run["stroke"][wz]
+    Wz, sz = col["wob"][wz], col["stroke"][wz]
     z = heave_filtered(t[wz])
     ok = np.isfinite(Wz) & np.isfinite(sz)
     yb = delta0 - Wz / kF
@@ -172,4 +187,5 @@ def estimate(run, params, heave_filtered, *, window=WINDOW, stuck_speed=STUCK_SP
                and abs(W_meas - W0) <= REST_SIGMAS * se_W + 0.01 * W0)
     return InitialState(stroke=s0, stroke_velocity=v0, lower_displacement=float(yb0), lower_velocity=float(vb0),
                         stuck=bool(stuck), heave_reference=zref, wob=W_meas, at_rest=bool(at_rest),
-                        window=float(used), sigma={"stroke": se_s, "heave_reference": se_z, "wob": se_W})
+                        window=float(used), sigma={"stroke": se_s, "heave_reference": se_z, "wob": se_W},
+                        assumed=assumed)

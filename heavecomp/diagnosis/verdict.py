@@ -32,6 +32,7 @@ from heavecomp.diagnosis.joint import SecondSearch
 from heavecomp.diagnosis.replay import CH
 from heavecomp.diagnosis.screen import candidate_component
 from heavecomp.effects.base import COMPONENTS
+from heavecomp.effects.candidates import get
 
 CONFIDENCE = ("low", "medium", "high")
 
@@ -41,13 +42,15 @@ class Evidence:
     """What the verdict reads besides the fits: the equation-error ``shares`` of the gap
     (``where.components``), the pre-screen per candidate, the ``second`` effect search (None: not
     searched), the open search's ``discovered`` term (None: not run or nothing beat noise) and the
-    ``stationarity`` of a component's residual (a query: component -> dict or None)."""
+    ``stationarity`` of a component's residual (a query: component -> dict or None); ``not_observable``: the
+    components no equation computable from the log's channels carries (their share is 0 by construction)."""
 
     shares: dict
     prescreen: dict = dataclasses.field(default_factory=dict)
     second: SecondSearch | None = None
     discovered: dict | None = None
     stationarity: Callable = lambda component: None
+    not_observable: tuple = ()
 
 
 @dataclasses.dataclass(frozen=True)
@@ -105,17 +108,19 @@ def assess(fits, gap, floors, envelope, policy) -> Assessment:
     P = policy
     best = fits[0]
     runner = fits[1] if len(fits) > 1 else None
-    ratio = {c: gap[c]["rms_validate"] / max(floors[c], 1e-30) for c in CH}
+    chans = [c for c in CH if c in gap]  # the channels the log has (the first is the primary)
+    ratio = {c: gap[c]["rms_validate"] / max(floors[c], 1e-30) for c in chans}
     margin = best.score - runner.score if runner else 1.0
     # the margin must survive the replay's own input-noise spread (issue 12 item 6): how far a
     # candidate's explained share moves when the heave is redrawn within its noise, best and runner-up
     spread = math.hypot(*(abs(r.explained_replay - r.explained_perturbed) for r in (best, runner or best)))
     # the shrink is on wob (the primary channel) unless the gap lies elsewhere (e.g. a lagging stroke
     # sensor): wob's held-out gap over its floor is under a share of the largest channel's
-    ch = "wob" if ratio["wob"] >= P.shrink_channel_ratio * max(ratio.values()) else max(CH, key=ratio.get)
+    first = chans[0]
+    ch = first if ratio[first] >= P.shrink_channel_ratio * max(ratio.values()) else max(chans, key=ratio.get)
     # `none`: the held-out gap is no larger than measurement noise plus what the heave noise alone
     # makes of the replay (its envelope over independent draws: stick-event flips are rare but large)
-    input_ratio = max(gap[c]["rms_validate"] / max(envelope[c], 1e-30) for c in CH)
+    input_ratio = max(gap[c]["rms_validate"] / max(envelope[c], 1e-30) for c in chans)
     # held-out noise cannot be predicted: a candidate fitted on the fit part that shrinks the held-out
     # gap's rms on its channel has found something the noise floor estimate hides
     predicts = best.channels[ch]["shrink"] >= P.none_predicted and best.explained_perturbed >= P.min_explained
@@ -297,6 +302,7 @@ def _component(v, fits, P, evidence, warnings) -> None:
     if eff == "parameter_mismatch":
         _refit_check(v, shares, largest, P, warnings)
         _stationarity(v, evidence, warnings)
+    _table_check(v, shares, largest, P, evidence.not_observable)
     if best.explained >= P.min_explained or evidence.discovered is None:
         return
     found = evidence.discovered
@@ -308,6 +314,42 @@ def _component(v, fits, P, evidence, warnings) -> None:
                  note=f"no named effect explains half the gap (best {best.effect}: "
                       f"{100 * best.explained:.0f} %); the open search's term {found['term']} shrinks the "
                       f"held-out {found['component']} residual by {100 * found['shrink']:.0f} %")
+
+
+def _table_check(v, shares, largest, P, not_observable=()) -> None:
+    """One verdict, one component (issue 23 item 4): ``verdict.component`` is the component of the effect
+    the held-out replay fit named (that fit is what was scored), while the component table
+    (``where.components``) splits the equation residuals by their terms.  The two can disagree by the
+    measure :func:`_refit_check` uses (the table's largest component holds ``refit_share`` of the gap, the
+    verdict's under ``second_share``).  The verdict keeps its component and says why in
+    ``verdict.component_table`` {``largest``, ``share``, ``verdict_share``, ``reason``}: an effect its own
+    equation residual is blind to (``Effect.fit.screened`` false: dwell stiction and frictional lag act at
+    breakaway and reversals, which the top-mass balance leaves out; string damping hides in the
+    lower-mass balance's noise) leaves the table to what that equation does see; otherwise the table's
+    component may hold a second effect or what the equation split leaks (a parameter_mismatch whose refit
+    disagrees has already taken the table's component, :func:`_refit_check`).  A verdict's component that
+    is not observable with the log's channels (``not_observable``) has a share of 0 by construction."""
+    comp = v.get("component")
+    if v["effect"] == "none" or not comp or not _refit_disagrees(comp, shares, largest, P):
+        return
+    named = v["effect"] not in ("inconclusive", "discovered")
+    if comp in not_observable:
+        reason = (f"{comp.replace('_', ' ')} is not observable with this log's channels (every equation that carries "
+                  "it reads a channel the log does not have): the table cannot show it, the replay fit does")
+    elif named and not get(v["effect"]).fit.screened:
+        reason = (f"the {comp.replace('_', ' ')} equation residual is blind to {v['effect']} (it acts where that "
+                  f"equation is left out or hides in its noise); the held-out replay fit places the gap in "
+                  f"{comp.replace('_', ' ')}")
+    elif named:
+        reason = (f"the held-out replay fit of {v['effect']} explains {100 * v.get('explained', 0.0):.0f} % of the gap; "
+                  f"the equation error puts {100 * shares[largest]:.0f} % in {largest.replace('_', ' ')}: a second "
+                  f"effect there, or what the equation split leaks into it")
+    else:
+        reason = (f"the best candidate, which explains a real part of the held-out gap, lives in "
+                  f"{comp.replace('_', ' ')}; the equation error puts {100 * shares[largest]:.0f} % in "
+                  f"{largest.replace('_', ' ')}")
+    v["component_table"] = {"largest": largest, "share": float(shares[largest]),
+                            "verdict_share": float(shares.get(comp, 0.0)), "reason": reason}
 
 
 def _refit_disagrees(moved, shares, largest, P) -> bool:

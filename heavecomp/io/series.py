@@ -50,7 +50,7 @@ log = logging.getLogger(__name__)
 
 #: contract name -> physical kind (docs/contracts/measured-run.md)
 KINDS = {"t": "time", "heave": "length", "stroke": "length", "pressure": "pressure", "wob": "force",
-         "pitch": "angle"}
+         "pitch": "angle", "hook_load": "force"}
 #: SI unit of each kind
 SI = {"time": "s", "length": "m", "pressure": "Pa", "force": "N", "angle": "rad"}
 P_ATM = 101325.0
@@ -73,7 +73,7 @@ UNITS = {
 #: header spellings of the contract names (after normalisation: lower case, single spaces)
 ALIASES = {"t": ("t", "time", "timestamp", "datetime", "date time"), "heave": ("heave", "z_h", "zh"),
            "stroke": ("stroke", "s"), "pressure": ("pressure", "p"), "wob": ("wob", "weight on bit"),
-           "pitch": ("pitch",)}
+           "pitch": ("pitch",), "hook_load": ("hook_load", "hook load", "hookload")}
 #: largest file read (decompressed) [bytes]: a bigger one is refused before it fills the memory
 MAX_BYTES = 1 << 30
 DELIMITERS = (",", ";", "\t", "|")

@@ -5,6 +5,7 @@
     [measurement]
     columns = { t = "Time", heave = "MRU_heave", stroke = "CMC_pos", pressure = "P_main", wob = "WOB" }
     units = { t = "ms", pressure = "bar", wob = "kN", stroke = "mm" }
+    string_weight = 1.2e6   # N: a log with a hook load and no WOB reads wob = string_weight - hook_load
 
 Read by every command that reads a measured series (``diagnose``, a heave file of
 ``[heave] kind = "file"``); ``--columns`` / ``--units`` override it key by key.
@@ -19,7 +20,8 @@ from heavecomp.errors import ParameterError, did_you_mean
 from heavecomp.io.series import check_spec
 from heavecomp.errors import InputError
 
-KEYS = ("columns", "units")
+KEYS = ("columns", "units", "string_weight")
+TABLES = ("columns", "units")
 
 
 @dataclass(frozen=True)
@@ -28,6 +30,8 @@ class Measurement:
 
     columns: dict = field(default_factory=dict)
     units: dict = field(default_factory=dict)
+    #: string weight [N] the WOB is derived from when a log has a hook load and no WOB (None: not given)
+    string_weight: float | None = None
 
 
 def from_table(table) -> Measurement:
@@ -42,7 +46,7 @@ def from_table(table) -> Measurement:
     for k in table:
         if k not in KEYS:
             raise ParameterError(f"measurement.{k}: unknown key{did_you_mean(k, KEYS)}; known keys: {', '.join(KEYS)}")
-    for k in KEYS:
+    for k in TABLES:
         if k in table and not isinstance(table[k], dict):
             raise ParameterError(f"measurement.{k}: expected an inline table like {{ t = \"Time\" }}, "
                                  f"got {type(table[k]).__name__}")
@@ -50,7 +54,10 @@ def from_table(table) -> Measurement:
         cols, units = check_spec(table.get("columns"), table.get("units"), "measurement")
     except InputError as exc:
         raise ParameterError(str(exc)) from None
-    return Measurement(columns=cols, units=units)
+    w = table.get("string_weight")
+    if w is not None and (isinstance(w, bool) or not isinstance(w, (int, float)) or not w > 0 or w == float("inf")):
+        raise ParameterError(f"measurement.string_weight: expected a positive force in N, got {w!r}")
+    return Measurement(columns=cols, units=units, string_weight=None if w is None else float(w))
 
 
 def to_table(m: Measurement) -> dict:
@@ -61,4 +68,7 @@ def to_table(m: Measurement) -> dict:
     m : Measurement
         The validated table.
     """
-    return {k: dict(getattr(m, k)) for k in KEYS if getattr(m, k)}
+    out = {k: dict(getattr(m, k)) for k in TABLES if getattr(m, k)}
+    if m.string_weight is not None:
+        out["string_weight"] = m.string_weight
+    return out

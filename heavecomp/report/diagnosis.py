@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import copy
 import json
 import math
 import re
@@ -67,7 +68,7 @@ def write_json(diag, path) -> Path:
         The file to write.
     """
     path = Path(path)
-    d = diag.to_json()
+    d = copy.deepcopy(diag.to_json())  # the declarations go into the file, not into the diagnoser's own results
     for block in _parameter_blocks(d):  # the effect's own metadata, the channel's unit for a channel effect
         if isinstance(block.get("parameters"), dict) and isinstance(block.get("effect"), str):
             units = _effect_units(block["effect"], block["parameters"])
@@ -102,21 +103,23 @@ def fig_where(diag):
     t = tr["t"]
     v = tr["stroke_velocity"]
     a = np.gradient(v, t)
-    r = tr["nominal"]["wob"] - tr["measured"]["wob"]
+    ch = diag.where_.get("channel", "wob")  # the primary channel: WOB, else the first the log has
+    unit, sc = CH_UNITS[ch]
+    r = tr["nominal"][ch] - tr["measured"][ch]
     ok = np.isfinite(r) & (t >= diag.split_["settle"])
     fig, (ax, axb) = plt.subplots(1, 2, figsize=(11, 4.2), gridspec_kw={"width_ratios": [1.6, 1]})
     # binned, not one dot per sample: a long run overplots a scatter into a solid blot
     vv, aa = v[ok] * 1e3, a[ok]
     lim_v = np.percentile(np.abs(vv), 99.5) * 1.05 or 1.0
     lim_a = np.percentile(np.abs(aa), 99.5) * 1.05 or 1.0
-    hb = ax.hexbin(vv, aa, C=np.abs(r[ok]) / 1e3, reduce_C_function=np.mean, gridsize=(45, 25), mincnt=1,
+    hb = ax.hexbin(vv, aa, C=np.abs(r[ok]) * sc, reduce_C_function=np.mean, gridsize=(45, 25), mincnt=1,
                    cmap="viridis", extent=(-lim_v, lim_v, -lim_a, lim_a))
     ax.set_xlim(-lim_v, lim_v)
     ax.set_ylim(-lim_a, lim_a)
-    fig.colorbar(hb, ax=ax, label="mean |WOB residual| per bin [kN]")
+    fig.colorbar(hb, ax=ax, label=f"mean |{ch} residual| per bin [{unit}]")
     ax.set_xlabel("stroke velocity v [mm/s]")
     ax.set_ylabel("stroke acceleration [m/s²]")
-    ax.set_title("Where: WOB residual over (v, dv/dt) of the nominal replay", fontsize=10)
+    ax.set_title(f"Where: {ch} residual over (v, dv/dt) of the nominal replay", fontsize=10)
     ax.grid(alpha=0.3)
     w = diag.where_
     keys = list(w["regimes"]) + list(w["bands"])
@@ -125,7 +128,7 @@ def fig_where(diag):
     axb.barh(range(len(keys)), vals, color=cols)
     axb.set_yticks(range(len(keys)), [k.replace("_", " ") for k in keys], fontsize=8)
     axb.invert_yaxis()
-    axb.set_xlabel("share of squared WOB residual [-]")
+    axb.set_xlabel(f"share of squared {ch} residual [-]")
     axb.set_title("by regime (red) and frequency band (blue)", fontsize=10)
     axb.grid(alpha=0.3, axis="x")
     fig.tight_layout()
@@ -146,6 +149,9 @@ def fig_spectra(diag):
     fig, axs = plt.subplots(1, 3, figsize=(13, 3.8))
     for ax, c in zip(axs, ("wob", "stroke", "pressure")):
         unit, sc = CH_UNITS[c]
+        if c not in tr["measured"]:  # a channel the log does not have
+            _not_measured(ax, c)
+            continue
         y = tr["measured"][c]
         ok = np.isfinite(y) & (t >= diag.split_["settle"])
         for label, key, col in (("nominal", "nominal", "tab:red"), (f"with {tr['best_effect']}", "best", "tab:green"))[
@@ -187,16 +193,22 @@ def fig_overlay(diag, span=40.0):
     fig, axs = plt.subplots(4, 1, figsize=(11, 9), sharex=True)
     show = diag.verdict_["effect"] != "none"  # none: the nominal is the answer, no candidate is drawn
     ax = axs[3]
-    yw = tr["measured"]["wob"][m]
-    ax.plot(t[m], (tr["nominal"]["wob"][m] - yw) / 1e3, color="tab:red", lw=1.0, label="nominal − measured")
+    ch = diag.where_.get("channel", "wob")  # the primary channel: WOB, else the first the log has
+    unit_p, sc_p = CH_UNITS[ch]
+    yw = tr["measured"][ch][m]
+    ax.plot(t[m], (tr["nominal"][ch][m] - yw) * sc_p, color="tab:red", lw=1.0, label="nominal − measured")
     if show:
-        ax.plot(t[m], (tr["best"]["wob"][m] - yw) / 1e3, color="tab:green", lw=1.0, label=f"with {tr['best_effect']} − measured")
-    ax.set_ylabel("WOB residual [kN]")
+        ax.plot(t[m], (tr["best"][ch][m] - yw) * sc_p, color="tab:green", lw=1.0,
+                label=f"with {tr['best_effect']} − measured")
+    ax.set_ylabel(f"{ch} residual [{unit_p}]")
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8, loc="upper right")
     for ax, c in zip(axs, ("wob", "stroke", "pressure")):
         unit, sc = CH_UNITS[c]
-        ax.plot(t[m], tr["measured"][c][m] * sc, color="0.4", lw=0.8, label="measured")
+        if c in tr["measured"]:
+            ax.plot(t[m], tr["measured"][c][m] * sc, color="0.4", lw=0.8, label="measured")
+        else:
+            ax.set_title(f"{c}: not measured (model only)", fontsize=8, loc="left")
         ax.plot(t[m], tr["nominal"][c][m] * sc, color="tab:red", lw=1.1, label="nominal replay")
         if show:
             ax.plot(t[m], tr["best"][c][m] * sc, color="tab:green", lw=1.1, ls="--", label=f"with {tr['best_effect']}")
@@ -207,6 +219,13 @@ def fig_overlay(diag, span=40.0):
     axs[0].set_title(overlay_title(diag.verdict_, tr["best_effect"]), fontsize=10)
     fig.tight_layout()
     return fig
+
+
+def _not_measured(ax, c) -> None:
+    """An empty panel for a channel the log does not have."""
+    ax.text(0.5, 0.5, f"{c}: not measured", ha="center", va="center", transform=ax.transAxes, fontsize=10)
+    ax.set_xticks([])
+    ax.set_yticks([])
 
 
 def overlay_title(v, best) -> str:
@@ -260,9 +279,22 @@ def _component_lines(diag) -> list:
            "of the nominal model's own replay.", "",
            md_table(["component", "share [-]", "gap / noise [-]", "residual rms", "noise rms", "unit", "equation"],
                     [[r["component"], f"{r['share']:.2f}", f"{r['gap_to_noise']:.2f}", f"{r['rms']:.4g}",
-                      f"{r['noise']:.4g}", r["unit"], ", ".join(r["equations"]).replace("_", " ")] for r in rows])]
+                      f"{r['noise']:.4g}", r["unit"], ", ".join(r["equations"]).replace("_", " ")]
+                     if r.get("observable", True) else
+                     [r["component"], "not observable", "-", "-", "-", r["unit"],
+                      ", ".join(r["equations"]).replace("_", " ")] for r in rows])]
+    hidden = [r["component"] for r in rows if not r.get("observable", True)]
+    if hidden:
+        out += ["", "Not observable with this log's channels (every equation that carries them reads a channel "
+                    "the log does not have): " + ", ".join(c.replace("_", " ") for c in hidden)
+                + ". Their share is 0 by construction, not by measurement; the replay still sees them."]
     if v.get("component"):
         out += ["", f"The gap lives in: **{v['component'].replace('_', ' ')}**."]
+    ct = v.get("component_table")
+    if ct:  # the verdict's component and the table's largest share differ: why (verdict._table_check)
+        out += ["", f"The table puts {100 * ct['share']:.0f} % of the gap in {ct['largest'].replace('_', ' ')} and "
+                    f"{100 * ct['verdict_share']:.0f} % in {v['component'].replace('_', ' ')}, the verdict's "
+                    f"component: {ct['reason']}."]
     d = v.get("discovered")
     if d:
         out += ["", f"Open search (sparse regression on the {d['component'].replace('_', ' ')} residual, "
@@ -278,6 +310,15 @@ def _skipped_lines(diag) -> list:
         return []
     return ["", "Not replayed (pre-screen, equation error): " + "; ".join(
         f"`{c['effect']}` ({c['skipped'].split(': ', 1)[-1]})" for c in sk) + "."]
+
+
+def _not_fitted_lines(diag) -> list:
+    """Candidates not fitted because the log's sensor set cannot detect them (no computable residual)."""
+    nf = getattr(diag, "undetectable_", [])
+    if not nf:
+        return []
+    return ["", f"Not fitted (this sensor set, {', '.join(diag.sensors_)}, cannot detect them: no residual "
+                "computable from its channels carries them): " + ", ".join(f"`{n}`" for n in nf) + "."]
 
 
 def write_report(diag, out_dir, *, title="Sim-to-real gap diagnosis") -> dict:
@@ -300,8 +341,13 @@ def write_report(diag, out_dir, *, title="Sim-to-real gap diagnosis") -> dict:
     save(fig_overlay(diag), out / "overlay.png", dpi=90)
     v = diag.verdict_
     g = diag.gap_
+    pc = diag.where_.get("channel", "wob")
+    pu, ps = CH_UNITS[pc]
+    group = diag.verdict_group()
+    named = (f"**Verdict: one of {', '.join(f'`{m}`' for m in group)}** (this sensor set cannot tell them apart; "
+             f"`{v['effect']}` fitted best)" if group and len(group) > 1 else f"**Verdict: `{v['effect']}`**")
     lines = [f"# {title}", "",
-             f"**Verdict: `{v['effect']}`** (confidence {v['confidence']}); held-out shrink of the "
+             f"{named} (confidence {v['confidence']}); held-out shrink of the "
              f"{v.get('shrink_channel', 'wob')} residual {v['shrink']:.2f}."]
     if v.get("note"):
         lines.append(f"\n{v['note']}.")
@@ -327,9 +373,9 @@ def write_report(diag, out_dir, *, title="Sim-to-real gap diagnosis") -> dict:
                          f"{g['channels'][c]['nrmse']:.3f}",
                          f"{g['channels'][c]['rms_validate'] * CH_UNITS[c][1]:.4g}",
                          f"{g['channels'][c]['noise_floor'] * CH_UNITS[c][1]:.4g}"]
-                        for c in ("wob", "stroke", "pressure")]),
+                        for c in ("wob", "stroke", "pressure") if c in g["channels"]]),
               "", "## Where", "",
-              "Share of the squared WOB residual by regime: " + ", ".join(
+              f"Share of the squared {diag.where_.get('channel', 'wob')} residual by regime: " + ", ".join(
                   f"{k.replace('_', ' ')} {100 * x:.0f} %" for k, x in diag.where_["regimes"].items()) + ".",
               "By band: " + ", ".join(f"{k.replace('_', ' ')} {100 * x:.0f} %" for k, x in diag.where_["bands"].items())
               + f". Eigenfrequencies: {named_modes(diag.where_['eigenfrequencies_hz'])}.",
@@ -337,15 +383,16 @@ def write_report(diag, out_dir, *, title="Sim-to-real gap diagnosis") -> dict:
               "Largest in: " + ", ".join(f"{a:.1f}-{b:.1f} s" for a, b in diag.where_["segments"]) + ".",
               "", "![where](where.png)", "", "![spectra](spectra.png)", "",
               "## Which: every candidate, fitted on the fit part, scored on the held-out part", "",
-              md_table(["effect", "explained [-]", "score [-]", "wob rms before [kN]", "wob rms after [kN]",
+              md_table(["effect", "explained [-]", "score [-]", f"{pc} rms before [{pu}]", f"{pc} rms after [{pu}]",
                         "wob shrink [-]", "stroke shrink [-]", "pressure shrink [-]", "parameters"],
-                       [[c["effect"], f"{c['explained']:.2f}", f"{c['score']:.2f}", f"{c['rms_before'] / 1e3:.4g}",
-                         f"{c['rms_after'] / 1e3:.4g}", f"{c['channels']['wob']['shrink']:.2f}",
-                         f"{c['channels']['stroke']['shrink']:.2f}", f"{c['channels']['pressure']['shrink']:.2f}",
+                       [[c["effect"], f"{c['explained']:.2f}", f"{c['score']:.2f}", f"{c['rms_before'] * ps:.4g}",
+                         f"{c['rms_after'] * ps:.4g}",
+                         *(f"{c['channels'][k]['shrink']:.2f}" if k in c["channels"] else "not measured"
+                           for k in ("wob", "stroke", "pressure")),
                          ", ".join(_with_unit(k, val, units=_effect_units(c["effect"], c["parameters"]))
                                    for k, val in c["parameters"].items())]
                         for c in diag.candidates_ if not c.get("skipped")]),
-              *_skipped_lines(diag),
+              *_skipped_lines(diag), *_not_fitted_lines(diag),
               "", "## Where, by model component (equation error)", "", *_component_lines(diag),
               "", f"Split: fit {diag.split_['fit'][0]:.0f}-{diag.split_['fit'][1]:.0f} s, held out "
                   f"{diag.split_['validate'][0]:.0f}-{diag.split_['validate'][1]:.0f} s; first "
