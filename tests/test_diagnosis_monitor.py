@@ -113,6 +113,44 @@ def test_monitor_finds_a_seal_friction_onset_on_a_generated_log(tmp_path):
     assert not [c for c in res.changes if c["component"] == "friction"] and res.to_json()["skipped"]
 
 
+def test_size_reached_is_the_analytic_crossing_of_a_ramp_and_of_a_step():
+    """The one-block rms of a gap that grows linearly, a (t - tc), reaches s when
+    a^2 [(T - tc)^3 - (T - tc - W)^3] / (3 W) = s^2; a step of height g > s when (T - tc) / W = (s / g)^2
+    (the window half in the step). The larger channel decides; a gap that stays below never reaches it."""
+    from heavecomp.benchmark.long_logs import size_reached
+
+    dt, tc, w, size, a = 0.01, 100.0, 10.0, 5.0, 0.05
+    t = np.arange(0.0, 400.0, dt)
+    ramp = np.where(t >= tc, a * (t - tc), 0.0)
+    r = size_reached(t, {"stroke": 2.0 * ramp, "pressure": ramp}, {"stroke": 2.0, "pressure": 0.5}, tc, size,
+                     window=w)
+    # the pressure channel (gap / floor = 2 a (t - tc)) decides: solve (u^3 - (u - W)^3) / (3 W) = (s / 2a)^2
+    from scipy.optimize import brentq
+
+    u = brentq(lambda u: (u ** 3 - (u - w) ** 3) / (3 * w) - (size / (2 * a)) ** 2, w, 300.0)
+    assert abs(r["t_size"] - (tc + u)) < 2 * dt
+    g = 6.0
+    step = size_reached(t, {"wob": np.where(t >= tc, g, 0.0)}, {"wob": 1.0}, tc, size, lead=20.0, window=w)
+    assert abs(step["t_size"] - (tc - 20.0 + w * (size / g) ** 2)) < 2 * dt
+    assert step["size_blocks"][1] == pytest.approx(g)
+    assert size_reached(t, {"wob": np.where(t >= tc, 4.9, 0.0)}, {"wob": 1.0}, tc, size, window=w)["t_size"] is None
+
+
+@pytest.mark.slow
+def test_a_leak_reaches_its_asked_size_after_its_start_a_step_at_it():
+    """long_logs records when each change is at the asked size: a leak grows from nothing (its first
+    block far below the size), a seal friction is a step (its reference is its change time)."""
+    from heavecomp.benchmark.long_logs import long_log
+
+    tr = long_log([(600.0, "gas_leak")], seed=3, duration=1200.0, rate=10.0)
+    c = tr.truth["changes"][0]
+    assert c["size_blocks"][0] < 0.2 * c["gap_to_noise"] and c["size_blocks"][-1] > 5 * c["size_blocks"][0]
+    assert c["t_reference"] is None or c["t_reference"] > c["t"] + 60.0
+    tr = long_log([(600.0, "pressure_friction")], seed=3, duration=1200.0, rate=10.0)
+    c = tr.truth["changes"][0]
+    assert c["t_reference"] == c["t"] and c["t_size"] >= c["t"]
+
+
 def test_missing_channels_leave_out_the_equations_that_read_them():
     assert M.usable_equations(["heave", "stroke", "pressure"]) == (("gas",), {"lower_mass": ["wob"],
                                                                            "top_mass": ["wob"]})

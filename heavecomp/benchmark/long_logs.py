@@ -13,6 +13,11 @@ conditions after each change, cumulative) is simulated over the whole log from t
 spliced in at its change time with a raised-cosine blend of :data:`BLEND` seconds (:data:`BLEND_OP`
 for a set-point change: a driller turns the set-point over a minute); the blend is not a simulation
 of the transition: the states of two runs are mixed over a few seconds.
+
+Each change records when it is at the asked size (``t_reference``, the monitor's delay is scored
+from it): a step at its time; a change that grows from nothing (:data:`GROWS`, a leak) when its
+own gap, the clean channels with it less those without it on the same sea, first reaches ``size``
+x the noise floor over one block (:func:`size_reached`), which may be never within the log.
 """
 
 from __future__ import annotations
@@ -36,6 +41,11 @@ COMPONENT = {"operating": "operating_point", "formation": "string_formation", "p
 LABELS = tuple(COMPONENT)
 LEAD = 120.0  #: s simulated before the log starts (cut: the log starts mid-operation, not at rest) [s]
 NEAR = 0.1  #: the planted size is within +- this share of the asked one [-]
+SIZE_WINDOW = 10.0  #: trailing window of a change's own rms when it reaches its asked size: one monitor block [s]
+#: changes whose own gap grows from nothing after their time (a leak loses gas from the full charge): they
+#: reach the asked size when their one-block rms does (:func:`size_reached`); every other change is planted
+#: at its sized strength from its time (a step), so it is at the asked size at its time
+GROWS = ("gas_leak",)
 
 
 def _formation_draw(rng, setting):
@@ -58,7 +68,11 @@ def long_log(changes, *, seed=0, duration=3600.0, rate=10.0, sea="jonswap", para
     """A generated log with ``changes`` = [(t [s], label), ...] (labels :data:`LABELS`).
 
     Returns a :class:`heavecomp.benchmark.TestRun`; ``truth["changes"]`` lists each change's
-    ``t``, ``label``, ``component``, parameters and its own gap per channel (over the noise floor).
+    ``t``, ``label``, ``component``, parameters and its own gap per channel (over the noise floor);
+    ``t_size`` and ``size_blocks`` (:func:`size_reached`: when its own gap's one-block rms first
+    reaches ``size``, and that rms block by block from its time) and ``t_reference``, when it is at the
+    asked size: its time for a step, ``t_size`` for a change that grows (:data:`GROWS`; None when it
+    stays below the size for the whole log). The monitor's detection delay is scored from it.
 
     Parameters
     ----------
@@ -110,15 +124,20 @@ def long_log(changes, *, seed=0, duration=3600.0, rate=10.0, sea="jonswap", para
     t = s.t
     cols = dict(s.base)
     for k, (tc, label) in enumerate(sorted(changes)):
+        before = dict(cols)
         eff = parts[k].effects
         if eff and k == 0:  # a plant truth law: switched on at tc, the state carried on (no blend)
             cols = _onset(s, nominal, eff, tc)
-            continue
-        _, cfg = s.sim(parts[:k + 1])  # parameter changes apply on top of each other
-        width = BLEND_OP if label == "operating" else BLEND
-        w = 0.5 - 0.5 * np.cos(np.pi * np.clip((t - tc) / width, 0.0, 1.0))  # smooth: no kink in a
-        for c in s.OUT:
-            cols[c] = (1 - w) * cols[c] + w * cfg[c]
+        else:
+            _, cfg = s.sim(parts[:k + 1])  # parameter changes apply on top of each other
+            width = BLEND_OP if label == "operating" else BLEND
+            w = 0.5 - 0.5 * np.cos(np.pi * np.clip((t - tc) / width, 0.0, 1.0))  # smooth: no kink in a
+            cols = dict(cols)
+            for c in s.OUT:
+                cols[c] = (1 - w) * cols[c] + w * cfg[c]
+        if label != "operating":  # when the change's own gap reaches the asked size (same sea, same floor)
+            info[k].update(size_reached(t, {c: cols[c] - before[c] for c in s.OUT}, s.floor, tc, size, LEAD))
+        info[k]["t_reference"] = info[k].get("t_size") if label in GROWS else info[k]["t"]
     cols["heave"] = s.base["heave"] + s.heave_noise
     cols = {c: np.asarray(y, float) for c, y in cols.items()}
     for c in s.OUT:
@@ -127,6 +146,54 @@ def long_log(changes, *, seed=0, duration=3600.0, rate=10.0, sea="jonswap", para
              "sea": s.info, "rate": rate, "duration": duration, "param_set": params, "noise_floor": s.floor,
              "size": size}
     return TestRun(t=t, columns=cols, nominal=nominal, truth=truth).cropped(LEAD)
+
+
+def size_reached(t, diff, floor, tc, size, lead=0.0, window=SIZE_WINDOW):
+    """When a change's own gap reaches ``size`` x the noise floor.
+
+    The change's own gap is its effect alone on the same sea: the clean channels with the change less
+    the clean channels without it. Its size at time t is the largest channel's rms over the trailing
+    ``window`` (the sizing's rms, :meth:`heavecomp.benchmark.testbed.Testbed.gap`, over one monitor
+    block instead of the whole log) over the channel's noise floor. A step reaches its size when it
+    is planted (up to the blend); an effect that grows from nothing (a leak from the full charge)
+    reaches it later, or never within the log.
+
+    Parameters
+    ----------
+    t : ndarray [s]
+        Simulation clock.
+    diff : dict
+        Channel -> the change's own gap [SI] on ``t``.
+    floor : dict
+        Channel -> noise floor [SI].
+    tc : float [s]
+        The change's time on ``t``.
+    size : float [-]
+        The asked size (x the noise floor).
+    lead : float [s]
+        Offset of the log's clock from ``t`` (the log starts at ``lead``).
+    window : float [s]
+        Trailing rms window.
+
+    Returns
+    -------
+    dict
+        ``t_size`` [s, log time, or None: never within the log], ``size_blocks`` (the own gap's
+        largest-channel rms [-] over consecutive ``window`` blocks from the change on) and
+        ``size_window`` [s].
+    """
+    dt = float(t[1] - t[0])
+    n = max(1, int(round(window / dt)))
+    ratio = None
+    for c, d in diff.items():
+        c2 = np.concatenate([[0.0], np.cumsum((np.asarray(d, float) / floor[c]) ** 2)])
+        run = np.sqrt(np.maximum(c2[n:] - c2[:-n], 0.0) / n)  # trailing rms ending at sample i + n - 1
+        ratio = run if ratio is None else np.maximum(ratio, run)
+    ends = t[n - 1:]
+    k = np.flatnonzero((ends >= tc) & (ratio >= size))
+    t_size = float(ends[k[0]]) - lead if k.size else None
+    blocks = [round(float(ratio[i]), 3) for i in range(int(np.searchsorted(ends, tc)) + n - 1, ratio.size, n)]
+    return {"t_size": t_size, "size_blocks": blocks, "size_window": float(window)}
 
 
 def _onset(sea, nominal, effects, tc):
