@@ -170,12 +170,12 @@ def timeline_figure(summary, *, title=""):
                 ax.plot([th, th], [y - 0.3, y + 0.3], color="k", lw=1.5, label=lab)
     ax.set_yticks(range(len(logs)))
     ax.set_yticklabels([lg["log"] for lg in logs], fontsize=7)
-    ax.invert_yaxis()
+    ax.set_ylim(len(logs) - 0.5, -0.5)
     ax.set_xlabel("time in the log [h]")
     ax.set_ylabel("log [-]")
     ax.set_xlim(left=0.0)
     if seen:
-        ax.legend(fontsize=7, loc="upper right", ncol=2)
+        ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.0, 1.0))
     ax.grid(axis="x", alpha=0.3)
     ax.set_title(title or "Changes per log (dots: effect changes by component, at detection; ticks: operating "
                  "changes)", fontsize=10)
