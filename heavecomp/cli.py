@@ -261,7 +261,7 @@ def _staged(args):
 
     @contextlib.contextmanager
     def staged():
-        st = _staging.Staged(args.out, "--out", resumable=args.command == "campaign" or getattr(args, "resume", False))
+        st = _staging.Staged(args.out, "--out", resumable=args.command in ("campaign", "fleet"))
         args.out_final = args.out
         with st as work:
             args.out = str(work)

@@ -198,3 +198,76 @@ def test_manifest_gives_each_log_its_own_parameters_and_units(tmp_path):
     # a log's own entry wins over the arguments, which win over the manifest's top level
     tasks = {t.key: t for t in F.plan(logs, manifest=tmp_path / "m.toml", units={"wob": "kN"}, check=False)}
     assert tasks["a_friction"].units == {"wob": "kN"} and tasks["c_none"].units["pressure"] == "Pa"
+
+
+def test_logs_are_found_by_folder_or_glob_and_named_by_their_path(tmp_path):
+    for rel in ("a.csv", "b.csv.gz", "b.units.csv", ".hidden.csv", "notes.toml", "sub/c.parquet", "sub/d.csv"):
+        (tmp_path / rel).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / rel).write_text("x")
+    root, files = F.find_logs(tmp_path)
+    assert [f.name for f in files] == ["a.csv", "b.csv.gz"]  # a folder: its own logs, not sub-folders
+    root, files = F.find_logs(f"{tmp_path}/**/*.csv*")
+    assert sorted(F._key(root, f) for f in files) == ["a", "b", "sub--d"]
+    with pytest.raises(F.InputError, match="no log found"):
+        F.find_logs(tmp_path / "sub" / "*.mat")
+
+
+@pytest.mark.slow
+def test_dask_workers_give_the_same_table_as_one_process(fleet_dir, tmp_path):
+    distributed = pytest.importorskip("distributed")
+    from heavecomp.report.fleet import run_and_report
+
+    d, _ = fleet_dir
+    tasks = [t for t in F.plan(d / "logs", d / "p.toml") if t.key in ("a_friction", "c_none", "d_short")]
+    _, local = run_and_report(tasks, tmp_path / "one", F.Settings(), workers=1)
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
+                                  dashboard_address=None) as cluster:
+        info, remote = run_and_report(tasks, tmp_path / "dask", F.Settings(), scheduler=cluster.scheduler_address)
+    assert info.executor == "dask" and info.workers == 2 and info.n_computed == 3
+    assert remote["fleet"] == local["fleet"] and remote["changes"] == local["changes"]
+
+
+@pytest.mark.slow
+def test_an_interrupted_fleet_is_resumed_from_its_staging_folder(fleet_dir, tmp_path, monkeypatch):
+    from heavecomp.diagnosis import monitor as M
+    from heavecomp.report.output import staging_path
+
+    d, _ = fleet_dir
+    real = M.monitor
+
+    def interrupted(run, params, **kw):
+        if "b_leak" in run.source:
+            raise KeyboardInterrupt
+        return real(run, params, **kw)
+
+    monkeypatch.setattr(M, "monitor", interrupted)
+    out = tmp_path / "o"
+    args = [d / "logs", "--params", d / "p.toml", "--out", out, "--workers", "1"]
+    assert _fleet(*args) == 130
+    assert not out.exists()  # whole or absent
+    kept = staging_path(out) / F.RESULTS
+    assert sorted(p.name for p in kept.iterdir()) == ["a_friction"]  # the finished log, whole
+    first = F.read_task(kept / "a_friction")["fleet_run"]
+    monkeypatch.setattr(M, "monitor", real)
+    calls = _counting(monkeypatch)  # the real monitor again, counted
+    assert _fleet(*args, "--resume") == 0
+    assert [c.rsplit("/", 1)[-1] for c in calls] == ["b_leak.csv", "c_none.csv"]
+    assert F.read_task(out / F.RESULTS / "a_friction")["fleet_run"] == first
+
+
+@pytest.mark.slow
+def test_diagnose_gives_each_gap_segment_its_verdict_and_group(fleet_dir, tmp_path):
+    d, _ = fleet_dir
+    (tmp_path / "logs").mkdir()
+    (tmp_path / "logs" / "a_friction.csv").symlink_to(d / "logs" / "a_friction.csv")
+    assert _fleet(tmp_path / "logs", "--params", d / "p.toml", "--out", tmp_path / "o", "--workers", "1",
+                  "--diagnose") == 0
+    with open(tmp_path / "o" / "segments.csv", newline="") as fh:
+        segs = list(csv.DictReader(fh))
+    assert [s["verdict"] for s in segs][0] == "-"  # the reference stretch is not diagnosed
+    v = segs[1]
+    assert v["verdict component"] == "friction" and "pressure_friction" in v["group"]
+    diag = json.loads((tmp_path / "o" / "logs" / "a_friction" / "segment_1" / "diagnosis.json").read_text())
+    assert diag["verdict"]["effect"] == v["verdict"]
+    row = _rows(tmp_path / "o" / "fleet.csv")["a_friction"]
+    assert row["verdicts (segment: effect, confidence, group)"].startswith(f"1: {v['verdict']}, {v['confidence']}")

@@ -81,6 +81,10 @@ def run(args) -> int:
     settings = F.Settings(diagnose=args.diagnose, block=args.block)
     old = Path(final(args)) / F.RESULTS
     work = Path(args.out) / F.RESULTS
+    staged = Path(args.out) != Path(final(args))  # the CLI's staging folder (kept by an interrupted fleet)
+    if staged and not args.resume:  # a fresh fleet: nothing an interrupted run left is taken over
+        for p in Path(args.out).iterdir():
+            shutil.rmtree(p) if p.is_dir() else p.unlink()
     if args.resume and old.is_dir() and not work.exists():  # resume from a complete earlier result
         shutil.copytree(old, work)
     bar = Progress(f"fleet of {len(tasks)} logs")
