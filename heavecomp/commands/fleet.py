@@ -84,7 +84,10 @@ def run(args) -> int:
     staged = Path(args.out) != Path(final(args))  # the CLI's staging folder (kept by an interrupted fleet)
     if staged and not args.resume:  # a fresh fleet: nothing an interrupted run left is taken over
         for p in Path(args.out).iterdir():
-            shutil.rmtree(p) if p.is_dir() else p.unlink()
+            if p.is_dir():
+                shutil.rmtree(p)
+            else:
+                p.unlink()
     if args.resume and old.is_dir() and not work.exists():  # resume from a complete earlier result
         shutil.copytree(old, work)
     bar = Progress(f"fleet of {len(tasks)} logs")
