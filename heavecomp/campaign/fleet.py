@@ -289,7 +289,8 @@ def _head(path: Path, folder: Path) -> Path | None:
     with path.open("rb") as fh:
         magic = fh.read(6)
     opener = {b"\x1f\x8b": gzip.open, b"BZ": bz2.open, b"\xfd7": lzma.open}.get(magic[:2], open)
-    if magic[:4] in (b"PAR1", b"PK\x03\x04") or magic[:4] == b"\x89HDF" or magic.startswith(b"MATLAB"):
+    if magic[:4] in (b"PAR1", b"PK\x03\x04", b"\x89HDF") or magic.startswith(b"MATLAB") \
+            or path.name.lower().endswith((".mat", ".parquet")):
         return None
     try:
         with opener(path, "rb") as fh:
