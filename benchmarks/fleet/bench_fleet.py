@@ -105,7 +105,8 @@ def fleet(logs: Path, data: Path, out: Path, *extra) -> dict:
     timings = json.loads((out / "timings.json").read_text()) if (out / "timings.json").exists() else {}
     doc = json.loads((out / "fleet.json").read_text())
     tasks = [json.loads(f.read_text()) for f in sorted((out / "logs").glob("*/task.json"))]
-    return {"task_wall_sum_s": sum(t["wall_s"] for t in tasks), "failed": sum(t["status"] != "done" for t in tasks),
+    return {"task_wall_sum_s": sum(t["wall_s"] for t in tasks), "task_cpu_sum_s": sum(t["cpu_s"] for t in tasks),
+            "failed": sum(t["status"] != "done" for t in tasks),
             "command": " ".join(cmd), "wall_s": wall, "executor_wall_s": timings.get("fleet.json", {})
             .get("run", {}).get("wall_time_s"), "executor": doc["run"]["executor"], "workers": doc["run"]["workers"],
             "load_before": load0, "load_after": os.getloadavg(), "table": (out / "fleet.csv").read_text()}
@@ -152,15 +153,22 @@ def main(argv=None) -> int:
     (data / "results.json").write_text(json.dumps(res, indent=2) + "\n")
     print(f"{args.logs} logs, {res['hours_of_log']:.1f} h of log at 10 Hz; the same fleet.csv from every run: {same}; "
           f"minimum of {args.repeats} interleaved repeats")
-    print("| run | wall (command) | wall (executor) | sum of the tasks' wall | load avg (1 min) before -> after |")
-    print("|---|---|---|---|---|")
+    print("| run | wall (command) | wall (executor) | sum of the tasks' wall | tasks' CPU | cores busy (tasks' CPU / "
+          "executor wall) | load avg (1 min) before -> after |")
+    print("|---|---|---|---|---|---|---|")
     for k, lab in (("one", "--workers 1 (in-process)"), ("dask2", "Dask LocalCluster, 2 workers"),
                    ("proc2", "--workers 2 (local processes)")):
         r = res[k]
         print(f"| {lab} | {r['wall_s']:.1f} s | {r['executor_wall_s']} s | {r['task_wall_sum_s']:.1f} s | "
+              f"{r['task_cpu_sum_s']:.1f} s | {r['task_cpu_sum_s'] / r['executor_wall_s']:.2f} | "
               f"{r['load_before'][0]:.2f} -> "
               f"{r['load_after'][0]:.2f} |")
-    print(f"ratio 1 worker / 2 Dask workers: {res['ratio_dask2']:.2f}; / 2 processes: {res['ratio_proc2']:.2f}")
+    print(f"ratio 1 worker / 2 Dask workers: {res['ratio_dask2']:.2f}; / 2 processes: {res['ratio_proc2']:.2f} "
+          "(minimum wall of each)")
+    med = {k: sorted(r["wall_s"] for r in rs)[len(rs) // 2] for k, rs in runs.items()}
+    res["median_wall_s"] = med
+    print("every run's command wall [s]: " + "; ".join(f"{k} " + ", ".join(f"{r['wall_s']:.1f}" for r in rs)
+                                                     for k, rs in runs.items()))
     f = res["found"]
     print(f"found: {f['first_named_right']} of {f['planted']} planted changes first named right; "
           f"{f['alarms_without_change']} changes in the {f['hours_without_change']:.1f} h of logs without one")

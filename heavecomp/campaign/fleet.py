@@ -434,9 +434,9 @@ def run_log(settings: Settings, task: LogTask) -> dict:
     dict
         ``key``, ``status`` (``done`` or ``failed``), ``reason`` (failed: one line), ``monitor`` (the
         ``monitor.json`` content), ``diagnoses`` (segment index -> ``diagnosis.json`` content),
-        ``wall_s`` [s], ``pid``.
+        ``wall_s`` [s], ``cpu_s`` [s] (this process' CPU time of the task), ``pid``.
     """
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     out = {"key": task.key, "status": "done", "reason": "", "monitor": None, "diagnoses": {}, "pid": os.getpid()}
     try:
         params = load(task.params, heave_file=False)
@@ -455,7 +455,7 @@ def run_log(settings: Settings, task: LogTask) -> dict:
     except Exception as exc:  # noqa: BLE001 - a log's failure is recorded, the fleet goes on
         log.info("%s: failed: %s", task.key, _reason(exc))
         out.update(status="failed", reason=_reason(exc), monitor=None, diagnoses={})
-    out["wall_s"] = time.perf_counter() - t0
+    out["wall_s"], out["cpu_s"] = time.perf_counter() - t0, time.process_time() - c0
     return out
 
 
@@ -527,7 +527,8 @@ def _place(out: Path, key: str, result: dict, fp: str, run_id: str, write) -> No
     if result["status"] == "done":
         write(work, result)
     _write_json(work / TASK, {"key": key, "status": result["status"], "reason": result["reason"], "fingerprint": fp,
-                              "fleet_run": run_id, "wall_s": round(result["wall_s"], 3)})
+                              "fleet_run": run_id, "wall_s": round(result["wall_s"], 3),
+                              "cpu_s": round(result["cpu_s"], 3)})
     final = results / key
     if final.exists():
         shutil.rmtree(final)
