@@ -150,6 +150,7 @@ def main(argv=None) -> int:
     res["found"] = found(data, data / "out_1_0")
     res["ratio_dask2"] = res["one"]["wall_s"] / res["dask2"]["wall_s"]
     res["ratio_proc2"] = res["one"]["wall_s"] / res["proc2"]["wall_s"]
+    res["median_wall_s"] = {k: sorted(r["wall_s"] for r in rs)[len(rs) // 2] for k, rs in runs.items()}
     (data / "results.json").write_text(json.dumps(res, indent=2) + "\n")
     print(f"{args.logs} logs, {res['hours_of_log']:.1f} h of log at 10 Hz; the same fleet.csv from every run: {same}; "
           f"minimum of {args.repeats} interleaved repeats")
@@ -165,8 +166,6 @@ def main(argv=None) -> int:
               f"{r['load_after'][0]:.2f} |")
     print(f"ratio 1 worker / 2 Dask workers: {res['ratio_dask2']:.2f}; / 2 processes: {res['ratio_proc2']:.2f} "
           "(minimum wall of each)")
-    med = {k: sorted(r["wall_s"] for r in rs)[len(rs) // 2] for k, rs in runs.items()}
-    res["median_wall_s"] = med
     print("every run's command wall [s]: " + "; ".join(f"{k} " + ", ".join(f"{r['wall_s']:.1f}" for r in rs)
                                                      for k, rs in runs.items()))
     f = res["found"]
