@@ -29,6 +29,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "analyse": ("heavecomp.commands.analyse", "linear analysis: k_eff_dc, natural frequencies, heave -> WOB frequency response"),
     "diagnose": ("heavecomp.commands.diagnose", "sim-to-real gap diagnosis of a measured run (which unmodelled effect)"),
     "monitor": ("heavecomp.commands.monitor", "monitor a long log: when and where the sim-to-real gap appears or changes"),
+    "fleet": ("heavecomp.commands.fleet", "monitor (and diagnose) a folder of logs: one summary of segments, components and verdicts per log"),
     "campaign": ("heavecomp.commands.campaign", "run a sea-state campaign: WOB exceedance over a scatter diagram"),
     "stickslip": ("heavecomp.commands.stickslip", "paper B pneumatic cylinder: stick-slip analysis, simulation, map"),
     "identify": ("heavecomp.commands.identify", "identify from measured data: EMPS axis (+ residual diagnosis) or seal friction vs pressure"),
@@ -260,7 +261,7 @@ def _staged(args):
 
     @contextlib.contextmanager
     def staged():
-        st = _staging.Staged(args.out, "--out", resumable=args.command == "campaign")
+        st = _staging.Staged(args.out, "--out", resumable=args.command in ("campaign", "fleet"))
         args.out_final = args.out
         with st as work:
             args.out = str(work)

@@ -10,7 +10,8 @@ written last line is discarded) and simulates the rest.  ``DIR/manifest.json``
 holds the campaign's fingerprint; resuming into a folder of a *different*
 campaign is refused.
 
-Executors (no home-made job system):
+Executors (no home-made job system; :func:`execute`, which the fleet of logs,
+:mod:`heavecomp.campaign.fleet`, runs on too):
 
 - ``workers == 1``: in this process;
 - ``workers > 1`` (default: all cores): :class:`concurrent.futures.ProcessPoolExecutor`
@@ -207,7 +208,7 @@ def run_campaign(campaign, out_dir, *, workers: int | None = None, scheduler: st
     -------
     CampaignRun
     """
-    from heavecomp.campaign.batch import check_budget, run_chunk
+    from heavecomp.campaign.batch import check_budget
 
     out = Path(out_dir)
     _check_manifest(campaign, out)
@@ -235,45 +236,90 @@ def run_campaign(campaign, out_dir, *, workers: int | None = None, scheduler: st
         if progress:
             progress(count, total)
 
-    if client is not None or scheduler:
-        executor, nw = _run_dask(campaign, chunks, finished, scheduler, client)
-    else:
-        nw = int(workers) if workers else (os.cpu_count() or 1)
-        if nw < 1:
-            raise InputError(f"workers must be >= 1, got {workers}", option="workers")
-        nw = min(nw, max(1, len(chunks)))
-        if nw == 1:
-            executor = "in-process"
-            for ch in chunks:
-                finished(run_chunk(campaign, ch, threads=1))
-        else:
-            executor = "processes"
-            import multiprocessing as mp
-            from concurrent.futures import ProcessPoolExecutor, as_completed
-
-            with ProcessPoolExecutor(max_workers=nw, mp_context=mp.get_context("spawn"),
-                                     initializer=_init_worker, initargs=(os.getpid(),)) as pool:
-                futs = [pool.submit(run_chunk, campaign, ch, 1) for ch in chunks]
-                try:
-                    for f in as_completed(futs):
-                        finished(f.result())
-                except BaseException:
-                    for f in futs:
-                        f.cancel()
-                    raise
+    executor, nw = execute(_campaign_chunk, chunks, finished, shared=campaign, workers=workers,
+                           scheduler=scheduler, client=client)
     wall = time.perf_counter() - t0
     n_sim = count - n_skip
     log.info("%d runs simulated in %.1f s (%s, %d workers)", n_sim, wall, executor, nw)
     return CampaignRun(out, total, n_skip, n_sim, wall, executor, nw)
 
 
-def _run_dask(campaign, chunks, finished, scheduler, client):
+def _campaign_chunk(campaign, run_ids):
+    """One task of a campaign: a chunk of runs in one compiled batch call, one numba thread."""
+    from heavecomp.campaign.batch import run_chunk
+
+    return run_chunk(campaign, run_ids, 1)
+
+
+def execute(task, items, finished, *, shared=None, workers: int | None = None, scheduler: str | None = None,
+            client=None) -> tuple[str, int]:
+    """Run ``task(shared, item)`` for every item on the executor asked for; ``finished(result)`` is called
+    in this process as each task completes (the parent is the only writer).
+
+    The executor of :func:`run_campaign` and of :func:`heavecomp.campaign.fleet.run_fleet` (see the module
+    docstring): in this process (``workers == 1``), local ``spawn`` processes with one numba thread each
+    (``workers > 1``, default all cores, at most one per item), or :mod:`dask.distributed` (``scheduler``
+    or ``client``; ``shared`` is scattered to every worker once).
+
+    Parameters
+    ----------
+    task : callable (shared, item) -> result
+        A module-level function (it is pickled to the workers).
+    items : sequence
+        One entry per task.
+    finished : callable (result)
+        Called in this process with each task's result, in the order they complete.
+    shared : object, optional
+        The task's first argument, the same for every item (picklable).
+    workers : int, optional
+        Local worker processes (default: all cores); ignored with a scheduler.
+    scheduler : str, optional
+        Address of a Dask scheduler (``tcp://host:8786``).
+    client : dask.distributed.Client, optional
+        An existing client (takes precedence over ``scheduler``).
+
+    Returns
+    -------
+    (str, int)
+        The executor (``in-process``, ``processes``, ``dask``) and its number of workers.
+
+    Raises
+    ------
+    heavecomp.errors.InputError
+        ``workers`` < 1; no ``dask.distributed``; a scheduler that cannot be reached.
+    """
+    if client is not None or scheduler:
+        return _run_dask(task, items, finished, shared, scheduler, client)
+    nw = int(workers) if workers else (os.cpu_count() or 1)
+    if nw < 1:
+        raise InputError(f"workers must be >= 1, got {workers}", option="workers")
+    nw = min(nw, max(1, len(items)))
+    if nw == 1:
+        for it in items:
+            finished(task(shared, it))
+        return "in-process", nw
+    import multiprocessing as mp
+    from concurrent.futures import ProcessPoolExecutor, as_completed
+
+    with ProcessPoolExecutor(max_workers=nw, mp_context=mp.get_context("spawn"),
+                             initializer=_init_worker, initargs=(os.getpid(),)) as pool:
+        futs = [pool.submit(task, shared, it) for it in items]
+        try:
+            for f in as_completed(futs):
+                finished(f.result())
+        except BaseException:
+            for f in futs:
+                f.cancel()
+            raise
+    return "processes", nw
+
+
+def _run_dask(task, items, finished, shared, scheduler, client):
     try:
         from dask.distributed import Client, as_completed
     except ImportError:
         raise InputError("scheduler needs dask.distributed (pip install 'heavecomp[cluster]')",
                          option="scheduler") from None
-    from heavecomp.campaign.batch import run_chunk
 
     own = client is None
     if own:
@@ -284,8 +330,8 @@ def _run_dask(campaign, chunks, finished, scheduler, client):
                              option="scheduler") from None
     try:
         nw = len(client.scheduler_info().get("workers", {}))
-        fc = client.scatter(campaign, broadcast=True)
-        futs = client.map(run_chunk, [fc] * len(chunks), chunks, [1] * len(chunks), pure=False)
+        fs = client.scatter(shared, broadcast=True)
+        futs = client.map(task, [fs] * len(items), list(items), pure=False)
         for f in as_completed(futs):
             finished(f.result())
     finally:
