@@ -20,6 +20,7 @@ import sys
 
 import numpy as np
 
+from heavecomp.analysis.linear import operating_point
 from heavecomp.analysis.summary import analyse
 from heavecomp.benchmark import Case, generate
 from heavecomp.benchmark.truth import TRUTH
@@ -42,7 +43,18 @@ EFFECTS = {
     "string_damping": ("string", "quadratic drag c_q dv abs(dv) in the string tension"),
     "sensor_gain": ("sensor fault", "WOB load cell: g x its own 5 Hz first-order lag"),
     "gas_leak": ("gas", "laminar leak of the gas mass fraction (1-3 % of the charge over the log)"),
+    "gas_stiffness_mismatch": ("gas", "the nominal law with wrong values: the gas stiffness and a second parameter "
+                                      "off by 30-50 %"),
+    "string_stiffness_mismatch": ("string", "the nominal law with wrong values: the string stiffness and a second "
+                                            "parameter off by 30-50 %"),
 }
+#: the benchmark law each entry withholds (default: the entry's own name)
+LAW = {"gas_stiffness_mismatch": "parameter_mismatch", "string_stiffness_mismatch": "parameter_mismatch"}
+#: seeds not at the entry's position: ``parameter_mismatch`` draws two of gas stiffness, Coulomb force,
+#: string and formation stiffness (+-30-50 %); these are the first seeds from 115 (the first free one) whose
+#: 300 s draw touches the gas spring (117) and the string (116), chosen by the component drawn, never by its
+#: size or the loop's outcome (115's draw, Coulomb force and formation, touches neither)
+SEEDS = {"gas_stiffness_mismatch": 117, "string_stiffness_mismatch": 116}
 CONTROLLER = "linear-mpc"
 #: effects whose truth the linear MPC cannot see: a quadratic drag has no slope at rest, so the linear
 #: MPC's model (linearised there) is the nominal one; the nonlinear MPC carries it over the horizon
@@ -51,6 +63,10 @@ NONLINEAR = ("string_damping",)
 SEA = {"kind": "jonswap", "hs": 2.0, "tp": 12.0, "gamma": 3.3, "seed": 7, "amplitude": None, "period": None,
        "ramp": 20.0}
 WAVE_PERIODS = ("5", "8", "12", "16", "20")
+#: the linear MPC's osqp tolerance for the resolution runs (its own is 1e-4): how far the WOB std of one
+#: controller moves when its QPs are solved 100 x tighter is the resolution of a difference between two
+#: controllers in the same sea with the same noise (the runs are otherwise deterministic)
+TIGHT_EPS = 1e-6
 
 
 class TruthSensorGain(SensorGain):
@@ -69,7 +85,10 @@ class TruthSensorGain(SensorGain):
 
 
 def truth_effects(name: str, parameters: dict) -> list:
-    """The truth plant's effects: the benchmark's truth-law instance with its planted parameters."""
+    """The truth plant's effects: the benchmark's truth-law instance with its planted parameters
+    (none for a parameter mismatch: its truth is the nominal law with other values, :func:`truth_params`)."""
+    if name == "parameter_mismatch":
+        return []
     if name == "sensor_gain":
         e = TruthSensorGain(channel=parameters["channel"], factor=1.0 + parameters["gain_error"])
         e.bandwidth = parameters.get("bandwidth", TruthSensorGain.bandwidth)
@@ -77,12 +96,27 @@ def truth_effects(name: str, parameters: dict) -> list:
     return [TRUTH[name](**parameters)]
 
 
+def truth_params(nominal, name: str, parameters: dict):
+    """The truth plant's parameters: the nominal ones, or for a parameter mismatch the drawn values
+    (``"table.key": value`` [SI], the run's truth record)."""
+    if name != "parameter_mismatch":
+        return nominal
+    changes = {}
+    for path, value in parameters.items():
+        table, key = path.split(".")
+        changes.setdefault(table, {})[key] = value
+    return nominal.replace(**changes)
+
+
 def true_model(name: str, parameters: dict) -> tuple[list, str]:
     """The effects the true-model controller knows, and how they relate to the truth.
 
     The truth laws are Effect classes composed by the same mechanism as the library's, so the
     controller's casadi model traces them as they are.  The sensor's lag is no static map (the
-    controller's output model takes g y + o only): its true model is the gain without the lag."""
+    controller's output model takes g y + o only): its true model is the gain without the lag.  A
+    parameter mismatch's true model is the true values (:func:`truth_params`), no effect."""
+    if name == "parameter_mismatch":
+        return [], "the true parameter values (" + ", ".join(f"{k} = {v:.4g}" for k, v in parameters.items()) + ")"
     if name == "sensor_gain":
         return ([SensorGain(channel=parameters["channel"], factor=1.0 + parameters["gain_error"])],
                 "the truth's gain g as a library sensor_gain (its 5 Hz lag is not modelled)")
@@ -116,8 +150,38 @@ def _loop_metrics(res, W0: float) -> dict:
             "violations": m["violations_u_max"] + m["violations_rate"], "fallbacks": m["fallbacks"]}
 
 
-def loop_one(name: str, *, seed: int, log_duration: float, loop_duration: float, progress=None) -> dict:
+def _closed_loop(plant, ctrl, model, known, duration, truth_fx, seed, tight=False):
+    """One closed-loop run on the truth plant: ``ctrl`` designed on ``model`` knowing ``known``
+    (``tight``: the linear MPC's QPs solved to :data:`TIGHT_EPS`)."""
+    c = make(ctrl, model, effects=known)
+    if tight:
+        c.solver.update_settings(eps_abs=TIGHT_EPS, eps_rel=TIGHT_EPS)
+    return simulate_closed_loop(plant, c, duration, effects=truth_fx, noise=Noise(seed=seed))
+
+
+def _prediction(c, pressure: float) -> dict:
+    """What a linear MPC ``c`` predicts with: the WOB over its horizon after a unit force and after a
+    unit heave at step 0 [N/N, N/m], and its friction forecast at stroke velocities -0.5..0.5 m/s [N]."""
+    m, N = c.model, c.N
+    x, heave = m.Bw[:, 0].copy(), []
+    for _ in range(N):
+        heave.append(float(m.C[0] @ x))
+        x = m.Ad @ x
+    v = np.linspace(-0.5, 0.5, 41)
+    return {"force": np.asarray(c.Gu[:, 0]), "heave": np.asarray(heave),
+            "friction": np.asarray(c.estimation.friction.force(v, pressure))}
+
+
+def model_change(reference, other) -> dict:
+    """Relative change of each :func:`_prediction` part from ``reference`` to ``other`` [-]: 0 means
+    the controller's model does not use what it was given."""
+    return {k: float(np.linalg.norm(other[k] - reference[k]) / max(np.linalg.norm(reference[k]), 1e-300))
+            for k in reference}
+
+
+def loop_one(key: str, *, seed: int, log_duration: float, loop_duration: float, progress=None) -> dict:
     """The loop for one withheld effect (module docstring); returns its metrics and the three runs."""
+    name = LAW.get(key, key)
     tr = generate(Case(name, seed, "named", duration=log_duration, variant="wob" if name == "sensor_gain" else None))
     nominal = tr.nominal
     planted = tr.truth["parameters"][name]
@@ -132,54 +196,67 @@ def loop_one(name: str, *, seed: int, log_duration: float, loop_duration: float,
         cal_what += "; refitted: " + ", ".join(c["name"] for c in cal.changes if c.get("kind") == "parameter")
     true_fx, true_what = true_model(name, planted)
     true_plant = [e for e in true_fx if e.kind == "plant"]
+    true_p = truth_params(nominal, name, planted)
     ana = {"nominal": _analysis(nominal, ()), "calibrated": _analysis(cal.params, None),
-           "true": _analysis(nominal, true_plant)}
-    p = nominal.replace(heave=SEA)
+           "true": _analysis(true_p, true_plant)}
+    p = true_p.replace(heave=SEA)  # the truth plant in the loop's sea
     W0 = p.operating_point.wob_setpoint
     truth_fx = truth_effects(name, planted)
-    models = {"nominal": (p, ()), "calibrated": (cal.params.replace(heave=SEA), cal_fx), "true": (p, true_fx)}
-    runs, loops = {}, {}
-    controllers = (CONTROLLER, "nonlinear-mpc") if name in NONLINEAR else (CONTROLLER,)
+    models = {"nominal": (nominal.replace(heave=SEA), ()), "calibrated": (cal.params.replace(heave=SEA), cal_fx),
+              "true": (p, true_fx)}
+    runs, loops, resolution = {}, {}, {}
+    controllers = (CONTROLLER, "nonlinear-mpc") if key in NONLINEAR else (CONTROLLER,)
     for ctrl in controllers:
         loops[ctrl] = {}
         for label, (mp, known) in models.items():
             # the controller designed on its model (parameters and effects); the plant is the truth
-            res = simulate_closed_loop(p, make(ctrl, mp, effects=known), loop_duration, effects=truth_fx,
-                                       noise=Noise(seed=seed))
+            res = _closed_loop(p, ctrl, mp, known, loop_duration, truth_fx, seed)
             runs[label] = res  # the figure shows the last controller's runs
             loops[ctrl][label] = _loop_metrics(res, W0)
+    # does the controller use its model? the linear MPC's predictions on the calibrated and the true model
+    # against the nominal's (a fitted effect the linearisation drops leaves them unchanged)
+    p_op = operating_point(nominal).y[2]
+    pred = {label: _prediction(make(CONTROLLER, mp, effects=known), p_op) for label, (mp, known) in models.items()}
+    uses = {label: model_change(pred["nominal"], pred[label]) for label in ("calibrated", "true")}
+    # the comparison's resolution: the same sea and noise make the runs deterministic (a repeat is
+    # bit-identical); what is left is the QP solver's tolerance (the linear MPC's, solved 100 x tighter)
+    again = _loop_metrics(_closed_loop(p, CONTROLLER, *models["nominal"], loop_duration, truth_fx, seed), W0)
+    tight = {label: _loop_metrics(_closed_loop(p, CONTROLLER, mp, known, loop_duration, truth_fx, seed, tight=True),
+                                  W0)["wob_std"] for label, (mp, known) in models.items()}
+    resolution = {"repeat_identical": again["wob_std"] == loops[CONTROLLER]["nominal"]["wob_std"],
+                  "tight_eps": TIGHT_EPS, "wob_std_tight": tight,
+                  "wob_std": max(abs(tight[k] - loops[CONTROLLER][k]["wob_std"]) for k in tight)}
     controller = controllers[-1]
     loop = loops[controller]
-    out = {"kind": EFFECTS[name][0], "truth_law": EFFECTS[name][1], "planted": planted,
+    out = {"kind": EFFECTS[key][0], "truth_law": EFFECTS[key][1], "law": name, "seed": seed, "planted": planted,
            "gap_to_noise": tr.truth["gap_to_noise"][name],
            "verdict": {"effect": v["effect"], "confidence": v["confidence"], "shrink": v["shrink"],
                        "parameters": v.get("parameters", {}),
                        "second_effect": (v.get("second_effect") or {}).get("effect")},
            "calibrated": cal.block(), 
            "calibrated_model": cal_what, "true_model": true_what, "analysis": ana, "controller": controller,
-           "loop": loop, "loops": loops,
-           }
+           "loop": loop, "loops": loops, "resolution": resolution, "model_change": uses}
     return {"metrics": summarise(out), "runs": runs, "W0": W0}
-
-
-#: the true-model controller's WOB std must differ from the nominal one's by this share of it for
-#: ``recovered`` to mean something (below it the difference is the size of a re-run's spread) [-]
-MEANINGFUL = 0.02
 
 
 def summarise(m: dict) -> dict:
     """``m`` with ``recovered`` per controller (``recovered_by_controller``; ``recovered``: the linear
-    MPC's), ``std_difference_true`` [N], ``meaningful`` (the true model is worth at least
-    :data:`MEANINGFUL` of the nominal std, and helps) and, for a sensor fault, ``mean_error_removed``."""
+    MPC's), ``std_difference_true`` [N] (nominal minus true-model controller), its share of the
+    nominal std, ``resolved`` (the difference exceeds the resolution, the largest move of a WOB std
+    when the QPs are solved 100 x tighter, and the runs repeat bit for bit), ``true_model_helps``
+    (resolved and positive: only then is ``recovered`` a share of a gain) and, for a sensor fault,
+    ``mean_error_removed``."""
     rec, diff = {}, {}
     for ctrl, L in m["loops"].items():
         den = L["nominal"]["wob_std"] - L["true"]["wob_std"]
         diff[ctrl] = den
         rec[ctrl] = (L["nominal"]["wob_std"] - L["calibrated"]["wob_std"]) / den if den != 0 else None
     L = m["loops"][CONTROLLER]
+    res = m["resolution"]
+    resolved = bool(res["repeat_identical"] and abs(diff[CONTROLLER]) > res["wob_std"])
     m.update(recovered_by_controller=rec, std_difference_by_controller=diff, recovered=rec[CONTROLLER],
-             std_difference_true=diff[CONTROLLER],
-             meaningful=bool(diff[CONTROLLER] >= MEANINGFUL * L["nominal"]["wob_std"]))
+             std_difference_true=diff[CONTROLLER], std_difference_share=diff[CONTROLLER] / L["nominal"]["wob_std"],
+             resolved=resolved, true_model_helps=bool(resolved and diff[CONTROLLER] > 0))
     if m["kind"] == "sensor fault":
         e = {k: abs(x["wob_mean_error"]) for k, x in L.items()}
         m["mean_error_removed"] = 1.0 - e["calibrated"] / e["nominal"] if e["nominal"] > 0 else None
@@ -187,12 +264,14 @@ def summarise(m: dict) -> dict:
 
 
 def build(quick: bool = False, seed: int = 110) -> dict:
+    """The loop for every entry of :data:`EFFECTS` (seeds ``seed`` + its index), or two in ``quick``."""
     log_duration, loop_duration = (200.0, 60.0) if quick else (300.0, 180.0)
     names = ("pressure_friction", "sensor_gain") if quick else tuple(EFFECTS)
     res = {}
     for i, name in enumerate(names):
         log.info("sim_to_real_loop: %s", name)
-        res[name] = loop_one(name, seed=seed + i, log_duration=log_duration, loop_duration=loop_duration)
+        res[name] = loop_one(name, seed=SEEDS.get(name, seed + i), log_duration=log_duration,
+                             loop_duration=loop_duration)
     return {"effects": res, "log_duration": log_duration, "loop_duration": loop_duration, "seed": seed}
 
 
@@ -248,7 +327,9 @@ def write(r: dict, out, quick: bool) -> None:
     sections = [__doc__.strip(),
                 f"Passive logs of {r['log_duration']:g} s (the generator's sea, 50 Hz, its noise); closed-loop runs of "
                 f"{r['loop_duration']:g} s in a JONSWAP sea (H_s 2 m, T_p 12 s), the rig's sensor noise, "
-                f"statistics after the fade-in; seeds from {r['seed']}.",
+                f"statistics after the fade-in; seeds from {r['seed']} by position, the two parameter mismatches at "
+                f"the first seeds whose draw touches the gas spring ({SEEDS['gas_stiffness_mismatch']}) and the string "
+                f"({SEEDS['string_stiffness_mismatch']}).",
                 "## What the diagnosis found and what each controller knows",
                 md_table(["effect", "kind", "truth law", "gap / noise", "verdict", "confidence", "calibrated model",
                           "true model (controller)"], verdicts),
@@ -268,40 +349,62 @@ def write(r: dict, out, quick: bool) -> None:
                           "recovered"], rows,
                          fmt="{:.3g}"),
                 "![WOB per controller](wob_loop.png)"]
+    sections += ["## Does the controller use its model?",
+                 "Relative change of what the linear MPC predicts with, against the controller designed on the "
+                 "nominal model: the WOB over its horizon after a unit force and after a unit heave, and its friction "
+                 "forecast at stroke velocities -0.5..0.5 m/s. 0 means the model given to it changes nothing it "
+                 "predicts (the effect is dropped by its linearisation at rest, or is not in its friction).",
+                 md_table(["effect", "model", "WOB per force", "WOB per heave", "friction forecast"],
+                          [(n, label, *(f"{m['model_change'][label][k]:.2g}" for k in ("force", "heave", "friction")))
+                           for n, m in M.items() for label in ("calibrated", "true")])]
     findings = []
     for n, m in M.items():
         L = m["loops"][CONTROLLER]
         kn = {k: x["wob_std"] / 1e3 for k, x in L.items()}
-        line = (f"- {n} (verdict {m['verdict']['effect']}): WOB std with the linear MPC designed on the nominal / "
-                f"calibrated / true model {kn['nominal']:.3g} / {kn['calibrated']:.3g} / {kn['true']:.3g} kN")
+        res = m["resolution"]
+        line = (f"- {n} (withheld {m['law']}, seed {m['seed']}; verdict {m['verdict']['effect']}): WOB std with the "
+                f"linear MPC designed on the nominal / calibrated / true model {kn['nominal']:.4g} / "
+                f"{kn['calibrated']:.4g} / {kn['true']:.4g} kN; the true model is worth "
+                f"{m['std_difference_true']:.3g} N ({100 * m['std_difference_share']:.2g} % of the nominal std), the "
+                f"resolution is {res['wob_std']:.2g} N (a repeat is {'bit-identical' if res['repeat_identical'] else 'NOT identical'})")
         if m["kind"] == "sensor fault":
             e = {k: x["wob_mean_error"] / 1e3 for k, x in L.items()}
             line += (f"; the controller's own error, the mean WOB off the set-point, {e['nominal']:.3g} / "
                      f"{e['calibrated']:.3g} / {e['true']:.3g} kN: reading the WOB through the diagnosed gain removes "
                      f"{100 * m['mean_error_removed']:.0f} % of it.")
-        elif not m["meaningful"]:
-            line += (f": the true model is worth {m['std_difference_true'] / 1e3:.2g} kN of std, under "
-                     f"{100 * MEANINGFUL:.0f} % of the nominal's, so `recovered` "
-                     f"({'-' if m['recovered'] is None else format(m['recovered'], '.2f')}) means nothing here")
-            for ctrl, rec in m["recovered_by_controller"].items():
-                if ctrl != CONTROLLER:
-                    Lc = m["loops"][ctrl]
-                    line += (f"; with the {ctrl}: {Lc['nominal']['wob_std'] / 1e3:.3g} / {Lc['calibrated']['wob_std'] / 1e3:.3g}"
-                             f" / {Lc['true']['wob_std'] / 1e3:.3g} kN ({Lc['true']['violations']} commands beyond a "
-                             "limit with the true model)")
-            line += "."
+        elif not m["resolved"]:
+            line += ": the difference is within the resolution, so there is nothing to recover."
+        elif not m["true_model_helps"]:
+            line += (f": the true model makes the WOB std worse (resolved), so `recovered` "
+                     f"({'-' if m['recovered'] is None else format(m['recovered'], '.2f')}) is no share of a gain.")
         else:
-            line += f": recovered {m['recovered']:.2f} of the {m['std_difference_true'] / 1e3:.2g} kN the true model is worth."
+            line += (f": recovered {m['recovered']:.2f}"
+                     + (" (goal 0.8 met)" if m["recovered"] >= 0.8 else " (goal 0.8 **not** met)") + ".")
+        for ctrl, rec in m["recovered_by_controller"].items():
+            if ctrl != CONTROLLER:
+                Lc = m["loops"][ctrl]
+                line = line.rstrip(".") + (f"; with the {ctrl}: {Lc['nominal']['wob_std'] / 1e3:.3g} / "
+                                           f"{Lc['calibrated']['wob_std'] / 1e3:.3g} / {Lc['true']['wob_std'] / 1e3:.3g} kN "
+                                           f"({Lc['true']['violations']} commands beyond a limit with the true model).")
         findings.append(line)
     sections += ["## Findings", "\n".join(findings),
+                 "Resolution: the three controllers run in the same sea with the same sensor noise, so a run repeats bit "
+                 "for bit and a difference of WOB std between two of them is no sampling spread; what limits it is the "
+                 f"QP solver's tolerance (osqp 1e-4): each linear MPC is run again with its QPs solved to {TIGHT_EPS:g}, "
+                 "and the largest move of a WOB std is the resolution. A difference beyond it is real for this sea; "
+                 "whether its size carries to another sea is a separate question the scenario does not answer.",
                  "Where the true model is worth little: the MPCs' observer estimates a force disturbance at the "
                  "control rate, and a gas-law error (a thermal state relaxing in seconds, a charge leaking over "
                  "minutes) is slow against it, so most of it is absorbed there whether the model knows the law or "
-                 "not. A quadratic drag has no slope at rest, where the linear MPC linearises its model, so that "
-                 "model is the nominal one; the nonlinear MPC that carries the non-smooth drag over its horizon does "
-                 "worse than the nominal one. The candidate the diagnosis fits instead, a linear dashpot, is a damping "
-                 "the linearisation keeps, and it helps both MPCs. Effects keep the benchmark's own sizes (the "
-                 "generator's draw, sized only to be detectable in the passive log); none is enlarged here."]
+                 "not. The linear MPC linearises its model at rest: a leak's constant rate is an affine term the "
+                 "linearisation drops (the charge state it adds has no process noise in the observer, so it stays "
+                 "where it starts), and a quadratic drag has no slope at rest, so for both the linear model is the "
+                 "nominal one. The nonlinear MPC that carries the non-smooth drag over its horizon does worse than the "
+                 "nominal one; the candidate the diagnosis fits instead, a linear dashpot, is a damping the "
+                 "linearisation keeps, and it helps both MPCs. Where the model matters at the benchmark's own sizes is "
+                 "a wrong stiffness: the parameter_mismatch draws (30-50 % on the gas spring or the string) change "
+                 "k_eff and the modes the MPC predicts with. Effects keep the benchmark's own sizes (the generator's "
+                 "draw, sized only to be detectable in the passive log); none is enlarged here."]
     write_metrics(out, {"effects": M, "controller": CONTROLLER, "log_duration": r["log_duration"],
                              "loop_duration": r["loop_duration"], "seed": r["seed"], "quick": quick,
                              "goal": {"recovered_min": 0.8}})

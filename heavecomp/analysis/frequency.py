@@ -94,8 +94,8 @@ def effective_stiffness(sys, omega):
     return ct.frd(-H, w, inputs=["heave"], outputs=["k_eff"], name="k_eff")
 
 
-def transmissibility(sys, omega):
-    """Transmissibility |WOB/heave| normalised by its DC value: T(omega) = k_eff(omega) / k_eff(0) [-].
+def transmissibility(sys, omega, hold=()):
+    """Transmissibility |WOB/heave| normalised by its static value: T(omega) = k_eff(omega) / k_eff(0) [-].
 
     Parameters
     ----------
@@ -104,6 +104,8 @@ def transmissibility(sys, omega):
         Input ``heave``, output ``wob``.
     omega : array_like [rad/s]
         Frequencies.
+    hold : sequence of str
+        States held at their operating values in the static value (:func:`dc_gain`).
 
     Returns
     -------
@@ -115,11 +117,66 @@ def transmissibility(sys, omega):
 
     i, j = _siso(sys, "wob", "heave")
     w = np.asarray(omega, dtype=float)
-    H = freqresp_batch(sys.A, sys.B, sys.C, sys.D, np.concatenate([[0.0], w]))[i, j]
-    return ct.frd(H[1:] / H[0], w, inputs=["heave"], outputs=["T_wob"], name="transmissibility")
+    H = freqresp_batch(sys.A, sys.B, sys.C, sys.D, w)[i, j]
+    return ct.frd(H / dc_gain(sys, hold=hold), w, inputs=["heave"], outputs=["T_wob"], name="transmissibility")
 
 
-def dc_gain(sys, output="wob", input_="heave") -> float:
+def drift_states(sys, xdot=None) -> list[str]:
+    """States the linear model cannot hold still: an effect's charge that drifts or integrates.
+
+    Parameters
+    ----------
+    sys : control.StateSpace
+        Linear CMC model with named states (:func:`heavecomp.analysis.linear.linearise`).
+    xdot : array_like, optional
+        State derivative at the operating point (:attr:`heavecomp.analysis.linear.OperatingPoint.xdot`).
+
+    Returns
+    -------
+    list of str
+        Labels of the states whose row of ``[A B]`` is zero (to first order nothing moves them: a
+        pure integrator, a pole at 0 the heave never excites, e.g. ``gas_leak``'s charge change at
+        a fixed rate) or, beyond the four mechanical states, whose derivative at the operating
+        point is not zero (the operating point is no steady state for them: a leaking charge).
+    """
+    A, B = np.asarray(sys.A, dtype=float), np.asarray(sys.B, dtype=float)
+    scale = np.abs(np.hstack([A, B])).max(axis=1)
+    out = [k for k in range(A.shape[0]) if scale[k] == 0.0 or scale[k] <= 1e-14 * scale.max()]
+    if xdot is not None:
+        xdot = np.asarray(xdot, dtype=float).ravel()
+        out += [k for k in range(4, min(len(xdot), A.shape[0])) if abs(xdot[k]) > 1e-14 and k not in out]
+    labels = list(sys.state_labels)
+    return [labels[k] for k in sorted(out)]
+
+
+def frozen(sys, states=()):
+    """The model with ``states`` held at their operating values (their rows and columns removed).
+
+    Parameters
+    ----------
+    sys : control.StateSpace
+        Linear model with named states.
+    states : sequence of str
+        State labels to hold (:func:`drift_states`).
+
+    Returns
+    -------
+    control.StateSpace
+        ``sys`` itself when ``states`` is empty.  Holding a drifting charge at its present value is
+        the model of the heave time scale: the gain and the modes are those at today's charge.
+    """
+    if not states:
+        return sys
+    import control as ct
+
+    labels = list(sys.state_labels)
+    keep = [k for k, n in enumerate(labels) if n not in set(states)]
+    A, B, C = (np.asarray(m, dtype=float) for m in (sys.A, sys.B, sys.C))
+    return ct.ss(A[np.ix_(keep, keep)], B[keep], C[:, keep], sys.D, states=[labels[k] for k in keep],
+                 inputs=list(sys.input_labels), outputs=list(sys.output_labels), name=f"{sys.name}_frozen")
+
+
+def dc_gain(sys, output="wob", input_="heave", hold=()) -> float:
     """Static gain of one channel (solve of -A x = B; no inverse of D-only systems).
 
     Parameters
@@ -130,7 +187,12 @@ def dc_gain(sys, output="wob", input_="heave") -> float:
         Output label (default ``wob`` [N]).
     input_ : str
         Input label (default ``heave`` [m]).
+    hold : sequence of str
+        States held at their operating values (:func:`drift_states`, :func:`frozen`): an effect's
+        charge that integrates or drifts has no static value of its own (A is singular, or the
+        operating point is no steady state for it); the gain is then the one at the present charge.
     """
+    sys = frozen(sys, hold)
     i, j = _siso(sys, output, input_)
     return float((sys.D[i, j] - sys.C[i] @ np.linalg.solve(sys.A, sys.B[:, j])).real)
 
@@ -149,6 +211,8 @@ def undamped_natural_frequencies(sys) -> np.ndarray:
         The model or its A matrix, states ``[q_1, dq_1, q_2, dq_2]`` (:func:`~heavecomp.analysis.linear.linearise`).
     """
     A = np.asarray(sys.A if hasattr(sys, "A") else sys, dtype=float)
+    if A.shape != (4, 4):
+        raise ValueError("undamped_natural_frequencies: A has effect states beyond [q, dq]")
     pos, vel = [0, 2], [1, 3]
     sel = np.zeros((2, 4))
     sel[0, 1] = sel[1, 3] = 1.0
@@ -197,7 +261,7 @@ def modes(sys) -> dict:
     return out
 
 
-def response_table(sys, omega) -> dict[str, np.ndarray]:
+def response_table(sys, omega, hold=()) -> dict[str, np.ndarray]:
     """Columns of ``frequency_response.csv``: heave -> every output, magnitude and phase.
 
     Parameters
@@ -207,6 +271,8 @@ def response_table(sys, omega) -> dict[str, np.ndarray]:
         Input ``heave``, output ``wob`` among others.
     omega : array_like [rad/s]
         Frequencies.
+    hold : sequence of str
+        States held at their operating values in the static value (:func:`dc_gain`).
 
     Returns
     -------
@@ -221,7 +287,7 @@ def response_table(sys, omega) -> dict[str, np.ndarray]:
     j = list(sys.input_labels).index("heave")
     H = freqresp_batch(sys.A, sys.B, sys.C, sys.D, w)[:, j, :]
     i = list(sys.output_labels).index("wob")
-    k0 = -dc_gain(sys)
+    k0 = -dc_gain(sys, hold=hold)
     cols = {"omega": w, "frequency": w / (2 * np.pi), "period": 2 * np.pi / w,
             "k_eff_mag": np.abs(H[i]), "k_eff_phase_deg": np.degrees(np.angle(-H[i])),
             "transmissibility": np.abs(H[i]) / abs(k0)}

@@ -8,7 +8,7 @@ import numpy as np
 
 from heavecomp.analysis.frequency import WAVE_BAND
 from heavecomp.analysis.linear import linearise_details
-from heavecomp.analysis.frequency import dc_gain, frequency_grid, modes, response_table
+from heavecomp.analysis.frequency import dc_gain, drift_states, frequency_grid, frozen, modes, response_table
 
 
 def analyse(params, *, n_points: int = 1000, omega_min: float = 1e-3, omega_max: float | None = None,
@@ -35,16 +35,19 @@ def analyse(params, *, n_points: int = 1000, omega_min: float = 1e-3, omega_max:
     Returns
     -------
     dict
-        ``summary`` (the analysis.json content), ``table`` (CSV columns of the
+        ``summary`` (the analysis.json content; ``drift_states``: the effect states held at their
+        operating values in the static gain and the modes,
+        :func:`~heavecomp.analysis.frequency.drift_states`), ``table`` (CSV columns of the
         frictionless model), ``curves`` (label -> (omega, k_eff(omega))).
     """
 
     L0 = linearise_details(params, friction="none", effects=effects)
     sys = L0.sys
     w = frequency_grid(sys, n_points, omega_min, omega_max)
-    table = response_table(sys, w)
-    md = modes(sys)
-    k_dc = -dc_gain(sys)
+    drift = drift_states(sys, L0.op.xdot)  # a leaking charge: held at its present value (dc_gain)
+    table = response_table(sys, w, drift)
+    md = modes(frozen(sys, drift))
+    k_dc = -dc_gain(sys, hold=drift)
     lo, hi = WAVE_BAND
     summary = {
         "k_eff_dc": k_dc,
@@ -55,6 +58,7 @@ def analyse(params, *, n_points: int = 1000, omega_min: float = 1e-3, omega_max:
         "damping_ratios": md["damping_ratios"],
         "damped_natural_frequencies": md["damped_natural_frequencies"],
         "poles": md["poles"],
+        "drift_states": drift,
         "wave_band_rad_s": [lo, hi],
         "modes_in_wave_band": [bool(lo <= x <= hi) for x in md["natural_frequencies"]],
         "peak_k_eff": float(np.max(table["k_eff_mag"])),
@@ -62,27 +66,32 @@ def analyse(params, *, n_points: int = 1000, omega_min: float = 1e-3, omega_max:
         "transmissibility_at_wave_periods": {
             f"{T:g}": float(np.interp(2 * math.pi / T, w, table["transmissibility"])) for T in (5, 8, 12, 16, 20)},
         "operating_point": L0.op.as_dict(),
-        "linearisation": "frictionless (friction='none'); outputs are deviations from the operating point",
+        "linearisation": "frictionless (friction='none'); outputs are deviations from the operating point"
+                         + (f"; held at their operating values in k_eff_dc, the modes and the transmissibility's "
+                            f"reference: {', '.join(drift)} (an effect state that integrates or drifts, e.g. a leaking "
+                            "charge, has no static value: the gain is the one at the present charge)" if drift else ""),
         "frequency_points": int(len(w)),
         "friction_model": params.friction.model,
     }
     curves = {"frictionless": (w, -(table["wob_per_heave_mag"] * np.exp(1j * np.radians(table["wob_per_heave_phase_deg"]))))}
     if params.friction.viscous_coefficient is not None:
         Lv = linearise_details(params, friction="viscous", effects=effects)
-        mv = modes(Lv.sys)
-        tv = response_table(Lv.sys, w)
+        dv = drift_states(Lv.sys, Lv.op.xdot)
+        mv = modes(frozen(Lv.sys, dv))
+        tv = response_table(Lv.sys, w, dv)
         summary["viscous"] = {"viscous_coefficient": params.friction.viscous_coefficient,
                               "natural_frequencies": mv["natural_frequencies"],
-                              "damping_ratios": mv["damping_ratios"], "k_eff_dc": -dc_gain(Lv.sys)}
+                              "damping_ratios": mv["damping_ratios"], "k_eff_dc": -dc_gain(Lv.sys, hold=dv)}
         curves[f"viscous C_v = {params.friction.viscous_coefficient / 1e3:g} kN s/m"] = (
             w, -(tv["wob_per_heave_mag"] * np.exp(1j * np.radians(tv["wob_per_heave_phase_deg"]))))
     if sliding_velocity is not None and params.friction.model != "none":
         Ls = linearise_details(params, friction="sliding", velocity=sliding_velocity, effects=effects)
-        ms = modes(Ls.sys)
-        ts = response_table(Ls.sys, w)
+        dv = drift_states(Ls.sys, Ls.op.xdot)
+        ms = modes(frozen(Ls.sys, dv))
+        ts = response_table(Ls.sys, w, dv)
         summary["sliding"] = {"velocity": sliding_velocity, "friction_slope": Ls.friction_slope,
                               "natural_frequencies": ms["natural_frequencies"],
-                              "damping_ratios": ms["damping_ratios"], "k_eff_dc": -dc_gain(Ls.sys)}
+                              "damping_ratios": ms["damping_ratios"], "k_eff_dc": -dc_gain(Ls.sys, hold=dv)}
         curves[f"sliding at {sliding_velocity:g} m/s"] = (
             w, -(ts["wob_per_heave_mag"] * np.exp(1j * np.radians(ts["wob_per_heave_phase_deg"]))))
     return {"summary": summary, "table": table, "curves": curves}

@@ -287,6 +287,9 @@ def report_markdown(s: dict, source: str = "") -> str:
         f"| peak abs(k_eff(w)) | {s['peak_k_eff'] / 1e3:.1f} | kN/m |",
         f"| frequency of the peak | {s['peak_omega']:.3f} | rad/s |",
         "",
+        *([f"k_eff_dc, the modes and the transmissibility's reference hold {', '.join(s['drift_states'])} at the "
+           "operating point: an effect state that integrates or drifts (e.g. a leaking gas charge) has no static "
+           "value of its own, so the gain is the one at the present charge.", ""] if s.get("drift_states") else []),
         "Modes, sorted by frequency:",
         "",
         *modes,
