@@ -8,18 +8,6 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 
 
-@pytest.hookimpl(trylast=True)
-def pytest_collection_modifyitems(items):
-    """Slow tests first, each group of tests in its collection order otherwise.
-
-    Under ``pytest -n`` (``--dist loadgroup``, pyproject.toml) a worker takes the next test (or the
-    next ``xdist_group``, whose tests share a fixture's work and run on one worker) whenever it is
-    nearly idle, in this order: the long tests start while the short ones are left to fill the gaps at
-    the end, instead of one long diagnosis starting last and holding the whole suite while the
-    other worker idles.  Runs after pytest's own reordering (trylast), a stable sort."""
-    items.sort(key=lambda item: item.get_closest_marker("slow") is None)
-
-
 @pytest.fixture(scope="session")
 def data_dir() -> Path:
     """The measured data shipped inside the package (heavecomp/data, see its README)."""

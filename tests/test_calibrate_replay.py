@@ -22,9 +22,7 @@ from heavecomp.params import dumps
 pytestmark = pytest.mark.slow
 
 DURATION = 200.0
-#: one xdist group per case: its two tests read one diagnosis of the case's run (``diagnosed``), on one worker
-CASES = [pytest.param(c, marks=pytest.mark.xdist_group(f"calibrate_replay-{c}"))
-         for c in ("string_damping", "parameter_mismatch", "sensor_gain", "none")]
+CASES = ("string_damping", "parameter_mismatch", "sensor_gain", "none")
 
 
 @pytest.fixture(scope="module")

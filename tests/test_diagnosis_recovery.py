@@ -19,9 +19,6 @@ from heavecomp.diagnosis.stepper import replay_dt
 DUR = 90.0
 #: the truth of the parameter-mismatch run: gas spring and string stiffness moved
 MISMATCH = paper_a().replace(compensator={"gas_stiffness": 60e3}, drill_string={"stiffness": 1.2e6})
-#: tests reading one planted run (through ``once``) run on one worker under ``pytest -n``: it is fitted once
-MISMATCH_RUN = pytest.mark.xdist_group("recovery-parameter_mismatch")
-DRIFTING_OFFSET_RUN = pytest.mark.xdist_group("recovery-sensor_offset")
 
 
 def _planted(name, values, *, amplitude_hs=2.5, seed=4, params=None):
@@ -71,8 +68,7 @@ CASES = [
 ]
 
 
-@pytest.mark.parametrize("name,values,rtol", [
-    pytest.param(*c, id=c[0], marks=DRIFTING_OFFSET_RUN if c[0] == "sensor_offset" else ()) for c in CASES])
+@pytest.mark.parametrize("name,values,rtol", CASES, ids=[c[0] for c in CASES])
 def test_candidate_recovers_planted_parameters(name, values, rtol, once):
     _, _, d = once(_diagnosed, name, values, amplitude_hs=1.0 if name == "dwell_stiction" else 2.5)
     got = d.candidates_[0]["parameters"]
@@ -85,7 +81,6 @@ def test_candidate_recovers_planted_parameters(name, values, rtol, once):
 
 
 @pytest.mark.slow
-@MISMATCH_RUN
 def test_parameter_mismatch_names_what_moved(once):
     _, _, d = once(_diagnosed, "parameter_mismatch", {}, params=MISMATCH)
     got = d.candidates_[0]["parameters"]
@@ -95,7 +90,6 @@ def test_parameter_mismatch_names_what_moved(once):
 
 
 @pytest.mark.slow
-@MISMATCH_RUN
 def test_parameter_mismatch_rescan_leaves_the_stick_slip_side_minimum(once):
     """The side minimum a local fit reached on another kernel (F_S 12.5 kN against 23 kN, F_C's
     multiplier clipped): started there, the plain fit stays; the rescan of the rugged static
@@ -125,7 +119,6 @@ def test_parameter_mismatch_rescan_leaves_the_stick_slip_side_minimum(once):
     assert got["drill_string.stiffness"] == pytest.approx(1.2e6, rel=0.15)
 
 
-@DRIFTING_OFFSET_RUN
 def test_constant_offset_is_not_charged_for_a_drift(once):
     """An absolute-instead-of-gauge pressure (a constant offset) is fitted with its drift held at 0
     and one parameter counted, so the parsimony penalty does not favour a calibration gain, which

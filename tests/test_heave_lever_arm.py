@@ -113,7 +113,6 @@ def lever_case():
 
 
 @pytest.mark.slow
-@pytest.mark.xdist_group("heave_lever_arm-case")  # one worker generates the case for both tests
 def test_diagnosis_fits_the_lever_arm_from_a_logged_pitch(lever_case):
     from heavecomp.diagnosis.estimator import GapDiagnoser
 
@@ -127,7 +126,6 @@ def test_diagnosis_fits_the_lever_arm_from_a_logged_pitch(lever_case):
 
 
 @pytest.mark.slow
-@pytest.mark.xdist_group("heave_lever_arm-case")
 def test_without_its_pitch_column_no_confident_wrong_verdict(lever_case):
     from heavecomp.diagnosis.data import check_run
     from heavecomp.diagnosis.estimator import GapDiagnoser

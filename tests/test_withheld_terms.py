@@ -19,9 +19,6 @@ SEAL_WINDOWS = {"fit_window": (0.0, 45.0), "validate_window": (45.0, 1e9), "dead
 CP = "friction.pressure_coefficient"
 #: ~17 s on 2 cores (six diagnoses of the real records)
 pytestmark = pytest.mark.slow
-#: the tests reading one module fixture run on one worker under ``pytest -n``: its diagnoses run once
-EMPS = pytest.mark.xdist_group("withheld_terms-emps")
-SEAL = pytest.mark.xdist_group("withheld_terms-seal")
 
 
 @pytest.fixture(scope="module")
@@ -46,7 +43,6 @@ def _reachable(full, withheld):
     return 1.0 - full.baseline_["rms_validate"] / withheld.baseline_["rms_validate"]
 
 
-@EMPS
 def test_emps_without_coulomb_names_the_coulomb_force(emps):
     d = emps[("coulomb",)]
     v = d.verdict_
@@ -60,7 +56,6 @@ def test_emps_without_coulomb_names_the_coulomb_force(emps):
     assert d.results_[1]["shrink"] < 0.3 * v["shrink"]
 
 
-@EMPS
 def test_emps_without_the_direction_asymmetry_names_asymmetric_friction(emps):
     """F_off + F_c sign(v) is an asymmetric Coulomb force while the axis moves: without F_off the
     diagnosis names asymmetric_friction, whose Coulomb column takes F_off's place (and whose viscous
@@ -76,14 +71,12 @@ def test_emps_without_the_direction_asymmetry_names_asymmetric_friction(emps):
     assert d.results_[1]["shrink"] < 0.3 * v["shrink"]
 
 
-@EMPS
 def test_emps_control_has_no_gap_of_a_withheld_terms_size(emps):
     full, without = emps[()], emps[("coulomb",)]
     assert "friction.coulomb_force" not in full.verdict_["changes"]
     assert full.verdict_["shrink"] < 0.5 * without.verdict_["shrink"]
 
 
-@SEAL
 def test_seal_without_pressure_coefficient_names_pressure_friction(seal):
     d = seal[(CP,)]
     v = d.verdict_
@@ -93,7 +86,6 @@ def test_seal_without_pressure_coefficient_names_pressure_friction(seal):
     assert d.results_[1]["shrink"] < 0.3 * v["shrink"]
 
 
-@SEAL
 def test_seal_control_names_no_pressure_friction(seal):
     full = seal[()]
     assert all(r["effect"] != "pressure_friction" for r in full.results_) or \
