@@ -1,9 +1,17 @@
 import inspect
+import os
 from pathlib import Path
 import subprocess
 import sys
 
 import pytest
+
+# The suite runs one process per core (pytest-xdist, -n auto): a BLAS or OpenMP pool of its own in each
+# process only oversubscribes the cores. Set before any worker (and any CLI subprocess) starts: the
+# workers inherit the controller's environment. A user's own setting wins.
+for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_var, "1")
+
 
 ROOT = Path(__file__).resolve().parents[1]
 
