@@ -265,7 +265,7 @@ def summarise(m: dict) -> dict:
 
 def build(quick: bool = False, seed: int = 110) -> dict:
     """The loop for every entry of :data:`EFFECTS` (seeds ``seed`` + its index), or two in ``quick``."""
-    log_duration, loop_duration = (200.0, 60.0) if quick else (300.0, 180.0)
+    log_duration, loop_duration = (150.0, 60.0) if quick else (300.0, 180.0)
     names = ("pressure_friction", "sensor_gain") if quick else tuple(EFFECTS)
     res = {}
     for i, name in enumerate(names):
