@@ -832,7 +832,8 @@ def iter_chunks(path, required=("t",), *, optional=(), columns=None, units=None,
     :class:`Series` per chunk (consecutive rows; ``t`` of timestamps from the file's first sample; every
     chunk's ``measurement`` the same dict, complete once the file is read).
 
-    For a pass over a log of any length in bounded memory (``heavecomp monitor``): only one chunk's
+    For a pass over a log of any length in bounded memory (no command uses it yet: ``heavecomp monitor``
+    reads its log whole, through :func:`heavecomp.diagnosis.data.load_run`): only one chunk's
     arrays are held.  A carried (non-contract) column that holds text in a later chunk is left out from
     there on.
 
