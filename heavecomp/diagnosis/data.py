@@ -45,6 +45,8 @@ REQUIRED = ("t", "heave")
 #: the measured outputs, each optional (contract schema 3: any of them may be missing); the diagnosis works
 #: on those present (:attr:`MeasuredRun.sensors`)
 CHANNELS = ("wob", "stroke", "pressure")
+#: the same channels in contract order (the order of :attr:`MeasuredRun.sensors`, the checks and their warnings)
+OUTPUTS = ("stroke", "pressure", "wob")
 UNITS = {"t": "s", "heave": "m", "stroke": "m", "pressure": "Pa", "wob": "N"}
 #: optional vessel-angle columns [rad] (``heave_reference``'s lever arm): unit-checked, gaps bridged like the heave
 ANGLES = ("pitch",)
@@ -78,7 +80,7 @@ class MeasuredRun:
     @property
     def sensors(self) -> tuple:
         """The measured channels the run has, in contract order (``heave`` always; contract schema 3)."""
-        return ("heave",) + tuple(c for c in ("stroke", "pressure", "wob") if c in self.columns)
+        return ("heave",) + tuple(c for c in OUTPUTS if c in self.columns)
 
     @property
     def duration(self) -> float:
@@ -231,7 +233,7 @@ def check_run(t, columns: dict, *, params=None, source="<array>", rows=None) -> 
 
     t = np.asarray(t, dtype=float)
     columns = {k: np.asarray(v, dtype=float) for k, v in columns.items()}
-    checked = ("heave",) + tuple(c for c in ("stroke", "pressure", "wob") if c in columns) \
+    checked = ("heave",) + tuple(c for c in OUTPUTS if c in columns) \
         + tuple(a for a in ANGLES if a in columns)
     line = (lambda i: int(rows[i])) if rows is not None else (lambda i: int(i) + 2)
     for col in checked:  # the contract: non-finite values are an error (an inf, e.g. 1e400, is no dropout)
@@ -264,7 +266,7 @@ def check_run(t, columns: dict, *, params=None, source="<array>", rows=None) -> 
                         f"({t[i]:g} -> {t[i + 1]:g} s; longest bridged gap {MAX_GAP:g} s)")
     # a channel the log lacks (contract schema 3): diagnosed without it, said once, with the way to map it
     warnings = [f"no column '{c}': diagnosed with the channels present (if the log has it under another name, map "
-                f"it, {c}=NAME)" for c in ("stroke", "pressure", "wob") if c not in columns]
+                f"it, {c}=NAME)" for c in OUTPUTS if c not in columns]
     for col in checked:
         miss = ~np.isfinite(columns[col])
         frac = float(miss.mean())

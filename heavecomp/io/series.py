@@ -382,16 +382,12 @@ def _cells(body: list, body_lines, sep, n: int, src: str, quoted: bool) -> list:
 def _text_table(text: str, src: str):
     """Header names, raw string columns (one list per column), line numbers, delimiter, decimal."""
     lines = text.splitlines()
-    idx = [i for i, ln in enumerate(lines) if ln.strip() and not ln.lstrip().startswith("#")]
-    if not idx:
+    content = [ln for ln in lines if ln.strip() and not ln.lstrip().startswith("#")]
+    if not content:
         raise DataError(f"{src}: empty file (no header, no data)")
-    content = [lines[i] for i in idx]
     sep, decimal, header, has_header = _head(content, src)
-    body, body_idx = (content[1:], idx[1:]) if has_header else (content, idx)
-    n = len(header)
-    body_lines = np.asarray(body_idx, dtype=int) + 1
-    cells = _cells(body, body_lines, sep, n, src, '"' in text)
-    cols = [[row[j] for row in cells] for j in range(n)]
+    # the whole text is the checked path's one chunk (a quote anywhere in it lets csv split the rows)
+    cols, body_lines = _checked_chunk(lines, 0, sep, len(header), src, skip_first=has_header, quoted='"' in text)
     return header, cols, body_lines, sep, decimal
 
 
@@ -632,15 +628,15 @@ def _fast_chunk(raw: bytes, text: str, sep, decimal, n: int, kinds: list, encodi
             for j in range(n)], rows
 
 
-def _checked_chunk(lines, base: int, sep, n: int, src: str, skip_first: bool = False):
+def _checked_chunk(lines, base: int, sep, n: int, src: str, skip_first: bool = False, quoted=None):
     """The checked path of one chunk: cells split in Python, a ragged row named by its line
-    (``base``: lines of the file before the chunk)."""
+    (``base``: lines of the file before the chunk; ``quoted``: split by csv, None: if a row holds a quote)."""
     idx = [i for i, ln in enumerate(lines) if ln.strip() and not ln.lstrip().startswith("#")]
     if skip_first:
         idx = idx[1:]
     body = [lines[i] for i in idx]
     body_lines = base + 1 + np.asarray(idx, dtype=int)
-    cells = _cells(body, body_lines, sep, n, src, any('"' in ln for ln in body))
+    cells = _cells(body, body_lines, sep, n, src, any('"' in ln for ln in body) if quoted is None else quoted)
     return [[row[j] for row in cells] for j in range(n)], body_lines
 
 
@@ -836,7 +832,8 @@ def iter_chunks(path, required=("t",), *, optional=(), columns=None, units=None,
     :class:`Series` per chunk (consecutive rows; ``t`` of timestamps from the file's first sample; every
     chunk's ``measurement`` the same dict, complete once the file is read).
 
-    For a pass over a log of any length in bounded memory (``heavecomp monitor``): only one chunk's
+    For a pass over a log of any length in bounded memory (no command uses it yet: ``heavecomp monitor``
+    reads its log whole, through :func:`heavecomp.diagnosis.data.load_run`): only one chunk's
     arrays are held.  A carried (non-contract) column that holds text in a later chunk is left out from
     there on.
 
