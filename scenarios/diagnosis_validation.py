@@ -37,8 +37,6 @@ from __future__ import annotations
 
 import concurrent.futures as cf
 import dataclasses
-import hashlib
-import json
 import logging
 import shutil
 import sys
@@ -54,7 +52,8 @@ from heavecomp.errors import InputError
 from heavecomp.benchmark import Case, corruption, generate, NEAR_NOISE, parameter_sets, validation_cases
 from heavecomp.params import load
 from heavecomp.report.provenance import write_params
-from heavecomp.report.scenario import ROOT, md_table, parse_args, run, write_metrics, write_report
+from heavecomp.report.scenario import (ROOT, frozen_check, md_table, parse_args, run, settings_hash, write_metrics,
+                                       write_report)
 
 log = logging.getLogger("diagnosis_validation")
 
@@ -81,11 +80,6 @@ def frozen_digest(nominal, settings: dict) -> str:
     """The hash of the settings plus every field of the verdict policy the diagnoser decides with
     (``GapDiagnoser.verdict_policy()``): a threshold changed anywhere changes it."""
     return settings_hash({**settings, "policy": GapDiagnoser(nominal).verdict_policy().to_json()})
-
-
-def settings_hash(settings: dict) -> str:
-    """sha256 (16 hex digits) of the settings, keys sorted."""
-    return hashlib.sha256(json.dumps(settings, sort_keys=True, default=str).encode()).hexdigest()[:16]
 
 
 # ------------------------------------------------------------------------------ one run
@@ -244,16 +238,7 @@ def _fmt(x, pct=False):
 
 def _settings_check(which, digest):
     """(ok, message): the scoring set needs the settings frozen by the committed tuning report."""
-    if which != "scoring":
-        return True, f"settings hash `{digest}` (this tuning report freezes them for the scoring set)"
-    if not TUNING_METRICS.is_file():
-        msg = f"no tuning report at {TUNING_METRICS.relative_to(ROOT)}: run --set tuning first and commit it"
-        return False, msg
-    frozen = json.loads(TUNING_METRICS.read_text()).get("settings_hash")
-    if frozen != digest:
-        return False, (f"GapDiagnoser settings hash {digest} differs from the tuning report's {frozen}: the "
-                       "thresholds were changed after tuning")
-    return True, f"settings hash `{digest}` = the committed tuning report's (thresholds frozen)"
+    return frozen_check(which, digest, TUNING_METRICS, "GapDiagnoser", "thresholds")
 
 
 def write(out: Path, which, rows, summary, settings, digest, frozen_note, quick):

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import hashlib
 import json
 import logging
 import sys
@@ -103,6 +104,53 @@ def write_metrics(out: Path, metrics: dict) -> Path:
     path.write_text(json.dumps(_clean(metrics), indent=2) + "\n")
     annotate_json(path, stamp())
     return path
+
+
+def settings_hash(settings: dict) -> str:
+    """sha256 (16 hex digits) of a scenario's frozen settings, keys sorted.
+
+    Parameters
+    ----------
+    settings : dict
+        The settings (JSON-ready; anything else is hashed by its ``str``).
+
+    Returns
+    -------
+    str
+    """
+    return hashlib.sha256(json.dumps(settings, sort_keys=True, default=str).encode()).hexdigest()[:16]
+
+
+def frozen_check(which: str, digest: str, tuning_metrics: Path, owner: str, what: str) -> tuple[bool, str]:
+    """(ok, message): a scoring set runs only with the settings the committed tuning report froze.
+
+    Parameters
+    ----------
+    which : str
+        The set asked for; only ``scoring`` is checked.
+    digest : str
+        The current settings' :func:`settings_hash`.
+    tuning_metrics : pathlib.Path
+        The committed tuning report's ``metrics.json`` (its ``settings_hash``).
+    owner : str
+        Whose settings, in the refusal (``monitor``, ``GapDiagnoser``).
+    what : str
+        What a change would have changed (``settings``, ``thresholds``).
+
+    Returns
+    -------
+    (bool, str)
+        Whether the set may be scored, and the sentence the report and the refusal print.
+    """
+    if which != "scoring":
+        return True, f"settings hash `{digest}` (this tuning report freezes them for the scoring set)"
+    if not tuning_metrics.is_file():
+        return False, f"no tuning report at {tuning_metrics.relative_to(ROOT)}: run --set tuning first and commit it"
+    frozen = json.loads(tuning_metrics.read_text()).get("settings_hash")
+    if frozen != digest:
+        return False, (f"{owner} settings hash {digest} differs from the tuning report's {frozen}: the {what} "
+                       "were changed after tuning")
+    return True, f"settings hash `{digest}` = the committed tuning report's ({what} frozen)"
 
 
 def md_table(header, rows, fmt="{:.2f}") -> str:
