@@ -35,7 +35,6 @@ honest answer is none or a low-confidence verdict). Thresholds are the frozen tu
 
 from __future__ import annotations
 
-import concurrent.futures as cf
 import dataclasses
 import logging
 import shutil
@@ -52,8 +51,8 @@ from heavecomp.errors import InputError
 from heavecomp.benchmark import Case, corruption, generate, NEAR_NOISE, parameter_sets, validation_cases
 from heavecomp.params import load
 from heavecomp.report.provenance import write_params
-from heavecomp.report.scenario import (ROOT, frozen_check, md_table, parse_args, run, settings_hash, write_metrics,
-                                       write_report)
+from heavecomp.report.scenario import (ROOT, frozen_check, md_table, parse_args, run, run_cases, settings_hash,
+                                       write_metrics, write_report)
 
 log = logging.getLogger("diagnosis_validation")
 
@@ -497,18 +496,12 @@ def main_corrupted(args, nominal, settings, digest) -> int:
     cases = corrupted_cases(args.quick)
     t0 = time.perf_counter()
     groups = [None] * len(cases)
-    if args.jobs == 1:
-        for i, c in enumerate(cases):
-            groups[i] = run_corrupted_base(c, n_jobs=2)
-            _log_corrupted(groups[i], t0)
-    else:
-        import multiprocessing as mp
 
-        with cf.ProcessPoolExecutor(args.jobs, mp_context=mp.get_context("spawn")) as ex:
-            futs = {ex.submit(run_corrupted_base, c, 1): i for i, c in enumerate(cases)}
-            for f in cf.as_completed(futs):
-                groups[futs[f]] = f.result()
-                _log_corrupted(groups[futs[f]], t0)
+    def done(i, group):
+        groups[i] = group
+        _log_corrupted(group, t0)
+
+    run_cases(run_corrupted_base, cases, (), args.jobs, done)
     rows = [r for g in groups for r in g]
     summary = summarize_corrupted(rows)
     summary["wall_time_s"] = time.perf_counter() - t0
@@ -724,16 +717,7 @@ def main_sensors(args, nominal, settings, digest) -> int:
                  "; ".join(f"{k} {g['verdict']} ({g['confidence']})" for k, g in row["sets"].items()))
 
     try:
-        if args.jobs == 1:
-            for i, c in enumerate(cases):
-                done(i, run_sensor_case(c, workdir, sets, n_jobs=2))
-        else:
-            import multiprocessing as mp
-
-            with cf.ProcessPoolExecutor(args.jobs, mp_context=mp.get_context("spawn")) as ex:
-                futs = {ex.submit(run_sensor_case, c, workdir, sets, 1): i for i, c in enumerate(cases)}
-                for f in cf.as_completed(futs):
-                    done(futs[f], f.result())
+        run_cases(run_sensor_case, cases, (workdir, sets), args.jobs, done)
     finally:
         if not args.runs:
             shutil.rmtree(workdir, ignore_errors=True)
@@ -789,19 +773,12 @@ def main(argv=None) -> int:
     t0 = time.perf_counter()
     rows = [None] * len(cases)
     try:
-        if args.jobs == 1:
-            for i, c in enumerate(cases):
-                rows[i] = run_case(c, workdir, n_jobs=2)
-                _log_row(rows[i], i, len(cases), t0)
-        else:
-            import multiprocessing as mp
 
-            with cf.ProcessPoolExecutor(args.jobs, mp_context=mp.get_context("spawn")) as ex:
-                futs = {ex.submit(run_case, c, workdir, 1): i for i, c in enumerate(cases)}
-                for f in cf.as_completed(futs):
-                    i = futs[f]
-                    rows[i] = f.result()
-                    _log_row(rows[i], i, len(cases), t0)
+        def done(i, row):
+            rows[i] = row
+            _log_row(row, i, len(cases), t0)
+
+        run_cases(run_case, cases, (workdir,), args.jobs, done)
     finally:
         if not args.runs:
             shutil.rmtree(workdir, ignore_errors=True)

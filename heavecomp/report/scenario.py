@@ -153,6 +153,39 @@ def frozen_check(which: str, digest: str, tuning_metrics: Path, owner: str, what
     return True, f"settings hash `{digest}` = the committed tuning report's ({what} frozen)"
 
 
+def run_cases(task, items, extra, jobs: int, done, order=None) -> None:
+    """``task(item, *extra, n_jobs)`` for every item: in this process with ``n_jobs`` 2 (``jobs`` 1), or in
+    ``jobs`` ``spawn`` processes with ``n_jobs`` 1 each; ``done(i, result)`` in this process as each finishes.
+
+    Parameters
+    ----------
+    task : callable
+        A module-level function (it is pickled to the workers).
+    items : sequence
+        One entry per task.
+    extra : tuple
+        The task's arguments after the item, the same for every item.
+    jobs : int
+        Parallel processes (1: none).
+    done : callable (int, result)
+        Called with the item's index and its result, in the order they finish.
+    order : sequence of int, optional
+        The order the items are started in (default: as given).
+    """
+    order = range(len(items)) if order is None else order
+    if jobs == 1:
+        for i in order:
+            done(i, task(items[i], *extra, 2))
+        return
+    import concurrent.futures as cf
+    import multiprocessing as mp
+
+    with cf.ProcessPoolExecutor(jobs, mp_context=mp.get_context("spawn")) as ex:
+        futs = {ex.submit(task, items[i], *extra, 1): i for i in order}
+        for f in cf.as_completed(futs):
+            done(futs[f], f.result())
+
+
 def md_table(header, rows, fmt="{:.2f}") -> str:
     """Markdown table; floats formatted with ``fmt``.
 
