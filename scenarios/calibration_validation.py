@@ -18,7 +18,6 @@ No threshold of the diagnosis or of these checks is tuned on this set: it is run
 
 from __future__ import annotations
 
-import concurrent.futures as cf
 import dataclasses
 import json
 import logging
@@ -33,7 +32,7 @@ from heavecomp.cli import main as cli
 from heavecomp.diagnosis.calibrate import replay_shrink
 from heavecomp.effects.spec import load
 from heavecomp.report.provenance import write_params
-from heavecomp.report.scenario import md_table, parse_args, run, write_metrics, write_report
+from heavecomp.report.scenario import md_table, parse_args, run, run_cases, write_metrics, write_report
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from diagnosis_validation import judge  # noqa: E402 - the scoring rules of the diagnosis validation
@@ -238,8 +237,10 @@ def main(argv=None) -> int:
     workdir.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
     rows = [None] * len(cs)
+    summary = None
 
     def done(i, row):  # the report is rewritten after every run: an interrupted set leaves its part
+        nonlocal summary
         rows[i] = row
         _log_row(row, i, len(cs), t0)
         finished = [r for r in rows if r is not None]
@@ -247,20 +248,10 @@ def main(argv=None) -> int:
         summary["wall_time_s"] = time.perf_counter() - t0
         summary["not_run"] = [f"{c.label} ({c.seed})" for c, r in zip(cs, rows) if r is None]
         write(args.out, finished, summary, args.quick)
-        return summary
 
     order = sorted(range(len(cs)), key=lambda i: cs[i].duration)  # short logs first
     try:
-        if args.jobs == 1:
-            for i in order:
-                summary = done(i, run_case(cs[i], workdir, jobs=2))
-        else:
-            import multiprocessing as mp
-
-            with cf.ProcessPoolExecutor(args.jobs, mp_context=mp.get_context("spawn")) as ex:
-                futs = {ex.submit(run_case, cs[i], workdir, 1): i for i in order}
-                for f in cf.as_completed(futs):
-                    summary = done(futs[f], f.result())
+        run_cases(run_case, cs, (workdir,), args.jobs, done, order)
     finally:
         if not args.runs:
             shutil.rmtree(workdir, ignore_errors=True)

@@ -35,10 +35,7 @@ honest answer is none or a low-confidence verdict). Thresholds are the frozen tu
 
 from __future__ import annotations
 
-import concurrent.futures as cf
 import dataclasses
-import hashlib
-import json
 import logging
 import shutil
 import sys
@@ -54,7 +51,8 @@ from heavecomp.errors import InputError
 from heavecomp.benchmark import Case, corruption, generate, NEAR_NOISE, parameter_sets, validation_cases
 from heavecomp.params import load
 from heavecomp.report.provenance import write_params
-from heavecomp.report.scenario import ROOT, md_table, parse_args, run, write_metrics, write_report
+from heavecomp.report.scenario import (ROOT, frozen_check, md_table, parse_args, run, run_cases, settings_hash,
+                                       write_metrics, write_report)
 
 log = logging.getLogger("diagnosis_validation")
 
@@ -81,11 +79,6 @@ def frozen_digest(nominal, settings: dict) -> str:
     """The hash of the settings plus every field of the verdict policy the diagnoser decides with
     (``GapDiagnoser.verdict_policy()``): a threshold changed anywhere changes it."""
     return settings_hash({**settings, "policy": GapDiagnoser(nominal).verdict_policy().to_json()})
-
-
-def settings_hash(settings: dict) -> str:
-    """sha256 (16 hex digits) of the settings, keys sorted."""
-    return hashlib.sha256(json.dumps(settings, sort_keys=True, default=str).encode()).hexdigest()[:16]
 
 
 # ------------------------------------------------------------------------------ one run
@@ -244,16 +237,7 @@ def _fmt(x, pct=False):
 
 def _settings_check(which, digest):
     """(ok, message): the scoring set needs the settings frozen by the committed tuning report."""
-    if which != "scoring":
-        return True, f"settings hash `{digest}` (this tuning report freezes them for the scoring set)"
-    if not TUNING_METRICS.is_file():
-        msg = f"no tuning report at {TUNING_METRICS.relative_to(ROOT)}: run --set tuning first and commit it"
-        return False, msg
-    frozen = json.loads(TUNING_METRICS.read_text()).get("settings_hash")
-    if frozen != digest:
-        return False, (f"GapDiagnoser settings hash {digest} differs from the tuning report's {frozen}: the "
-                       "thresholds were changed after tuning")
-    return True, f"settings hash `{digest}` = the committed tuning report's (thresholds frozen)"
+    return frozen_check(which, digest, TUNING_METRICS, "GapDiagnoser", "thresholds")
 
 
 def write(out: Path, which, rows, summary, settings, digest, frozen_note, quick):
@@ -512,18 +496,12 @@ def main_corrupted(args, nominal, settings, digest) -> int:
     cases = corrupted_cases(args.quick)
     t0 = time.perf_counter()
     groups = [None] * len(cases)
-    if args.jobs == 1:
-        for i, c in enumerate(cases):
-            groups[i] = run_corrupted_base(c, n_jobs=2)
-            _log_corrupted(groups[i], t0)
-    else:
-        import multiprocessing as mp
 
-        with cf.ProcessPoolExecutor(args.jobs, mp_context=mp.get_context("spawn")) as ex:
-            futs = {ex.submit(run_corrupted_base, c, 1): i for i, c in enumerate(cases)}
-            for f in cf.as_completed(futs):
-                groups[futs[f]] = f.result()
-                _log_corrupted(groups[futs[f]], t0)
+    def done(i, group):
+        groups[i] = group
+        _log_corrupted(group, t0)
+
+    run_cases(run_corrupted_base, cases, (), args.jobs, done)
     rows = [r for g in groups for r in g]
     summary = summarize_corrupted(rows)
     summary["wall_time_s"] = time.perf_counter() - t0
@@ -739,16 +717,7 @@ def main_sensors(args, nominal, settings, digest) -> int:
                  "; ".join(f"{k} {g['verdict']} ({g['confidence']})" for k, g in row["sets"].items()))
 
     try:
-        if args.jobs == 1:
-            for i, c in enumerate(cases):
-                done(i, run_sensor_case(c, workdir, sets, n_jobs=2))
-        else:
-            import multiprocessing as mp
-
-            with cf.ProcessPoolExecutor(args.jobs, mp_context=mp.get_context("spawn")) as ex:
-                futs = {ex.submit(run_sensor_case, c, workdir, sets, 1): i for i, c in enumerate(cases)}
-                for f in cf.as_completed(futs):
-                    done(futs[f], f.result())
+        run_cases(run_sensor_case, cases, (workdir, sets), args.jobs, done)
     finally:
         if not args.runs:
             shutil.rmtree(workdir, ignore_errors=True)
@@ -804,19 +773,12 @@ def main(argv=None) -> int:
     t0 = time.perf_counter()
     rows = [None] * len(cases)
     try:
-        if args.jobs == 1:
-            for i, c in enumerate(cases):
-                rows[i] = run_case(c, workdir, n_jobs=2)
-                _log_row(rows[i], i, len(cases), t0)
-        else:
-            import multiprocessing as mp
 
-            with cf.ProcessPoolExecutor(args.jobs, mp_context=mp.get_context("spawn")) as ex:
-                futs = {ex.submit(run_case, c, workdir, 1): i for i, c in enumerate(cases)}
-                for f in cf.as_completed(futs):
-                    i = futs[f]
-                    rows[i] = f.result()
-                    _log_row(rows[i], i, len(cases), t0)
+        def done(i, row):
+            rows[i] = row
+            _log_row(row, i, len(cases), t0)
+
+        run_cases(run_case, cases, (workdir,), args.jobs, done)
     finally:
         if not args.runs:
             shutil.rmtree(workdir, ignore_errors=True)

@@ -41,8 +41,6 @@ set-point and a softer formation are scored beside them.
 from __future__ import annotations
 
 import concurrent.futures as cf
-import hashlib
-import json
 import logging
 import math
 import pickle
@@ -55,7 +53,8 @@ import numpy as np
 
 from heavecomp.diagnosis import monitor as M
 from heavecomp.benchmark.long_logs import COMPONENT, GROWS, long_log
-from heavecomp.report.scenario import ROOT, md_table, parse_args, run, write_metrics, write_report
+from heavecomp.report.scenario import (ROOT, frozen_check, md_table, parse_args, run, settings_hash, write_metrics,
+                                       write_report)
 
 log = logging.getLogger("monitor_validation")
 
@@ -79,21 +78,9 @@ def settings() -> dict:
     return out
 
 
-def settings_hash(st: dict) -> str:
-    return hashlib.sha256(json.dumps(st, sort_keys=True, default=str).encode()).hexdigest()[:16]
-
-
 def settings_check(which, digest):
     """(ok, message): the scoring set needs the settings frozen by the committed tuning report."""
-    if which != "scoring":
-        return True, f"settings hash `{digest}` (this tuning report freezes them for the scoring set)"
-    if not TUNING_METRICS.is_file():
-        return False, f"no tuning report at {TUNING_METRICS.relative_to(ROOT)}: run --set tuning first and commit it"
-    frozen = json.loads(TUNING_METRICS.read_text()).get("settings_hash")
-    if frozen != digest:
-        return False, (f"monitor settings hash {digest} differs from the tuning report's {frozen}: the settings "
-                       "were changed after tuning")
-    return True, f"settings hash `{digest}` = the committed tuning report's (settings frozen)"
+    return frozen_check(which, digest, TUNING_METRICS, "monitor", "settings")
 
 
 def _c(label, seed, *, sea="jonswap", rate=10.0, duration=2400.0, params="paper_a"):

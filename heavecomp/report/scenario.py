@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import hashlib
 import json
 import logging
 import sys
@@ -103,6 +104,86 @@ def write_metrics(out: Path, metrics: dict) -> Path:
     path.write_text(json.dumps(_clean(metrics), indent=2) + "\n")
     annotate_json(path, stamp())
     return path
+
+
+def settings_hash(settings: dict) -> str:
+    """sha256 (16 hex digits) of a scenario's frozen settings, keys sorted.
+
+    Parameters
+    ----------
+    settings : dict
+        The settings (JSON-ready; anything else is hashed by its ``str``).
+
+    Returns
+    -------
+    str
+    """
+    return hashlib.sha256(json.dumps(settings, sort_keys=True, default=str).encode()).hexdigest()[:16]
+
+
+def frozen_check(which: str, digest: str, tuning_metrics: Path, owner: str, what: str) -> tuple[bool, str]:
+    """(ok, message): a scoring set runs only with the settings the committed tuning report froze.
+
+    Parameters
+    ----------
+    which : str
+        The set asked for; only ``scoring`` is checked.
+    digest : str
+        The current settings' :func:`settings_hash`.
+    tuning_metrics : pathlib.Path
+        The committed tuning report's ``metrics.json`` (its ``settings_hash``).
+    owner : str
+        Whose settings, in the refusal (``monitor``, ``GapDiagnoser``).
+    what : str
+        What a change would have changed (``settings``, ``thresholds``).
+
+    Returns
+    -------
+    (bool, str)
+        Whether the set may be scored, and the sentence the report and the refusal print.
+    """
+    if which != "scoring":
+        return True, f"settings hash `{digest}` (this tuning report freezes them for the scoring set)"
+    if not tuning_metrics.is_file():
+        return False, f"no tuning report at {tuning_metrics.relative_to(ROOT)}: run --set tuning first and commit it"
+    frozen = json.loads(tuning_metrics.read_text()).get("settings_hash")
+    if frozen != digest:
+        return False, (f"{owner} settings hash {digest} differs from the tuning report's {frozen}: the {what} "
+                       "were changed after tuning")
+    return True, f"settings hash `{digest}` = the committed tuning report's ({what} frozen)"
+
+
+def run_cases(task, items, extra, jobs: int, done, order=None) -> None:
+    """``task(item, *extra, n_jobs)`` for every item: in this process with ``n_jobs`` 2 (``jobs`` 1), or in
+    ``jobs`` ``spawn`` processes with ``n_jobs`` 1 each; ``done(i, result)`` in this process as each finishes.
+
+    Parameters
+    ----------
+    task : callable
+        A module-level function (it is pickled to the workers).
+    items : sequence
+        One entry per task.
+    extra : tuple
+        The task's arguments after the item, the same for every item.
+    jobs : int
+        Parallel processes (1: none).
+    done : callable (int, result)
+        Called with the item's index and its result, in the order they finish.
+    order : sequence of int, optional
+        The order the items are started in (default: as given).
+    """
+    order = range(len(items)) if order is None else order
+    if jobs == 1:
+        for i in order:
+            done(i, task(items[i], *extra, 2))
+        return
+    import concurrent.futures as cf
+    import multiprocessing as mp
+
+    with cf.ProcessPoolExecutor(jobs, mp_context=mp.get_context("spawn")) as ex:
+        futs = {ex.submit(task, items[i], *extra, 1): i for i in order}
+        for f in cf.as_completed(futs):
+            done(futs[f], f.result())
 
 
 def md_table(header, rows, fmt="{:.2f}") -> str:
