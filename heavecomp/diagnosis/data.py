@@ -79,8 +79,9 @@ class MeasuredRun:
 
     @property
     def sensors(self) -> tuple:
-        """The measured channels the run has, in contract order (``heave`` always; contract schema 3)."""
-        return ("heave",) + tuple(c for c in OUTPUTS if c in self.columns)
+        """The measured channels the run has, in contract order (contract schema 3): a column with at least
+        one finite sample (heave, required, is always one after :func:`check_run`)."""
+        return tuple(c for c in ("heave",) + OUTPUTS if c in self.columns and np.isfinite(self.columns[c]).any())
 
     @property
     def duration(self) -> float:

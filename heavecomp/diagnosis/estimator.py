@@ -231,7 +231,7 @@ class GapDiagnoser(GapEstimator):
         P = self.verdict_policy()
         # the log's sensor set (contract schema 3: heave required, any of stroke, pressure and wob may be
         # missing); a candidate the set cannot detect (by the model's structure) is not fitted
-        self.sensors_ = tuple(c for c in ST.CHANNELS if c in run.columns and np.isfinite(run[c]).any())
+        self.sensors_ = run.sensors
         check_memory(run, self.nominal, self.n_jobs)  # before any replay
         self.undetectable_ = self.undetectable(self.sensors_)
         fitted = [n for n in self.candidates if n not in self.undetectable_]

@@ -337,10 +337,6 @@ def cusum(u, learn=LEARN, drift=DRIFT, threshold=THRESHOLD, start=0, window=WIND
     return None
 
 
-def _sensors(run) -> list:
-    return [c for c in OP_CHANNELS if c in run.columns and np.isfinite(run[c]).any()]
-
-
 # ---------------------------------------------------------------------------- pass 1: operating point
 def operating_changes(op, block_t, block, params, *, threshold=THRESHOLD_OP, learn=LEARN):
     """Changes of the block-mean WOB; each classified by the load balance (module docstring).
@@ -834,7 +830,7 @@ def monitor(run, params, *, block=BLOCK, chunk=CHUNK, threshold=THRESHOLD, thres
     -------
     MonitorResult
     """
-    sensors = _sensors(run)
+    sensors = list(run.sensors)
     use, skip = usable_equations(sensors)
     missing = [c for c in OP_CHANNELS if c not in sensors]
     if not use:
