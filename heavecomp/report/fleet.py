@@ -11,8 +11,8 @@ from pathlib import Path
 from heavecomp.campaign.fleet import RESULTS, read_task, run_fleet
 from heavecomp.effects.base import COMPONENTS
 from heavecomp.report.figures import _plt, save
-from heavecomp.report.monitor import write_segment_diagnoses
-from heavecomp.report.provenance import _clean, write_units_csv
+from heavecomp.report.monitor import dump_json, write_segment_diagnoses
+from heavecomp.report.provenance import write_units_csv
 from heavecomp.report.scenario import md_table
 
 #: ``fleet.csv``: one row per log (header -> unit, for ``fleet.units.csv``)
@@ -43,7 +43,7 @@ def write_log(folder, result) -> None:
         :func:`heavecomp.campaign.fleet.run_log`'s answer.
     """
     folder = Path(folder)
-    (folder / "monitor.json").write_text(json.dumps(_clean(result["monitor"]), indent=2) + "\n", encoding="utf-8")
+    dump_json(result["monitor"], folder / "monitor.json")
     write_segment_diagnoses({int(i): d for i, d in result["diagnoses"].items()}, folder)
 
 
@@ -253,7 +253,7 @@ def write_report(out_dir, summary, run_info, *, source="") -> Path:
                      "duration_s": lg["monitor"]["duration_s"] if lg["monitor"] else None,
                      "changes": lg["monitor"]["changes"] if lg["monitor"] else [],
                      "segments": lg["monitor"]["segments"] if lg["monitor"] else []} for lg in summary["logs"]]}
-    (out / "fleet.json").write_text(json.dumps(_clean(doc), indent=2) + "\n", encoding="utf-8")
+    dump_json(doc, out / "fleet.json")
     save(timeline_figure(summary), out / "timeline.png")
     p = out / "report.md"
     p.write_text(report_markdown(summary, run_info, source=source), encoding="utf-8")
