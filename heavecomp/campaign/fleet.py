@@ -481,8 +481,19 @@ def read_task(folder) -> dict | None:
     folder : str or os.PathLike
         ``OUT/logs/<key>``.
     """
+    return read_json(Path(folder) / TASK)
+
+
+def read_json(path):
+    """The content of a JSON file of a fleet's result, or None (absent, unreadable, not JSON).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file.
+    """
     try:
-        return json.loads((Path(folder) / TASK).read_text())
+        return json.loads(Path(path).read_text(encoding="utf-8"))
     except (OSError, ValueError):
         return None
 

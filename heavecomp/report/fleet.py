@@ -5,10 +5,9 @@
 from __future__ import annotations
 
 import csv
-import json
 from pathlib import Path
 
-from heavecomp.campaign.fleet import RESULTS, read_task, run_fleet
+from heavecomp.campaign.fleet import RESULTS, read_json, read_task, run_fleet
 from heavecomp.effects.base import COMPONENTS
 from heavecomp.report.figures import _plt, save
 from heavecomp.report.monitor import dump_json, write_segment_diagnoses
@@ -47,15 +46,8 @@ def write_log(folder, result) -> None:
     write_segment_diagnoses({int(i): d for i, d in result["diagnoses"].items()}, folder)
 
 
-def _read(folder: Path, name: str):
-    try:
-        return json.loads((folder / name).read_text(encoding="utf-8"))
-    except (OSError, ValueError):
-        return None
-
-
 def _group(folder: Path, i: int) -> str:
-    d = _read(folder, f"segment_{i}/diagnosis.json")
+    d = read_json(folder / f"segment_{i}" / "diagnosis.json")
     g = ((d or {}).get("verdict") or {}).get("group")
     return "{" + ", ".join(g) + "}" if g else "-"
 
@@ -80,7 +72,7 @@ def collect(out_dir, keys) -> dict:
     for key in keys:
         folder = Path(out_dir) / RESULTS / key
         task = read_task(folder) or {"status": "missing", "reason": "not run (incomplete fleet: rerun to resume)"}
-        mon = _read(folder, "monitor.json") if task["status"] == "done" else None
+        mon = read_json(folder / "monitor.json") if task["status"] == "done" else None
         logs.append({"log": key, "status": task["status"], "reason": task.get("reason", ""), "monitor": mon})
         row = dict.fromkeys(FLEET_COLUMNS, "")
         row.update({"log": key, "status": task["status"], "reason": task.get("reason", "")})
