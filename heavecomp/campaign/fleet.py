@@ -132,27 +132,23 @@ class FleetRun:
 
 
 # ------------------------------------------------------------------------------------------- finding
+def _uncompressed(name: str) -> str:
+    """``name`` without its compression suffix (:data:`COMPRESSED`, any case)."""
+    low = name.lower()
+    return next((name[: -len(z)] for z in COMPRESSED if low.endswith(z)), name)
+
+
 def _is_log(p: Path) -> bool:
     name = p.name.lower()
     if name.startswith(".") or name.endswith(".units.csv") or not p.is_file():
         return False
-    for z in COMPRESSED:
-        if name.endswith(z):
-            name = name[: -len(z)]
-            break
-    return name.endswith(LOG_SUFFIXES)
+    return _uncompressed(name).endswith(LOG_SUFFIXES)
 
 
 def _stem(name: str) -> str:
+    name = _uncompressed(name)
     low = name.lower()
-    for z in COMPRESSED:
-        if low.endswith(z):
-            name, low = name[: -len(z)], low[: -len(z)]
-            break
-    for s in LOG_SUFFIXES:
-        if low.endswith(s):
-            return name[: -len(s)]
-    return name
+    return next((name[: -len(s)] for s in LOG_SUFFIXES if low.endswith(s)), name)
 
 
 def find_logs(source) -> tuple[Path, list]:
@@ -485,8 +481,19 @@ def read_task(folder) -> dict | None:
     folder : str or os.PathLike
         ``OUT/logs/<key>``.
     """
+    return read_json(Path(folder) / TASK)
+
+
+def read_json(path):
+    """The content of a JSON file of a fleet's result, or None (absent, unreadable, not JSON).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file.
+    """
     try:
-        return json.loads((Path(folder) / TASK).read_text())
+        return json.loads(Path(path).read_text(encoding="utf-8"))
     except (OSError, ValueError):
         return None
 

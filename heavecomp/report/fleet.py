@@ -5,14 +5,13 @@
 from __future__ import annotations
 
 import csv
-import json
 from pathlib import Path
 
-from heavecomp.campaign.fleet import RESULTS, read_task, run_fleet
+from heavecomp.campaign.fleet import RESULTS, read_json, read_task, run_fleet
 from heavecomp.effects.base import COMPONENTS
 from heavecomp.report.figures import _plt, save
-from heavecomp.report.monitor import write_segment_diagnoses
-from heavecomp.report.provenance import _clean, write_units_csv
+from heavecomp.report.monitor import dump_json, write_segment_diagnoses
+from heavecomp.report.provenance import write_units_csv
 from heavecomp.report.scenario import md_table
 
 #: ``fleet.csv``: one row per log (header -> unit, for ``fleet.units.csv``)
@@ -43,19 +42,12 @@ def write_log(folder, result) -> None:
         :func:`heavecomp.campaign.fleet.run_log`'s answer.
     """
     folder = Path(folder)
-    (folder / "monitor.json").write_text(json.dumps(_clean(result["monitor"]), indent=2) + "\n", encoding="utf-8")
+    dump_json(result["monitor"], folder / "monitor.json")
     write_segment_diagnoses({int(i): d for i, d in result["diagnoses"].items()}, folder)
 
 
-def _read(folder: Path, name: str):
-    try:
-        return json.loads((folder / name).read_text(encoding="utf-8"))
-    except (OSError, ValueError):
-        return None
-
-
 def _group(folder: Path, i: int) -> str:
-    d = _read(folder, f"segment_{i}/diagnosis.json")
+    d = read_json(folder / f"segment_{i}" / "diagnosis.json")
     g = ((d or {}).get("verdict") or {}).get("group")
     return "{" + ", ".join(g) + "}" if g else "-"
 
@@ -80,7 +72,7 @@ def collect(out_dir, keys) -> dict:
     for key in keys:
         folder = Path(out_dir) / RESULTS / key
         task = read_task(folder) or {"status": "missing", "reason": "not run (incomplete fleet: rerun to resume)"}
-        mon = _read(folder, "monitor.json") if task["status"] == "done" else None
+        mon = read_json(folder / "monitor.json") if task["status"] == "done" else None
         logs.append({"log": key, "status": task["status"], "reason": task.get("reason", ""), "monitor": mon})
         row = dict.fromkeys(FLEET_COLUMNS, "")
         row.update({"log": key, "status": task["status"], "reason": task.get("reason", "")})
@@ -253,7 +245,7 @@ def write_report(out_dir, summary, run_info, *, source="") -> Path:
                      "duration_s": lg["monitor"]["duration_s"] if lg["monitor"] else None,
                      "changes": lg["monitor"]["changes"] if lg["monitor"] else [],
                      "segments": lg["monitor"]["segments"] if lg["monitor"] else []} for lg in summary["logs"]]}
-    (out / "fleet.json").write_text(json.dumps(_clean(doc), indent=2) + "\n", encoding="utf-8")
+    dump_json(doc, out / "fleet.json")
     save(timeline_figure(summary), out / "timeline.png")
     p = out / "report.md"
     p.write_text(report_markdown(summary, run_info, source=source), encoding="utf-8")

@@ -64,6 +64,25 @@ def write_json(res, path, extra=None) -> Path:
     """
     d = res.to_json()
     d.update(extra or {})
+    return dump_json(d, path)
+
+
+def dump_json(d, path) -> Path:
+    """Write the JSON-ready copy of ``d`` (NaN -> null, numpy -> Python) to ``path``, indented: how
+    ``monitor.json``, each segment's ``diagnosis.json`` and the fleet's JSON files are written (by ``monitor`` and
+    by ``fleet``).
+
+    Parameters
+    ----------
+    d : dict
+        The content (``monitor.json``: :meth:`heavecomp.diagnosis.monitor.MonitorResult.to_json`).
+    path : str or Path
+        The file to write.
+
+    Returns
+    -------
+    pathlib.Path
+    """
     path = Path(path)
     path.write_text(json.dumps(clean(d), indent=2) + "\n", encoding="utf-8")
     return path
@@ -84,9 +103,7 @@ def write_segment_diagnoses(diagnoses, out) -> list:
     for i, d in sorted(diagnoses.items()):
         sub = Path(out) / f"segment_{i}"
         sub.mkdir(parents=True, exist_ok=True)
-        p = sub / "diagnosis.json"
-        p.write_text(json.dumps(clean(d), indent=2) + "\n", encoding="utf-8")
-        paths.append(p)
+        paths.append(dump_json(d, sub / "diagnosis.json"))
     return paths
 
 
