@@ -793,10 +793,10 @@ def read_series(path, required=("t",), *, optional=(), columns=None, units=None,
     byte = None
     for encoding in ("utf-8-sig", "latin-1"):  # text not UTF-8 past the first chunk: read again as Latin-1
         warnings: list[str] = [] if byte is None else [f"not UTF-8 (byte {byte}); read as Latin-1"]
-        parts, rows, meta = {}, [], None
+        parts, rows, meta, state = {}, [], None, {}
         total = 0
         try:
-            for s in _chunks(path, src, tuple(required), tuple(optional), columns, units, encoding, warnings):
+            for s in _chunks(path, src, tuple(required), tuple(optional), columns, units, encoding, warnings, state):
                 meta = s
                 for k in list(parts):
                     if k not in s.columns:  # a carried column that turned out to hold text: dropped whole
@@ -821,8 +821,7 @@ def read_series(path, required=("t",), *, optional=(), columns=None, units=None,
     del rows
     info = meta.measurement
     if "t" in out:
-        _check_time_unit(out["t"], info.get("_t_declared", False), meta.source, info["columns"]["t"])
-    info.pop("_t_declared", None)
+        _check_time_unit(out["t"], state["t_declared"], meta.source, info["columns"]["t"])
     return Series(columns=out, source=meta.source, measurement=info, warnings=meta.warnings, rows=np.asarray(lines))
 
 
@@ -866,11 +865,11 @@ def iter_chunks(path, required=("t",), *, optional=(), columns=None, units=None,
     byte = None
     for encoding in ("utf-8-sig", "latin-1"):
         warnings: list[str] = [] if byte is None else [f"not UTF-8 (byte {byte}); read as Latin-1"]
-        started = False
+        started, state = False, {}
         try:
-            for s in _chunks(path, src, tuple(required), tuple(optional), columns, units, encoding, warnings):
+            for s in _chunks(path, src, tuple(required), tuple(optional), columns, units, encoding, warnings, state):
                 if check_time and not started and "t" in s.columns:
-                    _check_time_unit(s.columns["t"], s.measurement["_t_declared"], src, s.measurement["columns"]["t"])
+                    _check_time_unit(s.columns["t"], state["t_declared"], src, s.measurement["columns"]["t"])
                 started = True
                 yield s
             return
@@ -881,22 +880,24 @@ def iter_chunks(path, required=("t",), *, optional=(), columns=None, units=None,
             byte = exc.byte
 
 
-def _chunks(path, src, required, optional, columns, units, encoding, warnings):
-    """The Series of each chunk (see :func:`iter_chunks`)."""
+def _chunks(path, src, required, optional, columns, units, encoding, warnings, state):
+    """The Series of each chunk (see :func:`iter_chunks`); ``state`` receives what the reader itself
+    needs and the caller is not shown (``t_declared``: the time column's unit was declared or read)."""
     info = {"format": "csv"}
     kinds: list = []
     header, chunks, scalars = _table(path, src, info, warnings, kinds, encoding)
     stream = scalars.pop("_stream", None)
     try:
         yield from _converted(header, chunks, scalars, info, src, required, optional, columns, units, warnings,
-                              kinds)
+                              kinds, state)
     finally:
         if stream is not None:
             stream.close()
 
 
-def _converted(header, chunks, scalars, info, src, required, optional, columns, units, warnings, kinds):
-    """The chunks' columns mapped, converted to SI and checked (see :func:`iter_chunks`)."""
+def _converted(header, chunks, scalars, info, src, required, optional, columns, units, warnings, kinds, state):
+    """The chunks' columns mapped, converted to SI and checked (see :func:`iter_chunks`); ``state`` as
+    :func:`_chunks`'s (kept out of ``info``, the ``measurement`` every caller sees)."""
     decimal = info.get("decimal", ".")
     chosen, norm = _choose(header, required, optional, columns, src)
     used_units, conversions, scale = _units(header, norm, chosen, units, src)
@@ -967,7 +968,7 @@ def _converted(header, chunks, scalars, info, src, required, optional, columns, 
             for name in list(used_units):
                 if used_units[name] is None:
                     used_units[name] = f"{SI[KINDS[name]]} (assumed)"
-            info["_t_declared"] = "t" in chosen and ("t" in units or norm[chosen["t"]][1] is not None
+            state["t_declared"] = "t" in chosen and ("t" in units or norm[chosen["t"]][1] is not None
                                                     or used_units["t"] == "timestamp")
             kinds[:] = ["drop"] * len(header)
             for name, j in chosen.items():
