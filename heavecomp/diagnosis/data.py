@@ -32,8 +32,7 @@ from heavecomp.diagnosis import quality
 from heavecomp.effects.spec import correct, reading_effects
 from heavecomp.errors import DataError
 from heavecomp.simulate.excitation import HeaveSamples
-from heavecomp.io.series import MAX_DT_S, gaps
-from heavecomp.io.series import UNITS as SOURCE_UNITS, check_spec, read_series
+from heavecomp.io.series import MAX_DT_S, gaps, read_series
 from heavecomp.signals import flat_zero_phase
 
 P_ATM = 101325.0  #: atmospheric pressure [Pa] (cmc-reference.md)
@@ -184,31 +183,15 @@ def wob_from_hook_load(data: dict, series, string_weight) -> None:
 
 
 def _frame_run(df, params, columns: dict, units: dict) -> MeasuredRun:
-    """:func:`load_run` of a pandas DataFrame: contract columns (or mapped ones), time as a column or the index."""
-    columns, units = check_spec(columns, units, "measurement")
-    src = "<DataFrame>"
-    names = [str(c) for c in df.columns]
-    data = {}
-    for name in REQUIRED + CHANNELS + ANGLES:
-        want = columns.get(name, name)
-        if want in names:
-            data[name] = np.asarray(df[df.columns[names.index(want)]], dtype=float)
-        elif name == "t" and (df.index.name in (want, "time") or (want == "t" and df.index.name == "t")):
-            data[name] = np.asarray(df.index, dtype=float)
-        elif name in REQUIRED:
-            raise DataError(f"{src}: missing column '{name}' (columns: {', '.join(names[:12])}; index "
-                            f"{df.index.name!r}); map it in a column mapping, {name}=NAME",
-                            option="columns", example=f"{name}=NAME")
-    conversions = []
-    for name, unit in units.items():
-        if name in data:
-            _kind, scale, offset = SOURCE_UNITS[unit.strip().lower()]
-            data[name] = data[name] * scale + offset
-            conversions.append(f"{name}: {unit} -> SI")
+    """:func:`load_run` of a pandas DataFrame: its columns mapped, unit-checked and converted by the file
+    reader (:func:`heavecomp.io.series.read_series` reads a frame as a file with its header)."""
+    s = read_series(df, REQUIRED, optional=CHANNELS + ANGLES, columns=columns, units=units, what="measured run")
+    data = dict(s.columns)
     t = data.pop("t")
-    run = check_run(t, data, params=params, source=src)
-    run.measurement = {"format": "pandas.DataFrame", "units": dict(units), "conversions": conversions}
-    return quality.checked(run, params)
+    run = check_run(t, data, params=params, source=s.source, rows=s.rows)
+    run.warnings[:0] = s.warnings
+    run.measurement = s.measurement
+    return quality.checked(run, params, rows=s.rows)
 
 
 def check_run(t, columns: dict, *, params=None, source="<array>", rows=None) -> MeasuredRun:

@@ -713,10 +713,53 @@ def _arrow_column(col, pa):
     return [None if v is None else str(v) for v in col.to_pylist()]
 
 
+FRAME = "<DataFrame>"  #: the source name of a pandas DataFrame read as a series
+
+
+def is_frame(obj) -> bool:
+    """Whether ``obj`` is a table handed over in memory (a pandas DataFrame), not a file name.
+
+    Parameters
+    ----------
+    obj : object
+        What a reader was given.
+    """
+    return hasattr(obj, "columns") and hasattr(obj, "index") and not isinstance(obj, (str, bytes, Path))
+
+
+def _frame_column(values):
+    """A frame's column (or index) as the reader's column: float64, datetime64[ns] or a list of strings."""
+    v = np.asarray(values)
+    if v.dtype.kind in "iufb":
+        return v.astype(float)
+    if v.dtype.kind == "M":
+        return v.astype("datetime64[ns]")
+    return [None if x is None or (isinstance(x, float) and x != x) else str(x) for x in v.tolist()]
+
+
+def _frame_table(df, info: dict):
+    """``(header, one chunk, {})`` of a pandas DataFrame, as a file with the same header would be read: its
+    columns, and first its index when that is named and no column has its name (time as the index, as
+    ``SimulationResult.to_pandas()`` gives it).  Row numbers as for a file with a header line (first row: 2)."""
+    info["format"] = "pandas.DataFrame"
+    names = [str(c) for c in df.columns]
+    header, cols = [], []
+    if df.index.name is not None and str(df.index.name) not in names:
+        header.append(str(df.index.name))
+        cols.append(_frame_column(df.index))
+    for j, name in enumerate(names):
+        header.append(name)
+        cols.append(_frame_column(df.iloc[:, j]))
+    return header, iter([(cols, np.arange(len(df)) + 2)]), {}
+
+
 def _table(path: Path, src: str, info: dict, warnings: list, kinds: list, encoding: str = "utf-8-sig"):
     """``(header, iterator of (cols, lines), MATLAB scalars)`` of any supported file (a streamed CSV's
     open stream under ``"_stream"`` in the third, for the caller to close): Parquet and
-    (compressed) CSV streamed in chunks; MATLAB, compressed Parquet and UTF-16 text read whole (one chunk)."""
+    (compressed) CSV streamed in chunks; MATLAB, compressed Parquet and UTF-16 text read whole (one chunk);
+    a pandas DataFrame (:func:`is_frame`) as one chunk."""
+    if is_frame(path):
+        return _frame_table(path, info)
     stream, comp, magic = _open(path, src)
     with stream:
         head = _read(stream, 65536, src, comp)
@@ -755,16 +798,25 @@ def _table(path: Path, src: str, info: dict, warnings: list, kinds: list, encodi
 
 
 # ---------------------------------------------------------------- table -> Series
+def _source(path):
+    """``(what to read, its name for messages)``: a file's path, or a DataFrame as it is (:data:`FRAME`)."""
+    if is_frame(path):
+        return path, FRAME
+    path = Path(path)
+    return path, short(path)
+
+
 def read_series(path, required=("t",), *, optional=(), columns=None, units=None, what="measured series") -> Series:
     """Read a measured series from a file in any supported format (see the module docstring).
 
     CSV (plain or compressed) and Parquet are read in chunks (:data:`CHUNK_BYTES` of text,
     :data:`PARQUET_ROWS` rows): the memory is the float64 arrays of the columns (8 bytes per value,
-    plus 8 per row for its line number) and one chunk, never the file's text.
+    plus 8 per row for its line number) and one chunk, never the file's text.  A pandas DataFrame is
+    read as a file with its header would be (its named index first, when no column has that name).
 
     Parameters
     ----------
-    path : str or Path
+    path : str or Path, or pandas.DataFrame
     required : tuple of str
         Contract names that must be present (``t``, ``heave``, ``stroke``, ``pressure``, ``wob``).
     optional : tuple of str
@@ -787,8 +839,7 @@ def read_series(path, required=("t",), *, optional=(), columns=None, units=None,
     DataError
         One line naming the column (and row) for every problem.
     """
-    path = Path(path)
-    src = short(path)
+    path, src = _source(path)
     columns, units = check_spec(columns, units, "measurement")
     byte = None
     for encoding in ("utf-8-sig", "latin-1"):  # text not UTF-8 past the first chunk: read again as Latin-1
@@ -859,8 +910,7 @@ def iter_chunks(path, required=("t",), *, optional=(), columns=None, units=None,
     Series
         The next rows, contract columns in SI units, ``rows`` their file lines.
     """
-    path = Path(path)
-    src = short(path)
+    path, src = _source(path)
     columns, units = check_spec(columns, units, "measurement")
     byte = None
     for encoding in ("utf-8-sig", "latin-1"):
