@@ -98,3 +98,27 @@ def test_runs_frame_refuses_in_one_line(tmp_path, monkeypatch, given, fragment):
     with pytest.raises(InputError) as e:
         runs_frame(given)
     assert fragment in str(e.value) and "\n" not in str(e.value)
+
+
+def test_load_run_frame_derives_the_wob_from_the_hook_load_as_a_file(sim, tmp_path):
+    """A frame with a hook load and no WOB column: W = string weight - hook load, as for a file (the string
+    weight from the parameter file's [measurement] table or the keyword); without one, one line naming the
+    column and the key."""
+    from heavecomp.diagnosis.data import load_run
+    from heavecomp.errors import DataError
+    from heavecomp.params import load, paper_a
+    from heavecomp.params.cmc import save
+
+    W_s = 1.5e6
+    df = sim.to_pandas()[["heave", "stroke", "pressure", "wob"]]
+    df = df.assign(hook_load=W_s - df["wob"]).drop(columns="wob")
+    run = load_run(df, paper_a(), string_weight=W_s)
+    np.testing.assert_allclose(run["wob"], sim["wob"], rtol=1e-9)
+    assert run.measurement["wob_from"]["string_weight_N"] == W_s
+    toml = tmp_path / "p.toml"
+    save(paper_a(), toml)
+    toml.write_text(toml.read_text() + f"\n[measurement]\nstring_weight = {W_s}\n")
+    np.testing.assert_allclose(load_run(df, load(toml))["wob"], sim["wob"], rtol=1e-9)
+    with pytest.raises(DataError) as e:
+        load_run(df, paper_a())
+    assert "'hook_load'" in str(e.value) and "string_weight" in str(e.value) and "\n" not in str(e.value)

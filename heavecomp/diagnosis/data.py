@@ -103,6 +103,8 @@ def load_run(path, params=None, *, columns=None, units=None, string_weight=None)
     The file is read by :func:`heavecomp.io.series.read_series` (CSV with any delimiter,
     decimal comma, header case/units; gzip/bz2/xz/zip; Parquet; MATLAB .mat; time in s, ms
     or ISO timestamps) and converted to SI; how it was read is kept in ``run.measurement``.
+    A DataFrame takes the same path as a file (the reader reads it as a file with its header):
+    the same checks, hook-load conversion and ``[[effects]]`` reading corrections.
 
     Parameters
     ----------
@@ -129,8 +131,6 @@ def load_run(path, params=None, *, columns=None, units=None, string_weight=None)
     spec = getattr(params, "extra", {}).get("measurement") if params is not None else None
     cols = {**(spec.columns if spec else {}), **(columns or {})}
     uns = {**(spec.units if spec else {}), **(units or {})}
-    if hasattr(path, "columns") and hasattr(path, "index") and not isinstance(path, (str, bytes)):
-        return _frame_run(path, params, cols, uns)
     s = read_series(path, REQUIRED, optional=CHANNELS + ANGLES + (HOOK_LOAD,), columns=cols, units=uns,
                     what="measured run")
     data = dict(s.columns)
@@ -180,18 +180,6 @@ def wob_from_hook_load(data: dict, series, string_weight) -> None:
     m = series.measurement = dict(series.measurement or {})
     m["wob_from"] = {"column": HOOK_LOAD, "string_weight_N": w, "formula": "wob = string_weight - hook_load"}
     m["conversions"] = list(m.get("conversions", [])) + [f"wob: string weight {w:.6g} N - hook_load"]
-
-
-def _frame_run(df, params, columns: dict, units: dict) -> MeasuredRun:
-    """:func:`load_run` of a pandas DataFrame: its columns mapped, unit-checked and converted by the file
-    reader (:func:`heavecomp.io.series.read_series` reads a frame as a file with its header)."""
-    s = read_series(df, REQUIRED, optional=CHANNELS + ANGLES, columns=columns, units=units, what="measured run")
-    data = dict(s.columns)
-    t = data.pop("t")
-    run = check_run(t, data, params=params, source=s.source, rows=s.rows)
-    run.warnings[:0] = s.warnings
-    run.measurement = s.measurement
-    return quality.checked(run, params, rows=s.rows)
 
 
 def check_run(t, columns: dict, *, params=None, source="<array>", rows=None) -> MeasuredRun:
