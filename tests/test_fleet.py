@@ -274,3 +274,68 @@ def test_diagnose_gives_each_gap_segment_its_verdict_and_group(fleet_dir, tmp_pa
     assert diag["verdict"]["effect"] == v["verdict"]
     row = _rows(tmp_path / "o" / "fleet.csv")["a_friction"]
     assert row["verdicts (segment: effect, confidence, group)"].startswith(f"1: {v['verdict']}, {v['confidence']}")
+
+
+def _binary_logs(folder, n=20000, wob="wob"):
+    """A Parquet and a .mat log of n samples at 10 Hz at paper A's operating point (no simulation needed), the
+    WOB column named ``wob``; and paper A's parameter file."""
+    import numpy as np
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+    import scipy.io
+
+    from heavecomp.params import dumps, paper_a
+
+    P = paper_a()
+    t = 0.1 * np.arange(n)
+    cols = {"t": t, "heave": np.sin(t), "stroke": 0.1 * np.sin(t), "pressure": P.p0 + 1e4 * np.sin(t),
+            wob: P.operating_point.wob_setpoint + 1e3 * np.sin(t)}
+    logs = folder / "logs"
+    logs.mkdir(parents=True)
+    pq.write_table(pa.table(cols), logs / "a.parquet", row_group_size=4000)
+    scipy.io.savemat(logs / "b.mat", cols)
+    (folder / "p.toml").write_text(dumps(P))
+    return logs, folder / "p.toml"
+
+
+def test_the_check_before_work_reads_a_binary_log_s_start_only(tmp_path, monkeypatch, capsys):
+    """Brief item 5: a Parquet or .mat log is read whole once (in its task), not also by the check before any
+    work: the check reads a Parquet log's first rows (their magnitudes still checked) and a .mat log's
+    variable headers (scipy.io.whosmat, no loadmat); bad input is still one line naming the column, exit 2."""
+    import pyarrow.parquet as pq
+    import scipy.io
+
+    from heavecomp.io import series as S
+
+    logs, p = _binary_logs(tmp_path)
+    rows = []
+    real_iter = pq.ParquetFile.iter_batches
+
+    def counted(self, *a, **kw):
+        for b in real_iter(self, *a, **kw):
+            rows.append(b.num_rows)
+            yield b
+
+    def no_loadmat(*a, **kw):
+        raise AssertionError("loadmat: a .mat log read whole by the check")
+
+    monkeypatch.setattr(pq.ParquetFile, "iter_batches", counted)
+    monkeypatch.setattr(scipy.io, "loadmat", no_loadmat)
+    assert [t.key for t in F.plan(logs, p)] == ["a", "b"]
+    assert 0 < sum(rows) <= S.HEAD_ROWS < 20000
+
+    def refused(folder, *args):
+        capsys.readouterr()
+        assert cli.main(["fleet", str(folder), "--params", str(p), *args, "--out", str(tmp_path / "o")]) == 2
+        assert not (tmp_path / "o").exists()
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1, err
+        return err[0]
+
+    assert "a.parquet: column 'wob': mean" in refused(logs, "--units", "wob=kN")  # the head's magnitudes
+    assert "column 'wob' mapped to 'W': no such column" in refused(logs, "--columns", "wob=W")
+    mm, _ = _binary_logs(tmp_path / "mm", wob="wob_mm")  # a header unit of the wrong kind
+    msg = refused(mm)
+    assert "column 'wob' ('wob_mm'): unit 'mm' is a length unit" in msg and ("a.parquet" in msg or "b.mat" in msg)
+    (mm / "a.parquet").unlink()
+    assert "b.mat: column 'wob' ('wob_mm'): unit 'mm' is a length unit" in refused(mm)

@@ -150,3 +150,22 @@ def test_the_rows_are_estimated_from_the_size_before_reading(tmp_path):
 
     pq.write_table(pa.table({c: data[:, j] for j, c in enumerate(COLS)}), tmp_path / "log.parquet")
     assert S.estimate_rows(tmp_path / "log.parquet") == 5000
+
+
+@pytest.mark.parametrize("name", ["log.csv", "log.parquet"])
+def test_chunks_show_callers_no_private_key(tmp_path, small_chunks, name):
+    """The reader's own bookkeeping (whether the time unit was declared) stays out of ``measurement``, which a
+    caller records in its results: every chunk's and the joined series' keys are the documented ones."""
+    data = _table()
+    if name.endswith(".parquet"):
+        pa = pytest.importorskip("pyarrow")
+        import pyarrow.parquet as pq
+
+        f = tmp_path / name
+        pq.write_table(pa.table({c: data[:, j] for j, c in enumerate(COLS)}), f)
+    else:
+        f = _write(tmp_path / name, data)
+    parts = list(S.iter_chunks(f, COLS))
+    for m in [p.measurement for p in parts] + [S.read_series(f, COLS).measurement]:
+        assert not [k for k in m if k.startswith("_")], sorted(m)
+        assert {"format", "columns", "units", "conversions"} <= set(m)

@@ -3,8 +3,9 @@ of the campaign executor (issue 23 item 5).
 
 :func:`plan` finds the logs (a folder, or a glob) and checks everything a user can get wrong before any
 work: no log found, a parameter file, an unknown key of the manifest, a log whose columns cannot be
-mapped or whose units do not fit (the head of each text log is read with the reader ``diagnose`` uses,
-:func:`heavecomp.diagnosis.data.load_run`: the same one-line messages naming the column).
+mapped or whose units do not fit (the start of each log is read with the reader ``diagnose`` uses,
+:func:`heavecomp.diagnosis.data.check_head`: the same one-line messages naming the column; a log is read
+whole once, in its task).
 
 :func:`run_fleet` runs :func:`run_log` on each log through :func:`heavecomp.campaign.execute.execute`
 (in this process, local processes, or Dask) and is the only writer: each finished log's result is
@@ -43,7 +44,6 @@ import json
 import logging
 import os
 import shutil
-import tempfile
 import time
 import uuid
 from pathlib import Path
@@ -51,7 +51,7 @@ from pathlib import Path
 from heavecomp import __version__
 from heavecomp.campaign.execute import execute
 from heavecomp.diagnosis import monitor as M
-from heavecomp.diagnosis.data import load_run
+from heavecomp.diagnosis.data import check_head, load_run
 from heavecomp.effects.spec import load
 from heavecomp.errors import InputError, did_you_mean
 from heavecomp.io.series import check_spec, parse_mapping, short
@@ -67,7 +67,6 @@ LOG_SUFFIXES = (".csv", ".txt", ".tsv", ".dat", ".parquet", ".mat")
 COMPRESSED = (".gz", ".bz2", ".xz", ".zip")
 MANIFEST_KEYS = ("params", "columns", "units", "logs")
 LOG_KEYS = ("params", "columns", "units")
-HEAD_BYTES = 1 << 16  #: bytes of a text log's head read by the check before any work [bytes]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -275,39 +274,10 @@ def _method_hash() -> str:
     return h.hexdigest()
 
 
-def _head(path: Path, folder: Path) -> Path | None:
-    """The first :data:`HEAD_BYTES` of a text log (decompressed), cut at a line end, as a file of the same
-    name in ``folder``; None for a binary (Parquet, .mat) or zipped log, read whole instead."""
-    import bz2
-    import gzip
-    import lzma
-
-    with path.open("rb") as fh:
-        magic = fh.read(6)
-    opener = {b"\x1f\x8b": gzip.open, b"BZ": bz2.open, b"\xfd7": lzma.open}.get(magic[:2], open)
-    if magic[:4] in (b"PAR1", b"PK\x03\x04", b"\x89HDF") or magic.startswith(b"MATLAB") \
-            or path.name.lower().endswith((".mat", ".parquet")):
-        return None
-    try:
-        with opener(path, "rb") as fh:
-            data = fh.read(HEAD_BYTES)
-            more = bool(fh.read(1))
-    except (OSError, EOFError, lzma.LZMAError):
-        return None  # the whole read names what is wrong
-    if b"\x00" in data[:4096]:
-        return None
-    if more:
-        data = data[: data.rfind(b"\n") + 1]
-    out = folder / _stem(path.name)
-    out = out.with_name(out.name + ".csv")
-    out.write_bytes(data)
-    return out
-
-
 def check_log(path, params, *, columns=None, units=None) -> None:
-    """Check a log before any work: its columns map, its units are known and its magnitudes fit
-    ``params`` (:func:`heavecomp.diagnosis.data.load_run` on the head of a text log; a binary log is
-    read whole).
+    """Check a log before any work, reading only its start (:func:`heavecomp.diagnosis.data.check_head`):
+    its columns map, its units are known and of the right kind, and (a text or Parquet log) the
+    magnitudes of its first rows fit ``params``; of a MATLAB log only the variable headers are read.
 
     Parameters
     ----------
@@ -323,16 +293,7 @@ def check_log(path, params, *, columns=None, units=None) -> None:
     heavecomp.errors.DataError
         One line naming the log and the column, as ``load_run`` says it.
     """
-    path = Path(path)
-    with tempfile.TemporaryDirectory(prefix="hc") as tmp:
-        head = _head(path, Path(tmp))
-        try:
-            load_run(head or path, params, columns=columns, units=units)
-        except InputError as exc:
-            if head is None:
-                raise
-            msg = str(exc).replace(short(head), short(path)).replace(str(head), str(path))
-            raise type(exc)(msg, option=exc.option, example=exc.example) from None
+    check_head(path, params, columns=columns, units=units)
 
 
 def plan(source, params=None, *, manifest=None, columns=None, units=None, check=True) -> list:

@@ -32,8 +32,7 @@ from heavecomp.diagnosis import quality
 from heavecomp.effects.spec import correct, reading_effects
 from heavecomp.errors import DataError
 from heavecomp.simulate.excitation import HeaveSamples
-from heavecomp.io.series import MAX_DT_S, gaps
-from heavecomp.io.series import UNITS as SOURCE_UNITS, check_spec, read_series
+from heavecomp.io.series import MAX_DT_S, gaps, iter_chunks, read_series
 from heavecomp.signals import flat_zero_phase
 
 P_ATM = 101325.0  #: atmospheric pressure [Pa] (cmc-reference.md)
@@ -104,6 +103,8 @@ def load_run(path, params=None, *, columns=None, units=None, string_weight=None)
     The file is read by :func:`heavecomp.io.series.read_series` (CSV with any delimiter,
     decimal comma, header case/units; gzip/bz2/xz/zip; Parquet; MATLAB .mat; time in s, ms
     or ISO timestamps) and converted to SI; how it was read is kept in ``run.measurement``.
+    A DataFrame takes the same path as a file (the reader reads it as a file with its header):
+    the same checks, hook-load conversion and ``[[effects]]`` reading corrections.
 
     Parameters
     ----------
@@ -127,16 +128,65 @@ def load_run(path, params=None, *, columns=None, units=None, string_weight=None)
         One line naming the column (and row) for every problem.
     """
 
+    cols, uns, weight = _reading(params, columns, units, string_weight)
+    s = read_series(path, REQUIRED, optional=CHANNELS + ANGLES + (HOOK_LOAD,), columns=cols, units=uns,
+                    what="measured run")
+    return _checked_run(s, params, weight)
+
+
+def check_head(path, params=None, *, columns=None, units=None, string_weight=None) -> None:
+    """:func:`load_run`'s checks on the start of a log only, before any work (a fleet checks every log so):
+    the first chunk of a text log or the first rows of a Parquet file (:func:`heavecomp.io.series.iter_chunks`
+    ``head``) take every check ``load_run`` makes; of a MATLAB file only the variable headers are read (the
+    column mapping, the units, a hook load without a string weight, a log without any measured output), its
+    magnitudes are checked when the log is read whole.
+
+    Parameters
+    ----------
+    path : str or Path, or pandas.DataFrame
+        The log.
+    params : CMCParams, optional
+        Nominal parameters (magnitude checks, ``[measurement]``), as :func:`load_run`'s.
+    columns, units : dict, optional
+        Contract name -> source column / unit, as :func:`load_run`'s.
+    string_weight : float [N], optional
+        The string weight of a hook load, as :func:`load_run`'s.
+
+    Raises
+    ------
+    DataError
+        One line naming the column (and row), as :func:`load_run` says it.
+    """
+    cols, uns, weight = _reading(params, columns, units, string_weight)
+    chunks = iter_chunks(path, REQUIRED, optional=CHANNELS + ANGLES + (HOOK_LOAD,), columns=cols, units=uns,
+                         what="measured run", head=True)
+    try:
+        s = next(chunks)
+    finally:
+        chunks.close()
+    if s.rows.size:
+        _checked_run(s, params, weight)
+        return
+    data = dict(s.columns)  # a MATLAB file's columns without samples
+    data.pop("t")
+    wob_from_hook_load(data, s, weight)
+    _check_channels(data, s.source)
+
+
+def _reading(params, columns, units, string_weight):
+    """(column mapping, units, string weight) of a log: the keywords over the parameters' ``[measurement]``."""
     spec = getattr(params, "extra", {}).get("measurement") if params is not None else None
     cols = {**(spec.columns if spec else {}), **(columns or {})}
     uns = {**(spec.units if spec else {}), **(units or {})}
-    if hasattr(path, "columns") and hasattr(path, "index") and not isinstance(path, (str, bytes)):
-        return _frame_run(path, params, cols, uns)
-    s = read_series(path, REQUIRED, optional=CHANNELS + ANGLES + (HOOK_LOAD,), columns=cols, units=uns,
-                    what="measured run")
+    return cols, uns, string_weight if string_weight is not None else getattr(spec, "string_weight", None)
+
+
+def _checked_run(s, params, string_weight) -> MeasuredRun:
+    """The run of a series read (:func:`load_run`): the WOB from a hook load, the ``[[effects]]`` reading
+    corrections, the contract checks and the data-quality pass."""
     data = dict(s.columns)
     t = data.pop("t")
-    wob_from_hook_load(data, s, string_weight if string_weight is not None else getattr(spec, "string_weight", None))
+    wob_from_hook_load(data, s, string_weight)
     fixes = reading_effects(params) if params is not None else []
     if fixes:  # [[effects]] sensor effects: the log is read as the rig truly moved (docs/contracts/parameter-file.md)
         data, notes = correct(fixes, t, data)
@@ -183,34 +233,6 @@ def wob_from_hook_load(data: dict, series, string_weight) -> None:
     m["conversions"] = list(m.get("conversions", [])) + [f"wob: string weight {w:.6g} N - hook_load"]
 
 
-def _frame_run(df, params, columns: dict, units: dict) -> MeasuredRun:
-    """:func:`load_run` of a pandas DataFrame: contract columns (or mapped ones), time as a column or the index."""
-    columns, units = check_spec(columns, units, "measurement")
-    src = "<DataFrame>"
-    names = [str(c) for c in df.columns]
-    data = {}
-    for name in REQUIRED + CHANNELS + ANGLES:
-        want = columns.get(name, name)
-        if want in names:
-            data[name] = np.asarray(df[df.columns[names.index(want)]], dtype=float)
-        elif name == "t" and (df.index.name in (want, "time") or (want == "t" and df.index.name == "t")):
-            data[name] = np.asarray(df.index, dtype=float)
-        elif name in REQUIRED:
-            raise DataError(f"{src}: missing column '{name}' (columns: {', '.join(names[:12])}; index "
-                            f"{df.index.name!r}); map it in a column mapping, {name}=NAME",
-                            option="columns", example=f"{name}=NAME")
-    conversions = []
-    for name, unit in units.items():
-        if name in data:
-            _kind, scale, offset = SOURCE_UNITS[unit.strip().lower()]
-            data[name] = data[name] * scale + offset
-            conversions.append(f"{name}: {unit} -> SI")
-    t = data.pop("t")
-    run = check_run(t, data, params=params, source=src)
-    run.measurement = {"format": "pandas.DataFrame", "units": dict(units), "conversions": conversions}
-    return quality.checked(run, params)
-
-
 def check_run(t, columns: dict, *, params=None, source="<array>", rows=None) -> MeasuredRun:
     """Check arrays against the contract (see the module docstring); returns a :class:`MeasuredRun`.
 
@@ -240,11 +262,7 @@ def check_run(t, columns: dict, *, params=None, source="<array>", rows=None) -> 
     for col in checked:  # the contract: non-finite values are an error (an inf, e.g. 1e400, is no dropout)
         if col in columns and np.isinf(columns[col]).any():
             raise DataError(f"{source}: column '{col}', row {line(np.flatnonzero(np.isinf(columns[col]))[0])}: non-finite value")
-    for col in REQUIRED[1:]:  # heave; any of stroke, pressure and wob may be missing (contract schema 3)
-        if col not in columns:
-            raise DataError(f"{source}: missing column '{col}'")
-    if not any(c in columns for c in CHANNELS):
-        raise DataError(f"{source}: no measured output: need at least one of columns 'stroke', 'pressure', 'wob'")
+    _check_channels(columns, source)
     if t.size < MIN_SAMPLES:
         raise DataError(f"{source}: column 't': need at least {MIN_SAMPLES} samples, got {t.size}")
     bad = np.flatnonzero(~np.isfinite(t))
@@ -300,6 +318,16 @@ def check_run(t, columns: dict, *, params=None, source="<array>", rows=None) -> 
     if params is not None:
         check_units(run, params)
     return run
+
+
+def _check_channels(columns, source) -> None:
+    """The heave and at least one measured output (any of stroke, pressure and wob may be missing: contract
+    schema 3), else one line naming them."""
+    for col in REQUIRED[1:]:
+        if col not in columns:
+            raise DataError(f"{source}: missing column '{col}'")
+    if not any(c in columns for c in CHANNELS):
+        raise DataError(f"{source}: no measured output: need at least one of columns 'stroke', 'pressure', 'wob'")
 
 
 def _runs(mask):

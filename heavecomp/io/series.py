@@ -466,18 +466,41 @@ def _mat_table(data: bytes, src: str):
         mat = scipy.io.loadmat(io.BytesIO(data), squeeze_me=False)
     except Exception as exc:  # noqa: BLE001 - scipy raises several types for a bad file
         raise DataError(f"{src}: unreadable MATLAB file ({type(exc).__name__})") from None
-    vecs = {}
-    for k, v in mat.items():
-        if k.startswith("__") or not isinstance(v, np.ndarray) or v.dtype.kind not in "iufb":
-            continue
-        if v.ndim == 2 and 1 in v.shape and v.size > 1:
-            vecs[k] = np.asarray(v, dtype=float).ravel()
+    header = _mat_columns({k: v.shape for k, v in mat.items()
+                           if not k.startswith("__") and isinstance(v, np.ndarray) and v.dtype.kind in "iufb"}, src)
+    return header, [np.asarray(mat[k], dtype=float).ravel() for k in header], \
+        {k: v for k, v in mat.items() if not k.startswith("__")}
+
+
+#: MATLAB classes of numeric variables (``scipy.io.whosmat``'s third field)
+MAT_NUMERIC = ("double", "single", "int8", "int16", "int32", "int64", "uint8", "uint16", "uint32", "uint64",
+               "logical")
+
+
+def _mat_columns(shapes: dict, src: str) -> list:
+    """The variables of a MATLAB file that are its columns: numeric vectors (``shapes``: name -> shape of each
+    numeric variable) of the most common length."""
+    vecs = {k: int(np.prod(sh)) for k, sh in shapes.items() if len(sh) == 2 and 1 in sh and int(np.prod(sh)) > 1}
     if not vecs:
         raise DataError(f"{src}: MATLAB file without any numeric vector variable")
-    lengths = [v.size for v in vecs.values()]
+    lengths = list(vecs.values())
     n = max(set(lengths), key=lengths.count)
-    header = [k for k, v in vecs.items() if v.size == n]
-    return header, [vecs[k] for k in header], {k: v for k, v in mat.items() if not k.startswith("__")}
+    return [k for k, m in vecs.items() if m == n]
+
+
+def _mat_header(path: Path, src: str) -> list:
+    """The column variables of a MATLAB file from its variable headers (``scipy.io.whosmat``), no data read."""
+    with path.open("rb") as fh:
+        data = fh.read(516)
+    if data[:4] == b"\x89HDF" or data[512:516] == b"\x89HDF":
+        raise DataError(f"{src}: MATLAB v7.3 (HDF5) file; save it with save(..., '-v7') or export CSV")
+    import scipy.io
+
+    try:
+        info = scipy.io.whosmat(str(path))
+    except Exception as exc:  # noqa: BLE001 - scipy raises several types for a bad file
+        raise DataError(f"{src}: unreadable MATLAB file ({type(exc).__name__})") from None
+    return _mat_columns({name: tuple(shape) for name, shape, cls in info if cls in MAT_NUMERIC}, src)
 
 
 # ---------------------------------------------------------------- streamed reading
@@ -487,6 +510,8 @@ CHUNK_BYTES = 4 << 20
 FIRST_CHUNK_BYTES = 256 << 10
 #: rows per chunk of a Parquet file
 PARQUET_ROWS = 200_000
+#: rows of a Parquet file's head (:func:`iter_chunks` ``head``): about as many as a text log's first chunk holds
+HEAD_ROWS = 5000
 #: largest float arrays the reader builds [bytes] (rows x (columns + 1 line number) x 8)
 MAX_ARRAY_BYTES = 1 << 30
 
@@ -677,8 +702,9 @@ def _csv_chunks(stream, src: str, info: dict, comp, encoding: str, kinds: list):
     return header, rows()
 
 
-def _parquet_chunks(path: Path, src: str):
-    """``(header, iterator of (cols, lines))`` of a Parquet file read :data:`PARQUET_ROWS` rows at a time."""
+def _parquet_chunks(path: Path, src: str, size: int = 0):
+    """``(header, iterator of (cols, lines))`` of a Parquet file read ``size`` (default :data:`PARQUET_ROWS`)
+    rows at a time."""
     try:
         import pyarrow as pa
         import pyarrow.parquet as pq
@@ -693,7 +719,7 @@ def _parquet_chunks(path: Path, src: str):
     def rows():
         done = 0
         try:
-            for batch in pf.iter_batches(batch_size=PARQUET_ROWS):
+            for batch in pf.iter_batches(batch_size=size or PARQUET_ROWS):
                 yield [_arrow_column(batch.column(j), pa) for j in range(len(header))], done + 1 + np.arange(batch.num_rows)
                 done += batch.num_rows
         except Exception as exc:  # noqa: BLE001 - pyarrow raises several types for a bad file
@@ -713,19 +739,67 @@ def _arrow_column(col, pa):
     return [None if v is None else str(v) for v in col.to_pylist()]
 
 
-def _table(path: Path, src: str, info: dict, warnings: list, kinds: list, encoding: str = "utf-8-sig"):
+FRAME = "<DataFrame>"  #: the source name of a pandas DataFrame read as a series
+
+
+def is_frame(obj) -> bool:
+    """Whether ``obj`` is a table handed over in memory (a pandas DataFrame), not a file name.
+
+    Parameters
+    ----------
+    obj : object
+        What a reader was given.
+    """
+    return hasattr(obj, "columns") and hasattr(obj, "index") and not isinstance(obj, (str, bytes, Path))
+
+
+def _frame_column(values):
+    """A frame's column (or index) as the reader's column: float64, datetime64[ns] or a list of strings."""
+    v = np.asarray(values)
+    if v.dtype.kind in "iufb":
+        return v.astype(float)
+    if v.dtype.kind == "M":
+        return v.astype("datetime64[ns]")
+    return [None if x is None or (isinstance(x, float) and x != x) else str(x) for x in v.tolist()]
+
+
+def _frame_table(df, info: dict):
+    """``(header, one chunk, {})`` of a pandas DataFrame, as a file with the same header would be read: its
+    columns, and first its index when that is named and no column has its name (time as the index, as
+    ``SimulationResult.to_pandas()`` gives it).  Row numbers as for a file with a header line (first row: 2)."""
+    info["format"] = "pandas.DataFrame"
+    names = [str(c) for c in df.columns]
+    header, cols = [], []
+    if df.index.name is not None and str(df.index.name) not in names:
+        header.append(str(df.index.name))
+        cols.append(_frame_column(df.index))
+    for j, name in enumerate(names):
+        header.append(name)
+        cols.append(_frame_column(df.iloc[:, j]))
+    return header, iter([(cols, np.arange(len(df)) + 2)]), {}
+
+
+def _table(path: Path, src: str, info: dict, warnings: list, kinds: list, encoding: str = "utf-8-sig",
+           start_only: bool = False):
     """``(header, iterator of (cols, lines), MATLAB scalars)`` of any supported file (a streamed CSV's
     open stream under ``"_stream"`` in the third, for the caller to close): Parquet and
-    (compressed) CSV streamed in chunks; MATLAB, compressed Parquet and UTF-16 text read whole (one chunk)."""
+    (compressed) CSV streamed in chunks; MATLAB, compressed Parquet and UTF-16 text read whole (one chunk);
+    a pandas DataFrame (:func:`is_frame`) as one chunk.  ``start_only`` (:func:`iter_chunks`' ``head``): Parquet in chunks of
+    :data:`HEAD_ROWS`, and of a MATLAB file only its variable headers (:func:`_mat_header`; one chunk without rows)."""
+    if is_frame(path):
+        return _frame_table(path, info)
     stream, comp, magic = _open(path, src)
     with stream:
         head = _read(stream, 65536, src, comp)
     if magic[:4] == b"PAR1":
         info["format"] = "parquet"
-        header, it = _parquet_chunks(path, src)
+        header, it = _parquet_chunks(path, src, HEAD_ROWS if start_only else 0)
         return header, it, {}
     if magic[:19] == b"MATLAB 5.0 MAT-file" or magic[:4] == b"\x89HDF" or path.suffix.lower() == ".mat":
         info["format"] = "mat"
+        if start_only:
+            header = _mat_header(path, src)
+            return header, iter([([np.zeros(0) for _ in header], np.zeros(0, dtype=int))]), {}
         header, cols, scalars = _mat_table(_read_bytes(path, src), src)
         return header, iter([(cols, np.arange(cols[0].size) + 1)]), scalars
     if comp:
@@ -755,16 +829,25 @@ def _table(path: Path, src: str, info: dict, warnings: list, kinds: list, encodi
 
 
 # ---------------------------------------------------------------- table -> Series
+def _source(path):
+    """``(what to read, its name for messages)``: a file's path, or a DataFrame as it is (:data:`FRAME`)."""
+    if is_frame(path):
+        return path, FRAME
+    path = Path(path)
+    return path, short(path)
+
+
 def read_series(path, required=("t",), *, optional=(), columns=None, units=None, what="measured series") -> Series:
     """Read a measured series from a file in any supported format (see the module docstring).
 
     CSV (plain or compressed) and Parquet are read in chunks (:data:`CHUNK_BYTES` of text,
     :data:`PARQUET_ROWS` rows): the memory is the float64 arrays of the columns (8 bytes per value,
-    plus 8 per row for its line number) and one chunk, never the file's text.
+    plus 8 per row for its line number) and one chunk, never the file's text.  A pandas DataFrame is
+    read as a file with its header would be (its named index first, when no column has that name).
 
     Parameters
     ----------
-    path : str or Path
+    path : str or Path, or pandas.DataFrame
     required : tuple of str
         Contract names that must be present (``t``, ``heave``, ``stroke``, ``pressure``, ``wob``).
     optional : tuple of str
@@ -787,16 +870,15 @@ def read_series(path, required=("t",), *, optional=(), columns=None, units=None,
     DataError
         One line naming the column (and row) for every problem.
     """
-    path = Path(path)
-    src = short(path)
+    path, src = _source(path)
     columns, units = check_spec(columns, units, "measurement")
     byte = None
     for encoding in ("utf-8-sig", "latin-1"):  # text not UTF-8 past the first chunk: read again as Latin-1
         warnings: list[str] = [] if byte is None else [f"not UTF-8 (byte {byte}); read as Latin-1"]
-        parts, rows, meta = {}, [], None
+        parts, rows, meta, state = {}, [], None, {}
         total = 0
         try:
-            for s in _chunks(path, src, tuple(required), tuple(optional), columns, units, encoding, warnings):
+            for s in _chunks(path, src, tuple(required), tuple(optional), columns, units, encoding, warnings, state):
                 meta = s
                 for k in list(parts):
                     if k not in s.columns:  # a carried column that turned out to hold text: dropped whole
@@ -821,21 +903,20 @@ def read_series(path, required=("t",), *, optional=(), columns=None, units=None,
     del rows
     info = meta.measurement
     if "t" in out:
-        _check_time_unit(out["t"], info.get("_t_declared", False), meta.source, info["columns"]["t"])
-    info.pop("_t_declared", None)
+        _check_time_unit(out["t"], state["t_declared"], meta.source, info["columns"]["t"])
     return Series(columns=out, source=meta.source, measurement=info, warnings=meta.warnings, rows=np.asarray(lines))
 
 
 def iter_chunks(path, required=("t",), *, optional=(), columns=None, units=None, what="measured series",
-                check_time=True):
+                check_time=True, head=False):
     """Read a measured series chunk by chunk: :func:`read_series`'s reading, checks and messages, one
     :class:`Series` per chunk (consecutive rows; ``t`` of timestamps from the file's first sample; every
     chunk's ``measurement`` the same dict, complete once the file is read).
 
-    For a pass over a log of any length in bounded memory (no command uses it yet: ``heavecomp monitor``
-    reads its log whole, through :func:`heavecomp.diagnosis.data.load_run`): only one chunk's
-    arrays are held.  A carried (non-contract) column that holds text in a later chunk is left out from
-    there on.
+    For a pass over a log of any length in bounded memory: only one chunk's arrays are held.  A carried
+    (non-contract) column that holds text in a later chunk is left out from there on.  ``head`` reads the
+    log's start only, for the checks before any work (:func:`heavecomp.diagnosis.data.check_head`, a
+    fleet's :func:`heavecomp.campaign.fleet.check_log`): one chunk, of a MATLAB file without rows.
 
     Parameters
     ----------
@@ -854,25 +935,31 @@ def iter_chunks(path, required=("t",), *, optional=(), columns=None, units=None,
     check_time : bool
         Check on the first chunk that undeclared time does not look like milliseconds (interval and
         span; :func:`read_series` checks the whole column instead).
+    head : bool
+        Yield the first chunk only: a text log's first :data:`FIRST_CHUNK_BYTES`, a Parquet file's first
+        :data:`HEAD_ROWS` rows, a MATLAB file's columns from its variable headers (``scipy.io.whosmat``:
+        the mapping and units checked, no samples read; arrays of length 0).
 
     Yields
     ------
     Series
         The next rows, contract columns in SI units, ``rows`` their file lines.
     """
-    path = Path(path)
-    src = short(path)
+    path, src = _source(path)
     columns, units = check_spec(columns, units, "measurement")
     byte = None
     for encoding in ("utf-8-sig", "latin-1"):
         warnings: list[str] = [] if byte is None else [f"not UTF-8 (byte {byte}); read as Latin-1"]
-        started = False
+        started, state = False, {}
         try:
-            for s in _chunks(path, src, tuple(required), tuple(optional), columns, units, encoding, warnings):
+            for s in _chunks(path, src, tuple(required), tuple(optional), columns, units, encoding, warnings, state,
+                             head):
                 if check_time and not started and "t" in s.columns:
-                    _check_time_unit(s.columns["t"], s.measurement["_t_declared"], src, s.measurement["columns"]["t"])
+                    _check_time_unit(s.columns["t"], state["t_declared"], src, s.measurement["columns"]["t"])
                 started = True
                 yield s
+                if head:
+                    return
             return
         except _NotUTF8 as exc:
             if started:  # the caller holds rows read as UTF-8 already: they cannot be read again
@@ -881,22 +968,24 @@ def iter_chunks(path, required=("t",), *, optional=(), columns=None, units=None,
             byte = exc.byte
 
 
-def _chunks(path, src, required, optional, columns, units, encoding, warnings):
-    """The Series of each chunk (see :func:`iter_chunks`)."""
+def _chunks(path, src, required, optional, columns, units, encoding, warnings, state, head=False):
+    """The Series of each chunk (see :func:`iter_chunks`); ``state`` receives what the reader itself
+    needs and the caller is not shown (``t_declared``: the time column's unit was declared or read)."""
     info = {"format": "csv"}
     kinds: list = []
-    header, chunks, scalars = _table(path, src, info, warnings, kinds, encoding)
+    header, chunks, scalars = _table(path, src, info, warnings, kinds, encoding, head)
     stream = scalars.pop("_stream", None)
     try:
         yield from _converted(header, chunks, scalars, info, src, required, optional, columns, units, warnings,
-                              kinds)
+                              kinds, state)
     finally:
         if stream is not None:
             stream.close()
 
 
-def _converted(header, chunks, scalars, info, src, required, optional, columns, units, warnings, kinds):
-    """The chunks' columns mapped, converted to SI and checked (see :func:`iter_chunks`)."""
+def _converted(header, chunks, scalars, info, src, required, optional, columns, units, warnings, kinds, state):
+    """The chunks' columns mapped, converted to SI and checked (see :func:`iter_chunks`); ``state`` as
+    :func:`_chunks`'s (kept out of ``info``, the ``measurement`` every caller sees)."""
     decimal = info.get("decimal", ".")
     chosen, norm = _choose(header, required, optional, columns, src)
     used_units, conversions, scale = _units(header, norm, chosen, units, src)
@@ -967,7 +1056,7 @@ def _converted(header, chunks, scalars, info, src, required, optional, columns, 
             for name in list(used_units):
                 if used_units[name] is None:
                     used_units[name] = f"{SI[KINDS[name]]} (assumed)"
-            info["_t_declared"] = "t" in chosen and ("t" in units or norm[chosen["t"]][1] is not None
+            state["t_declared"] = "t" in chosen and ("t" in units or norm[chosen["t"]][1] is not None
                                                     or used_units["t"] == "timestamp")
             kinds[:] = ["drop"] * len(header)
             for name, j in chosen.items():
