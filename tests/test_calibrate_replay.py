@@ -86,6 +86,10 @@ def _reproduces_the_reported_shrink(case, diagnosed):
 
 
 def _rediagnosis_reads_none_or_a_smaller_gap(case, diagnosed):
+    if case == "none":
+        # calibrated.toml equals the nominal file (asserted above): its re-diagnosis is the first diagnosis
+        # again, input for input, and the first read ``none`` (asserted above) -- not run twice
+        return
     d, diag = diagnosed(case)
     out = d / "rediag"
     assert main(["diagnose", str(d / "run.csv"), "--params", str(d / "diag" / "calibrated.toml"), "--out", str(out),

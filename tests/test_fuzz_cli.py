@@ -3,7 +3,7 @@ parameter files and corrupted logs give no traceback, no hang and no confident v
 
 The fast tests run the generators of the fuzz script in-process (``cli.main`` for the parameter files,
 ``load_run`` for the logs: the input checks, not the diagnosis); the slow one runs the script itself
-(``--quick``: 30 files and 4 logs (one clean, three corruption classes) through the CLI in subprocesses, each diagnosed; every corruption class is fuzzed in process by test_fuzz_inputs)."""
+(``--quick``: 12 files and 4 logs (one clean, three corruption classes) through the CLI in subprocesses, each diagnosed; every corruption class is fuzzed in process by test_fuzz_inputs)."""
 
 import importlib.util
 import random

@@ -333,10 +333,10 @@ def main(argv=None):
     ap.add_argument("--seed", type=int, default=21)
     ap.add_argument("--jobs", type=int, default=3, help="subprocesses at once")
     ap.add_argument("--out", default=None, help="results json")
-    ap.add_argument("--quick", action="store_true", help="the test suite's small run (30 files, 4 logs of 75 s)")
+    ap.add_argument("--quick", action="store_true", help="the test suite's small run (12 files, 4 logs of 75 s)")
     a = ap.parse_args(argv)
     if a.quick:
-        a.params, a.simulate, a.logs, a.duration = 30, 0, 4, 75.0
+        a.params, a.simulate, a.logs, a.duration = 12, 0, 4, 75.0
     t0 = time.time()
     rows_p, rows_l = [], []
     with tempfile.TemporaryDirectory(prefix="heavecomp_fuzz_") as tmp:
