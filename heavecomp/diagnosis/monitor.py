@@ -137,6 +137,14 @@ MIN_EXCITATION = 0.5
 #: smallest block-to-block noise of a standardised block coefficient, as a share of its median
 #: magnitude (a feature the residual never carries would otherwise be standardised by ~0) [-]
 COEF_SIGMA_MIN = 1e-3
+#: follow every equation's block constant (the top-mass balance has none in its split): the force balance of
+#: the mean.  A WOB load-cell gain scales the measured WOB as a whole while the stroke, pressure and heave,
+#: and the compensator's balance that sets the static WOB, are unchanged: the top-mass balance's constant
+#: moves by the misread mean load, with the lower-mass balance (both read the WOB: ``sensors``).  A softer
+#: formation changes the dynamics (the lower-mass coefficients) and leaves the mean's balance.  Without it
+#: the top-mass balance was seen only through its mean square, which stick-slip bursts under a JONSWAP sea
+#: standardise by a wide scale: a WOB gain moved it 2.6 sigmas (buoy: 12) and was named string_formation
+BALANCE_CONSTANT = True
 RIDGE = 1e-6  #: relative ridge of a block's normalised normal equations (features of unit scale) [-]
 OP_CHANNELS = ("heave", "stroke", "pressure", "wob")
 MIN_DURATION = 120.0  #: shortest log monitored [s]: a reference stretch of LEARN blocks and as many to compare
@@ -491,13 +499,17 @@ def coefficient_features() -> dict:
     """{equation: ((component, feature), ...)}: the features whose block coefficients the monitor follows
     (the equation's own split, :data:`heavecomp.diagnosis.components.SPLIT`, less :data:`NOT_PER_BLOCK`;
     the own component's nominal structure, ``components.STRUCTURE``, where the split lists none: the
-    seal friction's sign(v) and v in the top-mass balance)."""
+    seal friction's sign(v) and v in the top-mass balance; with :data:`BALANCE_CONSTANT`, every
+    equation's constant, under its own component: the top-mass balance's is the force balance of the
+    mean, which a misread load moves and a seal friction, odd in v, does not)."""
     out = {}
     for e, split in CR.SPLIT.items():
         keys = [(c, f) for c, fs in split.items() for f in fs if f not in NOT_PER_BLOCK]
         own = CR.OWN[e]
         if not split.get(own):
             keys += [(own, f) for f in CR.STRUCTURE.get(own, ())]
+        if BALANCE_CONSTANT and not any(f == "const" for _, f in keys):
+            keys.append((own, "const"))
         out[e] = tuple(keys)
     return out
 
