@@ -264,6 +264,38 @@ def test_a_wob_gain_under_jonswap_is_sensors_a_formation_is_string_formation(lab
     assert eff[0]["component"] == want
 
 
+def test_friction_in_one_stroke_band_is_found_in_its_band_and_named_friction():
+    """A worn band of the bore: the friction the top-mass balance needs grows in one stroke band only.
+    Its block mean per band (residual x sign(v)) steps there; the whole-stroke coefficients (flat here)
+    would dilute it. Found in that band's series, named friction; nothing before the step."""
+    nb, k_worn = 400, 2
+    sums = _sums(nb=nb, seed=3)
+    rng = np.random.default_rng(4)
+    nbands = M.STROKE_BANDS
+    sums.band_count["top_mass"] = np.full((nb, nbands), 25.0)
+    mean = rng.normal(0.0, 1.0, (nb, nbands))
+    mean[200:, k_worn] += 3.0  # 3 block sigmas in the worn band from block 200
+    sums.band_sum["top_mass"] = mean * 25.0
+    ch = M.component_changes(sums, np.arange(nb) * 10.0, 10.0, [])
+    assert ch and 2000.0 <= ch[0]["t"] <= 2100.0
+    assert ch[0]["column"] == f"top_mass:band{k_worn}" and ch[0]["component"] == "friction"
+
+
+@pytest.mark.slow
+def test_a_position_friction_is_detected_in_its_stroke_band():
+    """The buoy log of the fifth scoring set (spent seed 450015, 10 Hz) with a position friction at 5x its
+    noise half-way: not detected by the whole-stroke statistics; with the stroke bands it is, as friction,
+    and nothing is raised before it."""
+    from heavecomp.benchmark.long_logs import long_log
+
+    seed = 450015
+    tc = float(np.random.default_rng(seed).uniform(0.4, 0.6)) * 2400.0
+    tr = long_log([(tc, "position_friction")], seed=seed, duration=2400.0, rate=10.0, sea="buoy")
+    ch = M.monitor(tr.to_run(), tr.nominal).changes
+    assert ch and ch[0]["t"] >= tc - 10.0
+    assert ch[0]["t"] <= tc + 300.0 and ch[0]["component"] == "friction"
+
+
 def test_a_segment_is_sliced_with_its_own_clock_and_only_effect_segments_carry_a_gap():
     from heavecomp.diagnosis.data import MeasuredRun
 
