@@ -10,6 +10,9 @@ effect class (optionally jointly after ``fixed`` configurations already fitted):
   linear least squares per channel, refined through the replay on stroke and WOB;
 - :func:`fit_delay_output` -- a channel delay (sensor_delay): a scan refined by a bounded scalar search.
 
+A nominal candidate (``parameter_mismatch``) goes through the replay too, by a forward stepwise
+refit (:func:`stepwise`): only the parameters the fit part asks for are released.
+
 :func:`fit` picks the strategy; :func:`score` turns a fit into a :class:`CandidateFit`, its held-out
 record (the rows of ``diagnosis.json``'s ``candidates``).
 """
@@ -245,7 +248,8 @@ def fit_cost(ctx, name) -> float:
     starts the costliest first so that no long fit is left running alone at the end.  A plant effect
     replays on the library stepper (~1.5x the plain one) ~40 times (grid + Nelder-Mead), weighted
     2.7 per replay (the order bench_600s was measured with; 1.5 measured the same under load); the
-    six-parameter refit ~100 times on the plain stepper (least squares + rescan); an output
+    six-parameter refit ~300 times on the plain stepper (the stepwise refit: about half of them
+    single-parameter scans on the grid span; seeds 116, 117 of the loop scenario); an output
     candidate a few times.  The order changes no result (every fit is independent).
 
     Parameters
@@ -258,6 +262,8 @@ def fit_cost(ctx, name) -> float:
     cls = candidate_class(ctx, name)
     if cls.kind == "output":
         return 1.0
+    if cls.kind == "nominal":
+        return 300.0
     per_replay = 2.7 if cls.kind == "plant" else 1.0
     return per_replay * (40.0 if cls.n_params() <= 2 else 100.0)
 
@@ -327,8 +333,13 @@ def fit_replayed(ctx, cls, start=None, fixed=(), *, search=Search(), hint=None) 
 
     # a joint fit starts from the candidate's own fit, next to its optimum: a share of the budget
     budget = max(1, int(P.joint_nfev * search.max_nfev)) if fixed else search.max_nfev
+    t_grid = min(t_end, ctx.split["settle"] + P.grid_span)
+    if cls.kind == "nominal":  # a nominal refit releases only the parameters the fit part asks for
+        release = None if start is None else np.flatnonzero(x0 != cls.x0())
+        r = stepwise(fun, x0 if start else cls.x0(), lo, hi, budget, t_grid, P.refit_release, search, release)
+        return Fit(cls.from_x(r.x), sigma(cls, r), int(r.nfev), float(2 * r.cost))
     if start is None:
-        x0 = _start(cls, fun, x0, lo, hi, min(t_end, ctx.split["settle"] + P.grid_span), search.grid, hint)
+        x0 = _start(cls, fun, x0, lo, hi, t_grid, search.grid, hint)
     if x0.size <= 2:
         r = nelder_mead(fun, x0, lo, hi, budget)
     else:
@@ -336,6 +347,144 @@ def fit_replayed(ctx, cls, start=None, fixed=(), *, search=Search(), hint=None) 
         if start is None:
             r = rescan(cls, fun, r, lo, hi, ctx.replay.nominal, search)
     return Fit(cls.from_x(r.x), sigma(cls, r), int(r.nfev), float(2 * r.cost))
+
+
+def stepwise(fun, x0, lo, hi, budget, t_grid, release_share, search=Search(), release=None):
+    """Forward stepwise refit of a nominal parameter set (``parameter_mismatch``): from the nominal
+    ``x0``, the parameters are released one at a time.  Each step scans every parameter not yet
+    released alone (the others held; ``search.grid`` points over 10-90 % of its range on the first
+    ``t_grid`` s, refined by a bounded scalar search); the two whose scans cost least and the one the
+    linearised joint fit favours (:func:`_joint_pick`) are each refitted jointly with the released
+    ones on the whole fit part (Nelder-Mead up to two parameters, else least squares), and the
+    lowest fit cost is the step's candidate.  It is released only when it lowers the fit cost by at
+    least ``release_share`` of the nominal's; then the search stops, and every parameter not
+    released stays exactly nominal (its multiplier 1, its 1-sigma 0).  Releasing all parameters at once lets near-collinear ones (a
+    stiffer string against a softer gas spring, a viscous against a Coulomb force) trade off along a
+    valley, and the local fit from the nominal stalls in it (a planted gas-spring and Coulomb
+    mismatch refitted with every parameter moved, at eight times the truth's fit cost; the forward
+    search reaches the truth's).
+
+    Parameters
+    ----------
+    fun : callable
+        Residual vector of a fit vector ``x`` (and an optional end of the replay ``t_stop`` [s]).
+    x0 : numpy.ndarray
+        The start: the nominal fit vector (forward search), or an earlier refit's (``release``); the
+        parameters not released stay at it.
+    lo, hi : numpy.ndarray
+        Bounds of the fit vector.
+    budget : int
+        Evaluations of each joint refit.
+    t_grid : float [s]
+        End of the span the single-parameter scans are scored on.
+    release_share : float [-]
+        Least share of the nominal fit cost a release must remove (``VerdictPolicy.refit_release``).
+    search : Search
+        Scan points (``grid``) and threads of the least-squares Jacobian (``n_jobs``).
+    release : sequence of int, optional
+        Parameters released from the start (a joint fit from an earlier refit: its released set,
+        refitted from ``x0``); None: the forward search.
+    """
+    from scipy.optimize import minimize_scalar
+
+    def cost(x, t_stop=None):
+        r = fun(x) if t_stop is None else fun(x, t_stop)
+        return float(r @ r)
+
+    def refit(x, act):
+        act = np.asarray(act, dtype=int)
+
+        def f(z, t_stop=None):
+            xx = x.copy()
+            xx[act] = z
+            return fun(xx) if t_stop is None else fun(xx, t_stop)
+
+        z0 = np.clip(x[act], lo[act] + 1e-9, hi[act] - 1e-9)
+        r = nelder_mead(f, z0, lo[act], hi[act], budget) if act.size <= 2 else \
+            least_squares(f, z0, lo[act], hi[act], budget, search.n_jobs)
+        xx = x.copy()
+        xx[act] = r.x
+        J = np.zeros((r.fun.size, x.size))
+        J[:, act] = r.jac
+        return types.SimpleNamespace(x=xx, fun=np.asarray(r.fun), jac=J, nfev=int(r.nfev), cost=float(r.cost))
+
+    x = np.asarray(x0, dtype=float).copy()
+    f0 = fun(x)
+    best = types.SimpleNamespace(x=x, fun=f0, jac=np.zeros((f0.size, x.size)), nfev=1, cost=0.5 * float(f0 @ f0))
+    c_nom, nfev = 2 * best.cost, 1
+    if release is not None:
+        if len(release):
+            best = refit(x, release)
+            nfev += best.nfev
+        best.nfev = nfev
+        return best
+    active: list = []
+    while len(active) < x.size:
+        base = best.x
+        rest = [j for j in range(x.size) if j not in active]
+        scanned = {}  # j -> (cost on the scan span with j alone released, its value)
+        for j in rest:
+            axis = np.linspace(lo[j] + 0.1 * (hi[j] - lo[j]), hi[j] - 0.1 * (hi[j] - lo[j]), search.grid)
+
+            def cj(v, j=j):
+                xx = base.copy()
+                xx[j] = v
+                return cost(xx, t_grid)
+
+            cs = [cj(v) for v in axis]
+            k = int(np.argmin(cs))
+            r = minimize_scalar(cj, bounds=(axis[max(k - 1, 0)], axis[min(k + 1, axis.size - 1)]), method="bounded",
+                                options={"xatol": 0.02, "maxiter": 8})
+            nfev += axis.size + int(r.nfev)
+            scanned[j] = (float(r.fun), float(r.x)) if r.fun < cs[k] else (cs[k], float(axis[k]))
+        # two ways to pick the next release: the largest drop with it alone released (far from the
+        # nominal, where the cost is far from quadratic), and the largest drop predicted jointly with
+        # the released ones (the Jacobian's column orthogonalised against theirs: a parameter
+        # near-collinear with a released one, e.g. the string against the formation stiffness, shows
+        # little alone but much jointly)
+        picks = sorted(rest, key=lambda j: scanned[j][0])[:2]
+        if active:
+            picks.append(_joint_pick(fun, base, best, active, rest, hi - lo))
+            nfev += len(rest)
+        trials = []
+        for j in dict.fromkeys(picks):
+            start = base.copy()
+            start[j] = scanned[j][1]
+            got = refit(start, active + [j])
+            nfev += got.nfev
+            trials.append((got.cost, j, got))
+            log.debug("diagnose: stepwise refit: releasing %s with %d: fit cost %.4g -> %.4g", active, j,
+                      2 * best.cost, 2 * got.cost)
+        _, j, got = min(trials, key=lambda t: t[0])
+        if 2 * got.cost > 2 * best.cost - release_share * c_nom:
+            log.debug("diagnose: stepwise refit stops: releasing parameter %d lowers the fit cost %.4g -> %.4g", j,
+                      2 * best.cost, 2 * got.cost)
+            break
+        active.append(j)
+        best = got
+    best.nfev = nfev
+    return best
+
+
+def _joint_pick(fun, base, best, active, rest, span) -> int:
+    """Of the parameters ``rest``, the one whose release jointly with the ``active`` ones the
+    linearised fit at ``base`` predicts to lower the cost most: its forward-difference Jacobian
+    column (step 3 % of its range), orthogonalised against the active ones' (``best.jac``), projected
+    on the residual ``best.fun`` (orthogonal matching pursuit)."""
+    r = np.asarray(best.fun, dtype=float)
+    JA = np.asarray(best.jac, dtype=float)[:, active]
+    Q, _ = np.linalg.qr(JA) if JA.size else (np.zeros((r.size, 0)), None)
+    gain = {}
+    for j in rest:
+        xx = base.copy()
+        h = 0.03 * span[j]
+        xx[j] += h
+        col = (fun(xx) - r) / h
+        q = col - Q @ (Q.T @ col)
+        qq = float(q @ q)
+        gain[j] = float(q @ r) ** 2 / qq if qq > 0 else 0.0
+    log.debug("diagnose: stepwise refit: predicted joint gains %s", gain)
+    return max(rest, key=lambda j: gain[j])
 
 
 def _start(cls, fun, x0, lo, hi, t_grid, grid, hint):

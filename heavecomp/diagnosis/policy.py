@@ -118,6 +118,11 @@ class VerdictPolicy:
     """... and by this share of its mean magnitude: guards against reading a time-varying effect
     as a constant parameter error."""
 
+    refit_release: float = 0.02
+    """Share of the nominal fit cost a parameter's release must remove for a ``parameter_mismatch``
+    refit to release it (forward stepwise, :func:`heavecomp.diagnosis.fitting.stepwise`): guards
+    against a refit that moves every nominal parameter along a valley of near-collinear ones."""
+
     # ---------------------------------------------------------------- search budget
     joint_nfev: float = 0.5
     """Share of ``max_nfev`` a joint second-effect fit gets (it starts from the candidate's own fit)."""

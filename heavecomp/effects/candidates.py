@@ -43,7 +43,8 @@ class MismatchParams:
 class ParameterMismatch(Effect):
     """``parameter_mismatch``: no missing physics; the nominal parameters are off.
 
-    Refits multipliers of six nominal parameters (:data:`MISMATCH_KEYS`); the
+    Refits multipliers of six nominal parameters (:data:`MISMATCH_KEYS`), releasing them
+    stepwise (:func:`heavecomp.diagnosis.fitting.stepwise`: those not released stay at 1); the
     report gives the refitted values and names those that moved.
     """
 

@@ -86,8 +86,13 @@ class GasHeatTransfer(Effect):
 
     @classmethod
     def null(cls, plant):
-        return {"effective_index": float(plant.PP[N]), "loss_coefficient": 0.0, "warming": 0.0,
-                "warming_time": 300.0}
+        """The nominal gas law: n_eff at the plant's index, no loss, no warming.  Without a ``plant``
+        (None: what :meth:`~heavecomp.effects.base.Effect.null_like` and a calibrated file's missing
+        parameters ask for) the values that need none: n_eff, the plant's own, is left out."""
+        out = {"loss_coefficient": 0.0, "warming": 0.0, "warming_time": 300.0}
+        if plant is not None:
+            out = {"effective_index": float(plant.PP[N]), **out}
+        return out
 
 
 EFFECT = GasHeatTransfer
