@@ -1,8 +1,7 @@
 """scenarios/campaign_default.py --quick: runs, writes its report, and friction orders the band exceedance."""
 
 import json
-import subprocess
-import sys
+import runpy
 from pathlib import Path
 
 import pytest
@@ -12,9 +11,8 @@ ROOT = Path(__file__).resolve().parents[1]
 
 @pytest.mark.slow
 def test_campaign_default_quick(tmp_path):
-    r = subprocess.run([sys.executable, str(ROOT / "scenarios" / "campaign_default.py"), "--quick", "--out",
-                        str(tmp_path)], capture_output=True, text=True)
-    assert r.returncode == 0, r.stderr
+    main = runpy.run_path(str(ROOT / "scenarios" / "campaign_default.py"), run_name="scenario")["main"]
+    assert main(["--quick", "--out", str(tmp_path)]) == 0  # in this process: the script's own work only
     m = json.loads((tmp_path / "metrics.json").read_text())
     lt = m["long_term"]
     assert m["n_runs"] == 81

@@ -1,14 +1,14 @@
 """Closed loop (issue 5): limits respected, MPC beats PID with a perfect model, failures handled."""
 
 import json
-import subprocess
-import sys
 
 import numpy as np
 import pytest
 
 from heavecomp.params import dumps, paper_a
 from heavecomp.closed_loop.loop import simulate_closed_loop
+
+from _cli import run as run_cli  # in this process: these tests check what the command writes or refuses
 
 
 def _u_rate(res):
@@ -186,8 +186,8 @@ def test_nonlinear_mpc_runs_within_limits_and_falls_back_on_nlp_failure():
 def test_cli_simulate_with_controller_writes_u_active_and_metrics(tmp_path):
     f = tmp_path / "p.toml"
     f.write_text(dumps(paper_a()))
-    r = subprocess.run([sys.executable, "-m", "heavecomp.cli", "simulate", str(f), "--duration", "30",
-                        "--out", str(tmp_path / "o"), "--controller", "linear-mpc"], capture_output=True, text=True)
+    r = run_cli("simulate", str(f), "--duration", "30",
+                "--out", str(tmp_path / "o"), "--controller", "linear-mpc")
     assert r.returncode == 0, r.stderr
     header = (tmp_path / "o" / "timeseries.csv").read_text().splitlines()[0].split(",")
     assert header[:5] == ["t", "heave", "stroke", "pressure", "wob"] and "u_active" in header
@@ -204,8 +204,8 @@ def test_cli_simulate_with_controller_writes_u_active_and_metrics(tmp_path):
 def test_cli_bad_active_table_exits_2_with_one_line(tmp_path):
     f = tmp_path / "p.toml"
     f.write_text(dumps(paper_a()) + "\n[active]\nu_max = -1.0\n")
-    r = subprocess.run([sys.executable, "-m", "heavecomp.cli", "simulate", str(f), "--duration", "10",
-                        "--out", str(tmp_path / "o"), "--controller", "pid"], capture_output=True, text=True)
+    r = run_cli("simulate", str(f), "--duration", "10",
+                "--out", str(tmp_path / "o"), "--controller", "pid")
     assert r.returncode == 2
     assert r.stderr.strip() == ("heavecomp simulate: error: active.u_max = -1 N is outside the possible "
                                 "range [1000, 1e+07] N")
@@ -214,9 +214,8 @@ def test_cli_bad_active_table_exits_2_with_one_line(tmp_path):
 def test_cli_closed_loop_rate_must_divide_the_control_rate(tmp_path):
     f = tmp_path / "p.toml"
     f.write_text(dumps(paper_a()))
-    r = subprocess.run([sys.executable, "-m", "heavecomp.cli", "simulate", str(f), "--duration", "10",
-                        "--out", str(tmp_path / "o"), "--controller", "pid", "--rate", "7"],
-                       capture_output=True, text=True)
+    r = run_cli("simulate", str(f), "--duration", "10",
+                "--out", str(tmp_path / "o"), "--controller", "pid", "--rate", "7")
     assert r.returncode == 2
     assert r.stderr.strip() == ("heavecomp simulate: error: --rate 7 Hz: a closed-loop run writes at the control "
                                 "rate [active].control_rate = 20 Hz or an integer fraction of it")
@@ -259,9 +258,8 @@ def test_measured_heave_record_covering_just_the_run_is_enough():
 def test_cli_bad_controller_option_exits_2_with_one_line(tmp_path, opt, msg):
     f = tmp_path / "p.toml"
     f.write_text(dumps(paper_a()))
-    r = subprocess.run([sys.executable, "-m", "heavecomp.cli", "simulate", str(f), "--duration", "10",
-                        "--out", str(tmp_path / "o"), "--controller", "linear-mpc", "--controller-option", opt],
-                       capture_output=True, text=True)
+    r = run_cli("simulate", str(f), "--duration", "10",
+                "--out", str(tmp_path / "o"), "--controller", "linear-mpc", "--controller-option", opt)
     assert r.returncode == 2
     assert r.stderr.strip() == f"heavecomp simulate: error: {msg}"
 
@@ -269,10 +267,9 @@ def test_cli_bad_controller_option_exits_2_with_one_line(tmp_path, opt, msg):
 def test_cli_controller_options_reach_the_controller(tmp_path):
     f = tmp_path / "p.toml"
     f.write_text(dumps(paper_a()))
-    r = subprocess.run([sys.executable, "-m", "heavecomp.cli", "simulate", str(f), "--duration", "10",
-                        "--out", str(tmp_path / "o"), "--controller", "linear-mpc", "--controller-option",
-                        "horizon=12", "--controller-option", "friction_feedforward=false"],
-                       capture_output=True, text=True)
+    r = run_cli("simulate", str(f), "--duration", "10",
+                "--out", str(tmp_path / "o"), "--controller", "linear-mpc", "--controller-option",
+                        "horizon=12", "--controller-option", "friction_feedforward=false")
     assert r.returncode == 0, r.stderr
     m = json.loads((tmp_path / "o" / "metrics.json").read_text())
     assert m["config"]["horizon"] == 12 and m["config"]["friction_feedforward"] is False
@@ -315,8 +312,8 @@ def test_options_with_an_own_controller_are_refused():
 def _cli(tmp_path, *extra):
     f = tmp_path / "p.toml"
     f.write_text(dumps(paper_a()))
-    return subprocess.run([sys.executable, "-m", "heavecomp.cli", "simulate", str(f), "--duration", "10",
-                           "--out", str(tmp_path / "o"), *extra], capture_output=True, text=True)
+    return run_cli("simulate", str(f), "--duration", "10",
+                "--out", str(tmp_path / "o"), *extra)
 
 
 @pytest.mark.slow

@@ -4,11 +4,12 @@ dropouts and jittered sampling, and the Python API's contract fields."""
 
 import json
 import math
-import subprocess
-import sys
+import runpy
 from pathlib import Path
 
 import pytest
+
+from _cli import run as run_cli  # in this process: these tests check what the command writes
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -52,9 +53,8 @@ def test_cli_diagnose_contract_json(tmp_path):
     f = tr.to_csv(tmp_path / "run.csv")
     toml = tmp_path / "nom.toml"
     toml.write_text(dumps(tr.nominal))
-    r = subprocess.run([sys.executable, "-m", "heavecomp.cli", "diagnose", str(f), "--params", str(toml), "--out",
-                        str(tmp_path / "out"), "--candidates", "sensor_delay,flow_loss,string_damping"],
-                       capture_output=True, text=True)
+    r = run_cli("diagnose", str(f), "--params", str(toml), "--out",
+                str(tmp_path / "out"), "--candidates", "sensor_delay,flow_loss,string_damping")
     assert r.returncode == 0, r.stderr[-2000:]
     d = json.loads((tmp_path / "out" / "diagnosis.json").read_text())
     assert d["schema"] == 3
@@ -95,9 +95,8 @@ def test_cli_diagnose_contract_json(tmp_path):
 def test_diagnosis_example_scenario_quick(tmp_path):
     """Withheld quadratic string drag: the linear-dashpot candidate fits a positive damping that
     shrinks the held-out WOB residual, and the report files are written."""
-    r = subprocess.run([sys.executable, str(ROOT / "scenarios" / "diagnosis_example.py"), "--quick", "--out",
-                        str(tmp_path)], capture_output=True, text=True)
-    assert r.returncode == 0, r.stderr[-2000:]
+    main = runpy.run_path(str(ROOT / "scenarios" / "diagnosis_example.py"), run_name="scenario")["main"]
+    assert main(["--quick", "--out", str(tmp_path)]) == 0  # in this process: the script's own work only
     m = json.loads((tmp_path / "metrics.json").read_text())
     sd = next(c for c in m["candidates"] if c["effect"] == "string_damping")
     assert sd["parameters"]["damping"] > 1e3

@@ -1,13 +1,12 @@
 """Issue 13.3 (output side): output paths are checked before any work; one line naming the flag, exit 2."""
 
-import subprocess
-import sys
 
 import pytest
 
+from _cli import run as run_cli
 
-def _run(*args, cwd=None):
-    return subprocess.run([sys.executable, "-m", "heavecomp", *args], capture_output=True, text=True, cwd=cwd)
+
+_run = run_cli  # in this process (tests/_cli.py): what the command writes or refuses
 
 
 def _one_line(r, *fragments):

@@ -1,13 +1,13 @@
 """Parameter files: the TOML contract, round trip, and every class of bad input (one line, exit 2)."""
 
 import math
-import subprocess
-import sys
 
 import pytest
 
 from heavecomp.errors import ParameterError
 from heavecomp.params import dumps, load, loads, paper_a
+
+from _cli import run as run_cli
 
 CONTRACT_EXAMPLE = """
 [heave]
@@ -130,8 +130,7 @@ def test_replace_is_validated():
         p.replace(friction={"coulomb_force": 30e3})
 
 
-def _cli(*args, cwd=None):
-    return subprocess.run([sys.executable, "-m", "heavecomp.cli", *args], capture_output=True, text=True, cwd=cwd)
+_cli = run_cli  # in this process (tests/_cli.py): what the command writes or refuses
 
 
 @pytest.mark.parametrize("desc,old,new,fragment", [BAD[0], BAD[6], BAD[10], BAD[13]], ids=["misspelt", "nan", "static<coulomb", "unit"])

@@ -5,9 +5,10 @@ import os
 import re
 import shutil
 import subprocess
-import sys
 
 import pytest
+
+from _cli import run as run_cli  # in this process: these tests check what the command writes
 
 
 def _browser():
@@ -24,8 +25,8 @@ def analysed(tmp_path_factory, ):
 
     d = tmp_path_factory.mktemp("html")
     (d / "p.toml").write_text(dumps(paper_a()))
-    r = subprocess.run([sys.executable, "-m", "heavecomp", "analyse", str(d / "p.toml"), "--out", str(d / "out"),
-                        "--points", "60", "-q"], capture_output=True, text=True)
+    r = run_cli("analyse", str(d / "p.toml"), "--out", str(d / "out"),
+                "--points", "60", "-q")
     assert r.returncode == 0, r.stderr
     return d / "out"
 

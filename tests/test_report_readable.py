@@ -1,12 +1,12 @@
 """Issue 13.7: reports people want to read — units in tables, figure defects fixed, modes sorted and named."""
 
 import re
-import subprocess
-import sys
 from types import SimpleNamespace
 
 import numpy as np
 import pytest
+
+from _cli import run as run_cli  # in this process: these tests check what the command writes
 
 
 def md_tables(text: str) -> list[list[str]]:
@@ -30,8 +30,8 @@ def assert_tables_have_units(text: str):
 
 
 def test_analysis_report_tables_have_units_and_sorted_named_modes(paper_a_toml, tmp_path):
-    r = subprocess.run([sys.executable, "-m", "heavecomp", "analyse", str(paper_a_toml), "--out", str(tmp_path),
-                        "--points", "40"], capture_output=True, text=True)
+    r = run_cli("analyse", str(paper_a_toml), "--out", str(tmp_path),
+                "--points", "40")
     assert r.returncode == 0, r.stderr
     text = (tmp_path / "report.md").read_text()
     assert_tables_have_units(text)

@@ -2,9 +2,6 @@
 from the folder's own parameter file give the same numbers; timings kept out of tracked results."""
 
 import json
-import os
-import subprocess
-import sys
 
 import numpy as np
 import pytest
@@ -12,13 +9,10 @@ import pytest
 from heavecomp.params import dumps, paper_a
 from heavecomp.simulate import excitation
 
+from _cli import run
 
-def _run(*args, cwd=None):
-    env = dict(os.environ)
-    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-    env["PYTHONPATH"] = root + os.pathsep + env.get("PYTHONPATH", "")
-    return subprocess.run([sys.executable, "-m", "heavecomp", *args], capture_output=True, text=True, cwd=cwd,
-                          env=env)
+
+_run = run  # in this process: these tests check the folders the commands write
 
 
 @pytest.fixture

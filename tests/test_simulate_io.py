@@ -1,8 +1,6 @@
 """simulate: CLI outputs, excitations (sine ramp, JONSWAP Hs/Tp, heave from file) and bad heave data."""
 
 import json
-import subprocess
-import sys
 
 import numpy as np
 import pytest
@@ -11,9 +9,10 @@ from heavecomp.errors import InputError
 from heavecomp.params import dumps, paper_a
 from heavecomp.simulate import excitation, simulate
 
+from _cli import run as run_cli
 
-def _cli(*args):
-    return subprocess.run([sys.executable, "-m", "heavecomp.cli", *args], capture_output=True, text=True)
+
+_cli = run_cli  # in this process (tests/_cli.py): what the command writes or refuses
 
 
 def test_cli_simulate_writes_contract_outputs(paper_a_toml, tmp_path):
