@@ -20,7 +20,9 @@ a sensor effect (``sensor_gain``,   an ``[[effects]]`` entry that corrects how a
 ``inconclusive``                  the nominal unchanged, a comment saying why
 ================================  ============================================================
 
-A second effect the diagnosis named (``verdict.second_effect``) is added the same way.
+A second effect the diagnosis named (``verdict.second_effect``) is added the same way.  Given the log
+(:func:`write`'s ``run``), a drifting effect's state at the log's start is fitted too (:func:`start_state`:
+a gas leak that began before the log is carried as ``charge_drift``, the charge at the log's start).
 
 :func:`replay_shrink` checks the calibrated model: it replays the log with it (the diagnosis' own
 replay, :class:`heavecomp.diagnosis.replay.Replay`) and measures the held-out shrink the diagnosis
@@ -48,6 +50,12 @@ from heavecomp.params import dumps
 
 #: file name of the calibrated model in the diagnosis folder
 FILE = "calibrated.toml"
+#: effects whose state drifts with no steady value (a log starts wherever the drift had got to), and the
+#: effect and parameter that hold that state at the log's start: a gas leak that began before the log has
+#: already moved the charge by then, which ``gas_leak`` (its change counted from the log's start) cannot say
+START_STATE = {"gas_leak": ("charge_drift", "charge_error")}
+#: function evaluations of the start-state refit (each one replay of the log)
+START_NFEV = 30
 
 
 @dataclass
@@ -61,11 +69,17 @@ class Calibrated:
     why: list = field(default_factory=list)
     expected_shrink: float = 0.0
     verdict: str = ""
+    #: the verdict's own held-out shrink when the calibrated model adds to what the verdict fitted (a start
+    #: state, :func:`start_state`), else None
+    verdict_shrink: float | None = None
 
     def block(self, path: str = FILE) -> dict:
         """The ``calibrated`` block of ``diagnosis.json`` (contract schema 3)."""
-        return {"path": path, "changes": self.changes, "expected_shrink": float(self.expected_shrink),
-                "verdict": self.verdict}
+        out = {"path": path, "changes": self.changes, "expected_shrink": float(self.expected_shrink),
+               "verdict": self.verdict}
+        if self.verdict_shrink is not None:
+            out["verdict_shrink"] = float(self.verdict_shrink)
+        return out
 
 
 def _entry(name: str, values: dict) -> tuple:
@@ -287,7 +301,7 @@ def to_toml(cal: Calibrated, source: str = "") -> str:
     return dumps(cal.params, header=header)
 
 
-def write(nominal, diagnosis: dict, out_dir, source: str = "") -> Calibrated:
+def write(nominal, diagnosis: dict, out_dir, source: str = "", run=None) -> Calibrated:
     """Write ``out_dir/calibrated.toml`` and return the :class:`Calibrated` model.
 
     Parameters
@@ -300,6 +314,9 @@ def write(nominal, diagnosis: dict, out_dir, source: str = "") -> Calibrated:
         Existing run folder the file is written into.
     source : str
         The measured log's name, for the header comment (empty: not named).
+    run : MeasuredRun, optional
+        The log as the diagnosis read it; given, the state a drifting effect had reached at the log's
+        start is fitted (:func:`start_state`).
     """
     from pathlib import Path
 
@@ -309,8 +326,97 @@ def write(nominal, diagnosis: dict, out_dir, source: str = "") -> Calibrated:
         cal = Calibrated(nominal, verdict=diagnosis["verdict"]["effect"],
                          why=[f"diagnosis verdict: {diagnosis['verdict']['effect']} -- its values cannot be written "
                               f"into a valid parameter file ({exc}); this is the nominal file"])
+    if run is not None and cal.changes:
+        cal = start_state(cal, run, diagnosis)
     (Path(out_dir) / FILE).write_text(to_toml(cal, source), encoding="utf-8")
     return cal
+
+
+# ------------------------------------------------------------------------------------ start state
+def start_state(cal: Calibrated, run, diagnosis: dict) -> Calibrated:
+    """The state a drifting effect of the calibrated model had reached when the log started.
+
+    An effect whose state drifts with no steady value (:data:`START_STATE`: ``gas_leak``) counts its
+    change from the log's start, but a log starts mid-operation: a leak that began before it has
+    already moved the charge.  The verdict's fit left that start state out (its candidate has no such
+    parameter), so the calibrated model would replay a charge that is right only at the log's first
+    sample plus the drift, and the re-diagnosis would find the difference as a constant pressure
+    offset.  Here the start state (``charge_drift.charge_error``, the charge at the log's start) and the
+    drift rate are refitted together on the diagnosis' fit part (``split.fit`` after ``split.settle``)
+    through the diagnosis' own replay (:func:`_replay`, as the re-diagnosis replays the file), every
+    channel weighted by its noise floor (``diagnosis.json`` ``noise_floor``); the held-out part is
+    left out of the fit and gives ``expected_shrink`` (1 - rms_after / rms_before of the verdict's
+    shrink channel, nominal replay before), the verdict's own shrink kept as ``verdict_shrink``.
+
+    Parameters
+    ----------
+    cal : Calibrated
+        The calibrated model (:func:`calibrate`).
+    run : MeasuredRun
+        The log as the diagnosis read it (its time from 0 at the analysed span's start).
+    diagnosis : dict
+        ``diagnosis.json`` content: ``split``, ``noise_floor``, ``verdict.shrink_channel``.
+
+    Returns
+    -------
+    Calibrated
+        ``cal`` itself when its model has no drifting effect, else a new one with the start state added.
+    """
+    from scipy.optimize import least_squares
+
+    drifting = [(i, n, v) for i, (n, v) in enumerate(cal.params.effects) if n in START_STATE]
+    if not drifting:
+        return cal
+    i, name, vals = drifting[0]
+    holder, key = START_STATE[name]
+    (rate_key,) = [f.name for f in classes()[name].fields()]
+    lo_h, hi_h = next(f.metadata["bounds"] for f in classes()[holder].fields() if f.name == key)
+    lo_r, hi_r = next(f.metadata["bounds"] for f in classes()[name].fields() if f.name == rate_key)
+    split, floor = diagnosis["split"], diagnosis.get("noise_floor", {})
+    chans = [c for c in ("wob", "stroke", "pressure") if c in run.columns and floor.get(c)]
+    t = run.t
+    fit = (t >= float(split.get("settle", 0.0))) & (t < float(split["fit"][1]))
+    base = [e for e in cal.params.effects if e[0] != holder]
+
+    def model(x):
+        fx = list(base)
+        fx[i] = (name, {**vals, rate_key: float(x[1])})
+        return cal.params.replace(effects=fx + [(holder, {key: float(x[0])})])
+
+    def resid(x):
+        pred = _replay(model(x), run)
+        parts = []
+        for c in chans:
+            m = fit & np.isfinite(run[c]) & np.isfinite(pred[c])
+            parts.append((pred[c][m] - run[c][m]) / float(floor[c]))
+        r = np.concatenate(parts)
+        return np.where(np.isfinite(r), r, 1e3)
+
+    r0 = float(vals[rate_key])
+    x0 = np.array([0.0, r0])
+    sol = least_squares(resid, x0, bounds=([lo_h, lo_r], [hi_h, hi_r]), x_scale=[1e-3, max(abs(r0), 1e-6)],
+                        max_nfev=START_NFEV)
+    r_x0 = resid(x0)
+    if float(sol.cost) >= 0.5 * float(r_x0 @ r_x0):  # the start at the log's first sample fits as well
+        return cal
+    spec = _entry(holder, {key: float(sol.x[0])})
+    params = model([spec[1][key], sol.x[1]])
+    ch = diagnosis["verdict"].get("shrink_channel", "wob")
+    val = (t >= float(split["validate"][0])) & np.isfinite(run[ch])
+
+    def rms(p):
+        return float(np.sqrt(np.mean((_replay(p, run)[ch][val] - run[ch][val]) ** 2)))
+
+    before = rms(cal.params.replace(effects=[e for e in cal.params.effects if e[0] not in (name, holder)]))
+    after = rms(params)
+    changes = [dict(c, parameters={**c["parameters"], rate_key: float(sol.x[1])})
+               if c.get("kind") == "effect" and c["name"] == name else c for c in cal.changes]
+    changes.append({"kind": "effect", "name": holder, "role": "plant", "parameters": spec[1], "start_state_of": name})
+    why = (f"start state: {name} counts its change from the log's start; the charge had already moved by "
+           f"{100 * spec[1][key]:+.3f} % when the log started ({holder}.{key}), refitted on the fit part with the "
+           f"{rate_key} ({r0:.4g} -> {sol.x[1]:.4g} 1/s)")
+    return Calibrated(params, changes, list(cal.why) + [why], 1.0 - after / before if before > 0 else
+                      cal.expected_shrink, cal.verdict, verdict_shrink=cal.expected_shrink)
 
 
 # ------------------------------------------------------------------------------------ replay
