@@ -545,6 +545,57 @@ def coefficient_features() -> dict:
     return out
 
 
+def _new_sums(cr, nb, feats) -> BlockSums:
+    """Empty block sums for the equations of the first chunk's residuals ``cr`` over ``nb`` blocks."""
+    sums = BlockSums({e: np.zeros(nb) for e in cr.equations}, {}, {e: np.zeros(nb) for e in cr.equations},
+                     {e: cr.noise[e] for e in cr.equations})
+    for e in cr.equations:
+        m = len(feats.get(e, ()))
+        sums.xtx[e], sums.xtr[e] = np.zeros((nb, m, m)), np.zeros((nb, m))
+    return sums
+
+
+def _open_bands(sums, cr, nb, xs) -> None:
+    """The stroke bands of :data:`BAND_EQUATION`: edges at the quantiles of the first chunk's stroke about
+    the segment's static stroke ``xs`` [m], and empty per-band sums over ``nb`` blocks."""
+    r = cr.equations[BAND_EQUATION]
+    ok = cr.mask & np.isfinite(r)
+    xr = cr.signals["x"][ok] - xs
+    sums.band_edges = (np.quantile(xr, np.arange(1, STROKE_BANDS) / STROKE_BANDS) if xr.size
+                       else np.zeros(STROKE_BANDS - 1))
+    sums.band_sum[BAND_EQUATION] = np.zeros((nb, STROKE_BANDS))
+    sums.band_count[BAND_EQUATION] = np.zeros((nb, STROKE_BANDS))
+
+
+def _add_chunk(sums, cr, blocks, loc, feats, xs) -> None:
+    """Add one chunk's residuals ``cr`` into ``sums`` for the blocks ``blocks`` (a slice), which start at the
+    chunk's samples ``loc[:-1]``: squared residual, count, regression sums, per-band sums and component
+    parts per equation."""
+    at = loc[:-1]
+    for e, r in cr.equations.items():
+        ok = cr.mask & np.isfinite(r)
+        sums.eq[e][blocks] = np.add.reduceat(np.where(ok, r * r, 0.0), at)
+        sums.count[e][blocks] = np.add.reduceat(ok.astype(float), at)
+        X = [np.where(ok, CR._column(cr.signals, f), 0.0) for _, f in feats.get(e, ())]
+        r0 = np.where(ok, r, 0.0)
+        if e in sums.band_sum:
+            band = np.searchsorted(sums.band_edges, cr.signals["x"] - xs)
+            rs = r0 * np.sign(cr.signals["v"])
+            for k in range(STROKE_BANDS):
+                inb = ok & (band == k)
+                sums.band_sum[e][blocks, k] = np.add.reduceat(np.where(inb, rs, 0.0), at)
+                sums.band_count[e][blocks, k] = np.add.reduceat(inb.astype(float), at)
+        for i, xi in enumerate(X):
+            sums.xtr[e][blocks, i] = np.add.reduceat(xi * r0, at)
+            for k in range(i + 1):
+                sums.xtx[e][blocks, i, k] = sums.xtx[e][blocks, k, i] = np.add.reduceat(xi * X[k], at)
+        for c in COMPONENTS:
+            part = cr.parts.get(c, {}).get(e)
+            if part is not None:
+                sums.parts.setdefault((c, e), np.zeros(sums.eq[e].size))[blocks] = \
+                    np.add.reduceat(np.where(ok, part * part, 0.0), at)
+
+
 def component_blocks(run, params, edges, op_bounds, op, noise, *, block=BLOCK, chunk=CHUNK, pad=PAD,
                      progress=None, equations=None) -> BlockSums:
     """Block sums of the equation residuals and their component parts (pass 2), chunk by chunk, each
@@ -599,44 +650,10 @@ def component_blocks(run, params, edges, op_bounds, op, noise, *, block=BLOCK, c
             if equations is not None:
                 cr.equations = {e: r for e, r in cr.equations.items() if e in equations}
             if sums is None:
-                sums = BlockSums({e: np.zeros(nb) for e in cr.equations}, {}, {e: np.zeros(nb) for e in cr.equations},
-                                 {e: cr.noise[e] for e in cr.equations})
-                for e in cr.equations:
-                    m = len(feats.get(e, ()))
-                    sums.xtx[e], sums.xtr[e] = np.zeros((nb, m, m)), np.zeros((nb, m))
-            loc = edges[a:b + 1] - j0
+                sums = _new_sums(cr, nb, feats)
             if STROKE_BANDS > 1 and BAND_EQUATION in cr.equations and BAND_EQUATION not in sums.band_sum:
-                r = cr.equations[BAND_EQUATION]
-                ok = cr.mask & np.isfinite(r)
-                xr = cr.signals["x"][ok] - xs
-                sums.band_edges = (np.quantile(xr, np.arange(1, STROKE_BANDS) / STROKE_BANDS) if xr.size
-                                   else np.zeros(STROKE_BANDS - 1))
-                sums.band_sum[BAND_EQUATION] = np.zeros((nb, STROKE_BANDS))
-                sums.band_count[BAND_EQUATION] = np.zeros((nb, STROKE_BANDS))
-            for e, r in cr.equations.items():
-                ok = cr.mask & np.isfinite(r)
-                sums.eq[e][a:b] = np.add.reduceat(np.where(ok, r * r, 0.0), loc[:-1])
-                sums.count[e][a:b] = np.add.reduceat(ok.astype(float), loc[:-1])
-                X = [np.where(ok, CR._column(cr.signals, f), 0.0) for _, f in feats.get(e, ())]
-                r0 = np.where(ok, r, 0.0)
-                if e in sums.band_sum:
-                    band = np.searchsorted(sums.band_edges, cr.signals["x"] - xs)
-                    rs = r0 * np.sign(cr.signals["v"])
-                    for k in range(STROKE_BANDS):
-                        inb = ok & (band == k)
-                        sums.band_sum[e][a:b, k] = np.add.reduceat(np.where(inb, rs, 0.0), loc[:-1])
-                        sums.band_count[e][a:b, k] = np.add.reduceat(inb.astype(float), loc[:-1])
-                for i, xi in enumerate(X):
-                    sums.xtr[e][a:b, i] = np.add.reduceat(xi * r0, loc[:-1])
-                    for k in range(i + 1):
-                        sums.xtx[e][a:b, i, k] = sums.xtx[e][a:b, k, i] = np.add.reduceat(xi * X[k], loc[:-1])
-                for c in COMPONENTS:
-                    part = cr.parts.get(c, {}).get(e)
-                    if part is not None:
-                        key = (c, e)
-                        if key not in sums.parts:
-                            sums.parts[key] = np.zeros(nb)
-                        sums.parts[key][a:b] = np.add.reduceat(np.where(ok, part * part, 0.0), loc[:-1])
+                _open_bands(sums, cr, nb, xs)
+            _add_chunk(sums, cr, slice(a, b), edges[a:b + 1] - j0, feats, xs)
             done += b - a
             if progress:
                 progress(done / max(nb, 1), f"component residuals to {t[i1 - 1]:.0f} s")
