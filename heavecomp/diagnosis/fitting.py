@@ -385,28 +385,12 @@ def stepwise(fun, x0, lo, hi, budget, t_grid, release_share, search=Search(), re
         Parameters released from the start (a joint fit from an earlier refit: its released set,
         refitted from ``x0``); None: the forward search.
     """
-    from scipy.optimize import minimize_scalar
-
     def cost(x, t_stop=None):
         r = fun(x) if t_stop is None else fun(x, t_stop)
         return float(r @ r)
 
     def refit(x, act):
-        act = np.asarray(act, dtype=int)
-
-        def f(z, t_stop=None):
-            xx = x.copy()
-            xx[act] = z
-            return fun(xx) if t_stop is None else fun(xx, t_stop)
-
-        z0 = np.clip(x[act], lo[act] + 1e-9, hi[act] - 1e-9)
-        r = nelder_mead(f, z0, lo[act], hi[act], budget) if act.size <= 2 else \
-            least_squares(f, z0, lo[act], hi[act], budget, search.n_jobs)
-        xx = x.copy()
-        xx[act] = r.x
-        J = np.zeros((r.fun.size, x.size))
-        J[:, act] = r.jac
-        return types.SimpleNamespace(x=xx, fun=np.asarray(r.fun), jac=J, nfev=int(r.nfev), cost=float(r.cost))
+        return _refit_subset(fun, x, act, lo, hi, budget, search.n_jobs)
 
     x = np.asarray(x0, dtype=float).copy()
     f0 = fun(x)
@@ -424,19 +408,16 @@ def stepwise(fun, x0, lo, hi, budget, t_grid, release_share, search=Search(), re
         rest = [j for j in range(x.size) if j not in active]
         scanned = {}  # j -> (cost on the scan span with j alone released, its value)
         for j in rest:
-            axis = np.linspace(lo[j] + 0.1 * (hi[j] - lo[j]), hi[j] - 0.1 * (hi[j] - lo[j]), search.grid)
+            axis = _grid_axis(lo[j], hi[j], search.grid)
 
             def cj(v, j=j):
                 xx = base.copy()
                 xx[j] = v
                 return cost(xx, t_grid)
 
-            cs = [cj(v) for v in axis]
-            k = int(np.argmin(cs))
-            r = minimize_scalar(cj, bounds=(axis[max(k - 1, 0)], axis[min(k + 1, axis.size - 1)]), method="bounded",
-                                options={"xatol": 0.02, "maxiter": 8})
+            c_k, x_k, r = _scan_refine(cj, axis, xatol=0.02, maxiter=8)
             nfev += axis.size + int(r.nfev)
-            scanned[j] = (float(r.fun), float(r.x)) if r.fun < cs[k] else (cs[k], float(axis[k]))
+            scanned[j] = (float(r.fun), float(r.x)) if r.fun < c_k else (c_k, x_k)
         # two ways to pick the next release: the largest drop with it alone released (far from the
         # nominal, where the cost is far from quadratic), and the largest drop predicted jointly with
         # the released ones (the Jacobian's column orthogonalised against theirs: a parameter
@@ -464,6 +445,45 @@ def stepwise(fun, x0, lo, hi, budget, t_grid, release_share, search=Search(), re
         best = got
     best.nfev = nfev
     return best
+
+
+def _refit_subset(fun, x, act, lo, hi, budget, n_jobs):
+    """The fit vector ``x`` with its entries ``act`` refitted (Nelder-Mead up to two, else least squares;
+    ``budget`` evaluations) and the rest held: a result with ``x``, ``fun``, ``jac`` (zero columns for the
+    held entries), ``nfev`` and ``cost`` (half the sum of squares)."""
+    act = np.asarray(act, dtype=int)
+
+    def f(z, t_stop=None):
+        xx = x.copy()
+        xx[act] = z
+        return fun(xx) if t_stop is None else fun(xx, t_stop)
+
+    z0 = np.clip(x[act], lo[act] + 1e-9, hi[act] - 1e-9)
+    r = nelder_mead(f, z0, lo[act], hi[act], budget) if act.size <= 2 else \
+        least_squares(f, z0, lo[act], hi[act], budget, n_jobs)
+    xx = x.copy()
+    xx[act] = r.x
+    J = np.zeros((r.fun.size, x.size))
+    J[:, act] = r.jac
+    return types.SimpleNamespace(x=xx, fun=np.asarray(r.fun), jac=J, nfev=int(r.nfev), cost=float(r.cost))
+
+
+def _grid_axis(lo, hi, n):
+    """``n`` scan points over 10-90 % of the range [``lo``, ``hi``] of one parameter."""
+    return np.linspace(lo + 0.1 * (hi - lo), hi - 0.1 * (hi - lo), n)
+
+
+def _scan_refine(obj, xs, **options):
+    """``obj`` at the points ``xs``, then a bounded scalar search between the best point's neighbours
+    (``options``: scipy's ``minimize_scalar`` options): the best point's value and position, and the
+    search's result (the callers choose between the two)."""
+    from scipy.optimize import minimize_scalar
+
+    costs = [obj(x) for x in xs]
+    k = int(np.argmin(costs))
+    r = minimize_scalar(obj, bounds=(xs[max(k - 1, 0)], xs[min(k + 1, xs.size - 1)]), method="bounded",
+                        options=options)
+    return costs[k], float(xs[k]), r
 
 
 def _joint_pick(fun, base, best, active, rest, span) -> int:
@@ -499,8 +519,7 @@ def _start(cls, fun, x0, lo, hi, t_grid, grid, hint):
             x0 = x_ee
     k = x0.size
     if k <= 2:
-        axes = [np.linspace(lo[i] + 0.1 * (hi[i] - lo[i]), hi[i] - 0.1 * (hi[i] - lo[i]),
-                            grid if k == 1 else max(3, (grid + 3) // 2)) for i in range(k)]
+        axes = [_grid_axis(lo[i], hi[i], grid if k == 1 else max(3, (grid + 3) // 2)) for i in range(k)]
         pts = np.array(np.meshgrid(*axes)).reshape(k, -1).T
         costs = [float(np.sum(fun(x, t_grid) ** 2)) for x in pts]
         c0 = float(np.sum(fun(x0, t_grid) ** 2))
@@ -674,8 +693,6 @@ def fit_delay_output(ctx, cls, fixed=()) -> Fit:
     fixed : sequence of (str, dict)
         Configurations ``(effect name, values)`` already fitted and held in the model.
     """
-    from scipy.optimize import minimize_scalar
-
     (field,) = cls.fields()
     a, b = field.metadata["bounds"]
     base = ctx.simulate(list(fixed), ctx.split["fit"][1])
@@ -688,10 +705,7 @@ def fit_delay_output(ctx, cls, fixed=()) -> Fit:
             pred[c] = cls.apply(base["t"], grid[:, 0], grid[:, SC.index(c)], x)
             r = ctx.resid_vec(pred)
             return float(r @ r)
-        xs = np.linspace(a, b, n_scan)
-        k = int(np.argmin([obj(x) for x in xs]))
-        r = minimize_scalar(obj, bounds=(xs[max(k - 1, 0)], xs[min(k + 1, xs.size - 1)]), method="bounded",
-                            options={"xatol": 1e-4})
+        _, _, r = _scan_refine(obj, np.linspace(a, b, n_scan), xatol=1e-4)
         if best is None or r.fun < best[0]:
             best = (r.fun, c, float(r.x))
     return Fit({"channel": best[1], field.name: best[2]}, {field.name: math.nan}, n_scan * len(ctx.channels), best[0])
