@@ -263,6 +263,31 @@ def check_run(t, columns: dict, *, params=None, source="<array>", rows=None) -> 
         if col in columns and np.isinf(columns[col]).any():
             raise DataError(f"{source}: column '{col}', row {line(np.flatnonzero(np.isinf(columns[col]))[0])}: non-finite value")
     _check_channels(columns, source)
+    _check_time(t, source, line)
+    # a channel the log lacks (contract schema 3): diagnosed without it, said once, with the way to map it
+    warnings = [f"no column '{c}': diagnosed with the channels present (if the log has it under another name, map "
+                f"it, {c}=NAME)" for c in OUTPUTS if c not in columns]
+    warnings += _check_missing(t, columns, checked, source, line)
+    angles = tuple(a for a in ANGLES if a in columns)
+    for col in angles:
+        rms = float(np.sqrt(np.nanmean(columns[col] ** 2)))
+        if rms > MAX_ANGLE_RMS:
+            raise DataError(f"{source}: column '{col}': rms {rms:.4g} rad ({math.degrees(rms):.0f} deg) is no vessel "
+                            f"angle — degrees? convert the column to rad or declare its unit, {col}=deg",
+                            option="units", example=f"{col}=deg")
+    d = np.diff(t)
+    if np.ptp(d) > 1e-6 * np.median(d):
+        warnings.append(f"non-uniform sampling (intervals {d.min():.4g}..{d.max():.4g} s): replay uses the "
+                        "actual times, spectra a uniform resampling")
+    run = MeasuredRun(t=t - t[0], columns=columns, source=source, warnings=warnings)
+    if params is not None:
+        check_units(run, params)
+    return run
+
+
+def _check_time(t, source, line) -> None:
+    """The time column: enough samples, finite, strictly increasing, in seconds, without long holes
+    (one line naming column 't' and the row, else nothing)."""
     if t.size < MIN_SAMPLES:
         raise DataError(f"{source}: column 't': need at least {MIN_SAMPLES} samples, got {t.size}")
     bad = np.flatnonzero(~np.isfinite(t))
@@ -283,9 +308,12 @@ def check_run(t, columns: dict, *, params=None, source="<array>", rows=None) -> 
         i = hole[0]
         raise DataError(f"{source}: column 't', row {line(i + 1)}: {t[i + 1] - t[i]:.3g} s without samples "
                         f"({t[i]:g} -> {t[i + 1]:g} s; longest bridged gap {MAX_GAP:g} s)")
-    # a channel the log lacks (contract schema 3): diagnosed without it, said once, with the way to map it
-    warnings = [f"no column '{c}': diagnosed with the channels present (if the log has it under another name, map "
-                f"it, {c}=NAME)" for c in OUTPUTS if c not in columns]
+
+
+def _check_missing(t, columns, checked, source, line) -> list:
+    """Missing samples per checked column: at most :data:`MAX_MISSING` of each, and the replay's inputs
+    (heave, vessel angles) without a dropout longer than :data:`MAX_GAP`; returns the warnings."""
+    warnings = []
     for col in checked:
         miss = ~np.isfinite(columns[col])
         frac = float(miss.mean())
@@ -295,8 +323,7 @@ def check_run(t, columns: dict, *, params=None, source="<array>", rows=None) -> 
         if miss.any():
             warnings.append(f"column '{col}': {int(miss.sum())} missing samples "
                             + ("interpolated in the replay input" if col not in CHANNELS else "excluded from the residuals"))
-    angles = tuple(a for a in ANGLES if a in columns)
-    for col in ("heave",) + angles:  # the replay's inputs: gaps bridged by interpolation
+    for col in ("heave",) + tuple(a for a in ANGLES if a in columns):  # the replay's inputs: gaps bridged by interpolation
         miss = ~np.isfinite(columns[col])
         for a, b in _runs(miss) if miss.any() else ():
             lo = t[max(a - 1, 0)]
@@ -304,20 +331,7 @@ def check_run(t, columns: dict, *, params=None, source="<array>", rows=None) -> 
             if hi - lo > MAX_GAP:
                 raise DataError(f"{source}: column '{col}', row {line(a)}: dropout of {hi - lo:.3g} s "
                                 f"(longest bridged gap {MAX_GAP:g} s)")
-    for col in angles:
-        rms = float(np.sqrt(np.nanmean(columns[col] ** 2)))
-        if rms > MAX_ANGLE_RMS:
-            raise DataError(f"{source}: column '{col}': rms {rms:.4g} rad ({math.degrees(rms):.0f} deg) is no vessel "
-                            f"angle — degrees? convert the column to rad or declare its unit, {col}=deg",
-                            option="units", example=f"{col}=deg")
-    d = np.diff(t)
-    if np.ptp(d) > 1e-6 * np.median(d):
-        warnings.append(f"non-uniform sampling (intervals {d.min():.4g}..{d.max():.4g} s): replay uses the "
-                        "actual times, spectra a uniform resampling")
-    run = MeasuredRun(t=t - t[0], columns=columns, source=source, warnings=warnings)
-    if params is not None:
-        check_units(run, params)
-    return run
+    return warnings
 
 
 def _check_channels(columns, source) -> None:
