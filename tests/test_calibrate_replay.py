@@ -21,7 +21,7 @@ from heavecomp.params import dumps
 
 pytestmark = pytest.mark.slow
 
-DURATION = 200.0
+DURATION = 120.0
 CASES = ("string_damping", "parameter_mismatch", "sensor_gain", "none")
 
 
