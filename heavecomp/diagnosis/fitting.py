@@ -248,8 +248,9 @@ def fit_cost(ctx, name) -> float:
     starts the costliest first so that no long fit is left running alone at the end.  A plant effect
     replays on the library stepper (~1.5x the plain one) ~40 times (grid + Nelder-Mead), weighted
     2.7 per replay (the order bench_600s was measured with; 1.5 measured the same under load); the
-    six-parameter refit ~300 times on the plain stepper (the stepwise refit: about half of them
-    single-parameter scans on the grid span; seeds 116, 117 of the loop scenario); an output
+    six-parameter refit ~800 times on the plain stepper (the stepwise refit: each step scans and
+    refits every parameter not yet released, ~6 x 55 replays on the first step, fewer later, and
+    its floating step as many per earlier release); an output
     candidate a few times.  The order changes no result (every fit is independent).
 
     Parameters
@@ -263,7 +264,7 @@ def fit_cost(ctx, name) -> float:
     if cls.kind == "output":
         return 1.0
     if cls.kind == "nominal":
-        return 300.0
+        return 800.0
     per_replay = 2.7 if cls.kind == "plant" else 1.0
     return per_replay * (40.0 if cls.n_params() <= 2 else 100.0)
 
@@ -336,7 +337,8 @@ def fit_replayed(ctx, cls, start=None, fixed=(), *, search=Search(), hint=None) 
     t_grid = min(t_end, ctx.split["settle"] + P.grid_span)
     if cls.kind == "nominal":  # a nominal refit releases only the parameters the fit part asks for
         release = None if start is None else np.flatnonzero(x0 != cls.x0())
-        r = stepwise(fun, x0 if start else cls.x0(), lo, hi, budget, t_grid, P.refit_release, search, release)
+        r = stepwise(fun, x0 if start else cls.x0(), lo, hi, budget, t_grid, P.refit_release, search, release,
+                     noise_cost(ctx), P.refit_f)
         return Fit(cls.from_x(r.x), sigma(cls, r), int(r.nfev), float(2 * r.cost))
     if start is None:
         x0 = _start(cls, fun, x0, lo, hi, t_grid, search.grid, hint)
@@ -349,20 +351,63 @@ def fit_replayed(ctx, cls, start=None, fixed=(), *, search=Search(), hint=None) 
     return Fit(cls.from_x(r.x), sigma(cls, r), int(r.nfev), float(2 * r.cost))
 
 
-def stepwise(fun, x0, lo, hi, budget, t_grid, release_share, search=Search(), release=None):
+def effective_samples(r) -> float:
+    """Independent samples [-] of a residual vector ``r`` whose samples are correlated: its length
+    over the integrated autocorrelation time 1 + 2 sum rho_k, the sum over the initial positive
+    sequence of the autocorrelation rho_k (Geyer's truncation); at least 1."""
+    r = np.asarray(r, dtype=float)
+    r = r - r.mean()
+    m = r.size
+    if m < 3 or not np.any(r):
+        return float(max(m, 1))
+    f = np.fft.rfft(r, 2 * m)
+    ac = np.fft.irfft(f * np.conj(f))[:m]
+    rho = ac / ac[0]
+    stop = np.flatnonzero(rho[1:] <= 0.0)
+    tau = 1.0 + 2.0 * float(np.sum(rho[1:1 + (stop[0] if stop.size else m - 1)]))
+    return float(max(m / tau, 1.0))
+
+
+def noise_cost(ctx) -> float:
+    """Expected fit cost [-] of the output noise alone: what a right model's replay leaves of the
+    weighted, decimated fit residual (:meth:`heavecomp.diagnosis.replay.ReplayContext.resid_vec`),
+    each channel's samples times its weight times its noise floor squared."""
+    total = 0.0
+    for c in ctx.channels:
+        n = int(np.count_nonzero((ctx.fitmask & np.isfinite(ctx.y[c][: ctx.fitmask.size]))[:: ctx.decimate]))
+        total += n * ctx.weights[c] * ctx.noise_floor[c] ** 2
+    return float(total)
+
+
+def stepwise(fun, x0, lo, hi, budget, t_grid, release_share, search=Search(), release=None, floor=0.0,
+             f_crit=0.0):
     """Forward stepwise refit of a nominal parameter set (``parameter_mismatch``): from the nominal
     ``x0``, the parameters are released one at a time.  Each step scans every parameter not yet
     released alone (the others held; ``search.grid`` points over 10-90 % of its range on the first
-    ``t_grid`` s, refined by a bounded scalar search); the two whose scans cost least and the one the
-    linearised joint fit favours (:func:`_joint_pick`) are each refitted jointly with the released
-    ones on the whole fit part (Nelder-Mead up to two parameters, else least squares), and the
-    lowest fit cost is the step's candidate.  It is released only when it lowers the fit cost by at
-    least ``release_share`` of the nominal's; then the search stops, and every parameter not
-    released stays exactly nominal (its multiplier 1, its 1-sigma 0).  Releasing all parameters at once lets near-collinear ones (a
-    stiffer string against a softer gas spring, a viscous against a Coulomb force) trade off along a
-    valley, and the local fit from the nominal stalls in it (a planted gas-spring and Coulomb
-    mismatch refitted with every parameter moved, at eight times the truth's fit cost; the forward
-    search reaches the truth's).
+    ``t_grid`` s, refined by a bounded scalar search) for its start, then refits every one of them
+    jointly with the released ones on the whole fit part (Nelder-Mead up to two parameters, else
+    least squares); the lowest fit cost is the step's candidate.  It is released only when it
+    passes a partial F-test of stepwise regression: it removes at least the share
+    max(``release_share``, ``f_crit`` / n_eff) of the fit cost still left (the current refit's cost,
+    and never less than the noise floor's expected cost ``floor``), n_eff the independent samples of
+    the current residual (:func:`effective_samples`: a replay residual is correlated over seconds,
+    so a short log asks more of a release); and nothing is released once the cost left is within
+    the noise's own spread of ``floor`` (under floor (1 + sqrt(2 ``f_crit`` / n_eff)), a chi-square's
+    relative spread at the same significance): what is left is noise.  Else the search stops, and
+    every parameter not released stays exactly nominal (its multiplier 1, its 1-sigma 0).
+
+    Releasing all parameters at once lets near-collinear ones (a stiffer string against a softer gas
+    spring, a viscous against a Coulomb force) trade off along a valley, and the local fit from the
+    nominal stalls in it (a planted gas-spring and Coulomb mismatch refitted with every parameter
+    moved, at eight times the truth's fit cost; the forward search reaches the truth's).  A bar on
+    the nominal cost instead of on what is left misses a second parameter near-collinear with the
+    first (the string stiffness once the formation's is released: 30 % of the cost left, 0.7 % of
+    the nominal's); trying only the best single-parameter scans misses it too (alone it shows little).
+    Forward selection alone keeps a first pick that only stood in for a near-collinear parameter
+    (loop seed 571008: a softer string and a lower Coulomb force refitted as a softer formation,
+    then the Coulomb, static, string and gas parameters to make up for it, at 1.3 times the truth's
+    cost); so after each release a floating step swaps an earlier release for each parameter not
+    released (it back at its start, the other scanned from there) while a swap lowers the cost.
 
     Parameters
     ----------
@@ -378,12 +423,17 @@ def stepwise(fun, x0, lo, hi, budget, t_grid, release_share, search=Search(), re
     t_grid : float [s]
         End of the span the single-parameter scans are scored on.
     release_share : float [-]
-        Least share of the nominal fit cost a release must remove (``VerdictPolicy.refit_release``).
+        Least share of the fit cost left that a release must remove (``VerdictPolicy.refit_release``).
     search : Search
         Scan points (``grid``) and threads of the least-squares Jacobian (``n_jobs``).
     release : sequence of int, optional
         Parameters released from the start (a joint fit from an earlier refit: its released set,
         refitted from ``x0``); None: the forward search.
+    floor : float [-]
+        Expected fit cost of the output noise alone (a model that is right leaves it); the cost the
+        share is taken of never drops under it.
+    f_crit : float [-]
+        Critical value of the partial F-test (``VerdictPolicy.refit_f``); 0: the share alone.
     """
     def cost(x, t_stop=None):
         r = fun(x) if t_stop is None else fun(x, t_stop)
@@ -392,10 +442,24 @@ def stepwise(fun, x0, lo, hi, budget, t_grid, release_share, search=Search(), re
     def refit(x, act):
         return _refit_subset(fun, x, act, lo, hi, budget, search.n_jobs)
 
+    def scan_start(base, j):
+        """``base`` with parameter ``j`` at the best point of a scan of it alone, and the evaluations."""
+        axis = _grid_axis(lo[j], hi[j], search.grid)
+
+        def cj(v):
+            xx = base.copy()
+            xx[j] = v
+            return cost(xx, t_grid)
+
+        c_k, x_k, r = _scan_refine(cj, axis, xatol=0.02, maxiter=8)
+        start = base.copy()
+        start[j] = float(r.x) if r.fun < c_k else x_k
+        return start, axis.size + int(r.nfev)
+
     x = np.asarray(x0, dtype=float).copy()
     f0 = fun(x)
     best = types.SimpleNamespace(x=x, fun=f0, jac=np.zeros((f0.size, x.size)), nfev=1, cost=0.5 * float(f0 @ f0))
-    c_nom, nfev = 2 * best.cost, 1
+    nfev = 1
     if release is not None:
         if len(release):
             best = refit(x, release)
@@ -406,43 +470,49 @@ def stepwise(fun, x0, lo, hi, budget, t_grid, release_share, search=Search(), re
     while len(active) < x.size:
         base = best.x
         rest = [j for j in range(x.size) if j not in active]
-        scanned = {}  # j -> (cost on the scan span with j alone released, its value)
-        for j in rest:
-            axis = _grid_axis(lo[j], hi[j], search.grid)
-
-            def cj(v, j=j):
-                xx = base.copy()
-                xx[j] = v
-                return cost(xx, t_grid)
-
-            c_k, x_k, r = _scan_refine(cj, axis, xatol=0.02, maxiter=8)
-            nfev += axis.size + int(r.nfev)
-            scanned[j] = (float(r.fun), float(r.x)) if r.fun < c_k else (c_k, x_k)
-        # two ways to pick the next release: the largest drop with it alone released (far from the
-        # nominal, where the cost is far from quadratic), and the largest drop predicted jointly with
-        # the released ones (the Jacobian's column orthogonalised against theirs: a parameter
-        # near-collinear with a released one, e.g. the string against the formation stiffness, shows
-        # little alone but much jointly)
-        picks = sorted(rest, key=lambda j: scanned[j][0])[:2]
-        if active:
-            picks.append(_joint_pick(fun, base, best, active, rest, hi - lo))
-            nfev += len(rest)
         trials = []
-        for j in dict.fromkeys(picks):
-            start = base.copy()
-            start[j] = scanned[j][1]
+        for j in rest:
+            # its start: the best point of a scan with it alone released (far from the nominal the
+            # cost is far from quadratic); then refitted jointly with the released ones (a parameter
+            # near-collinear with a released one, e.g. the string against the formation stiffness,
+            # shows little alone but much jointly)
+            start, n = scan_start(base, j)
             got = refit(start, active + [j])
-            nfev += got.nfev
+            nfev += n + got.nfev
             trials.append((got.cost, j, got))
             log.debug("diagnose: stepwise refit: releasing %s with %d: fit cost %.4g -> %.4g", active, j,
                       2 * best.cost, 2 * got.cost)
         _, j, got = min(trials, key=lambda t: t[0])
-        if 2 * got.cost > 2 * best.cost - release_share * c_nom:
+        n_eff = effective_samples(best.fun)
+        share = max(release_share, f_crit / n_eff) if f_crit > 0 else release_share
+        at_floor = 2 * best.cost <= floor * (1.0 + math.sqrt(2.0 * f_crit / n_eff))
+        if at_floor or 2 * (best.cost - got.cost) < share * max(2 * best.cost, floor):
             log.debug("diagnose: stepwise refit stops: releasing parameter %d lowers the fit cost %.4g -> %.4g", j,
                       2 * best.cost, 2 * got.cost)
             break
         active.append(j)
         best = got
+        # floating step: an earlier release may only have stood in for a parameter near-collinear
+        # with it (the formation stiffness for the string's in k_eff); each earlier one is swapped
+        # for each parameter not released (back at its start, the other scanned from there) and
+        # the lowest cost kept, as long as a swap lowers it
+        for _ in range(x.size):
+            swaps = []
+            for i in active[:-1]:
+                for k in [k for k in range(x.size) if k not in active]:
+                    held = best.x.copy()
+                    held[i] = x[i]
+                    start, n = scan_start(held, k)
+                    act = [a for a in active if a != i] + [k]
+                    got = refit(start, act)
+                    nfev += n + got.nfev
+                    swaps.append((got.cost, i, k, got))
+                    log.debug("diagnose: stepwise refit: swapping %d for %d: fit cost %.4g -> %.4g", i, k,
+                              2 * best.cost, 2 * got.cost)
+            if not swaps or min(swaps, key=lambda t: t[0])[0] >= best.cost:
+                break
+            _, i, k, best = min(swaps, key=lambda t: t[0])
+            active = [a for a in active if a != i] + [k]
     best.nfev = nfev
     return best
 
@@ -484,27 +554,6 @@ def _scan_refine(obj, xs, **options):
     r = minimize_scalar(obj, bounds=(xs[max(k - 1, 0)], xs[min(k + 1, xs.size - 1)]), method="bounded",
                         options=options)
     return costs[k], float(xs[k]), r
-
-
-def _joint_pick(fun, base, best, active, rest, span) -> int:
-    """Of the parameters ``rest``, the one whose release jointly with the ``active`` ones the
-    linearised fit at ``base`` predicts to lower the cost most: its forward-difference Jacobian
-    column (step 3 % of its range), orthogonalised against the active ones' (``best.jac``), projected
-    on the residual ``best.fun`` (orthogonal matching pursuit)."""
-    r = np.asarray(best.fun, dtype=float)
-    JA = np.asarray(best.jac, dtype=float)[:, active]
-    Q, _ = np.linalg.qr(JA) if JA.size else (np.zeros((r.size, 0)), None)
-    gain = {}
-    for j in rest:
-        xx = base.copy()
-        h = 0.03 * span[j]
-        xx[j] += h
-        col = (fun(xx) - r) / h
-        q = col - Q @ (Q.T @ col)
-        qq = float(q @ q)
-        gain[j] = float(q @ r) ** 2 / qq if qq > 0 else 0.0
-    log.debug("diagnose: stepwise refit: predicted joint gains %s", gain)
-    return max(rest, key=lambda j: gain[j])
 
 
 def _start(cls, fun, x0, lo, hi, t_grid, grid, hint):
