@@ -475,9 +475,14 @@ def stepwise(fun, x0, lo, hi, budget, t_grid, release_share, search=Search(), re
         ct = cost(xt)
         return (ct, xt) if ct < c1 else (c1, x1)
 
-    def passes(c, share):
-        """Whether a release that leaves the cost ``2 c`` passes the partial F-test at ``share``."""
-        return 2 * (best.cost - c) >= share * max(2 * best.cost, floor)
+    def share_of(r):
+        """The partial F-test's least share of the cost left, at the residual ``r`` (its n_eff)."""
+        return max(release_share, f_crit / effective_samples(r)) if f_crit > 0 else release_share
+
+    def passes(c, c_after, share):
+        """Whether a release that lowers the half cost ``c`` to ``c_after`` passes the partial F-test
+        at ``share`` (of the cost left before it, never counted under the noise's ``floor``)."""
+        return 2 * (c - c_after) >= share * max(2 * c, floor)
 
     def noise_left():
         """Whether the cost left is the output noise's (within its own spread at ``f_crit``)."""
@@ -495,27 +500,43 @@ def stepwise(fun, x0, lo, hi, budget, t_grid, release_share, search=Search(), re
         return best
     active: list = []
     floating = 0  # swaps left to try after the last release (the floating step)
-    while len(active) < x.size:
-        if not floating and noise_left():
+    for _ in range(4 * x.size):  # releases, drops and swaps (each drop or swap lowers a count or the cost)
+        if len(active) == x.size or not floating and noise_left():
             break
         rest = [j for j in range(x.size) if j not in active]
         if active:  # one forward-difference Jacobian at the current best, for the step's predictions
             J = _jacobian(fun, best, rest, lo, hi)
             nfev += len(rest)
-        if floating:
+        if floating and len(active) > 1:
             # floating step: an earlier release may only have stood in for a parameter near-collinear
-            # with it (the formation stiffness for the string's in k_eff); each swap of an earlier
-            # release (back at its start) for a parameter not released is predicted by the linearised
-            # fit and probed, the best probed refitted and kept only if its fit cost is lower
+            # with it (the formation stiffness for the string's in k_eff).  A release that no longer
+            # passes the test against the others is dropped: the one whose drop the linearised fit
+            # predicts to cost least, refitted when that prediction fails the test.  Else each swap
+            # of an earlier release (back at its start) for a parameter not released is predicted
+            # and probed, the best probed refitted and kept only if its fit cost is lower
             floating -= 1
-            probes = []
-            for i in active[:-1]:
-                held = best.fun + J[:, i] * (x[i] - best.x[i])  # the residual predicted with i back at its start
+            held = {i: best.fun + J[:, i] * (x[i] - best.x[i]) for i in active}  # i back at its start
+            moves = [(i, None) for i in active] + [(i, k) for i in active[:-1] for k in rest]  # drops, swaps
+            moves = [(i, [a for a in active if a != i], k) for i, k in moves]
+            lin = [(_lin_fit(J, held[i], act + ([] if k is None else [k])), i, k, act) for i, act, k in moves]
+            (c_l, dx), i, _, act = min((m for m in lin if m[2] is None), key=lambda m: m[0][0])
+            if not passes(0.5 * c_l, best.cost, share_of(held[i])):
                 origin = best.x.copy()
                 origin[i] = x[i]
-                for k in rest:
-                    act = [a for a in active if a != i] + [k]
-                    probes.append(probe(origin, held, J, _lin_fit(J, held, act)[1]) + (i, k, act))
+                c_p, start = probe(origin, held[i], J, dx)
+                got = refit(start, act)
+                nfev += 2 + got.nfev
+                log.debug("diagnose: stepwise refit: dropping %d (probed %.4g): fit cost %.4g -> %.4g", i, c_p,
+                          2 * best.cost, 2 * got.cost)
+                if not passes(got.cost, best.cost, share_of(got.fun)):
+                    active, best = act, got
+                    continue
+            probes = []
+            for (c_l, dx), i, k, act in lin:
+                if k is not None:
+                    origin = best.x.copy()
+                    origin[i] = x[i]
+                    probes.append(probe(origin, held[i], J, dx) + (i, k, act + [k]))
             nfev += 2 * len(probes)
             c_p, start, i, k, act = min(probes, key=lambda t: t[0])
             got = refit(start, act)
@@ -533,8 +554,7 @@ def stepwise(fun, x0, lo, hi, budget, t_grid, release_share, search=Search(), re
         # released one, e.g. the string against the formation stiffness, shows little alone but much
         # jointly), its actual cost probed along it (far from the nominal the linearised cost
         # misranks); the two best probed are refitted from their probes
-        n_eff = effective_samples(best.fun)
-        share = max(release_share, f_crit / n_eff) if f_crit > 0 else release_share
+        share = share_of(best.fun)
         if active:
             probes = sorted((probe(best.x, best.fun, J, _lin_fit(J, best.fun, active + [j])[1]) + (j,) for j in rest),
                             key=lambda t: t[0])
@@ -554,7 +574,7 @@ def stepwise(fun, x0, lo, hi, budget, t_grid, release_share, search=Search(), re
             log.debug("diagnose: stepwise refit: releasing %s with %d: fit cost %.4g -> %.4g", active, j,
                       2 * best.cost, 2 * got.cost)
         c, j, got = min(trials, key=lambda t: t[0])
-        if not passes(c, share):
+        if not passes(best.cost, c, share):
             log.debug("diagnose: stepwise refit stops: releasing parameter %d lowers the fit cost %.4g -> %.4g", j,
                       2 * best.cost, 2 * c)
             break
