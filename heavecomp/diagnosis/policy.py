@@ -128,7 +128,9 @@ class VerdictPolicy:
     noise-fitting release removed on loop seed 117 (0.6 % of the cost left, after the gas spring and
     the Coulomb force); the string stiffness next to a released formation's removed 6 % (loop seed
     116 at 300 s) and 30 % (loop seed 570008: 0.66 % of the nominal cost, which the former bar, 2 %
-    of the NOMINAL cost, did not release: the MPC on that refit recovered 0.11)."""
+    of the NOMINAL cost, did not release: the MPC on that refit recovered 0.11).  The floating step
+    drops a release that no longer passes the same test against the others (loop seed 570008 at
+    150 s: a Coulomb release at x1.03 stayed after the string had been swapped in)."""
     refit_f: float = 9.9
     """Critical value of the partial F-test a ``parameter_mismatch`` release must pass: it removes at
     least ``refit_f`` / n_eff of the fit cost still left, n_eff the independent samples of the current
