@@ -453,136 +453,166 @@ def stepwise(fun, x0, lo, hi, budget, t_grid, release_share, search=Search(), re
     f_crit : float [-]
         Critical value of the partial F-test (``VerdictPolicy.refit_f``); 0: the share alone.
     """
-    def cost(x):
-        r = fun(x)
-        return float(r @ r)
-
-    def refit(x, act):
-        return _refit_subset(fun, x, act, lo, hi, budget, search.n_jobs)
-
-    def probe(origin, r0, J, dx):
-        """The actual fit cost along the linearised fit's step ``dx`` from ``origin`` (its residual
-        ``r0``, or its prediction): at the full step, then at the minimum of the parabola through the
-        cost at the origin, its slope there (from ``J``) and the full step's cost (far from the
-        nominal the cost is far from quadratic, so the full step can overshoot a parameter whose
-        response bends).  Returns the lower cost and its point (clipped to the bounds)."""
-        c0, g = float(r0 @ r0), 2.0 * float(r0 @ (J @ dx))
-        x1 = np.clip(origin + dx, lo + 1e-9, hi - 1e-9)
-        c1 = cost(x1)
-        a = c1 - c0 - g
-        t = float(np.clip(-g / (2 * a), 0.2, 2.0)) if a > 0 else 2.0
-        xt = np.clip(origin + t * dx, lo + 1e-9, hi - 1e-9)
-        ct = cost(xt)
-        return (ct, xt) if ct < c1 else (c1, x1)
-
-    def share_of(r):
-        """The partial F-test's least share of the cost left, at the residual ``r`` (its n_eff)."""
-        return max(release_share, f_crit / effective_samples(r)) if f_crit > 0 else release_share
-
-    def passes(c, c_after, share):
-        """Whether a release that lowers the half cost ``c`` to ``c_after`` passes the partial F-test
-        at ``share`` (of the cost left before it, never counted under the noise's ``floor``)."""
-        return 2 * (c - c_after) >= share * max(2 * c, floor)
-
-    def noise_left():
-        """Whether the cost left is the output noise's (within its own spread at ``f_crit``)."""
-        return 2 * best.cost <= floor * (1.0 + math.sqrt(2.0 * f_crit / effective_samples(best.fun)))
-
-    x = np.asarray(x0, dtype=float).copy()
-    f0 = fun(x)
-    best = types.SimpleNamespace(x=x, fun=f0, jac=np.zeros((f0.size, x.size)), nfev=1, cost=0.5 * float(f0 @ f0))
-    nfev = 1
+    S = _Stepwise(fun, np.asarray(x0, dtype=float).copy(), lo, hi, budget, search.n_jobs, release_share, floor,
+                  f_crit)
+    x, best = S.x0, S.nominal()
     if release is not None:
         if len(release):
-            best = refit(x, release)
-            nfev += best.nfev
-        best.nfev = nfev
+            best = S.refit(x, release)
+        best.nfev = S.nfev
         return best
     active: list = []
     floating = 0  # swaps left to try after the last release (the floating step)
     for _ in range(4 * x.size):  # releases, drops and swaps (each drop or swap lowers a count or the cost)
-        if len(active) == x.size or not floating and noise_left():
+        if len(active) == x.size or not floating and S.noise_left(best):
             break
         rest = [j for j in range(x.size) if j not in active]
-        if active:  # one forward-difference Jacobian at the current best, for the step's predictions
-            J = _jacobian(fun, best, rest, lo, hi)
-            nfev += len(rest)
+        J = S.jacobian(best, rest) if active else None  # one Jacobian at the current best, for the predictions
         if floating and len(active) > 1:
-            # floating step: an earlier release may only have stood in for a parameter near-collinear
-            # with it (the formation stiffness for the string's in k_eff).  A release that no longer
-            # passes the test against the others is dropped: the one whose drop the linearised fit
-            # predicts to cost least, refitted when that prediction fails the test.  Else each swap
-            # of an earlier release (back at its start) for a parameter not released is predicted
-            # and probed, the best probed refitted and kept only if its fit cost is lower
             floating -= 1
-            held = {i: best.fun + J[:, i] * (x[i] - best.x[i]) for i in active}  # i back at its start
-            moves = [(i, None) for i in active] + [(i, k) for i in active[:-1] for k in rest]  # drops, swaps
-            moves = [(i, [a for a in active if a != i], k) for i, k in moves]
-            lin = [(_lin_fit(J, held[i], act + ([] if k is None else [k])), i, k, act) for i, act, k in moves]
-            (c_l, dx), i, _, act = min((m for m in lin if m[2] is None), key=lambda m: m[0][0])
-            if not passes(0.5 * c_l, best.cost, share_of(held[i])):
-                origin = best.x.copy()
-                origin[i] = x[i]
-                c_p, start = probe(origin, held[i], J, dx)
-                got = refit(start, act)
-                nfev += 2 + got.nfev
-                log.debug("diagnose: stepwise refit: dropping %d (probed %.4g): fit cost %.4g -> %.4g", i, c_p,
-                          2 * best.cost, 2 * got.cost)
-                if not passes(got.cost, best.cost, share_of(got.fun)):
-                    active, best = act, got
-                    continue
-            probes = []
-            for (c_l, dx), i, k, act in lin:
-                if k is not None:
-                    origin = best.x.copy()
-                    origin[i] = x[i]
-                    probes.append(probe(origin, held[i], J, dx) + (i, k, act + [k]))
-            nfev += 2 * len(probes)
-            c_p, start, i, k, act = min(probes, key=lambda t: t[0])
-            got = refit(start, act)
-            nfev += got.nfev
-            log.debug("diagnose: stepwise refit: swapping %d for %d (probed %.4g): fit cost %.4g -> %.4g", i, k,
-                      c_p, 2 * best.cost, 2 * got.cost)
-            if got.cost < best.cost:
-                active, best = act, got
+            moved = S.floating(best, active, rest, J)
+            if moved is not None:
+                active, best = moved
                 continue
             floating = 0
-            if noise_left():
+            if S.noise_left(best):
                 break
-        # the next release: each parameter not released at the point the linearised JOINT fit with the
-        # released ones predicts (orthogonal matching pursuit: a parameter near-collinear with a
-        # released one, e.g. the string against the formation stiffness, shows little alone but much
-        # jointly), its actual cost probed along it (far from the nominal the linearised cost
-        # misranks); the two best probed are refitted from their probes
-        share = share_of(best.fun)
-        if active:
-            probes = sorted((probe(best.x, best.fun, J, _lin_fit(J, best.fun, active + [j])[1]) + (j,) for j in rest),
-                            key=lambda t: t[0])
-            nfev += 2 * len(probes)
-            log.debug("diagnose: stepwise refit: probed costs %s", [(p[2], round(p[0], 4)) for p in probes])
-            picks = [(j, start if c_p < 2 * best.cost else best.x) for c_p, start, j in probes[:2]]
-        else:
-            # from the nominal the linearised fit is poorest (a stiffness 40 % off): the first
-            # release's two picks are the best single-parameter scans
-            picks = _best_scans(fun, x, lo, hi, t_grid, search.grid)[:2]
-            nfev += x.size * search.grid
+        # the next release: two picks (the best scans from the nominal, else the best probed joint
+        # predictions), each refitted jointly with the released ones; the lower kept if it passes
+        share = S.share_of(best.fun)
+        picks = S.probed_picks(best, active, rest, J) if active else S.scanned_picks(t_grid, search.grid)
         trials = []
         for j, start in picks:
-            got = refit(start, active + [j])
-            nfev += got.nfev
+            got = S.refit(start, active + [j])
             trials.append((got.cost, j, got))
             log.debug("diagnose: stepwise refit: releasing %s with %d: fit cost %.4g -> %.4g", active, j,
                       2 * best.cost, 2 * got.cost)
         c, j, got = min(trials, key=lambda t: t[0])
-        if not passes(best.cost, c, share):
+        if not S.passes(best.cost, c, share):
             log.debug("diagnose: stepwise refit stops: releasing parameter %d lowers the fit cost %.4g -> %.4g", j,
                       2 * best.cost, 2 * c)
             break
         active.append(j)
         best = got
         floating = x.size if len(active) > 1 else 0
-    best.nfev = nfev
+    best.nfev = S.nfev
     return best
+
+
+class _Stepwise:
+    """The evaluations of :func:`stepwise`: the residual ``fun`` of a fit vector, its bounds, the
+    joint refit's ``budget`` and threads, the partial F-test's ``release_share``, ``floor`` and
+    ``f_crit``, and the count of evaluations ``nfev`` (a refit's own count included)."""
+
+    def __init__(self, fun, x0, lo, hi, budget, n_jobs, release_share, floor, f_crit):
+        self.fun, self.x0, self.lo, self.hi, self.budget, self.n_jobs = fun, x0, lo, hi, budget, n_jobs
+        self.release_share, self.floor, self.f_crit = release_share, floor, f_crit
+        self.nfev = 0
+
+    def cost(self, x) -> float:
+        """Fit cost (sum of squares) at ``x``."""
+        r = self.fun(x)
+        self.nfev += 1
+        return float(r @ r)
+
+    def nominal(self):
+        """The start ``x0`` as a fit result (``x``, ``fun``, ``jac`` zero, ``cost`` half the sum of squares)."""
+        f0 = self.fun(self.x0)
+        self.nfev += 1
+        return types.SimpleNamespace(x=self.x0, fun=f0, jac=np.zeros((f0.size, self.x0.size)), nfev=1,
+                                     cost=0.5 * float(f0 @ f0))
+
+    def refit(self, x, act):
+        """``x`` with its entries ``act`` refitted (:func:`_refit_subset`)."""
+        got = _refit_subset(self.fun, x, act, self.lo, self.hi, self.budget, self.n_jobs)
+        self.nfev += got.nfev
+        return got
+
+    def jacobian(self, best, rest):
+        """:func:`_jacobian` at ``best`` for the parameters ``rest``."""
+        self.nfev += len(rest)
+        return _jacobian(self.fun, best, rest, self.lo, self.hi)
+
+    def probe(self, best, origin, r0, J, dx):
+        """The actual fit cost along the linearised fit's step ``dx`` from ``origin`` (its residual
+        ``r0``, or its prediction): at the full step, then at the minimum of the parabola through the
+        cost at the origin, its slope there (from ``J``) and the full step's cost (far from the
+        nominal the cost is far from quadratic, so the full step can overshoot a parameter whose
+        response bends).  Returns the lower cost and its point (clipped to the bounds)."""
+        lo, hi = self.lo, self.hi
+        c0, g = float(r0 @ r0), 2.0 * float(r0 @ (J @ dx))
+        x1 = np.clip(origin + dx, lo + 1e-9, hi - 1e-9)
+        c1 = self.cost(x1)
+        a = c1 - c0 - g
+        t = float(np.clip(-g / (2 * a), 0.2, 2.0)) if a > 0 else 2.0
+        xt = np.clip(origin + t * dx, lo + 1e-9, hi - 1e-9)
+        ct = self.cost(xt)
+        return (ct, xt) if ct < c1 else (c1, x1)
+
+    def share_of(self, r) -> float:
+        """The partial F-test's least share of the cost left, at the residual ``r`` (its n_eff)."""
+        return max(self.release_share, self.f_crit / effective_samples(r)) if self.f_crit > 0 else self.release_share
+
+    def passes(self, c, c_after, share) -> bool:
+        """Whether a release that lowers the half cost ``c`` to ``c_after`` passes the partial F-test
+        at ``share`` (of the cost left before it, never counted under the noise's ``floor``)."""
+        return 2 * (c - c_after) >= share * max(2 * c, self.floor)
+
+    def noise_left(self, best) -> bool:
+        """Whether the cost left is the output noise's (within its own spread at ``f_crit``)."""
+        return 2 * best.cost <= self.floor * (1.0 + math.sqrt(2.0 * self.f_crit / effective_samples(best.fun)))
+
+    def scanned_picks(self, t_grid, n):
+        """The first release's two picks: the best single-parameter scans (:func:`_best_scans`; from the
+        nominal the linearised fit is poorest, e.g. a stiffness 40 % off)."""
+        self.nfev += self.x0.size * n
+        return _best_scans(self.fun, self.x0, self.lo, self.hi, t_grid, n)[:2]
+
+    def probed_picks(self, best, active, rest, J):
+        """A later release's two picks: each parameter of ``rest`` at the point the linearised JOINT
+        fit with the ``active`` ones predicts (orthogonal matching pursuit: a parameter near-collinear
+        with a released one, e.g. the string against the formation stiffness, shows little alone but
+        much jointly), its actual cost probed along it (far from the nominal the linearised cost
+        misranks); the two best probed, each from its probe (or ``best`` if the probe costs more)."""
+        probes = sorted((self.probe(best, best.x, best.fun, J, _lin_fit(J, best.fun, active + [j])[1]) + (j,)
+                         for j in rest), key=lambda t: t[0])
+        log.debug("diagnose: stepwise refit: probed costs %s", [(p[2], round(p[0], 4)) for p in probes])
+        return [(j, start if c_p < 2 * best.cost else best.x) for c_p, start, j in probes[:2]]
+
+    def floating(self, best, active, rest, J):
+        """The floating step: an earlier release may only have stood in for a parameter near-collinear
+        with it (the formation stiffness for the string's in k_eff).  A release that no longer passes
+        the test against the others is dropped: the one whose drop the linearised fit predicts to
+        cost least, refitted when that prediction fails the test.  Else each swap of an earlier
+        release (back at its start) for a parameter of ``rest`` is predicted and probed, the best
+        probed refitted and kept only if its fit cost is lower.  Returns the new (active, best), or
+        None."""
+        x = self.x0
+        held = {i: best.fun + J[:, i] * (x[i] - best.x[i]) for i in active}  # i back at its start
+        moves = [(i, None) for i in active] + [(i, k) for i in active[:-1] for k in rest]  # drops, swaps
+        moves = [(i, [a for a in active if a != i], k) for i, k in moves]
+        lin = [(_lin_fit(J, held[i], act + ([] if k is None else [k])), i, k, act) for i, act, k in moves]
+
+        def origin(i):
+            o = best.x.copy()
+            o[i] = x[i]
+            return o
+
+        (c_l, dx), i, _, act = min((m for m in lin if m[2] is None), key=lambda m: m[0][0])
+        if not self.passes(0.5 * c_l, best.cost, self.share_of(held[i])):
+            c_p, start = self.probe(best, origin(i), held[i], J, dx)
+            got = self.refit(start, act)
+            log.debug("diagnose: stepwise refit: dropping %d (probed %.4g): fit cost %.4g -> %.4g", i, c_p,
+                      2 * best.cost, 2 * got.cost)
+            if not self.passes(got.cost, best.cost, self.share_of(got.fun)):
+                return act, got
+        probes = [self.probe(best, origin(i), held[i], J, dx) + (i, k, act + [k]) for (c_l, dx), i, k, act in lin
+                  if k is not None]
+        c_p, start, i, k, act = min(probes, key=lambda t: t[0])
+        got = self.refit(start, act)
+        log.debug("diagnose: stepwise refit: swapping %d for %d (probed %.4g): fit cost %.4g -> %.4g", i, k, c_p,
+                  2 * best.cost, 2 * got.cost)
+        return (act, got) if got.cost < best.cost else None
 
 
 def _best_scans(fun, x, lo, hi, t_grid, n):
