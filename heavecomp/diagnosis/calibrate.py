@@ -16,6 +16,8 @@ a sensor effect (``sensor_gain``,   an ``[[effects]]`` entry that corrects how a
 ``heave_reference``)
 ``discovered`` (friction)         ``discovered_term`` (:mod:`heavecomp.effects.discovered_term`)
                                   with the open search's coefficients
+``discovered`` (sensors)          ``sensor_term`` (:mod:`heavecomp.effects.sensor_term`): the
+                                  channel search's misreading, a correction of how the log is read
 ``none``                          the nominal unchanged, a comment saying so
 ``inconclusive``                  the nominal unchanged, a comment saying why
 ================================  ============================================================
@@ -44,6 +46,7 @@ from heavecomp.diagnosis import replay as R
 from heavecomp.effects.candidates import MISMATCH_KEYS
 from heavecomp.effects.discovered_term import COMPONENT as DISCOVERED_COMPONENT
 from heavecomp.effects.discovered_term import FEATURES as DISCOVERED_FEATURES
+from heavecomp.effects import sensor_term as ST
 from heavecomp.effects.spec import build, classes, reading_effects
 from heavecomp.errors import InputError
 from heavecomp.params import dumps
@@ -249,12 +252,45 @@ def _add_discovered(out: Calibrated, d: dict, add) -> bool:
                        f"{d.get('term', '')}, carried as effect discovered_term (it shrinks the held-out friction "
                        f"residual by {d.get('shrink', 0.0):.2f}; its replay shrink is not known until replayed)")
         return True
+    reading = _sensor_term(d)
+    if reading is not None:
+        add("sensor_term", reading)
+        out.changes[-1]["component_shrink"] = float(d.get("shrink", 0.0))
+        out.expected_shrink = 0.0
+        out.why.append(f"diagnosis verdict: discovered -- the channel search's misreading of {d['channel']}, "
+                       f"{d.get('term', '')}, carried as effect sensor_term: a correction of how the log's "
+                       f"{d['channel']} is read (the plant is unchanged; it shrinks the held-out equation residuals "
+                       f"by {d.get('shrink', 0.0):.2f}; its replay shrink is not known until replayed)")
+        return True
     out.why.append(f"diagnosis verdict: discovered -- the open search's term on the "
                    f"{d.get('component', '?')} residual, {d.get('term', '')}, has no model form at its hook "
-                   f"(discovered_term carries the friction features {', '.join(DISCOVERED_FEATURES)}); "
-                   "nothing is changed: this is the nominal file")
+                   f"(discovered_term carries the friction features {', '.join(DISCOVERED_FEATURES)}, sensor_term "
+                   "a channel's misreading with its levels); nothing is changed: this is the nominal file")
     out.expected_shrink = 0.0
     return False
+
+
+def _sensor_term(d: dict) -> dict | None:
+    """The ``sensor_term`` values of a ``sensors`` discovered block (channel search: ``channel``,
+    ``features`` ``"<channel>:<feature>"``, ``coefficients``, ``levels``), or None when it has no form
+    there (no levels recorded, a feature the effect does not carry, two plays of different widths).
+
+    Parameters
+    ----------
+    d : dict
+        The verdict's ``discovered`` block.
+    """
+    if d.get("component") != "sensors" or not d.get("channel") or not d.get("levels") or not d.get("features"):
+        return None
+    vals = {"channel": d["channel"]}
+    for f in d["features"]:
+        kind = ST.base_name(f.split(":", 1)[-1])
+        key = ST.COEFFICIENT.get(kind)
+        if key is None or key in vals:
+            return None
+        vals[key] = float(d["coefficients"][f])
+    vals.update({k: float(v) for k, v in d["levels"].items()})
+    return vals
 
 
 def _add_second(out: Calibrated, se, params, add):
@@ -469,7 +505,9 @@ def replay_shrink(path, calibrated, nominal, diagnosis: dict, *, columns=None, u
     pred = cal[ch]
     for e in reading_effects(calibrated):  # read the calibrated prediction as the rig's sensors do
         if getattr(e, "channel", None) == ch:
-            pred = e.measure(t, t, pred)
+            # a reading term may read the string top's motion: the calibrated replay's (heave + stroke)
+            pred = e.measure(t, t, pred, motion=fixed["heave"] + cal["stroke"]) if hasattr(e, "undo") \
+                else e.measure(t, t, pred)
     lo = float(diagnosis["split"]["validate"][0])
     y = raw[ch]
     m = (t >= lo) & np.isfinite(y) & np.isfinite(pred)

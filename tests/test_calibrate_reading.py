@@ -1,0 +1,82 @@
+"""Reading corrections of the calibrated model (issue 22): a channel's discovered misreading carried as
+``sensor_term``, and a reading candidate's fit that does not stop short.
+
+The truths are the generator's (a run of the benchmark's) with a misreading the test makes itself
+(a load cell that clips), never the equation of the effect that carries it.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from heavecomp.diagnosis import components as CR
+from heavecomp.diagnosis.calibrate import FILE, calibrate, to_toml
+from heavecomp.diagnosis.data import load_run
+from heavecomp.effects import spec
+from tests._cli import run as cli
+
+
+@pytest.fixture(scope="module")
+def clipped(tmp_path_factory):
+    """A generated run with no effect whose WOB the test clips at its mean + 0.8 std (a load cell that
+    saturates); the clean WOB kept."""
+    from heavecomp.benchmark import Case, generate
+
+    tr = generate(Case("none", 11, "none", duration=200.0))
+    clean = np.asarray(tr.columns["wob"], float).copy()
+    w_max = float(np.mean(clean) + 0.8 * np.std(clean))
+    tr.columns["wob"] = np.minimum(clean, w_max)
+    d = tmp_path_factory.mktemp("clip")
+    return tr, clean, w_max, tr.to_csv(d / "run.csv"), d
+
+
+def _discovered(tr, path):
+    """The channel search's term on the log, as the verdict's ``discovered`` block carries it."""
+    run = load_run(path, tr.nominal)
+    cr = CR.residuals(run, tr.nominal)
+    t = run.t
+    fit = t < 0.67 * t[-1]
+    return CR.channel_search(cr, fit & cr.mask, ~fit & cr.mask)
+
+
+def test_a_discovered_sensors_term_round_trips_and_rereads_the_log_right(clipped):
+    tr, clean, w_max, path, d = clipped
+    found = _discovered(tr, path)
+    assert found is not None and found["channel"] == "wob" and found["levels"]
+    diag = {"verdict": {"effect": "discovered", "confidence": "low", "shrink": 0.2, "shrink_channel": "wob",
+                        "component": "sensors", "discovered": dict(found, component="sensors")},
+            "split": {"fit": [0.0, 134.0], "validate": [134.0, 200.0]}}
+    cal = calibrate(tr.nominal, diag)
+    assert [(c["name"], c["role"]) for c in cal.changes] == [("sensor_term", "reading")]
+    # the file passes `heavecomp params` and reads back to the same correction
+    (d / FILE).write_text(to_toml(cal), encoding="utf-8")
+    res = cli("params", d / FILE, "-o", d / "checked.toml")
+    assert res.returncode == 0, res.stderr
+    (e,) = spec.reading_effects(spec.load(d / FILE))
+    assert e.name == "sensor_term" and e.channel == "wob"
+    # the log read through the file: the clipped samples move back towards the clean load
+    raw, fixed = load_run(path, tr.nominal), load_run(path, spec.load(d / FILE))
+    at = clean > w_max
+    before = np.sqrt(np.mean((raw["wob"][at] - clean[at]) ** 2))
+    after = np.sqrt(np.mean((fixed["wob"][at] - clean[at]) ** 2))
+    assert after < 0.6 * before
+    # where the cell did not clip, the reading is left (nearly) as it was: within the WOB's own noise
+    below = clean < w_max - 3 * tr.truth["noise_floor"]["wob"]
+    assert np.sqrt(np.mean((fixed["wob"][below] - raw["wob"][below]) ** 2)) < 2 * tr.truth["noise_floor"]["wob"]
+
+
+@pytest.mark.slow
+def test_a_planted_lever_arm_is_fitted_within_its_sigma():
+    """The generator's lever arm (heave measured L m from the compensator, a logged pitch): the reading
+    fit, re-weighted by its own residual, finds L within its 1-sigma (the nominal's weights stopped at
+    8.8 m of ~13.6 m on spent seed 560018)."""
+    from heavecomp.benchmark import Case, generate
+    from heavecomp.diagnosis import fitting as F
+    from heavecomp.diagnosis.replay import prepare
+
+    tr = generate(Case("heave_reference", 560018, "named", variant="lever_arm", sea="buoy", duration=300.0))
+    ctx = prepare(tr.to_run(), tr.nominal, decimate=2)
+    got = F.fit(ctx, "heave_reference")
+    truth = tr.truth["parameters"]["heave_reference"]["lever_arm"]
+    assert abs(got.values["lever_arm"] - truth) <= max(got.sigma["lever_arm"], 0.05 * truth)
