@@ -80,3 +80,24 @@ def test_a_planted_lever_arm_is_fitted_within_its_sigma():
     got = F.fit(ctx, "heave_reference")
     truth = tr.truth["parameters"]["heave_reference"]["lever_arm"]
     assert abs(got.values["lever_arm"] - truth) <= max(got.sigma["lever_arm"], 0.05 * truth)
+
+
+def test_a_discovered_flow_line_term_is_carried_at_the_line_hook_and_round_trips(tmp_path):
+    from heavecomp.params import paper_a
+
+    nom = paper_a()
+    d = {"component": "flow_line", "features": ["v_abs_v"], "coefficients": {"v_abs_v": -3.1e6}, "shrink": 0.7,
+         "term": "-3.1e6*v*|v|", "levels": {"x_mean": 0.1}}
+    diag = {"verdict": {"effect": "discovered", "confidence": "low", "shrink": 0.3, "shrink_channel": "pressure",
+                        "component": "flow_line", "discovered": d}, "split": {"fit": [0, 100], "validate": [100, 150]}}
+    cal = calibrate(nom, diag)
+    assert [(c["name"], c["role"]) for c in cal.changes] == [("line_term", "plant")]
+    (tmp_path / FILE).write_text(to_toml(cal), encoding="utf-8")
+    assert cli("params", tmp_path / FILE, "-o", tmp_path / "checked.toml").returncode == 0
+    (e,) = spec.plant_effects(spec.load(tmp_path / FILE))
+    # the hook adds the term to the cylinder pressure: a turbulent drop against the flow
+    assert e.line(0.2, 2e6, (), None, *e.prm) == pytest.approx(2e6 - 3.1e6 * 0.04)
+    # a feature the hook cannot compute (time): not carried, the nominal kept and the file says why
+    cal = calibrate(nom, dict(diag, verdict=dict(diag["verdict"], discovered=dict(d, features=["t"],
+                                                                                 coefficients={"t": 5.0}))))
+    assert cal.changes == [] and "has no model form" in to_toml(cal)

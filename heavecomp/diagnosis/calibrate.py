@@ -16,6 +16,9 @@ a sensor effect (``sensor_gain``,   an ``[[effects]]`` entry that corrects how a
 ``heave_reference``)
 ``discovered`` (friction)         ``discovered_term`` (:mod:`heavecomp.effects.discovered_term`)
                                   with the open search's coefficients
+``discovered`` (flow_line,        ``line_term`` / ``gas_term`` / ``string_term`` at the component's
+gas_spring, string_formation)     hook (:mod:`heavecomp.effects.hook_term`), when its features have a
+                                  form there
 ``discovered`` (sensors)          ``sensor_term`` (:mod:`heavecomp.effects.sensor_term`): the
                                   channel search's misreading, a correction of how the log is read
 ``none``                          the nominal unchanged, a comment saying so
@@ -46,6 +49,7 @@ from heavecomp.diagnosis import replay as R
 from heavecomp.effects.candidates import MISMATCH_KEYS
 from heavecomp.effects.discovered_term import COMPONENT as DISCOVERED_COMPONENT
 from heavecomp.effects.discovered_term import FEATURES as DISCOVERED_FEATURES
+from heavecomp.effects import hook_term as HT
 from heavecomp.effects import sensor_term as ST
 from heavecomp.effects.spec import build, classes, reading_effects
 from heavecomp.errors import InputError
@@ -252,6 +256,19 @@ def _add_discovered(out: Calibrated, d: dict, add) -> bool:
                        f"{d.get('term', '')}, carried as effect discovered_term (it shrinks the held-out friction "
                        f"residual by {d.get('shrink', 0.0):.2f}; its replay shrink is not known until replayed)")
         return True
+    hooked = HT.carried(d.get("component", ""), feats)
+    if hooked is not None and ("x" not in feats or "x_mean" in d.get("levels", {})):
+        vals = {f: float(d["coefficients"][f]) for f in feats}
+        if "x" in feats:
+            vals["x_mean"] = float(d["levels"]["x_mean"])
+        add(hooked.name, vals)
+        out.changes[-1]["component_shrink"] = float(d.get("shrink", 0.0))
+        out.expected_shrink = 0.0
+        out.why.append(f"diagnosis verdict: discovered -- the open search's term on the {d['component']} residual, "
+                       f"{d.get('term', '')}, carried as effect {hooked.name} at the {hooked.hook} hook (it shrinks the "
+                       f"held-out {d['component']} residual by {d.get('shrink', 0.0):.2f}; its replay shrink is not "
+                       "known until replayed)")
+        return True
     reading = _sensor_term(d)
     if reading is not None:
         add("sensor_term", reading)
@@ -265,7 +282,8 @@ def _add_discovered(out: Calibrated, d: dict, add) -> bool:
     out.why.append(f"diagnosis verdict: discovered -- the open search's term on the "
                    f"{d.get('component', '?')} residual, {d.get('term', '')}, has no model form at its hook "
                    f"(discovered_term carries the friction features {', '.join(DISCOVERED_FEATURES)}, sensor_term "
-                   "a channel's misreading with its levels); nothing is changed: this is the nominal file")
+                   "a channel's misreading with its levels, line_term / gas_term / string_term the memoryless "
+                   "features of their hook); nothing is changed: this is the nominal file")
     out.expected_shrink = 0.0
     return False
 

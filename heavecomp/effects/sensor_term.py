@@ -67,7 +67,13 @@ def play(y, width):
 
 
 def base_name(feature: str) -> str:
-    """The feature's kind (``play0.1`` -> ``play``; the others are their own)."""
+    """The feature's kind (``play0.1`` -> ``play``; the others are their own).
+
+    Parameters
+    ----------
+    feature : str
+        A channel-search feature name (without its ``channel:`` prefix).
+    """
     return "play" if feature.startswith("play") else feature
 
 

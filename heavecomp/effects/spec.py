@@ -31,6 +31,7 @@ import numpy as np
 
 from heavecomp.effects.base import ChannelEffect, Effect, HeaveEffect, SENSOR_CHANNELS
 from heavecomp.effects.discovered_term import DiscoveredTerm
+from heavecomp.effects.hook_term import BY_COMPONENT as HOOK_TERMS
 from heavecomp.effects.sensor_term import SensorTerm
 from heavecomp.effects.registry import library, resolve
 from heavecomp.errors import ParameterError, did_you_mean
@@ -40,9 +41,11 @@ from heavecomp.params.core import check_value
 
 def classes() -> dict:
     """name -> effect class of every effect a parameter file may name: the registry's, plus
-    ``discovered_term`` and ``sensor_term`` (the open search's terms at the seal-friction hook and on a
-    channel's reading; not candidates, not in the library composition)."""
-    return {**library(), DiscoveredTerm.name: DiscoveredTerm, SensorTerm.name: SensorTerm}
+    the open search's terms (not candidates, not in the library composition): ``discovered_term`` at the
+    seal-friction hook, ``line_term``, ``gas_term``, ``string_term`` at the line, gas-spring and string
+    hooks (:mod:`heavecomp.effects.hook_term`) and ``sensor_term`` on a channel's reading."""
+    return {**library(), DiscoveredTerm.name: DiscoveredTerm, SensorTerm.name: SensorTerm,
+            **{c.name: c for c in HOOK_TERMS.values()}}
 
 
 def build(name: str, values: dict, where: str = "effects") -> Effect:
