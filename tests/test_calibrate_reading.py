@@ -68,9 +68,9 @@ def test_a_discovered_sensors_term_round_trips_and_rereads_the_log_right(clipped
 
 @pytest.mark.slow
 def test_a_planted_lever_arm_is_fitted_within_its_sigma():
-    """The generator's lever arm (heave measured L m from the compensator, a logged pitch): the reading
-    fit, re-weighted by its own residual, finds L within its 1-sigma (the nominal's weights stopped at
-    8.8 m of ~13.6 m on spent seed 560018)."""
+    """The generator's lever arm (heave measured L m from the compensator, a logged pitch; never the
+    candidate's equation): the reading fit, its lever arm rescanned and re-weighted by its own residual,
+    finds L."""
     from heavecomp.benchmark import Case, generate
     from heavecomp.diagnosis import fitting as F
     from heavecomp.diagnosis.replay import prepare
@@ -79,7 +79,10 @@ def test_a_planted_lever_arm_is_fitted_within_its_sigma():
     ctx = prepare(tr.to_run(), tr.nominal, decimate=2)
     got = F.fit(ctx, "heave_reference")
     truth = tr.truth["parameters"]["heave_reference"]["lever_arm"]
-    assert abs(got.values["lever_arm"] - truth) <= max(got.sigma["lever_arm"], 0.05 * truth)
+    # found within 1 % (measured: 10.957 m of 10.974 m; the stalled local fit stopped at 8.8-9.2 m of 13.65 m on
+    # 560018's 600 s log).  Not within the reported 1-sigma (4.7 mm, 3.5x smaller than the error): the
+    # Jacobian's sigma, even inflated for correlated residuals, under-states a stick-slip fit's spread
+    assert got.values["lever_arm"] == pytest.approx(truth, rel=0.01)
 
 
 def test_a_discovered_flow_line_term_is_carried_at_the_line_hook_and_round_trips(tmp_path):
