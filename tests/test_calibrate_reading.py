@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from heavecomp.diagnosis import components as CR
-from heavecomp.diagnosis.calibrate import FILE, calibrate, to_toml
+from heavecomp.diagnosis.calibrate import FILE, calibrate, replay_shrink, to_toml, write
 from heavecomp.diagnosis.data import load_run
 from heavecomp.effects import spec
 from tests._cli import run as cli
@@ -40,6 +40,7 @@ def _discovered(tr, path):
     return CR.channel_search(cr, fit & cr.mask, ~fit & cr.mask)
 
 
+@pytest.mark.slow
 def test_a_discovered_sensors_term_round_trips_and_rereads_the_log_right(clipped):
     tr, clean, w_max, path, d = clipped
     found = _discovered(tr, path)
@@ -61,6 +62,11 @@ def test_a_discovered_sensors_term_round_trips_and_rereads_the_log_right(clipped
     before = np.sqrt(np.mean((raw["wob"][at] - clean[at]) ** 2))
     after = np.sqrt(np.mean((fixed["wob"][at] - clean[at]) ** 2))
     assert after < 0.6 * before
+    # written with the log, the file reports the term's held-out replay shrink, and replaying reproduces it
+    cal = write(tr.nominal, diag, d, source="run.csv", run=raw)
+    assert cal.expected_shrink > 0.2 and cal.verdict_shrink == 0.2
+    rep = replay_shrink(path, spec.load(d / FILE), tr.nominal, dict(diag, calibrated=cal.block()))
+    assert rep["agreement"] <= 0.1
     # where the cell did not clip, the reading is left (nearly) as it was: within the WOB's own noise
     below = clean < w_max - 3 * tr.truth["noise_floor"]["wob"]
     assert np.sqrt(np.mean((fixed["wob"][below] - raw["wob"][below]) ** 2)) < 2 * tr.truth["noise_floor"]["wob"]
