@@ -128,8 +128,9 @@ def _mismatch(nominal, parameters: dict):
         upd.setdefault(table, {})[key] = float(value)
     fr = upd.get("friction", {})
     fs = fr.get("static_force", nominal.friction.static_force)
-    if "coulomb_force" in fr and fs is not None:
-        fr["coulomb_force"] = min(fr["coulomb_force"], fs)
+    fc = fr.get("coulomb_force", nominal.friction.coulomb_force)
+    if fs is not None and fc is not None and fc > fs:  # as the fit's model: F_C clipped to F_S, moved or not
+        upd.setdefault("friction", fr)["coulomb_force"] = float(fs)
     if nominal.friction.model == "none":
         upd.pop("friction", None)
     for table, kv in upd.items():
