@@ -44,14 +44,14 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from heavecomp.diagnosis.estimator import GapDiagnoser
-from heavecomp.diagnosis.data import load_run
+from heavecomp.diagnosis.data import MeasuredRun, load_run
 from heavecomp.diagnosis import replay as R
 from heavecomp.effects.candidates import MISMATCH_KEYS
 from heavecomp.effects.discovered_term import COMPONENT as DISCOVERED_COMPONENT
 from heavecomp.effects.discovered_term import FEATURES as DISCOVERED_FEATURES
 from heavecomp.effects import hook_term as HT
 from heavecomp.effects import sensor_term as ST
-from heavecomp.effects.spec import build, classes, reading_effects
+from heavecomp.effects.spec import build, classes, correct, reading_effects
 from heavecomp.errors import InputError
 from heavecomp.params import dumps
 
@@ -247,39 +247,22 @@ def _add_discovered(out: Calibrated, d: dict, add) -> bool:
         False when the term has no model form (the nominal file is kept).
     """
     feats = list(d.get("features", []))
-    if d.get("component") == DISCOVERED_COMPONENT and feats and all(f in DISCOVERED_FEATURES for f in feats):
-        add("discovered_term", {f: float(d["coefficients"][f]) for f in feats})
-        out.changes[-1]["component_shrink"] = float(d.get("shrink", 0.0))
-        # verdict.shrink is the best *named* candidate's; the term's own replay shrink is unknown until
-        # replayed (replay_shrink): nothing is promised for it
-        out.expected_shrink = 0.0
-        out.why.append(f"diagnosis verdict: discovered -- the open search's term on the friction residual, "
-                       f"{d.get('term', '')}, carried as effect discovered_term (it shrinks the held-out friction "
-                       f"residual by {d.get('shrink', 0.0):.2f}; its replay shrink is not known until replayed)")
-        return True
-    hooked = HT.carried(d.get("component", ""), feats)
+    comp = d.get("component", "?")
+    if comp == DISCOVERED_COMPONENT and feats and all(f in DISCOVERED_FEATURES for f in feats):
+        return _carry(out, add, "discovered_term", {f: float(d["coefficients"][f]) for f in feats}, d,
+                      "the open search's term on the friction residual")
+    hooked = HT.carried(comp, feats)
     if hooked is not None and ("x" not in feats or "x_mean" in d.get("levels", {})):
         vals = {f: float(d["coefficients"][f]) for f in feats}
         if "x" in feats:
             vals["x_mean"] = float(d["levels"]["x_mean"])
-        add(hooked.name, vals)
-        out.changes[-1]["component_shrink"] = float(d.get("shrink", 0.0))
-        out.expected_shrink = 0.0
-        out.why.append(f"diagnosis verdict: discovered -- the open search's term on the {d['component']} residual, "
-                       f"{d.get('term', '')}, carried as effect {hooked.name} at the {hooked.hook} hook (it shrinks the "
-                       f"held-out {d['component']} residual by {d.get('shrink', 0.0):.2f}; its replay shrink is not "
-                       "known until replayed)")
-        return True
+        return _carry(out, add, hooked.name, vals, d, f"the open search's term on the {comp} residual, at the "
+                                                       f"{hooked.hook} hook")
     reading = _sensor_term(d)
     if reading is not None:
-        add("sensor_term", reading)
-        out.changes[-1]["component_shrink"] = float(d.get("shrink", 0.0))
-        out.expected_shrink = 0.0
-        out.why.append(f"diagnosis verdict: discovered -- the channel search's misreading of {d['channel']}, "
-                       f"{d.get('term', '')}, carried as effect sensor_term: a correction of how the log's "
-                       f"{d['channel']} is read (the plant is unchanged; it shrinks the held-out equation residuals "
-                       f"by {d.get('shrink', 0.0):.2f}; its replay shrink is not known until replayed)")
-        return True
+        return _carry(out, add, "sensor_term", reading, d, f"the channel search's misreading of {d['channel']}, a "
+                                                            f"correction of how the log's {d['channel']} is read (the "
+                                                            "plant is unchanged)")
     out.why.append(f"diagnosis verdict: discovered -- the open search's term on the "
                    f"{d.get('component', '?')} residual, {d.get('term', '')}, has no model form at its hook "
                    f"(discovered_term carries the friction features {', '.join(DISCOVERED_FEATURES)}, sensor_term "
@@ -287,6 +270,36 @@ def _add_discovered(out: Calibrated, d: dict, add) -> bool:
                    "features of their hook); nothing is changed: this is the nominal file")
     out.expected_shrink = 0.0
     return False
+
+
+def _carry(out: Calibrated, add, name: str, values: dict, d: dict, what: str) -> bool:
+    """Add the effect ``name`` with ``values`` that carries the discovered term ``d`` (``what`` it is).
+
+    ``verdict.shrink`` is the best *named* candidate's and ``d['shrink']`` the component residual's: no
+    replay shrink is promised here (0); given the log, :func:`discovered_shrink` measures it.
+
+    Parameters
+    ----------
+    out : Calibrated
+        The calibrated model so far (extended in place).
+    add : callable
+        ``add(name, values)``: adds an effect entry.
+    name : str
+        The carrying effect.
+    values : dict
+        Its parameters [SI].
+    d : dict
+        The verdict's ``discovered`` block.
+    what : str
+        What the term is, for the file's comment.
+    """
+    add(name, values)
+    out.changes[-1]["component_shrink"] = float(d.get("shrink", 0.0))
+    out.expected_shrink = 0.0
+    out.why.append(f"diagnosis verdict: discovered -- {what}, {d.get('term', '')}, carried as effect {name} (it "
+                   f"shrinks the held-out {d.get('component', '?')} equation residual by {d.get('shrink', 0.0):.2f}; "
+                   "its replay shrink is measured by replaying the log)")
+    return True
 
 
 def _sensor_term(d: dict) -> dict | None:
@@ -581,9 +594,6 @@ def discovered_shrink(cal: Calibrated, run, nominal, diagnosis: dict) -> Calibra
     diagnosis : dict
         ``diagnosis.json`` content.
     """
-    from heavecomp.diagnosis.data import MeasuredRun
-    from heavecomp.effects.spec import correct
-
     new = [e for e in cal.params.effects if e not in list(nominal.effects)]
     readers = reading_effects(cal.params.replace(effects=new))
     cols, _ = correct(readers, run.t, dict(run.columns))
