@@ -133,3 +133,13 @@ def test_what_next_names_the_change_the_file_and_the_commands():
     assert "**wob** sensor misreads" in text
     text = "\n".join(what_next(calibrate(NOM, _diag("none")), "out", params_path="rig.toml"))
     assert "Nothing to change in `rig.toml`" in text
+
+
+def test_a_static_force_refitted_below_the_nominal_coulomb_force_clips_it_as_the_fit_does():
+    """Study rerun of spent 560028: F_S refitted to 11.2 kN, F_C left at its nominal 12 kN; the fit's model
+    uses min(F_C, F_S), so the file must too (it was refused as invalid and the nominal written)."""
+    fc = NOM.friction.coulomb_force
+    cal = calibrate(NOM, _diag("parameter_mismatch", {"friction.static_force": 0.9 * fc,
+                                                      "friction.coulomb_force": fc}))
+    p = _round_trip(cal)
+    assert p.friction.static_force == p.friction.coulomb_force == pytest.approx(0.9 * fc)

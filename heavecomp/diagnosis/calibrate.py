@@ -16,6 +16,11 @@ a sensor effect (``sensor_gain``,   an ``[[effects]]`` entry that corrects how a
 ``heave_reference``)
 ``discovered`` (friction)         ``discovered_term`` (:mod:`heavecomp.effects.discovered_term`)
                                   with the open search's coefficients
+``discovered`` (flow_line,        ``line_term`` / ``gas_term`` / ``string_term`` at the component's
+gas_spring, string_formation)     hook (:mod:`heavecomp.effects.hook_term`), when its features have a
+                                  form there
+``discovered`` (sensors)          ``sensor_term`` (:mod:`heavecomp.effects.sensor_term`): the
+                                  channel search's misreading, a correction of how the log is read
 ``none``                          the nominal unchanged, a comment saying so
 ``inconclusive``                  the nominal unchanged, a comment saying why
 ================================  ============================================================
@@ -39,12 +44,14 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from heavecomp.diagnosis.estimator import GapDiagnoser
-from heavecomp.diagnosis.data import load_run
+from heavecomp.diagnosis.data import MeasuredRun, load_run
 from heavecomp.diagnosis import replay as R
 from heavecomp.effects.candidates import MISMATCH_KEYS
 from heavecomp.effects.discovered_term import COMPONENT as DISCOVERED_COMPONENT
 from heavecomp.effects.discovered_term import FEATURES as DISCOVERED_FEATURES
-from heavecomp.effects.spec import build, classes, reading_effects
+from heavecomp.effects import hook_term as HT
+from heavecomp.effects import sensor_term as ST
+from heavecomp.effects.spec import build, classes, correct, reading_effects
 from heavecomp.errors import InputError
 from heavecomp.params import dumps
 
@@ -121,8 +128,9 @@ def _mismatch(nominal, parameters: dict):
         upd.setdefault(table, {})[key] = float(value)
     fr = upd.get("friction", {})
     fs = fr.get("static_force", nominal.friction.static_force)
-    if "coulomb_force" in fr and fs is not None:
-        fr["coulomb_force"] = min(fr["coulomb_force"], fs)
+    fc = fr.get("coulomb_force", nominal.friction.coulomb_force)
+    if fs is not None and fc is not None and fc > fs:  # as the fit's model: F_C clipped to F_S, moved or not
+        upd.setdefault("friction", fr)["coulomb_force"] = float(fs)
     if nominal.friction.model == "none":
         upd.pop("friction", None)
     for table, kv in upd.items():
@@ -239,22 +247,82 @@ def _add_discovered(out: Calibrated, d: dict, add) -> bool:
         False when the term has no model form (the nominal file is kept).
     """
     feats = list(d.get("features", []))
-    if d.get("component") == DISCOVERED_COMPONENT and feats and all(f in DISCOVERED_FEATURES for f in feats):
-        add("discovered_term", {f: float(d["coefficients"][f]) for f in feats})
-        out.changes[-1]["component_shrink"] = float(d.get("shrink", 0.0))
-        # verdict.shrink is the best *named* candidate's; the term's own replay shrink is unknown until
-        # replayed (replay_shrink): nothing is promised for it
-        out.expected_shrink = 0.0
-        out.why.append(f"diagnosis verdict: discovered -- the open search's term on the friction residual, "
-                       f"{d.get('term', '')}, carried as effect discovered_term (it shrinks the held-out friction "
-                       f"residual by {d.get('shrink', 0.0):.2f}; its replay shrink is not known until replayed)")
-        return True
+    comp = d.get("component", "?")
+    if comp == DISCOVERED_COMPONENT and feats and all(f in DISCOVERED_FEATURES for f in feats):
+        return _carry(out, add, "discovered_term", {f: float(d["coefficients"][f]) for f in feats}, d,
+                      "the open search's term on the friction residual")
+    hooked = HT.carried(comp, feats)
+    if hooked is not None and ("x" not in feats or "x_mean" in d.get("levels", {})):
+        vals = {f: float(d["coefficients"][f]) for f in feats}
+        if "x" in feats:
+            vals["x_mean"] = float(d["levels"]["x_mean"])
+        return _carry(out, add, hooked.name, vals, d, f"the open search's term on the {comp} residual, at the "
+                                                       f"{hooked.hook} hook")
+    reading = _sensor_term(d)
+    if reading is not None:
+        return _carry(out, add, "sensor_term", reading, d, f"the channel search's misreading of {d['channel']}, a "
+                                                            f"correction of how the log's {d['channel']} is read (the "
+                                                            "plant is unchanged)")
     out.why.append(f"diagnosis verdict: discovered -- the open search's term on the "
                    f"{d.get('component', '?')} residual, {d.get('term', '')}, has no model form at its hook "
-                   f"(discovered_term carries the friction features {', '.join(DISCOVERED_FEATURES)}); "
-                   "nothing is changed: this is the nominal file")
+                   f"(discovered_term carries the friction features {', '.join(DISCOVERED_FEATURES)}, sensor_term "
+                   "a channel's misreading with its levels, line_term / gas_term / string_term the memoryless "
+                   "features of their hook); nothing is changed: this is the nominal file")
     out.expected_shrink = 0.0
     return False
+
+
+def _carry(out: Calibrated, add, name: str, values: dict, d: dict, what: str) -> bool:
+    """Add the effect ``name`` with ``values`` that carries the discovered term ``d`` (``what`` it is).
+
+    ``verdict.shrink`` is the best *named* candidate's and ``d['shrink']`` the component residual's: no
+    replay shrink is promised here (0); given the log, :func:`discovered_shrink` measures it.
+
+    Parameters
+    ----------
+    out : Calibrated
+        The calibrated model so far (extended in place).
+    add : callable
+        ``add(name, values)``: adds an effect entry.
+    name : str
+        The carrying effect.
+    values : dict
+        Its parameters [SI].
+    d : dict
+        The verdict's ``discovered`` block.
+    what : str
+        What the term is, for the file's comment.
+    """
+    add(name, values)
+    out.changes[-1]["component_shrink"] = float(d.get("shrink", 0.0))
+    out.expected_shrink = 0.0
+    out.why.append(f"diagnosis verdict: discovered -- {what}, {d.get('term', '')}, carried as effect {name} (it "
+                   f"shrinks the held-out {d.get('component', '?')} equation residual by {d.get('shrink', 0.0):.2f}; "
+                   "its replay shrink is measured by replaying the log)")
+    return True
+
+
+def _sensor_term(d: dict) -> dict | None:
+    """The ``sensor_term`` values of a ``sensors`` discovered block (channel search: ``channel``,
+    ``features`` ``"<channel>:<feature>"``, ``coefficients``, ``levels``), or None when it has no form
+    there (no levels recorded, a feature the effect does not carry, two plays of different widths).
+
+    Parameters
+    ----------
+    d : dict
+        The verdict's ``discovered`` block.
+    """
+    if d.get("component") != "sensors" or not d.get("channel") or not d.get("levels") or not d.get("features"):
+        return None
+    vals = {"channel": d["channel"]}
+    for f in d["features"]:
+        kind = ST.base_name(f.split(":", 1)[-1])
+        key = ST.COEFFICIENT.get(kind)
+        if key is None or key in vals:
+            return None
+        vals[key] = float(d["coefficients"][f])
+    vals.update({k: float(v) for k, v in d["levels"].items()})
+    return vals
 
 
 def _add_second(out: Calibrated, se, params, add):
@@ -328,6 +396,8 @@ def write(nominal, diagnosis: dict, out_dir, source: str = "", run=None) -> Cali
                               f"into a valid parameter file ({exc}); this is the nominal file"])
     if run is not None and cal.changes:
         cal = start_state(cal, run, diagnosis)
+        if cal.verdict == "discovered":
+            cal = discovered_shrink(cal, run, nominal, diagnosis)
     (Path(out_dir) / FILE).write_text(to_toml(cal, source), encoding="utf-8")
     return cal
 
@@ -459,26 +529,79 @@ def replay_shrink(path, calibrated, nominal, diagnosis: dict, *, columns=None, u
     reported| / reported; 0 when both are 0).
     """
     v = diagnosis["verdict"]
-    ch = v.get("shrink_channel", "wob")
     reported = float(diagnosis.get("calibrated", {}).get("expected_shrink", v.get("shrink", 0.0)))
     raw = load_run(path, nominal, columns=columns, units=units)
     fixed = load_run(path, calibrated, columns=columns, units=units)
+    out = held_out_shrink(raw, fixed, calibrated, nominal, diagnosis)
+    shrink = out["shrink"]
+    agree = abs(shrink - reported) / abs(reported) if reported else abs(shrink)
+    return dict(out, reported=reported, agreement=agree)
+
+
+def held_out_shrink(raw, fixed, calibrated, nominal, diagnosis: dict) -> dict:
+    """Held-out shrink of the calibrated model on a log read twice (:func:`replay_shrink`).
+
+    Parameters
+    ----------
+    raw : MeasuredRun
+        The log read with the nominal file.
+    fixed : MeasuredRun
+        The same log read through the calibrated file (its reading effects corrected).
+    calibrated, nominal : CMCParams
+        The calibrated model and the parameter set the diagnosis was run against.
+    diagnosis : dict
+        ``diagnosis.json`` content: ``verdict.shrink_channel``, ``split.validate`` [s].
+
+    Returns
+    -------
+    dict: ``channel``, ``rms_before``, ``rms_after``, ``shrink``.
+    """
+    ch = diagnosis["verdict"].get("shrink_channel", "wob")
     nom = _replay(nominal, raw)
     cal = _replay(calibrated, fixed)
     t = raw.t
     pred = cal[ch]
     for e in reading_effects(calibrated):  # read the calibrated prediction as the rig's sensors do
         if getattr(e, "channel", None) == ch:
-            pred = e.measure(t, t, pred)
+            # a reading term may read the string top's motion: the calibrated replay's (heave + stroke)
+            pred = e.measure(t, t, pred, motion=fixed["heave"] + cal["stroke"]) if hasattr(e, "undo") \
+                else e.measure(t, t, pred)
     lo = float(diagnosis["split"]["validate"][0])
     y = raw[ch]
     m = (t >= lo) & np.isfinite(y) & np.isfinite(pred)
     before = float(np.sqrt(np.mean((nom[ch][m] - y[m]) ** 2)))
     after = float(np.sqrt(np.mean((pred[m] - y[m]) ** 2)))
-    shrink = 1.0 - after / before if before > 0 else 0.0
-    agree = abs(shrink - reported) / abs(reported) if reported else abs(shrink)
-    return {"channel": ch, "rms_before": before, "rms_after": after, "shrink": shrink, "reported": reported,
-            "agreement": agree}
+    return {"channel": ch, "rms_before": before, "rms_after": after,
+            "shrink": 1.0 - after / before if before > 0 else 0.0}
 
 
-__all__ = ["Calibrated", "calibrate", "replay_shrink", "to_toml", "write"]
+def discovered_shrink(cal: Calibrated, run, nominal, diagnosis: dict) -> Calibrated:
+    """A carried open-search term's held-out shrink, measured by replaying the log (:func:`held_out_shrink`).
+
+    The diagnosis reports the term's shrink of its component's equation residual, not of the replay, so
+    the calibrated block would promise nothing (0).  The term was fitted on the fit part only, so its
+    replay on the held-out part is a fair measure: it becomes ``expected_shrink`` (what replaying the file
+    reproduces), the verdict's own shrink (the best named candidate's) is kept as ``verdict_shrink``.
+
+    Parameters
+    ----------
+    cal : Calibrated
+        The calibrated model of a ``discovered`` verdict (:func:`calibrate`).
+    run : MeasuredRun
+        The log as the diagnosis read it (with the nominal file).
+    nominal : CMCParams
+        The parameter set the diagnosis was run against.
+    diagnosis : dict
+        ``diagnosis.json`` content.
+    """
+    new = [e for e in cal.params.effects if e not in list(nominal.effects)]
+    readers = reading_effects(cal.params.replace(effects=new))
+    cols, _ = correct(readers, run.t, dict(run.columns))
+    got = held_out_shrink(run, MeasuredRun(run.t, cols, run.source), cal.params, nominal, diagnosis)
+    why = (f"the carried term's held-out shrink of the {got['channel']} replay, measured by replaying the log: "
+           f"{got['shrink']:.3f}")
+    return Calibrated(cal.params, cal.changes, list(cal.why) + [why], got["shrink"], cal.verdict,
+                      verdict_shrink=float(diagnosis["verdict"].get("shrink", 0.0)))
+
+
+__all__ = ["Calibrated", "calibrate", "discovered_shrink", "held_out_shrink", "replay_shrink", "to_toml", "write"]

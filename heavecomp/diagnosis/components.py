@@ -59,6 +59,7 @@ import numpy as np
 from heavecomp.diagnosis import equation_error as EE
 from heavecomp.diagnosis.data import ANGLES, fill_gaps, lowpass_zero_phase, noise_floor
 from heavecomp.diagnosis.policy import VerdictPolicy
+from heavecomp.effects import sensor_term as ST
 from heavecomp.effects.base import COMPONENTS
 from heavecomp.effects.features import rest_durations
 from heavecomp.errors import DataError
@@ -453,18 +454,6 @@ SEEN = 1.0
 CONSISTENT_SHRINK = 0.05  #: every equation that sees the channel term must shrink at least this much [-]
 
 
-def _play(y, width):
-    """The textbook play (backlash) operator of width ``width``: the output holds until the input has
-    moved half the width past it (Prandtl-Ishlinskii's elementary hysteron)."""
-    h = 0.5 * width
-    out = np.empty_like(y)
-    o = float(y[0])
-    for i, x in enumerate(y.tolist()):
-        o = min(max(o, x - h), x + h)
-        out[i] = o
-    return out
-
-
 def channel_features(y, sigma, motion=None) -> dict:
     """Generic misreadings of one channel, functions of its own reading ``y`` only (noise ``sigma``):
     ``abs``/``sq`` (a reading that bends away from linear, ``|y - median|``, ``(y - median)^2``),
@@ -484,23 +473,44 @@ def channel_features(y, sigma, motion=None) -> dict:
     motion : numpy.ndarray [m], optional
         The string top's position ``z_h + s`` (adds the ``*_motion`` features); None: none.
     """
+    feats, _ = channel_terms(y, sigma, motion)
+    return feats
+
+
+def channel_terms(y, sigma, motion=None) -> tuple:
+    """:func:`channel_features` and their constants: ({name: (array, expression)}, levels), the levels
+    the features were made with (``center``, ``top_level``, ``bottom_level``, ``motion_top``,
+    ``motion_bottom`` [m, of the ``motion`` given], ``play_width`` by feature name): what
+    :class:`heavecomp.effects.sensor_term.SensorTerm` needs to carry a term as a reading correction.
+
+    Parameters
+    ----------
+    y : numpy.ndarray [unit of the channel]
+        The channel's (gap-filled) reading.
+    sigma : float [unit of the channel]
+        The channel's measurement noise.
+    motion : numpy.ndarray [m], optional
+        The string top's position ``z_h + s`` (adds the ``*_motion`` features); None: none.
+    """
     y = np.asarray(y, float)
-    d = y - float(np.median(y))
     hi, lo = np.quantile(y, [0.99, 0.01])
-    out = {"abs": (np.abs(d), "|y - median y|"), "sq": (d * d, "(y - median y)^2"),
-           "top": ((y >= hi - EDGE_SIGMAS * sigma).astype(float), f"(y >= {hi - EDGE_SIGMAS * sigma:.4g})"),
-           "bottom": ((y <= lo + EDGE_SIGMAS * sigma).astype(float), f"(y <= {lo + EDGE_SIGMAS * sigma:.4g})")}
+    lv = {"center": float(np.median(y)), "top_level": float(hi - EDGE_SIGMAS * sigma),
+          "bottom_level": float(lo + EDGE_SIGMAS * sigma)}
+    out = {"abs": (ST.feature("abs", y, lv), "|y - median y|"), "sq": (ST.feature("sq", y, lv), "(y - median y)^2"),
+           "top": (ST.feature("top", y, lv), f"(y >= {lv['top_level']:.4g})"),
+           "bottom": (ST.feature("bottom", y, lv), f"(y <= {lv['bottom_level']:.4g})")}
     if motion is not None:
         # held at its limit, the unread part follows what drives the channel: the string top's motion
         for k in ("top", "bottom"):
             at = out[k][0] > 0
             if at.any():
-                m = motion - float(np.mean(motion[at]))
-                out[f"{k}_motion"] = (at * m, f"{out[k][1]}*(z_h + s - mean there)")
+                lv[f"motion_{k}"] = float(np.mean(motion[at]))
+                out[f"{k}_motion"] = (ST.feature(f"{k}_motion", y, lv, motion), f"{out[k][1]}*(z_h + s - mean there)")
     sd = float(np.std(y))
     for k in PLAY_WIDTHS:
-        out[f"play{k:g}"] = (_play(y, k * sd) - y, f"(play(y, {k * sd:.3g}) - y)")
-    return out
+        lv[f"play{k:g}"] = k * sd
+        out[f"play{k:g}"] = (ST.feature("play", y, {"play_width": k * sd}), f"(play(y, {k * sd:.3g}) - y)")
+    return out, lv
 
 
 def _residualise(sig, eqs, n, fit, cols):
@@ -545,6 +555,27 @@ def _consistency(r, cols, fm, vm, eqs, n) -> dict:
             "consistent": len(agree) >= 2}
 
 
+def _levels_of(levels, feats, heave_reference) -> dict:
+    """The feature constants the features ``feats`` use (``levels`` of :func:`channel_terms`), as
+    :class:`heavecomp.effects.sensor_term.SensorTerm` reads them: a motion level on the log's own heave
+    (the equations' heave is measured from ``heave_reference`` [m]), a play's width as ``play_width``."""
+    out = {}
+    for f in feats:
+        kind = ST.base_name(f)
+        if kind == "play":
+            out["play_width"] = levels[f]
+            continue
+        out.setdefault("center", levels["center"])
+        if kind.startswith("top"):
+            out["top_level"] = levels["top_level"]
+        if kind.startswith("bottom"):
+            out["bottom_level"] = levels["bottom_level"]
+        if kind.endswith("_motion"):
+            key = "motion_" + kind.split("_")[0]
+            out[key] = levels[key] + float(heave_reference)
+    return out
+
+
 def channel_search(cr, fit, validate) -> dict | None:
     """Cross-channel consistency: the best misreading of ONE channel (:func:`channel_features` of its
     own reading) that explains the residual of every equation that reads it (:data:`READS`).
@@ -585,7 +616,7 @@ def channel_search(cr, fit, validate) -> dict | None:
         if c not in inp.get("present", READS) or len(eqs) < 2:  # a channel the log lacks, or seen once: no test
             continue
         sigma = float(inp["channel_noise"].get(c, 0.0)) or float(np.std(ch[c])) * 1e-3
-        feats = channel_features(ch[c], sigma, cr.signals["zh"] + cr.signals["x"])
+        feats, levels = channel_terms(ch[c], sigma, cr.signals["zh"] + cr.signals["x"])
         lib = {}
         for name, (f, expr) in feats.items():
             scale = float(np.std(f))
@@ -613,5 +644,6 @@ def channel_search(cr, fit, validate) -> dict | None:
                       d["equations"], d["consistent"])
             if d["consistent"] and d["shrink"] >= EE.MIN_SHRINK and (best is None or d["shrink"] > best["shrink"]):
                 term = " + ".join(f"{d['coefficients'][k]:.3g}*{lib[k][1]}" for k in feats)
-                best = dict(d, component="sensors", channel=c, features=feats, term=term)
+                best = dict(d, component="sensors", channel=c, features=feats, term=term,
+                            levels=_levels_of(levels, [k.split(":", 1)[1] for k in feats], inp["heave_reference"]))
     return best

@@ -292,13 +292,51 @@ def fit(ctx, name, start=None, fixed=(), *, search=Search(), hint=None) -> Fit:
     """
     cls = candidate_class(ctx, name)
     t0 = time.perf_counter()
-    if cls.kind == "output" and cls.fit.linear:
-        out = fit_linear_output(ctx, cls, fixed)
-    elif cls.kind == "output":
-        out = fit_delay_output(ctx, cls, fixed)
-    else:
-        out = fit_replayed(ctx, cls, start, fixed, search=search, hint=hint)
+    out = _fit_once(ctx, cls, start, fixed, search, hint)
+    if cls.kind in READING_KINDS:
+        for _ in range(ctx.policy.reading_reweight):
+            out = _fit_once(reweighted(ctx, list(fixed) + [(cls.name, out.values)]), cls, out.values, fixed, search,
+                            None, out.values.get("channel"))
     return dataclasses.replace(out, wall_time=time.perf_counter() - t0)
+
+
+#: effect kinds that correct a reading (a measured channel, the heave input): fitted with re-weighting
+READING_KINDS = ("output", "heave")
+
+
+def _fit_once(ctx, cls, start, fixed, search, hint, channel=None) -> Fit:
+    """One fit of ``cls`` with the strategy its kind asks for (``channel``: an output effect's channel
+    held, else every channel tried)."""
+    if cls.kind == "output" and cls.fit.linear:
+        return fit_linear_output(ctx, cls, fixed, channel)
+    if cls.kind == "output":
+        return fit_delay_output(ctx, cls, fixed, channel)
+    return fit_replayed(ctx, cls, start, fixed, search=search, hint=hint)
+
+
+def reweighted(ctx, config):
+    """``ctx`` with every channel's fit weight 1 / max(mse, noise floor^2) of the fit-part residual of
+    the configuration ``config`` (a fitted reading candidate) instead of the nominal's.
+
+    The nominal's weights (:func:`heavecomp.diagnosis.replay.prepare`) are smallest on the channel the
+    nominal misses worst; for a reading candidate that is the misread channel itself, whose fit then
+    stops short (``VerdictPolicy.reading_reweight``).  Weighted by the candidate's own residual, a
+    channel it fits down to its noise counts as much as its noise says.
+
+    Parameters
+    ----------
+    ctx : heavecomp.diagnosis.replay.ReplayContext
+        The prepared run.
+    config : sequence of (str, dict)
+        The fitted configuration ``(effect name, values)`` whose residual sets the weights.
+    """
+    pred = ctx.simulate(list(config), ctx.split["fit"][1])
+    mse_fit = ctx.mse(pred, ctx.fitmask)
+    weights = {c: 1.0 / max(mse_fit[c] if math.isfinite(mse_fit[c]) else math.inf, ctx.noise_floor[c] ** 2, 1e-30)
+               for c in ctx.channels}
+    if any(not math.isfinite(w) or w <= 1e-30 for w in weights.values()):  # a diverged replay: keep the nominal's
+        return ctx
+    return dataclasses.replace(ctx, weights=weights)
 
 
 # ------------------------------------------------------------------ through the replay
@@ -867,7 +905,7 @@ def sigma(cls, r) -> dict:
 
 
 # ------------------------------------------------------------------ channel readings
-def fit_delay_output(ctx, cls, fixed=()) -> Fit:
+def fit_delay_output(ctx, cls, fixed=(), channel=None) -> Fit:
     """A channel effect with one nonlinear parameter (sensor_delay): per channel, a scan of the
     parameter over its bounds (``delay_scan`` points of the policy) refined by a bounded scalar search,
     the channel reading made by the effect's own ``apply`` from the replay's grid (no re-simulation);
@@ -881,6 +919,8 @@ def fit_delay_output(ctx, cls, fixed=()) -> Fit:
         The candidate's effect class (one parameter, e.g. sensor_delay's delay [s]).
     fixed : sequence of (str, dict)
         Configurations ``(effect name, values)`` already fitted and held in the model.
+    channel : str, optional
+        The channel fitted (None: every channel the run has, the best wins).
     """
     (field,) = cls.fields()
     a, b = field.metadata["bounds"]
@@ -888,7 +928,7 @@ def fit_delay_output(ctx, cls, fixed=()) -> Fit:
     grid = base["_grid"]
     best = None
     n_scan = ctx.policy.delay_scan
-    for c in ctx.channels:
+    for c in ctx.channels if channel is None else (channel,):
         def obj(x, c=c):
             pred = dict(base)
             pred[c] = cls.apply(base["t"], grid[:, 0], grid[:, SC.index(c)], x)
@@ -900,7 +940,7 @@ def fit_delay_output(ctx, cls, fixed=()) -> Fit:
     return Fit({"channel": best[1], field.name: best[2]}, {field.name: math.nan}, n_scan * len(ctx.channels), best[0])
 
 
-def fit_linear_output(ctx, cls, fixed=()) -> Fit:
+def fit_linear_output(ctx, cls, fixed=(), channel=None) -> Fit:
     """A channel effect whose reading is affine in its parameters (``linear``: sensor_gain,
     sensor_offset): per channel, linear least squares of the measured channel on the columns
     the effect's own ``apply`` makes of the replay (no re-simulation, :func:`_fit_channel`); the
@@ -919,13 +959,15 @@ def fit_linear_output(ctx, cls, fixed=()) -> Fit:
         The candidate's effect class (affine reading, e.g. sensor_gain, sensor_offset).
     fixed : sequence of (str, dict)
         Configurations ``(effect name, values)`` already fitted and held in the model.
+    channel : str, optional
+        The channel fitted (None: every channel the run has, the best wins).
     """
     t_end = ctx.split["fit"][1]
     base0 = ctx.simulate(list(fixed), t_end)
     names = [f.name for f in cls.fields()]
     used = np.array([n not in cls.fit.optional for n in names])
     best = None
-    for c in ctx.channels:
+    for c in ctx.channels if channel is None else (channel,):
         got = _fit_channel(ctx, cls, base0, c, used)
         if c in ("stroke", "wob"):  # they also set the replay's start: Gauss-Newton on every channel
             got = _refine_reading(ctx, cls, fixed, t_end, c, got, used)

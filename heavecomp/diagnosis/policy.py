@@ -152,6 +152,17 @@ class VerdictPolicy:
     """Points of the scan of a channel delay over its bounds (then refined by a bounded scalar search)."""
     start_iterations: int = 2
     """Gauss-Newton steps of a stroke or WOB reading through the replay it starts."""
+    reading_reweight: int = 0
+    """Refits of a reading candidate (a sensor effect, heave_reference) with every channel re-weighted by
+    the fitted candidate's own fit-part residual (1 / max(mse, noise floor^2)) instead of the nominal's.
+    What it guards against: a reading fit that stops short because the channel the nominal misses worst
+    (the misread channel itself) gets almost no weight in the fit of its own reading (spent seed 210015:
+    a stroke read with sign -1 fitted -0.9745, the re-diagnosis found 1/0.9745 more).  Off (0) by
+    default: one refit (1) made a stand-in stronger too, since it weights up the channel the stand-in
+    already fits (tuning seed 20008, asymmetric friction: the stroke sensor_offset explained 0.83 and
+    the verdict dropped from high to medium confidence), while the lever arm that stopped short (spent
+    560018) was a stalled local fit, not its weights (the fit cost at the truth was a fifth of the fit's
+    under the nominal weights; ``heave_reference`` now rescans its lever arm)."""
 
     def to_json(self) -> dict:
         """Every field by name (JSON-ready): what the tuning report hashes."""

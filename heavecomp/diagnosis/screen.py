@@ -16,6 +16,8 @@ from __future__ import annotations
 import math
 import time
 
+import numpy as np
+
 from heavecomp.diagnosis import components as CR
 from heavecomp.diagnosis import equation_error as EE
 from heavecomp.effects.base import COMPONENTS
@@ -181,7 +183,9 @@ def discover(cr, fitmask, valmask, policy):
     gap = cr.gap()
     best = None
     for c in sorted((c for c in COMPONENTS if gap[c] > 0), key=lambda c: -gap[c])[:policy.discover_components]:
-        d = EE.open_search(cr.residual[c], cr.signals_for(c), fm, vm, component=c)
+        sig = cr.signals_for(c)
+        d = EE.open_search(cr.residual[c], sig, fm, vm, component=c)
         if d is not None and (best is None or d["shrink"] > best["shrink"]):
-            best = dict(d, unit=CR.UNITS[c])
+            # the constant of the x feature (x - mean x), for the calibrated model's term at its hook
+            best = dict(d, unit=CR.UNITS[c], levels={"x_mean": float(np.nanmean(sig["x"]))} if "x" in sig else {})
     return best

@@ -31,6 +31,8 @@ import numpy as np
 
 from heavecomp.effects.base import ChannelEffect, Effect, HeaveEffect, SENSOR_CHANNELS
 from heavecomp.effects.discovered_term import DiscoveredTerm
+from heavecomp.effects.hook_term import BY_COMPONENT as HOOK_TERMS
+from heavecomp.effects.sensor_term import SensorTerm
 from heavecomp.effects.registry import library, resolve
 from heavecomp.errors import ParameterError, did_you_mean
 from heavecomp.params import load as load_params
@@ -39,8 +41,11 @@ from heavecomp.params.core import check_value
 
 def classes() -> dict:
     """name -> effect class of every effect a parameter file may name: the registry's, plus
-    ``discovered_term`` (the open search's term; not a candidate, not in the library composition)."""
-    return {**library(), DiscoveredTerm.name: DiscoveredTerm}
+    the open search's terms (not candidates, not in the library composition): ``discovered_term`` at the
+    seal-friction hook, ``line_term``, ``gas_term``, ``string_term`` at the line, gas-spring and string
+    hooks (:mod:`heavecomp.effects.hook_term`) and ``sensor_term`` on a channel's reading."""
+    return {**library(), DiscoveredTerm.name: DiscoveredTerm, SensorTerm.name: SensorTerm,
+            **{c.name: c for c in HOOK_TERMS.values()}}
 
 
 def build(name: str, values: dict, where: str = "effects") -> Effect:
@@ -166,9 +171,15 @@ def effects_for(params, effects=None) -> list:
     return plant_effects(params) if effects is None else resolve(effects)
 
 
-def _undo_channel(e: ChannelEffect, t, y):
-    """The true channel from the reading ``y`` at times ``t`` of the channel effect ``e``."""
+def _undo_channel(e: ChannelEffect, t, y, cols=None):
+    """The true channel from the reading ``y`` at times ``t`` of the channel effect ``e`` (``cols``: the
+    log's channels, for a reading term that reads the string top's motion, heave + stroke)."""
     prm = e.prm
+    if hasattr(e, "undo"):  # an explicit correction of the reading (sensor_term)
+        motion = None
+        if cols is not None and "heave" in cols and "stroke" in cols:
+            motion = np.asarray(cols["heave"], dtype=float) + np.asarray(cols["stroke"], dtype=float)
+        return e.undo(y, motion)
     if getattr(e, "linear", False):  # affine reading y_meas = a0(t) + a1(t) y: invert it
         a0 = e.apply(t, t, np.zeros_like(y), *prm)
         a1 = e.apply(t, t, np.ones_like(y), *prm) - a0
@@ -209,7 +220,7 @@ def correct(effects, t, columns: dict) -> tuple[dict, list]:
         if isinstance(e, ChannelEffect):
             if e.channel not in cols:
                 raise ParameterError(f"effect {e.name}: channel {e.channel!r} is not in the log")
-            cols[e.channel] = _undo_channel(e, t, np.asarray(cols[e.channel], dtype=float))
+            cols[e.channel] = _undo_channel(e, t, np.asarray(cols[e.channel], dtype=float), cols)
             notes.append(f"{e.channel} corrected for {e!r}")
         elif isinstance(e, HeaveEffect):
             v = e.values

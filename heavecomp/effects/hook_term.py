@@ -1,0 +1,133 @@
+"""The open search's term carried at a plant hook other than the seal friction (issue 22).
+
+The gap diagnosis' open search (:func:`heavecomp.diagnosis.equation_error.open_search`) fits a sparse
+sum of features to a component's equation residual (measured minus nominal).  On the flow line, the
+gas spring and the drill string the memoryless features of the hook's own signals have a fixed form
+at that hook: the residual is what the hook's value lacks, so the term is added to it (the friction
+term is :mod:`heavecomp.effects.discovered_term`, a channel's misreading
+:mod:`heavecomp.effects.sensor_term`):
+
+==================  ===========  ===========================  ==============================================
+effect              hook         residual (unit)              features carried (the search's names)
+==================  ===========  ===========================  ==============================================
+``line_term``       line         gas law, flow part (Pa)      ``const``, ``v``, ``v_abs_v``, ``abs_v``, ``p``
+                                                              (v the stroke velocity, p the pressure)
+``gas_term``        gas spring   gas law, rest (Pa)           ``const``, ``x`` (the stroke less ``x_mean``),
+                                                              ``v``, ``v_abs_v``, ``abs_v``
+``string_term``     string       lower-mass balance (N)       ``const``, ``v``, ``v_abs_v``, ``abs_v``
+                                                              (v the string's relative velocity dz_h + v - v_b)
+==================  ===========  ===========================  ==============================================
+
+A feature the hook cannot compute (time, lags, stroke bands, the string's stretch) is not carried:
+:func:`carried` says which.  Not diagnosis candidates and not in the registry's library composition.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from heavecomp.effects.base import Effect
+from heavecomp.params.core import q
+
+_V = dict(bounds=(-1e12, 1e12))
+
+
+class _Term(Effect):
+    """Base of a hook term: every parameter optional, all 0 adds nothing."""
+
+    @classmethod
+    def null(cls, plant):
+        return {f.name: 0.0 for f in cls.fields()}
+
+
+class LineTerm(_Term):
+    """p_cyl -> p_cyl + c_0 + c_v v + c_vv v|v| + c_a |v| + c_p p (the flow_line residual's term)."""
+
+    name = "line_term"
+    hook = "line"
+    component_name = "flow_line"
+    optional = ("const", "v", "v_abs_v", "abs_v", "p")
+
+    @dataclass(frozen=True)
+    class Params:
+        const: float = q(0.0, "Pa", symbol="c_0", doc="constant pressure added", **_V)
+        v: float = q(0.0, "Pa s/m", symbol="c_v", doc="pressure added per stroke velocity", **_V)
+        v_abs_v: float = q(0.0, "Pa s^2/m^2", symbol="c_vv", doc="pressure added per v|v|", **_V)
+        abs_v: float = q(0.0, "Pa s/m", symbol="c_a", doc="pressure added per |v|", **_V)
+        p: float = q(0.0, "-", bounds=(-1.0, 1.0), symbol="c_p", doc="pressure added per pressure")
+
+    @staticmethod
+    def line(v, p, x, PP, c0, cv, cvv, ca, cp):
+        return p + c0 + cv * v + cvv * v * np.abs(v) + ca * np.abs(v) + cp * p
+
+
+
+class GasTerm(_Term):
+    """p_gas -> p_gas + c_0 + c_x (s - x_mean) + c_v v + c_vv v|v| + c_a |v| (the gas_spring residual's term)."""
+
+    name = "gas_term"
+    hook = "gas_spring"
+    component_name = "gas_spring"
+    optional = ("const", "x", "x_mean", "v", "v_abs_v", "abs_v")
+
+    @dataclass(frozen=True)
+    class Params:
+        const: float = q(0.0, "Pa", symbol="c_0", doc="constant pressure added", **_V)
+        x: float = q(0.0, "Pa/m", symbol="c_x", doc="pressure added per m of stroke from x_mean", **_V)
+        x_mean: float = q(0.0, "m", bounds=(-100.0, 100.0), symbol="x_m", doc="the stroke the x feature is taken from")
+        v: float = q(0.0, "Pa s/m", symbol="c_v", doc="pressure added per stroke velocity", **_V)
+        v_abs_v: float = q(0.0, "Pa s^2/m^2", symbol="c_vv", doc="pressure added per v|v|", **_V)
+        abs_v: float = q(0.0, "Pa s/m", symbol="c_a", doc="pressure added per |v|", **_V)
+
+    @staticmethod
+    def gas(s, v, p, x, PP, c0, cx, xm, cv, cvv, ca):
+        return p + c0 + cx * (s - xm) + cv * v + cvv * v * np.abs(v) + ca * np.abs(v)
+
+
+
+class StringTerm(_Term):
+    """T_ds -> T_ds + c_0 + c_v dv + c_vv dv|dv| + c_a |dv| (the string_formation residual's term)."""
+
+    name = "string_term"
+    hook = "string"
+    component_name = "string_formation"
+    optional = ("const", "v", "v_abs_v", "abs_v")
+
+    @dataclass(frozen=True)
+    class Params:
+        const: float = q(0.0, "N", symbol="c_0", doc="constant tension added", **_V)
+        v: float = q(0.0, "N s/m", symbol="c_v", doc="tension added per relative velocity", **_V)
+        v_abs_v: float = q(0.0, "N s^2/m^2", symbol="c_vv", doc="tension added per dv|dv|", **_V)
+        abs_v: float = q(0.0, "N s/m", symbol="c_a", doc="tension added per |dv|", **_V)
+
+    @staticmethod
+    def string(dv, T, x, PP, c0, cv, cvv, ca):
+        return T + c0 + cv * dv + cvv * dv * np.abs(dv) + ca * np.abs(dv)
+
+
+
+#: component -> the effect that carries its open-search term
+BY_COMPONENT = {c.component_name: c for c in (LineTerm, GasTerm, StringTerm)}
+
+
+def carried(component: str, features) -> type | None:
+    """The effect class that carries the open search's ``features`` on ``component``, or None when the
+    component has none or a feature has no form at its hook.
+
+    Parameters
+    ----------
+    component : str
+        The discovered term's component.
+    features : sequence of str
+        The open search's feature names.
+    """
+    cls = BY_COMPONENT.get(component)
+    if cls is None or not features:
+        return None
+    names = {f.name for f in cls.fields()} - {"x_mean"}
+    return cls if all(f in names for f in features) else None
+
+
+EFFECT = LineTerm
