@@ -23,6 +23,7 @@ import numpy as np
 from heavecomp.analysis.linear import operating_point
 from heavecomp.analysis.summary import analyse
 from heavecomp.benchmark import Case, generate
+from heavecomp.benchmark.seeds import spent as spent_ranges
 from heavecomp.benchmark.truth import TRUTH
 from heavecomp.benchmark.truth.sensor_gain import sensor_gain as truth_sensor_gain
 from heavecomp.closed_loop.loop import Noise, simulate_closed_loop
@@ -51,10 +52,10 @@ EFFECTS = {
 }
 #: the benchmark law each entry withholds (default: the entry's own name)
 LAW = {"gas_stiffness_mismatch": "parameter_mismatch", "string_stiffness_mismatch": "parameter_mismatch"}
-#: first seed of the loop's runs (571000+: fresh, used by no tuning or scoring set; the former runs at 110-117
-#: and 570000-570999 were looked at while the parameter_mismatch refit was built and rebuilt, so they no
-#: longer test it)
-SEED0 = 571000
+#: first seed of the loop's runs (600000+: fresh, used by no tuning or scoring set; the former runs at 110-117
+#: and 570000-572999 were looked at while the parameter_mismatch refit was built and rebuilt, so they no
+#: longer test it; a full run refuses a spent seed, :data:`heavecomp.benchmark.seeds.SPENT`)
+SEED0 = 600000
 #: the parameter a ``parameter_mismatch`` entry's draw must move: the benchmark draws two of gas stiffness,
 #: Coulomb force, string and formation stiffness (+-30-50 %); the entry takes the first seed from
 #: ``SEED0 + len(EFFECTS)`` whose draw moves it (chosen by the parameter drawn, never by its size or the
@@ -354,6 +355,12 @@ def main(argv=None) -> int:
                        help="run only this entry (repeatable; its seed as in the full run)")
 
     args = parse_args(argv, "sim_to_real_loop", __doc__, extra)
+    if not args.quick and not args.effect:  # a full run is a scoring run: fresh seeds only (--effect: study)
+        used = spent_ranges(range(args.seed, args.seed + len(EFFECTS) + 100))
+        if used:
+            print(f"--seed {args.seed}: seeds in a spent range ({', '.join(used)}); choose a fresh one "
+                  "(--effect NAME studies one entry on any seed)", file=sys.stderr)
+            return 2
     write(build(args.quick, seed=args.seed, jobs=max(1, args.jobs), only=args.effect), args.out, args.quick)
     return 0
 

@@ -1,0 +1,42 @@
+"""Seed ranges of the benchmark already used by a tuning or scoring set: the one registry.
+
+A scoring set is run once, on seeds no tuning, no study and no earlier scoring run has seen; a scenario
+that scores (``scenarios/calibration_validation.py``, ``scenarios/sim_to_real_loop.py``) refuses a seed
+in a range listed here.  A range is added when its set has been scored (or looked at while a method was
+built); it is never removed.  Study of a failure on a spent range is fine; scoring on it is not.
+"""
+
+from __future__ import annotations
+
+#: (first seed, next free seed, what spent it)
+SPENT = (
+    (20000, 21000, "diagnosis validation: the tuning set"),
+    (30000, 31000, "diagnosis validation: scoring"),
+    (50000, 51000, "diagnosis validation: scoring"),
+    (70000, 71000, "diagnosis validation: scoring"),
+    (90000, 91000, "diagnosis validation: scoring"),
+    (110000, 111000, "diagnosis validation: scoring"),
+    (130000, 131000, "diagnosis validation: scoring"),
+    (150000, 151000, "diagnosis validation: scoring"),
+    (170000, 171000, "diagnosis validation: scoring"),
+    (210000, 211000, "calibration validation: first scoring run (reports/calibration_validation/spent)"),
+    (230000, 231000, "diagnosis validation: scoring"),
+    (250000, 251000, "diagnosis validation: scoring"),
+    (350000, 351000, "sensor-set scoring"),
+    (450000, 451000, "sensor-set scoring"),
+    (560000, 561000, "calibration validation: second scoring run, then studied"),
+    (570000, 573000, "sim_to_real_loop: scored and studied while the parameter_mismatch refit was rebuilt"),
+    (580000, 590000, "monitor validation: scoring"),
+)
+
+
+def spent(seeds) -> list:
+    """The spent ranges (as ``"first+"`` strings) that any of ``seeds`` falls in; empty: all fresh.
+
+    Parameters
+    ----------
+    seeds : iterable of int
+        The seeds a run would use.
+    """
+    seeds = list(seeds)
+    return [f"{a}+" for a, b, _ in SPENT if any(a <= s < b for s in seeds)]
