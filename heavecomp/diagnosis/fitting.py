@@ -393,7 +393,13 @@ def fit_replayed(ctx, cls, start=None, fixed=(), *, search=Search(), hint=None) 
 def effective_samples(r) -> float:
     """Independent samples [-] of a residual vector ``r`` whose samples are correlated: its length
     over the integrated autocorrelation time 1 + 2 sum rho_k, the sum over the initial positive
-    sequence of the autocorrelation rho_k (Geyer's truncation); at least 1."""
+    sequence of the autocorrelation rho_k (Geyer's truncation); at least 1.
+
+    Parameters
+    ----------
+    r : array_like [-]
+        A residual vector (e.g. the weighted replay residual of a fit).
+    """
     r = np.asarray(r, dtype=float)
     r = r - r.mean()
     m = r.size
@@ -410,7 +416,13 @@ def effective_samples(r) -> float:
 def noise_cost(ctx) -> float:
     """Expected fit cost [-] of the output noise alone: what a right model's replay leaves of the
     weighted, decimated fit residual (:meth:`heavecomp.diagnosis.replay.ReplayContext.resid_vec`),
-    each channel's samples times its weight times its noise floor squared."""
+    each channel's samples times its weight times its noise floor squared.
+
+    Parameters
+    ----------
+    ctx : heavecomp.diagnosis.replay.ReplayContext
+        The prepared run: its fit mask, decimation, channel weights and noise floors.
+    """
     total = 0.0
     for c in ctx.channels:
         n = int(np.count_nonzero((ctx.fitmask & np.isfinite(ctx.y[c][: ctx.fitmask.size]))[:: ctx.decimate]))
