@@ -99,7 +99,7 @@ def test_cropping_keeps_the_verdict():
     the cut run is warned about and reports the state it started from."""
     from heavecomp.benchmark import benchmark_case, generate
 
-    tr = generate(benchmark_case("dwell_stiction", seed=1002, duration=200.0))
+    tr = generate(benchmark_case("dwell_stiction", seed=1002, duration=160.0))
     verdicts = {}
     for t0 in (0.0, 60.0):
         run = _crop(tr.nominal, tr.t, tr.columns, t0)
