@@ -103,6 +103,23 @@ def test_every_registered_effect_builds_both_mpcs_or_is_refused_in_one_line(effe
 
 
 @pytest.mark.parametrize("mpc", MPCS)
+def test_the_carried_terms_of_a_calibrated_file_build_both_mpcs(mpc):
+    """The open search's terms a ``calibrated.toml`` carries (not registered: no diagnosis candidate) reach
+    both controllers: each builds, and a term with a slope at rest (a velocity coefficient at the line, gas
+    or string hook) changes the linear model the MPC predicts with; the friction term changes its friction,
+    not the linear model."""
+    from heavecomp.effects.discovered_term import EFFECT as DiscoveredTerm
+    from heavecomp.effects.hook_term import GasTerm, LineTerm, StringTerm
+
+    nominal = _mpc(mpc, [], horizon=3).model.Ad
+    for eff, slope in ((LineTerm(v=2e5), True), (GasTerm(v=1e5), True), (StringTerm(v=2e4), True),
+                       (DiscoveredTerm(v=1e3), False)):
+        Ad = _mpc(mpc, [eff], horizon=3).model.Ad
+        assert Ad.shape == nominal.shape
+        assert (not np.allclose(Ad, nominal)) == slope, eff.name
+
+
+@pytest.mark.parametrize("mpc", MPCS)
 @pytest.mark.parametrize("effect, values, reason", REFUSED)
 def test_effects_without_a_time_invariant_model_are_refused_at_construction(effect, values, reason, mpc):
     with pytest.raises(ParameterError) as err:
