@@ -27,6 +27,8 @@ SPENT = (
     (560000, 561000, "calibration validation: second scoring run, then studied"),
     (570000, 573000, "sim_to_real_loop: scored and studied while the parameter_mismatch refit was rebuilt"),
     (580000, 590000, "monitor validation: scoring"),
+    (590000, 591000, "calibration validation: third scoring run (reports/calibration_validation/report.md), then studied"),
+    (600000, 601000, "sim_to_real_loop: scored (reports/sim_to_real_loop/)"),
 )
 
 
