@@ -564,8 +564,7 @@ def held_out_shrink(raw, fixed, calibrated, nominal, diagnosis: dict) -> dict:
     for e in reading_effects(calibrated):  # read the calibrated prediction as the rig's sensors do
         if getattr(e, "channel", None) == ch:
             # a reading term may read the string top's motion: the calibrated replay's (heave + stroke)
-            pred = e.measure(t, t, pred, motion=fixed["heave"] + cal["stroke"]) if hasattr(e, "undo") \
-                else e.measure(t, t, pred)
+            pred = e.measure(t, t, pred, motion=fixed["heave"] + cal["stroke"])
     lo = float(diagnosis["split"]["validate"][0])
     y = raw[ch]
     m = (t >= lo) & np.isfinite(y) & np.isfinite(pred)

@@ -583,7 +583,7 @@ class _Stepwise:
         self.nfev += len(rest)
         return _jacobian(self.fun, best, rest, self.lo, self.hi)
 
-    def probe(self, best, origin, r0, J, dx):
+    def probe(self, origin, r0, J, dx):
         """The actual fit cost along the linearised fit's step ``dx`` from ``origin`` (its residual
         ``r0``, or its prediction): at the full step, then at the minimum of the parabola through the
         cost at the origin, its slope there (from ``J``) and the full step's cost (far from the
@@ -624,7 +624,7 @@ class _Stepwise:
         with a released one, e.g. the string against the formation stiffness, shows little alone but
         much jointly), its actual cost probed along it (far from the nominal the linearised cost
         misranks); the two best probed, each from its probe (or ``best`` if the probe costs more)."""
-        probes = sorted((self.probe(best, best.x, best.fun, J, _lin_fit(J, best.fun, active + [j])[1]) + (j,)
+        probes = sorted((self.probe(best.x, best.fun, J, _lin_fit(J, best.fun, active + [j])[1]) + (j,)
                          for j in rest), key=lambda t: t[0])
         log.debug("diagnose: stepwise refit: probed costs %s", [(p[2], round(p[0], 4)) for p in probes])
         return [(j, start if c_p < 2 * best.cost else best.x) for c_p, start, j in probes[:2]]
@@ -650,13 +650,13 @@ class _Stepwise:
 
         (c_l, dx), i, _, act = min((m for m in lin if m[2] is None), key=lambda m: m[0][0])
         if not self.passes(0.5 * c_l, best.cost, self.share_of(held[i])):
-            c_p, start = self.probe(best, origin(i), held[i], J, dx)
+            c_p, start = self.probe(origin(i), held[i], J, dx)
             got = self.refit(start, act)
             log.debug("diagnose: stepwise refit: dropping %d (probed %.4g): fit cost %.4g -> %.4g", i, c_p,
                       2 * best.cost, 2 * got.cost)
             if not self.passes(got.cost, best.cost, self.share_of(got.fun)):
                 return act, got
-        probes = [self.probe(best, origin(i), held[i], J, dx) + (i, k, act + [k]) for (c_l, dx), i, k, act in lin
+        probes = [self.probe(origin(i), held[i], J, dx) + (i, k, act + [k]) for (c_l, dx), i, k, act in lin
                   if k is not None]
         c_p, start, i, k, act = min(probes, key=lambda t: t[0])
         got = self.refit(start, act)

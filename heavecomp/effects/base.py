@@ -298,8 +298,10 @@ class ChannelEffect(Effect):
         vals = "".join(f", {k}={v!r}" for k, v in self.values.items())
         return f"{type(self).__name__}(channel={self.channel!r}{vals})"
 
-    def measure(self, t, tg, y):
-        """The recorded channel at times ``t`` from the true ``y`` on the grid ``tg``."""
+    def measure(self, t, tg, y, motion=None):
+        """The recorded channel at times ``t`` from the true ``y`` on the grid ``tg`` (``motion``: the
+        string top's position z_h + s [m], for a reading that depends on it, e.g. ``sensor_term``'s
+        ``*_motion`` terms; the library's readings do not)."""
         return self.apply(np.asarray(t, dtype=float), np.asarray(tg, dtype=float), np.asarray(y, dtype=float),
                           *self.prm)
 

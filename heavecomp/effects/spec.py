@@ -175,7 +175,7 @@ def _undo_channel(e: ChannelEffect, t, y, cols=None):
     """The true channel from the reading ``y`` at times ``t`` of the channel effect ``e`` (``cols``: the
     log's channels, for a reading term that reads the string top's motion, heave + stroke)."""
     prm = e.prm
-    if hasattr(e, "undo"):  # an explicit correction of the reading (sensor_term)
+    if isinstance(e, SensorTerm):  # an explicit correction of the reading
         motion = None
         if cols is not None and "heave" in cols and "stroke" in cols:
             motion = np.asarray(cols["heave"], dtype=float) + np.asarray(cols["stroke"], dtype=float)
