@@ -164,6 +164,16 @@ class VerdictPolicy:
     560018) was a stalled local fit, not its weights (the fit cost at the truth was a fifth of the fit's
     under the nominal weights; ``heave_reference`` now rescans its lever arm)."""
 
+    reading_dynamics_gain: float = 0.1
+    """The calibrated file reads a sensor-fault verdict's channel with its own dynamics (``sensor_lag``:
+    factor, first-order lag and delay fitted jointly on that channel alone,
+    :func:`heavecomp.diagnosis.calibrate.reading_dynamics`) in place of the verdict's factor or delay when
+    its held-out rms of that channel is smaller by at least this share (0 or less: off).  What it guards
+    against: a re-diagnosis that finds the sensor's bandwidth the verdict's law lacks (spent 590015, a sign
+    flip through a 5 Hz lag; 590006, a first-order lag read as a 0.655 s delay), while a reading refit
+    that only fits the noise differently (a few per cent) leaves the verdict's law in the file.  It never
+    changes a verdict: it acts after it, on the calibrated file only."""
+
     def to_json(self) -> dict:
         """Every field by name (JSON-ready): what the tuning report hashes."""
         return dataclasses.asdict(self)

@@ -25,7 +25,7 @@ from heavecomp.diagnosis.policy import VerdictPolicy
 from heavecomp.effects.candidates import ParameterMismatch, get
 from heavecomp.diagnosis.stepper import CHANNELS as SC, replay_dt, run_segments
 from heavecomp.effects.compose import composition, composition_for, library_composition
-from heavecomp.effects.spec import plant_effects
+from heavecomp.effects.spec import plant_effects, reading_effects
 from heavecomp.errors import InputError
 from heavecomp.params.budget import MAX_REPLAY_STEPS
 from heavecomp.plants.cmc import D0, KF, plant_vectors
@@ -59,6 +59,9 @@ class Replay:
     stuck_speed: float
     #: the parameter file's own plant effects (``[[effects]]``), resolved once: part of every replay
     file_effects: tuple = ()
+    #: the parameter file's readings with dynamics (``sensor_lag``, ``model_side``): the log cannot be
+    #: corrected for their lag, so every replay reads its prediction of their channel through it
+    file_readers: tuple = ()
     #: segment starts per stroke/WOB reading (:meth:`start_for`), filled as configurations ask
     cache: dict = dataclasses.field(default_factory=dict, compare=False, repr=False)
 
@@ -102,6 +105,10 @@ class Replay:
         t = self.t if t_end is None else self.t[self.t <= tg[-1]]
         res = {c: np.interp(t, tg, out[:, SC.index(c)]) for c in CH + ("stroke_velocity", "stuck")}
         done = set()
+        for e in self.file_readers:  # the file's sensor lag, read on the model side (the log holds the lagged channel)
+            if e.channel in CH:
+                res[e.channel] = e.lag(t, tg, out[:, SC.index(e.channel)])
+                done.add(e.channel)
         for e in sensors:  # the first on a channel reads the model's grid, the next ones its reading
             c = e.channel
             if c in CH:
@@ -192,7 +199,8 @@ def build(run, nominal, *, stuck_speed=S.STUCK_SPEED, segment=None, reinit=1.5, 
         bounds, starts, rein = _segments(run, h, n_steps, plant.PP, segment, reinit, stuck_speed)
         starts[0] = initial.start()
     return Replay(run, nominal, h, n_steps, hs, plant, bounds, starts, rein, spline, initial, stuck_speed,
-                  tuple(plant_effects(nominal)))
+                  tuple(plant_effects(nominal)),
+                  tuple(e for e in reading_effects(nominal) if getattr(e, "model_side", False)))
 
 
 def grid(run, nominal) -> tuple:

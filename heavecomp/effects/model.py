@@ -142,7 +142,7 @@ def _static_affine(e):
             and np.allclose(g, g[20], rtol=1e-12, atol=1e-12)
             and np.allclose(ramp[4:-4], g[20] * t[4:-4] + o[20], rtol=1e-12, atol=1e-12 * (1 + abs(o[20])))):
         raise ParameterError(f"effect {e.name} on {e.channel} ({', '.join(f'{k}={v:g}' for k, v in e.values.items())}): "
-                             "the casadi model (linearise, MPC) takes a reading g y + o only; a delay or a drift "
+                             "the casadi model (linearise, MPC) takes a reading g y + o only; a delay, a lag or a drift "
                              "in time has no finite-state, time-invariant model: set it to 0")
     if e.channel == "heave" and g[20] == 0.0:
         raise ParameterError(f"effect {e.name} on heave: a gain of 0 leaves no heave to compensate")

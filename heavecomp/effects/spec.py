@@ -32,6 +32,7 @@ import numpy as np
 from heavecomp.effects.base import ChannelEffect, Effect, HeaveEffect, SENSOR_CHANNELS
 from heavecomp.effects.discovered_term import DiscoveredTerm
 from heavecomp.effects.hook_term import BY_COMPONENT as HOOK_TERMS
+from heavecomp.effects.sensor_lag import SensorLag
 from heavecomp.effects.sensor_term import SensorTerm
 from heavecomp.effects.registry import library, resolve
 from heavecomp.errors import ParameterError, did_you_mean
@@ -43,8 +44,9 @@ def classes() -> dict:
     """name -> effect class of every effect a parameter file may name: the registry's, plus
     the open search's terms (not candidates, not in the library composition): ``discovered_term`` at the
     seal-friction hook, ``line_term``, ``gas_term``, ``string_term`` at the line, gas-spring and string
-    hooks (:mod:`heavecomp.effects.hook_term`) and ``sensor_term`` on a channel's reading."""
-    return {**library(), DiscoveredTerm.name: DiscoveredTerm, SensorTerm.name: SensorTerm,
+    hooks (:mod:`heavecomp.effects.hook_term`) and ``sensor_term`` on a channel's reading; and the calibrated
+    model's ``sensor_lag`` (a reading with its own dynamics, :mod:`heavecomp.effects.sensor_lag`)."""
+    return {**library(), DiscoveredTerm.name: DiscoveredTerm, SensorTerm.name: SensorTerm, SensorLag.name: SensorLag,
             **{c.name: c for c in HOOK_TERMS.values()}}
 
 
@@ -180,6 +182,8 @@ def _undo_channel(e: ChannelEffect, t, y, cols=None):
         if cols is not None and "heave" in cols and "stroke" in cols:
             motion = np.asarray(cols["heave"], dtype=float) + np.asarray(cols["stroke"], dtype=float)
         return e.undo(y, motion)
+    if isinstance(e, SensorLag):  # its factor and delay; its lag is read on the model side (model_side)
+        return e.undo(t, y)
     if getattr(e, "linear", False):  # affine reading y_meas = a0(t) + a1(t) y: invert it
         a0 = e.apply(t, t, np.zeros_like(y), *prm)
         a1 = e.apply(t, t, np.ones_like(y), *prm) - a0
@@ -196,7 +200,8 @@ def correct(effects, t, columns: dict) -> tuple[dict, list]:
     """Undo the reading effects ``effects`` (instances) on the measured ``columns`` at times ``t`` [s].
 
     A channel effect's reading is inverted on its channel (gain and offset exactly, a delay by shifting
-    the channel back; its last t_d seconds become NaN, a dropout); ``heave_reference`` replaces the
+    the channel back; its last t_d seconds become NaN, a dropout; ``sensor_lag``'s factor and delay only:
+    its lag is read on the model side, the diagnosis' replay reads its prediction through it); ``heave_reference`` replaces the
     measured heave by the heave the compensator sees (``seen``, less the lever arm times the logged
     ``pitch`` when there is one).  Plant effects are ignored.
 

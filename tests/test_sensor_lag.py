@@ -1,0 +1,155 @@
+"""A reading with its own dynamics (``sensor_lag``, issue 22): the calibrated model reads a sensor-fault
+verdict's channel through a factor, a first-order lag and a delay fitted together.
+
+The truths are the generator's (a run of the benchmark's with no effect) read through a sensor the test
+makes itself: a first-order lag integrated by ``scipy.signal.lsim`` on the continuous transfer function
+1 / (tau s + 1), never the effect's own recursion.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from heavecomp.diagnosis.calibrate import FILE, fit_reading, replay_shrink, write
+from heavecomp.diagnosis.data import load_run
+from heavecomp.effects import spec
+from heavecomp.effects.sensor_lag import SensorLag
+from heavecomp.errors import ParameterError
+from heavecomp.params import dumps, loads, paper_a
+from tests._cli import run as cli
+
+#: the planted sensor: a sign flip read through a 0.6 s lag
+TAU, FACTOR = 0.6, -1.0
+
+
+def _lagged(t, y, tau):
+    """The test's own sensor: 1 / (tau s + 1) by scipy's lsim (linear interpolation of the input)."""
+    from scipy import signal
+
+    _, out, _ = signal.lsim(signal.lti([1.0], [tau, 1.0]), y - y[0], t)
+    return out + y[0]
+
+
+def test_the_lag_is_the_continuous_first_order_lag():
+    """On a 10 Hz grid the effect's lag of a mixed sea is the continuous lag (lsim) and its phase at
+    0.1 Hz is atan(w tau): no half-step delay of its own."""
+    t = np.arange(0.0, 200.0, 0.1)
+    y = np.sin(2 * np.pi * 0.1 * t) + 0.5 * np.sin(2 * np.pi * 0.23 * t + 1.0)
+    got = SensorLag(channel="stroke", time_constant=TAU).measure(t, t, y)
+    np.testing.assert_allclose(got, _lagged(t, y, TAU), atol=1e-6)
+
+
+def test_a_reading_fit_recovers_a_known_lag_factor_and_delay():
+    rng = np.random.default_rng(3)
+    t = np.arange(0.0, 300.0, 0.1)
+    y = sum(a * np.sin(2 * np.pi * f * t + p) for a, f, p in ((0.2, 0.08, 0.0), (0.1, 0.13, 1.0), (0.05, 0.3, 2.0)))
+    meas = 0.97 * np.interp(t - 0.2, t, _lagged(t, y, 0.85)) + rng.normal(0.0, 0.005, t.size)
+    got = fit_reading(t, y, meas, t < 200.0)
+    assert got["time_constant"] == pytest.approx(0.85, rel=0.05)
+    assert got["delay"] == pytest.approx(0.2, abs=0.03)
+    assert got["factor"] == pytest.approx(0.97, rel=0.01)
+
+
+@pytest.fixture(scope="module")
+def lagged_run(tmp_path_factory):
+    """A generated run with no effect whose stroke the test reads through its own sign-flipped lagged sensor."""
+    from heavecomp.benchmark import Case, generate
+
+    tr = generate(Case("none", 12, "none", duration=200.0))
+    t = np.asarray(tr.t, float)
+    tr.columns["stroke"] = FACTOR * _lagged(t, np.asarray(tr.columns["stroke"], float), TAU)
+    d = tmp_path_factory.mktemp("lag")
+    return tr, tr.to_csv(d / "run.csv"), d
+
+
+@pytest.mark.slow
+def test_a_reading_verdict_is_written_with_the_sensors_lag_and_round_trips(lagged_run):
+    """A verdict that read the lagged, sign-flipped stroke as a sign flip alone (sensor_gain, what the
+    diagnosis names): the calibrated file reads it with the sensor's lag found within 10 %, passes
+    ``heavecomp params``, and replaying it reproduces the shrink it reports."""
+    tr, path, d = lagged_run
+    run = load_run(path, tr.nominal)
+    T = float(run.t[-1])
+    diag = {"verdict": {"effect": "sensor_gain", "confidence": "high", "shrink": 0.9, "shrink_channel": "stroke",
+                        "parameters": {"channel": "stroke", "factor": -1.02}},
+            "split": {"fit": [0.0, 0.67 * T], "validate": [0.67 * T, T], "settle": 20.0}}
+    cal = write(tr.nominal, diag, d, run=run)
+    (lag,) = [c for c in cal.changes if c["name"] == "sensor_lag"]
+    assert [c["name"] for c in cal.changes] == ["sensor_lag"] and lag["replaces"] == ["sensor_gain"]
+    assert lag["parameters"]["time_constant"] == pytest.approx(TAU, rel=0.1)
+    assert lag["parameters"]["factor"] == pytest.approx(FACTOR, rel=0.02)
+    assert cal.verdict_shrink == 0.9
+    res = cli("params", str(d / FILE))
+    assert res.returncode == 0 and 'name = "sensor_lag"' in res.stdout
+    back = spec.load(d / FILE)
+    assert back.effects[-1] == ("sensor_lag", lag["parameters"])
+    got = replay_shrink(path, back, tr.nominal, {**diag, "calibrated": cal.block()})
+    assert got["shrink"] == pytest.approx(cal.expected_shrink, rel=0.1)
+    assert got["shrink"] > 0.9  # the sign flip and its lag: what the nominal misses on the stroke
+
+
+def test_a_bad_time_constant_is_one_line_naming_the_key(tmp_path):
+    entry = {"channel": "stroke", "factor": 1.0, "time_constant": -0.5}
+    with pytest.raises(ParameterError) as exc:
+        spec.check(paper_a().replace(effects=[("sensor_lag", entry)]))
+    msg = str(exc.value)
+    assert "\n" not in msg and "effects[0].time_constant" in msg and "s" in msg
+    bad = tmp_path / "bad.toml"
+    bad.write_text(dumps(paper_a().replace(effects=[("sensor_lag", {**entry, "time_constant": 0.5})]))
+                   .replace("time_constant = 0.5", "time_constant = -0.5"))
+    res = cli("params", str(bad))
+    assert res.returncode == 2 and "effects[0].time_constant" in res.stderr and len(res.stderr.strip().splitlines()) == 1
+
+
+def test_its_factor_and_delay_are_undone_on_the_log_and_its_lag_is_not():
+    """A log correction inverts the factor and the delay exactly; the lag is left for the model side
+    (inverting it would differentiate the noise)."""
+    t = np.arange(0.0, 100.0, 0.05)
+    y = 0.1 * np.sin(0.5 * t)
+    e = SensorLag(channel="stroke", factor=-0.9, time_constant=0.4, delay=0.3)
+    got, notes = spec.correct([e], t, {"stroke": e.measure(t, t, y)})
+    ok = np.isfinite(got["stroke"])
+    assert len(notes) == 1 and ok.sum() > 0.99 * t.size
+    np.testing.assert_allclose(got["stroke"][ok], e.lag(t, t, y)[ok], atol=1e-9)
+    assert not np.allclose(got["stroke"][ok], y[ok], atol=1e-3)
+
+
+def test_the_diagnosis_replay_reads_the_files_lag_on_the_model_side(lagged_run):
+    """The replay of a file with ``sensor_lag`` on the stroke predicts the lagged stroke (its other channels
+    unchanged); a file without it, the plant's."""
+    from heavecomp.diagnosis.replay import build
+    from heavecomp.diagnosis.stepper import CHANNELS
+
+    tr, path, _ = lagged_run
+    run = load_run(path, tr.nominal)
+    with_lag = tr.nominal.replace(effects=[("sensor_lag", {"channel": "stroke", "factor": 1.0, "time_constant": TAU,
+                                                         "delay": 0.0})])
+    plain = build(run, tr.nominal).simulate([])
+    lagged = build(run, with_lag).simulate([])
+    np.testing.assert_array_equal(lagged["wob"], plain["wob"])
+    want = SensorLag(channel="stroke", time_constant=TAU).lag(run.t, plain["_grid"][:, 0],
+                                                          plain["_grid"][:, CHANNELS.index("stroke")])
+    assert not np.allclose(lagged["stroke"], plain["stroke"], atol=1e-4)
+    np.testing.assert_allclose(lagged["stroke"], want, atol=1e-12)
+
+
+def test_the_mpcs_refuse_a_lag_in_one_line_and_take_a_factor():
+    from heavecomp.controllers import CONTROLLERS, ControllerConfig
+
+    p = paper_a("stribeck")
+    for mpc in ("linear-mpc", "nonlinear-mpc"):
+        with pytest.raises(ParameterError) as err:
+            CONTROLLERS[mpc](p, ControllerConfig.from_params(p, horizon=3),
+                             effects=[SensorLag(channel="wob", time_constant=0.5)])
+        msg = str(err.value)
+        assert "\n" not in msg and msg.startswith("effect sensor_lag") and "lag" in msg, msg
+        ctrl = CONTROLLERS[mpc](p, ControllerConfig.from_params(p, horizon=3),
+                                effects=[SensorLag(channel="wob", factor=1.05)])
+        assert ctrl.model.Ad.shape[0] == 4
+
+
+def test_a_file_round_trips_its_sensor_lag():
+    fx = [("sensor_lag", {"channel": "pressure", "factor": 0.98, "time_constant": 0.25, "delay": 0.05})]
+    back = loads(dumps(paper_a().replace(effects=fx)))
+    assert list(back.effects) == fx and [e.name for e in spec.reading_effects(back)] == ["sensor_lag"]
