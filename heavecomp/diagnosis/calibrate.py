@@ -510,6 +510,9 @@ def fit_reading(t, model, measured, fit, tau0=None, delay0=None) -> dict:
     """The linear reading of one channel, ``measured ~ g lag_tau(model)(t - t_d)``, fitted by least squares
     on the samples ``fit``: the factor exactly (linear), the time constant and the delay from a grid
     (:data:`LAG_GRID` x :data:`DELAY_GRID`, plus ``tau0`` / ``delay0``) refined by a bounded least squares.
+    The delay may go down to minus one sample of the log: where the log's stamps come late, or where the
+    sensor's lag is a logger's discrete filter (its output takes the current sample, half a sample ahead of
+    the continuous lag of the same time constant).
     Only this channel is in the fit: a reading does not change what the plant does, so the other channels
     (and the nominal's miss on this one, the diagnosis' weights) have no say in it.
 
@@ -542,13 +545,14 @@ def fit_reading(t, model, measured, fit, tau0=None, delay0=None) -> dict:
         g = float(np.clip(r @ y / den, *lo["factor"])) if den > 0 else 0.0
         return g, g * r - y
 
+    step = float(np.median(np.diff(t)))  # a log sample: the delay may go down to minus one (late time stamps)
     starts = [(a, b) for a in sorted(set(LAG_GRID + ((tau0,) if tau0 else ())))
-              for b in sorted(set(DELAY_GRID + ((delay0,) if delay0 else ())))]
+              for b in sorted(set(DELAY_GRID + (-step, -0.5 * step) + ((delay0,) if delay0 else ())))]
     cost = [float(np.sum(profile(a, b)[1] ** 2)) for a, b in starts]
     x0 = np.array(starts[int(np.argmin(cost))], float)
     hi = [min(lo["time_constant"][1], 2.0 * max(LAG_GRID)), min(lo["delay"][1], 2.0 * max(DELAY_GRID))]
-    sol = least_squares(lambda x: profile(x[0], x[1])[1], x0, bounds=([0.0, 0.0], hi),
-                        x_scale=[max(x0[0], 0.01), max(x0[1], 0.01)], diff_step=1e-3, max_nfev=60)
+    sol = least_squares(lambda x: profile(x[0], x[1])[1], x0, bounds=([0.0, max(-step, lo["delay"][0])], hi),
+                        x_scale=[max(x0[0], 0.01), max(abs(x0[1]), 0.01)], diff_step=1e-3, max_nfev=60)
     x = sol.x if float(np.sum(sol.fun ** 2)) <= min(cost) else x0
     g, r = profile(x[0], x[1])
     return {"factor": g, "time_constant": float(x[0]), "delay": float(x[1]), "rms": float(np.sqrt(np.mean(r * r)))}
@@ -604,8 +608,10 @@ def reading_dynamics(cal: Calibrated, run, nominal, diagnosis: dict, policy=None
     val = (t >= float(split["validate"][0])) & np.isfinite(y)
 
     def plant(readers):  # the calibrated plant's replay of the log read through ``readers`` (its start from it)
-        cols, _ = correct(reading_effects(base.replace(effects=readers)), t, dict(run.columns))
-        return _replay(base, MeasuredRun(t, cols, run.source))[c]
+        fx = reading_effects(base.replace(effects=readers))
+        cols, _ = correct(fx, t, dict(run.columns))
+        lagged = tuple(e for e in fx if getattr(e, "model_side", False))  # started as the file's replay starts
+        return _replay(base, R.unlagged(MeasuredRun(t, cols, run.source), lagged))[c]
 
     now = plant(mine)
     for e in reading_effects(base.replace(effects=mine)):

@@ -191,7 +191,8 @@ def build(run, nominal, *, stuck_speed=S.STUCK_SPEED, segment=None, reinit=1.5, 
     """
     h, n_steps = grid(run, nominal)
     spline = heave_filtered(run)
-    initial = S.estimate(run, nominal, spline, stuck_speed=stuck_speed, noise=noise)
+    readers = tuple(e for e in reading_effects(nominal) if getattr(e, "model_side", False))
+    initial = S.estimate(unlagged(run, readers), nominal, spline, stuck_speed=stuck_speed, noise=noise)
     hs = heave_samples(run, h, n_steps, reference=initial.heave_reference, spline=spline)
     plant = plant_vectors(nominal)
     bounds, starts, rein = [(0, n_steps)], [initial.start()], np.zeros(run.t.size, bool)
@@ -199,8 +200,44 @@ def build(run, nominal, *, stuck_speed=S.STUCK_SPEED, segment=None, reinit=1.5, 
         bounds, starts, rein = _segments(run, h, n_steps, plant.PP, segment, reinit, stuck_speed)
         starts[0] = initial.start()
     return Replay(run, nominal, h, n_steps, hs, plant, bounds, starts, rein, spline, initial, stuck_speed,
-                  tuple(plant_effects(nominal)),
-                  tuple(e for e in reading_effects(nominal) if getattr(e, "model_side", False)))
+                  tuple(plant_effects(nominal)), readers)
+
+
+#: s of the log's start a sensor lag is lifted from for the start estimate (:func:`_unlagged`)
+UNLAG_SPAN = 30.0
+#: Hz, the zero-phase low-pass of that lift (the lag's inverse differentiates: the start estimate needs no more)
+UNLAG_CUTOFF = 1.0
+
+
+def unlagged(run, readers):
+    """The run the start estimate reads when the file reads a stroke or WOB through a sensor lag
+    (``sensor_lag``, read on the model side): the log holds the lagged channel, which lags the state the
+    replay must start from (a stroke started off moves the gas spring's charge and the whole replay).  Over
+    its first :data:`UNLAG_SPAN` s the channel is lifted back, ``y_l + tau dy_l/dt`` on the channel low-passed
+    at :data:`UNLAG_CUTOFF` (zero phase); the rest of the log is not read by the start estimate.
+
+    Parameters
+    ----------
+    run : heavecomp.diagnosis.data.MeasuredRun
+        The measured run (read with the file: the lag's factor and delay undone).
+    readers : tuple of Effect
+        The file's model-side readings (``sensor_lag``).
+    """
+    lifts = [e for e in readers if e.channel in ("stroke", "wob") and e.channel in run.columns
+             and float(e.values["time_constant"]) > 0.0]
+    if not lifts:
+        return run
+    t = run.t
+    cols = dict(run.columns)
+    for e in lifts:
+        y = np.asarray(cols[e.channel], float).copy()
+        m = (t <= t[0] + UNLAG_SPAN) & np.isfinite(y)
+        if m.sum() < 8:
+            continue
+        yf, dy, _ = lowpass_zero_phase(t[m], y[m], UNLAG_CUTOFF)
+        y[m] = yf + float(e.values["time_constant"]) * dy
+        cols[e.channel] = y
+    return MeasuredRun(t, cols, run.source)
 
 
 def grid(run, nominal) -> tuple:

@@ -7,7 +7,9 @@ a mixed sea neither of them reads it right.  This effect is the generic linear r
 
     tau dy_l/dt = y - y_l,   y_meas(t) = g y_l(t - t_d)
 
-with ``factor`` g [-], ``time_constant`` tau [s] (0: no lag) and ``delay`` t_d [s].  It is a calibration
+with ``factor`` g [-], ``time_constant`` tau [s] (0: no lag) and ``delay`` t_d [s] (negative: the log's time
+stamps come late; the calibration fits it down to minus one log sample, where a continuous lag and a logger's
+discrete filter of the same tau differ by half a sample).  It is a calibration
 of a reading, kept apart from the plant (like ``sensor_gain``); it is not a diagnosis candidate and not in
 the registry's library composition: the calibrated model writes it
 (:func:`heavecomp.diagnosis.calibrate.reading_dynamics`) when a reading verdict's channel is read better
@@ -79,7 +81,9 @@ class SensorLag(ChannelEffect):
         factor: float = q(1.0, "-", bounds=(-2.0, 2.0), symbol="g", doc="factor the channel reads (-1: sign flipped)")
         time_constant: float = q(0.0, "s", bounds=(0.0, 10.0), symbol="tau",
                                  doc="time constant of the sensor's first-order lag (0: none)")
-        delay: float = q(0.0, "s", bounds=(0.0, 3.0), symbol="t_d", doc="transport delay after the lag")
+        delay: float = q(0.0, "s", bounds=(-1.0, 3.0), symbol="t_d",
+                         doc="transport delay after the lag (negative, by up to a log sample: the log's time "
+                             "stamps come late, e.g. a sample-and-hold stamped at the end of its interval)")
 
     @classmethod
     def null(cls, plant):
