@@ -613,11 +613,12 @@ def reading_dynamics(cal: Calibrated, run, nominal, diagnosis: dict, policy=None
         lagged = tuple(e for e in fx if getattr(e, "model_side", False))  # started as the file's replay starts
         return _replay(base, R.unlagged(MeasuredRun(t, cols, run.source), lagged))[c]
 
-    now = plant(mine)
-    for e in reading_effects(base.replace(effects=mine)):
+    first = plant(mine)
+    now = first
+    for e in reading_effects(base.replace(effects=mine)):  # the verdict's reading of it
         now = e.measure(t, t, now)
     delay0 = next((float(v["delay"]) for n, v in mine if n == "sensor_delay"), None)
-    got = fit_reading(t, plant(mine), y, fit, tau0=delay0, delay0=delay0)
+    got = fit_reading(t, first, y, fit, tau0=delay0, delay0=delay0)
     # again from the start the new reading gives (the log read through it, as the calibrated file reads it)
     model = plant([(SensorLag.name, {"channel": c, **{k: got[k] for k in ("factor", "time_constant", "delay")}})])
     got = fit_reading(t, model, y, fit, tau0=got["time_constant"], delay0=got["delay"])
