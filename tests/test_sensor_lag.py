@@ -92,6 +92,24 @@ def test_a_reading_verdict_is_written_with_the_sensors_lag_and_round_trips(lagge
     assert got["shrink"] > 0.9  # the sign flip and its lag: what the nominal misses on the stroke
 
 
+def test_a_re_diagnosis_reading_is_not_stacked_on_the_files_lag(lagged_run):
+    """A file that reads the stroke already (``sensor_lag``): a re-diagnosis' reading of the stroke is written as
+    the verdict says, not refitted into a second lag on the same channel."""
+    from heavecomp.diagnosis.calibrate import calibrate, reading_dynamics
+
+    tr, path, _, _ = lagged_run
+    nominal = tr.nominal.replace(effects=[("sensor_lag", {"channel": "stroke", "factor": FACTOR, "time_constant": TAU,
+                                                        "delay": 0.0})])
+    run = load_run(path, nominal)
+    T = float(run.t[-1])
+    diag = {"verdict": {"effect": "sensor_gain", "confidence": "low", "shrink": 0.3, "shrink_channel": "stroke",
+                        "parameters": {"channel": "stroke", "factor": 1.05}},
+            "split": {"fit": [0.0, 0.67 * T], "validate": [0.67 * T, T], "settle": 20.0}}
+    cal = calibrate(nominal, diag)
+    assert reading_dynamics(cal, run, nominal, diag) is cal
+    assert [n for n, _ in cal.params.effects] == ["sensor_lag", "sensor_gain"]
+
+
 def test_a_bad_time_constant_is_one_line_naming_the_key(tmp_path):
     entry = {"channel": "stroke", "factor": 1.0, "time_constant": -0.5}
     with pytest.raises(ParameterError) as exc:

@@ -570,7 +570,8 @@ def reading_dynamics(cal: Calibrated, run, nominal, diagnosis: dict, policy=None
     (:func:`fit_reading`: factor, first-order lag and delay jointly, on the fit part, this channel alone)
     against the replay of the calibrated plant, and carried as ``sensor_lag`` in place of the verdict's
     readings of that channel when its held-out rms is at least ``reading_dynamics_gain`` smaller than
-    theirs.  Nothing else changes (the verdict stays the verdict); ``expected_shrink`` becomes the
+    theirs (not when the nominal file reads that channel already: a re-diagnosis' reading stays the
+    verdict's, never stacked on the file's).  Nothing else changes (the verdict stays the verdict); ``expected_shrink`` becomes the
     calibrated file's replayed held-out shrink (:func:`held_out_shrink`), the verdict's own kept as
     ``verdict_shrink``.
 
@@ -601,6 +602,8 @@ def reading_dynamics(cal: Calibrated, run, nominal, diagnosis: dict, policy=None
     mine = [(n, v) for n, v in new if v.get("channel") == c]
     if any(n not in DYNAMIC_READINGS for n, _ in mine):  # e.g. an offset too: not a linear reading sensor_lag holds
         return cal
+    if any(v.get("channel") == c for _, v in nominal.effects):  # the file read it already (a re-diagnosis): left
+        return cal  # as the verdict says, not stacked on that reading
     base = cal.params.replace(effects=[e for e in cal.params.effects if e not in mine])
     t, y = run.t, run[c]
     split = diagnosis["split"]
