@@ -184,8 +184,11 @@ def discover(cr, fitmask, valmask, policy):
     best = None
     for c in sorted((c for c in COMPONENTS if gap[c] > 0), key=lambda c: -gap[c])[:policy.discover_components]:
         sig = cr.signals_for(c)
-        d = EE.open_search(cr.residual[c], sig, fm, vm, component=c)
+        own = cr.own_features(c)  # a part of another's equation: searched on its own parts only
+        d = EE.open_search(cr.residual[c], sig, fm, vm, component=c,
+                           features=None if own is None else EE.library(sig, own))
         if d is not None and (best is None or d["shrink"] > best["shrink"]):
             # the constant of the x feature (x - mean x), for the calibrated model's term at its hook
             best = dict(d, unit=CR.UNITS[c], levels={"x_mean": float(np.nanmean(sig["x"]))} if "x" in sig else {})
     return best
+
