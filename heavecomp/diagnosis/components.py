@@ -62,6 +62,9 @@ from heavecomp.diagnosis.data import ANGLES, fill_gaps, lowpass_zero_phase, nois
 from heavecomp.diagnosis.policy import VerdictPolicy
 from heavecomp.effects import sensor_term as ST
 from heavecomp.effects.base import COMPONENTS
+from heavecomp.effects.compose import Composition
+from heavecomp.effects.registry import library
+from heavecomp.effects.spec import plant_effects
 from heavecomp.effects.features import rest_durations
 from heavecomp.errors import DataError
 from heavecomp.friction.laws import friction_cont, friction_jump
@@ -95,7 +98,6 @@ def _dilate(t, flag, width):
 
 @functools.lru_cache(maxsize=16)
 def _composition(classes):
-    from heavecomp.effects.compose import Composition
     return Composition(classes)
 
 
@@ -113,9 +115,6 @@ def file_hooks(params):
     params : heavecomp.params.CMCParams
         Parameters whose ``effects`` are read.
     """
-    from heavecomp.effects.registry import library
-    from heavecomp.effects.spec import plant_effects
-
     effects = plant_effects(params) if getattr(params, "effects", None) else []
     use = [e for e in effects if not type(e).states]
     skipped = [e.name for e in effects if type(e).states]
