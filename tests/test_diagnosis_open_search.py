@@ -64,6 +64,16 @@ def test_the_line_inertance_is_found_through_the_acceleration_feature():
     assert d["coefficients"]["a"] == pytest.approx(L, rel=0.05)
 
 
+def test_a_named_law_is_replaced_by_the_search_form_only_when_the_plant_does_not_follow_it():
+    cr, fit, val = _residuals(lambda v, a: -4e5 * v * np.abs(v))  # turbulent: the laminar law is not the plant's
+    form = S.named_form(cr, "flow_loss", fit, val)
+    assert form is not None and form["replaces"] == "flow_loss" and form["features"] == ["v_abs_v"]
+    assert form["bic"] < form["named"]["bic"] and form["shrink"] > form["named"]["shrink"]
+    cr, fit, val = _residuals(lambda v, a: -1.2e5 * v)  # laminar: the named law is the plant's
+    assert S.named_form(cr, "flow_loss", fit, val) is None
+    assert S.named_form(cr, "parameter_mismatch", fit, val) is None  # no law of its own
+
+
 def test_the_equations_are_the_parameter_files():
     """A calibrated file's flow_loss is part of its model: the gas law's residual against the file no
     longer holds its R v (with the nominal equations it did, and a re-diagnosis counted it twice)."""
