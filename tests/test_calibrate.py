@@ -143,3 +143,20 @@ def test_a_static_force_refitted_below_the_nominal_coulomb_force_clips_it_as_the
                                                       "friction.coulomb_force": fc}))
     p = _round_trip(cal)
     assert p.friction.static_force == p.friction.coulomb_force == pytest.approx(0.9 * fc)
+
+
+def test_a_named_verdicts_search_form_is_carried_in_place_of_the_named_law():
+    """A laminar flow_loss verdict whose line the open search fits better as K v|v| (verdict.form,
+    heavecomp.diagnosis.screen.named_form): the file carries line_term, not flow_loss; its shrink is
+    measured by replaying the log (0 promised here), as a discovered term's."""
+    form = {"term": "-3.79e+05*v*|v|", "features": ["v_abs_v"], "coefficients": {"v_abs_v": -3.79e5},
+            "shrink": 0.93, "component": "flow_line", "replaces": "flow_loss",
+            "named": {"shrink": 0.69, "bic": 76.9, "coefficients": {"flow_loss": 1.13e5}}}
+    cal = calibrate(NOM, _diag("flow_loss", {"resistance": 1.14e5}, form=form))
+    (e,) = spec.plant_effects(_round_trip(cal))
+    assert e.name == "line_term" and e.values["v_abs_v"] == -3.79e5 and e.values["v"] == 0.0
+    assert cal.expected_shrink == 0.0 and "carried in the form the open search gave" in to_toml(cal)
+    # a form with no model form at its hook (the acceleration): the named law is carried
+    form = dict(form, features=["a"], coefficients={"a": -9e4})
+    cal = calibrate(NOM, _diag("flow_loss", {"resistance": 1.14e5}, form=form))
+    assert cal.params.effects == (("flow_loss", {"resistance": 1.14e5}),) and cal.expected_shrink == 0.6

@@ -180,7 +180,7 @@ def calibrate(nominal, diagnosis: dict) -> Calibrated:
     elif eff == "discovered":
         if not _add_discovered(out, v.get("discovered") or {}, add):
             return out
-    else:
+    elif not _add_form(out, v, add):  # the named law (its open-search form, when that fits better)
         add(eff, v.get("parameters", {}))
         role = out.changes[-1]["role"]
         out.why.append(f"diagnosis verdict: {eff} (confidence {v.get('confidence', '?')}) -- "
@@ -248,23 +248,14 @@ def _add_discovered(out: Calibrated, d: dict, add) -> bool:
     bool
         False when the term has no model form (the nominal file is kept).
     """
-    feats = list(d.get("features", []))
-    comp = d.get("component", "?")
-    if comp == DISCOVERED_COMPONENT and feats and all(f in DISCOVERED_FEATURES for f in feats):
-        return _carry(out, add, "discovered_term", {f: float(d["coefficients"][f]) for f in feats}, d,
-                      "the open search's term on the friction residual")
-    hooked = HT.carried(comp, feats)
-    if hooked is not None and ("x" not in feats or "x_mean" in d.get("levels", {})):
-        vals = {f: float(d["coefficients"][f]) for f in feats}
-        if "x" in feats:
-            vals["x_mean"] = float(d["levels"]["x_mean"])
-        return _carry(out, add, hooked.name, vals, d, f"the open search's term on the {comp} residual, at the "
-                                                       f"{hooked.hook} hook")
+    hooked = _plant_term(d)
+    if hooked is not None:
+        return _carry(out, add, *hooked, d)
     reading = _sensor_term(d)
     if reading is not None:
-        return _carry(out, add, "sensor_term", reading, d, f"the channel search's misreading of {d['channel']}, a "
+        return _carry(out, add, "sensor_term", reading, f"the channel search's misreading of {d['channel']}, a "
                                                             f"correction of how the log's {d['channel']} is read (the "
-                                                            "plant is unchanged)")
+                                                            "plant is unchanged)", d)
     out.why.append(f"diagnosis verdict: discovered -- the open search's term on the "
                    f"{d.get('component', '?')} residual, {d.get('term', '')}, has no model form at its hook "
                    f"(discovered_term carries the friction features {', '.join(DISCOVERED_FEATURES)}, sensor_term "
@@ -274,7 +265,55 @@ def _add_discovered(out: Calibrated, d: dict, add) -> bool:
     return False
 
 
-def _carry(out: Calibrated, add, name: str, values: dict, d: dict, what: str) -> bool:
+def _plant_term(d: dict) -> tuple | None:
+    """(effect name, values, what it is) of an open-search term at a plant hook (``discovered_term`` on
+    the friction, ``line_term`` / ``gas_term`` / ``string_term``), or None when it has no form there.
+
+    Parameters
+    ----------
+    d : dict
+        A discovered-term block: ``component``, ``features``, ``coefficients``, ``levels``.
+    """
+    feats = list(d.get("features", []))
+    comp = d.get("component", "?")
+    if comp == DISCOVERED_COMPONENT and feats and all(f in DISCOVERED_FEATURES for f in feats):
+        return ("discovered_term", {f: float(d["coefficients"][f]) for f in feats},
+                "the open search's term on the friction residual")
+    hooked = HT.carried(comp, feats)
+    if hooked is not None and ("x" not in feats or "x_mean" in d.get("levels", {})):
+        vals = {f: float(d["coefficients"][f]) for f in feats}
+        if "x" in feats:
+            vals["x_mean"] = float(d["levels"]["x_mean"])
+        return hooked.name, vals, f"the open search's term on the {comp} residual, at the {hooked.hook} hook"
+    return None
+
+
+def _add_form(out: Calibrated, v: dict, add) -> bool:
+    """Carry a named verdict's ``form`` (:func:`heavecomp.diagnosis.screen.named_form`: the open search's
+    form of the named effect's component, which fitted it better than the named law) in place of the
+    named effect, when it has a form at its hook; False: the named effect is carried.
+
+    Parameters
+    ----------
+    out : Calibrated
+        The calibrated model so far (extended in place).
+    v : dict
+        The diagnosis' verdict (``effect``, ``form``).
+    add : callable
+        ``add(name, values)``: adds an effect entry.
+    """
+    d = v.get("form") or {}
+    hooked = _plant_term(d) if d.get("replaces") == v["effect"] else None
+    if hooked is None:
+        return False
+    named = d.get("named", {})
+    return _carry(out, add, *hooked, d, lead=(
+        f"diagnosis verdict: {v['effect']} (confidence {v.get('confidence', '?')}), carried in the form the open "
+        f"search gave its {d.get('component', '?')} residual (held-out shrink {d.get('shrink', 0.0):.2f} against "
+        f"{named.get('shrink', 0.0):.2f} for the {v['effect']} law; a lower fit-part BIC)"))
+
+
+def _carry(out: Calibrated, add, name: str, values: dict, what: str, d: dict, lead: str = "") -> bool:
     """Add the effect ``name`` with ``values`` that carries the discovered term ``d`` (``what`` it is).
 
     ``verdict.shrink`` is the best *named* candidate's and ``d['shrink']`` the component residual's: no
@@ -290,15 +329,17 @@ def _carry(out: Calibrated, add, name: str, values: dict, d: dict, what: str) ->
         The carrying effect.
     values : dict
         Its parameters [SI].
-    d : dict
-        The verdict's ``discovered`` block.
     what : str
         What the term is, for the file's comment.
+    d : dict
+        The verdict's ``discovered`` block (or a named verdict's ``form``).
+    lead : str
+        The comment's start (empty: a ``discovered`` verdict's).
     """
     add(name, values)
     out.changes[-1]["component_shrink"] = float(d.get("shrink", 0.0))
     out.expected_shrink = 0.0
-    out.why.append(f"diagnosis verdict: discovered -- {what}, {d.get('term', '')}, carried as effect {name} (it "
+    out.why.append(f"{lead or 'diagnosis verdict: discovered'} -- {what}, {d.get('term', '')}, carried as effect {name} (it "
                    f"shrinks the held-out {d.get('component', '?')} equation residual by {d.get('shrink', 0.0):.2f}; "
                    "its replay shrink is measured by replaying the log)")
     return True
@@ -399,7 +440,7 @@ def write(nominal, diagnosis: dict, out_dir, source: str = "", run=None) -> Cali
     if run is not None and cal.changes:
         cal = start_state(cal, run, diagnosis)
         cal = reading_dynamics(cal, run, nominal, diagnosis)
-        if cal.verdict == "discovered":
+        if any("component_shrink" in c for c in cal.changes):  # a carried open-search term: measured by replay
             cal = discovered_shrink(cal, run, nominal, diagnosis)
     (Path(out_dir) / FILE).write_text(to_toml(cal, source), encoding="utf-8")
     return cal

@@ -51,6 +51,7 @@ above its noise).
 from __future__ import annotations
 
 import dataclasses
+import functools
 import logging
 import math
 
@@ -61,6 +62,9 @@ from heavecomp.diagnosis.data import ANGLES, fill_gaps, lowpass_zero_phase, nois
 from heavecomp.diagnosis.policy import VerdictPolicy
 from heavecomp.effects import sensor_term as ST
 from heavecomp.effects.base import COMPONENTS
+from heavecomp.effects.compose import Composition
+from heavecomp.effects.registry import library
+from heavecomp.effects.spec import plant_effects
 from heavecomp.effects.features import rest_durations
 from heavecomp.errors import DataError
 from heavecomp.friction.laws import friction_cont, friction_jump
@@ -92,8 +96,43 @@ def _dilate(t, flag, width):
     return np.convolve(flag.astype(float), np.ones(2 * n + 1), mode="same") > 0
 
 
+@functools.lru_cache(maxsize=16)
+def _composition(classes):
+    return Composition(classes)
+
+
+def file_hooks(params):
+    """The hook functions of ``params``' own plant effects (its ``[[effects]]``) that the equations can
+    evaluate on measured signals: (composition functions, EP, the effects left out), or None with none.
+
+    Only memoryless effects (no states of their own) are evaluated: an effect with a state (a leak's
+    charge, a lag, a warming) needs its history, which the measured signals do not give; it is left out
+    (logged), as before.  A calibrated file's ``flow_loss``, ``line_term``, ``string_damping`` ... are
+    therefore part of the equations, so its residuals show only what the file leaves.
+
+    Parameters
+    ----------
+    params : heavecomp.params.CMCParams
+        Parameters whose ``effects`` are read.
+    """
+    effects = plant_effects(params) if getattr(params, "effects", None) else []
+    use = [e for e in effects if not type(e).states]
+    skipped = [e.name for e in effects if type(e).states]
+    if skipped:
+        log.debug("component residuals: effects with a state of their own left out of the equations: %s", skipped)
+    if not use:
+        return None
+    order = list(library())
+    classes = tuple(sorted({type(e) for e in use}, key=lambda c: order.index(c.name) if c.name in order else 1e9))
+    comp = _composition(classes)
+    return comp.functions, comp.ep(use), skipped
+
+
 def equations(t, heave, stroke, pressure, wob, params, heave_reference=0.0, cutoff=CUTOFF):
     """The three equation residuals and the signals they are built from.
+
+    The model side is the nominal CMC with the memoryless plant effects of ``params``' own
+    ``[[effects]]`` at their hooks (:func:`file_hooks`): against a calibrated file, what it leaves.
 
     Parameters
     ----------
@@ -108,7 +147,7 @@ def equations(t, heave, stroke, pressure, wob, params, heave_reference=0.0, cuto
     wob : numpy.ndarray [N]
         Measured weight on bit.
     params : heavecomp.params.CMCParams
-        Nominal parameters.
+        The model's parameters (nominal tables and the file's own plant effects, :func:`file_hooks`).
     heave_reference : float [m]
         The heave of the operating point (``InitialState.heave_reference``).
     cutoff : float [Hz]
@@ -130,15 +169,22 @@ def equations(t, heave, stroke, pressure, wob, params, heave_reference=0.0, cuto
     sliding = np.abs(v) > STUCK_SPEED
     sv = np.sign(v)
     F_meas = net_force(p, T_meas, ddzh, 0.0, PP) - PP[MC] * a  # top-mass balance: the friction it needs
-    F_nom = friction_jump(code, np.abs(v), p, FP) * sv + friction_cont(code, v, p, FP)
+    hooks = file_hooks(params)
+    if hooks is None:
+        F_nom = friction_jump(code, np.abs(v), p, FP) * sv + friction_cont(code, v, p, FP)
+    else:
+        fx, EP, _ = hooks
+        X = np.zeros(4)  # memoryless effects only: no state is read
+        F_nom = fx["sliding_friction_fx"](code, sv, v, p, s, X, FP, EP)
     # the bit lifted off (W near 0, and the filter's reach around it): y_b is not read from W there
     lifted = _dilate(t, W < LIFTOFF * max(float(np.median(W)), 0.0), 1.0 / cutoff)
     # away from rest and reversals by the filter's reach: there the filtered sign(v) jump is smeared and
     # the nominal law at the filtered v differs from the filtered friction (artefact, not gap)
     clear = ~_dilate(t, ~sliding | (np.diff(sv, prepend=sv[0]) != 0), REACH / cutoff)
     res = {"top_mass": np.where(clear, F_meas - F_nom, np.nan),
-           "lower_mass": np.where(lifted, np.nan, T_meas - tension(s, v, yb, vb, zh, dzh, PP)),
-           "gas": p - gas_pressure(s, PP)}
+           "lower_mass": np.where(lifted, np.nan, T_meas - (tension(s, v, yb, vb, zh, dzh, PP) if hooks is None else
+                                                            fx["tension_fx"](s, v, yb, vb, zh, dzh, X, PP, EP))),
+           "gas": p - (gas_pressure(s, PP) if hooks is None else fx["cylinder_pressure_fx"](s, v, X, PP, EP))}
     dwell, rest = rest_durations(t, ~sliding)
     sig = {"t": t, "x": s, "v": v, "a": a, "p": p, "dp": dp, "wob": W, "dwob": dW, "zh": zh, "dzh": dzh,
            "ddzh": ddzh, "rel": zh + s - yb, "vrel": dzh + v - vb, "dwell": dwell, "rest": rest,
@@ -204,6 +250,9 @@ class ComponentResiduals:
     inputs: dict = dataclasses.field(default_factory=dict)
     #: the equations the log's channels cannot compute (:func:`unobservable`): their residuals are NaN
     missing: tuple = ()
+    #: {component: equation} for a component that is a part of another's equation (:data:`SPLIT`):
+    #: the equation its :attr:`residual` was taken from
+    host: dict = dataclasses.field(default_factory=dict)
 
     def observable(self) -> dict:
         """{component: whether an equation that carries a part of it is computable from the log's channels}."""
@@ -243,6 +292,24 @@ class ComponentResiduals:
     def gap_to_noise(self, mask=None) -> dict:
         """Per component: rms of its parts over the noise, sqrt(1 + gap) for its own equation [-]."""
         return {c: math.sqrt(1.0 + g) for c, g in self.gap(mask).items()}
+
+    def own_features(self, component) -> tuple | None:
+        """The open search's features of a component that is a part of another's equation: its own parts
+        in the equation its residual was taken from (:data:`SPLIT`; ``flow_line``: v, v|v| and the
+        acceleration a).  None for a component that owns an equation (the full library).
+
+        Its residual is that equation's rest plus its part, so the equation's own signals (the gas law's
+        p and x) would rebuild the residual's definition (the host's structure), not the part: a
+        flow-line search on a turbulent line kept const, signs, p and x and lost the v|v| term
+        (docs/diagnosis.md, "the open search per component").
+
+        Parameters
+        ----------
+        component : str
+            A component of :data:`heavecomp.effects.base.COMPONENTS`.
+        """
+        e = self.host.get(component)
+        return tuple(SPLIT[e][component]) if e is not None else None
 
     def signals_for(self, component) -> dict:
         """The ``sig`` of :meth:`Effect.features` for a component (``x``/``v`` are the string's relative
@@ -319,15 +386,16 @@ class ComponentResiduals:
 
 def residuals(run, params, *, heave_reference=None, noise=None, mask=None, cutoff=CUTOFF, seed=7,
               floor_channels=None) -> ComponentResiduals:
-    """Component residuals of a :class:`~heavecomp.diagnosis.data.MeasuredRun` against the nominal
-    ``params``.
+    """Component residuals of a :class:`~heavecomp.diagnosis.data.MeasuredRun` against the model of
+    ``params``: the nominal equations with the file's own memoryless plant effects at their hooks
+    (:func:`file_hooks`; a calibrated file's residuals show only what it leaves).
 
     Parameters
     ----------
     run : heavecomp.diagnosis.data.MeasuredRun
         The measured run (heave, stroke, pressure and wob columns).
     params : heavecomp.params.CMCParams
-        Nominal parameters.
+        The model's parameters (nominal tables and the file's plant effects).
     heave_reference : float [m], optional
         Heave of the operating point (default: the first filtered heave sample).
     noise : {channel: sigma}, optional
@@ -436,11 +504,13 @@ def _attribute(t, eq, sig, sig_noise, m):
         v = v[np.isfinite(v)]
         return float(np.mean(v * v)) / max(sig_noise[k], 1e-300) ** 2 if v.size else -1.0
 
+    host = {}
     for c in COMPONENTS:
         if c not in resid:
             e = max(parts[c], key=lambda k: size(c, k))
             resid[c] = parts[OWN[e]][e] + parts[c][e]
-    return ComponentResiduals(t, eq, sig_noise, parts, resid, sig, m)
+            host[c] = e
+    return ComponentResiduals(t, eq, sig_noise, parts, resid, sig, m, host=host)
 
 
 # ---------------------------------------------------------------------------- sensors: one channel misreads

@@ -190,7 +190,7 @@ def rank_effects(r, sig, effects, fit, validate, base=None, component="") -> lis
 
 
 # ---------------------------------------------------------------------------- open search
-def library(sig: dict) -> dict:
+def library(sig: dict, names=None) -> dict:
     """The open search's features from the signals present in ``sig`` (names as
     :meth:`heavecomp.effects.base.Effect.features`; optional ``rel`` relative displacement of a
     spring [m], ``still`` boolean at rest).
@@ -202,7 +202,16 @@ def library(sig: dict) -> dict:
     sig : dict
         Measured signals of the component ({``t`` [s], ``v`` [m/s], ``x`` [m], ``p`` [Pa], ...}:
         :meth:`heavecomp.diagnosis.components.ComponentResiduals.signals_for`). Optional ``rel`` [m] and ``still`` (bool) add their features.
+    names : sequence of str, optional
+        Only these features (a component's own parts,
+        :meth:`heavecomp.diagnosis.components.ComponentResiduals.own_features`); a name that is not a
+        library feature but a signal of ``sig`` (``a`` the acceleration, ``dp``, ``zh`` ...) is that
+        signal itself.  None: the whole library.
     """
+    if names is not None:
+        full = library(sig)
+        return {n: full[n] if n in full else (np.asarray(sig[n], float), n) for n in names
+                if n in full or n in sig}
     t = np.asarray(sig["t"], float)
     L = {"const": (np.ones(t.size), "1"), "t": (t - t[0], "(t - t0)")}
     v = sig.get("v")

@@ -357,7 +357,13 @@ class GapDiagnoser(GapEstimator):
                               tuple(self.where_.get("not_observable", ())))
         verdict = V.decide(fits, self.gap_["channels"], self.noise_floor_, self.input_envelope_, P, evidence)
         self.warnings_ += list(verdict.warnings)
-        return verdict.to_json()
+        out = verdict.to_json()
+        # a named law that is not the plant's: the open search's form of its component, when it fits better
+        form = S.named_form(self.components_, out.get("effect", ""), ctx.fitmask, ctx.valmask) \
+            if P.named_form else None
+        if form is not None:
+            out["form"] = form
+        return out
 
     def simulate(self, config, t_end=None, hs=None):
         """Model channels at the run's times (up to ``t_end``) for a configuration

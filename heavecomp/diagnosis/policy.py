@@ -107,6 +107,11 @@ class VerdictPolicy:
     equation-error fit) that turns ``inconclusive`` into ``discovered`` (or a low named verdict)."""
     discover_components: int = 3
     """Components (largest gap first) the open search looks in when no named effect explains the gap."""
+    named_form: bool = True
+    """When a named plant effect is the verdict, search its component's residual with the effect's
+    equation-error columns as base (:func:`heavecomp.diagnosis.screen.named_form`): a form that beats
+    the named law's fit-part BIC is reported as ``verdict.form`` and carried in ``calibrated.toml`` in
+    its place.  The verdict itself is unchanged."""
     refit_share: float = 0.5
     """A parameter_mismatch whose most-moved parameter's component holds under ``second_share``
     while another holds this share of the equation-error gap is a stand-in: confidence low, the

@@ -22,6 +22,7 @@ from heavecomp.diagnosis import components as CR
 from heavecomp.diagnosis import equation_error as EE
 from heavecomp.effects.base import COMPONENTS
 from heavecomp.effects.candidates import MISMATCH_KEYS, ParameterMismatch, get
+from heavecomp.errors import ParameterError
 
 #: component of each parameter table of parameter_mismatch
 TABLE_COMPONENT = {"compensator": "gas_spring", "friction": "friction", "drill_string": "string_formation",
@@ -184,8 +185,82 @@ def discover(cr, fitmask, valmask, policy):
     best = None
     for c in sorted((c for c in COMPONENTS if gap[c] > 0), key=lambda c: -gap[c])[:policy.discover_components]:
         sig = cr.signals_for(c)
-        d = EE.open_search(cr.residual[c], sig, fm, vm, component=c)
+        own = cr.own_features(c)  # a part of another's equation: searched on its own parts only
+        d = EE.open_search(cr.residual[c], sig, fm, vm, component=c,
+                           features=None if own is None else EE.library(sig, own))
         if d is not None and (best is None or d["shrink"] > best["shrink"]):
             # the constant of the x feature (x - mean x), for the calibrated model's term at its hook
             best = dict(d, unit=CR.UNITS[c], levels={"x_mean": float(np.nanmean(sig["x"]))} if "x" in sig else {})
     return best
+
+
+def _as_feature(col, lib) -> tuple | None:
+    """(library feature name, sign) of a column that is ``+-`` a library feature, or None."""
+    col = np.asarray(col, float)
+    for n, (f, _) in lib.items():
+        ok = np.isfinite(col) & np.isfinite(f)
+        if not ok.any() or not np.any(f[ok]):
+            continue
+        for sign in (1.0, -1.0):
+            if np.allclose(col[ok], sign * f[ok], rtol=1e-9, atol=1e-12 * float(np.max(np.abs(f[ok])))):
+                return n, sign
+    return None
+
+
+def named_form(cr, effect, fitmask, valmask):
+    """The open search's form of a named plant verdict's component, when it beats the named effect's law.
+
+    A named effect's law may not be the one the plant follows (a laminar line, ``R v``, fitted to a
+    turbulent orifice, ``K v|v|``): the verdict is right, yet its calibrated model leaves what the law
+    cannot express, and the re-diagnosis finds it.  Here the component's residual is searched
+    (:func:`heavecomp.diagnosis.equation_error.open_search`, the component's own library,
+    :meth:`~heavecomp.diagnosis.components.ComponentResiduals.own_features`) with the named effect's
+    equation-error columns as ``base`` (refitted alongside: a term only counts when it adds to the
+    named law).  A term found, the form is the sparse model over the named law's columns (as library
+    features) and the term's, searched again without a base (so the named column is dropped when it
+    no longer pays); it is returned when its fit-part BIC is below the named law's (the held-out part
+    only scores, as in the open search).
+
+    Returns the discovered-term block (``component``, ``features``, ``coefficients``, ``term``, ``shrink``
+    held out, ``unit``, ``levels``, ``bic``) with ``replaces`` (the named effect) and ``named`` (its
+    equation-error ``shrink``, ``bic`` and ``coefficients``), or None: not a plant effect with an
+    equation-error form, its columns not library features, no term found, or the named law's BIC lower.
+
+    Parameters
+    ----------
+    cr : heavecomp.diagnosis.components.ComponentResiduals
+        Component residuals of the run (against the parameter file's model).
+    effect : str
+        The verdict's effect name.
+    fitmask, valmask : numpy.ndarray of bool
+        Samples of the fit and held-out parts.
+    """
+    try:
+        cls = get(effect)
+    except ParameterError:  # none, inconclusive, discovered: no law
+        return None
+    comp = cls.component() if cls.kind == "plant" else ""
+    if comp not in cr.residual or not cr.observable().get(comp, True):
+        return None
+    fm, vm = fitmask & cr.mask, valmask & cr.mask
+    r, sig = cr.residual[comp], cr.signals_for(comp)
+    ranked = EE.rank_effects(r, sig, [cls], fm, vm, component=comp)
+    if not ranked:
+        return None
+    named = ranked[0]
+    base = cls.features(sig, named["shape"])
+    lib = EE.library(sig, cr.own_features(comp))
+    found = EE.open_search(r, sig, fm, vm, base=base, component=comp, features=lib)
+    if found is None:
+        return None
+    mapped = [_as_feature(col, lib) for col in base.values()]
+    if any(m is None for m in mapped):
+        return None
+    names = [n for n in lib if n in {m[0] for m in mapped} | set(found["features"])]
+    form = EE.open_search(r, sig, fm, vm, component=comp, features={n: lib[n] for n in names})
+    if form is None or form["bic"] >= named["bic"]:
+        return None
+    levels = {"x_mean": float(np.nanmean(sig["x"]))} if "x" in sig else {}
+    return dict(form, unit=CR.UNITS[comp], levels=levels, replaces=effect,
+                named={"shrink": float(named["shrink"]), "bic": float(named["bic"]),
+                       "coefficients": named["coefficients"]})
