@@ -240,3 +240,22 @@ def test_an_mpc_that_knows_a_stiction_effect_holds_the_wob_better():
     std = {known: simulate_closed_loop(p, _mpc("linear-mpc", eff if known else []), 60.0,
                                        effects=eff).metrics()["wob_std"] for known in (False, True)}
     assert std[True] < 0.75 * std[False], std
+
+
+@pytest.mark.parametrize("mpc", MPCS)
+def test_a_reading_with_its_own_dynamics_reaches_both_mpcs_through_its_static_map(mpc, caplog):
+    """``sensor_lag`` (a calibrated reading: factor, first-order lag, delay) builds both controllers: their
+    model reads its factor, exactly as a ``sensor_gain`` of that factor (same aim, same linear model), and
+    the lag and the delay it leaves out are named in a warning, not dropped silently."""
+    from heavecomp.effects.sensor_lag import SensorLag
+
+    lag = SensorLag(channel="wob", factor=1.1, time_constant=0.5, delay=0.02)
+    with caplog.at_level("WARNING", logger="heavecomp.effects.model"):
+        with_lag = _mpc(mpc, [lag], horizon=3)
+    with_gain = _mpc(mpc, [("sensor_gain", {"channel": "wob", "factor": 1.1})], horizon=3)
+    assert np.allclose(with_lag.model.Ad, with_gain.model.Ad) and np.allclose(with_lag.model.C, with_gain.model.C)
+    w0 = paper_a("stribeck").operating_point.wob_setpoint
+    assert with_lag.model.y0[0] == pytest.approx(1.1 * w0, rel=1e-12) == with_gain.model.y0[0]
+    said = " ".join(r.getMessage() for r in caplog.records)
+    assert "sensor_lag" in said and "time_constant=0.5" in said and "delay=0.02" in said, said
+    assert lag.values["time_constant"] == 0.5  # the file's effect itself is left as it is

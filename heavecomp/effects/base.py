@@ -286,6 +286,11 @@ class ChannelEffect(Effect):
     hook = "channel"
     kind = "output"
     apply = None
+    #: parameters of a reading's dynamics around a static map that carries something of its own (a
+    #: factor): a finite-state, time-invariant model (the controllers') reads the channel through the
+    #: static map, with these at their :meth:`null` values (:meth:`static`), and says what it leaves
+    #: out.  Empty: the whole reading must be static, else the model refuses it.
+    dynamic_params: tuple = ()
 
     def __init__(self, channel: str = "wob", **values):
         if channel not in SENSOR_CHANNELS:
@@ -297,6 +302,14 @@ class ChannelEffect(Effect):
     def __repr__(self):
         vals = "".join(f", {k}={v!r}" for k, v in self.values.items())
         return f"{type(self).__name__}(channel={self.channel!r}{vals})"
+
+    def static(self):
+        """The same reading with its :attr:`dynamic_params` at their :meth:`null` values (itself when it
+        has none): its static map."""
+        if not self.dynamic_params:
+            return self
+        null = self.null(None)
+        return type(self)(channel=self.channel, **{**self.values, **{k: null[k] for k in self.dynamic_params}})
 
     def measure(self, t, tg, y, motion=None):
         """The recorded channel at times ``t`` from the true ``y`` on the grid ``tg`` (``motion``: the

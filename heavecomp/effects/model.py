@@ -8,6 +8,8 @@ or effect equation is restated here.
 
 from __future__ import annotations
 
+import logging
+
 import numpy as np
 
 from heavecomp.effects.compose import composition
@@ -16,6 +18,8 @@ from heavecomp.errors import ParameterError
 from heavecomp.friction.laws import friction_cont
 from heavecomp.plants.cmc import MC, lower_accel_wob, plant_vectors, wob
 from heavecomp.plants.symbolic import casadi
+
+log = logging.getLogger(__name__)
 
 
 def casadi_model(params, *, eps: float | None = None, sym: str = "SX", effects=(), friction: bool = True):
@@ -133,7 +137,15 @@ def _static_gain(e, seen):
 
 
 def _static_affine(e):
-    """(g, o) of a channel effect that reads g y + o (memoryless, time-invariant), else ParameterError."""
+    """(g, o) of a channel effect that reads g y + o (memoryless, time-invariant), else ParameterError.
+    A reading with :attr:`~heavecomp.effects.base.ChannelEffect.dynamic_params` is read through its static
+    map (:meth:`~heavecomp.effects.base.ChannelEffect.static`), and what is left out is logged."""
+    left = {k: e.values[k] for k in e.dynamic_params if e.values[k] != e.static().values[k]}
+    if left:
+        log.warning("effect %s on %s: the casadi model (linearise, MPC) reads its static map; its %s "
+                    "is left out: the controller's model has no state for a reading's dynamics",
+                    e.name, e.channel, ", ".join(f"{k}={v:g}" for k, v in left.items()))
+        e = e.static()
     t = _PROBE_T
     o = e.measure(t, t, np.zeros_like(t))
     g = e.measure(t, t, np.ones_like(t)) - o

@@ -75,6 +75,8 @@ class SensorLag(ChannelEffect):
     model_side = True
     #: a file may leave the delay out (0)
     optional = ("delay",)
+    #: the controllers' finite-state model reads the factor (the static map) and leaves these out
+    dynamic_params = ("time_constant", "delay")
 
     @dataclass(frozen=True)
     class Params:
