@@ -5,7 +5,7 @@ fault) the benchmark's truth plant (the generator's own truth law, never the can
 diagnosis fits) is run passively and logged as the generator logs it; the gap diagnosis names an effect
 and fits it; the calibrated model is the nominal plus what the verdict found; the frequency analysis
 compares the nominal and the calibrated model; and the linear MPC, designed on (i) the nominal model,
-(ii) the calibrated model (``calibrated.toml``, :func:`heavecomp.diagnosis.calibrate.calibrate`) and (iii) the true model, runs on the truth plant in the same irregular sea
+(ii) the calibrated model (``calibrated.toml``, :func:`heavecomp.diagnosis.calibrate.from_log`, as ``diagnose`` writes it) and (iii) the true model, runs on the truth plant in the same irregular sea
 with the same measurement noise.  ``recovered`` = (std_nominal - std_calibrated) / (std_nominal -
 std_true): the share of the WOB-std difference between the nominal and the true-model controller that
 the calibrated controller wins back (the goal is 0.8 on each plant effect).  For the sensor fault the
@@ -28,7 +28,7 @@ from heavecomp.benchmark.truth import TRUTH
 from heavecomp.benchmark.truth.sensor_gain import sensor_gain as truth_sensor_gain
 from heavecomp.closed_loop.loop import Noise, simulate_closed_loop
 from heavecomp.controllers import make
-from heavecomp.diagnosis.calibrate import calibrate
+from heavecomp.diagnosis.calibrate import from_log
 from heavecomp.diagnosis.estimator import GapDiagnoser
 from heavecomp.effects.spec import check
 from heavecomp.errors import InputError
@@ -192,11 +192,12 @@ def loop_one(key: str, *, seed: int, log_duration: float, loop_duration: float, 
     tr = generate(Case(name, seed, "named", duration=log_duration, variant="wob" if name == "sensor_gain" else None))
     nominal = tr.nominal
     planted = tr.truth["parameters"][name]
-    # diagnose, as the command does: the gap diagnosis, then calibrated.toml's model (calibrate)
+    # diagnose, as the command does: the gap diagnosis, then calibrated.toml's model (from_log)
     d = GapDiagnoser(nominal, None, n_jobs=1)
-    d.fit(tr.to_run())
+    run = tr.to_run()
+    d.fit(run)
     v = d.verdict_
-    cal = calibrate(nominal, d.to_json())
+    cal = from_log(nominal, d.to_json(), run)  # what diagnose writes into calibrated.toml
     cal_fx = check(cal.params)  # plant effects and reading corrections, as instances
     cal_what = _describe(cal.params.effects)
     if cal.params.replace(effects=()) != nominal.replace(effects=()):

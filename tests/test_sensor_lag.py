@@ -158,21 +158,6 @@ def test_the_diagnosis_replay_reads_the_files_lag_on_the_model_side(lagged_run):
     assert abs(rp.initial.stroke - true[0]) < 0.5 * abs(no_lift.initial.stroke - true[0])
 
 
-def test_the_mpcs_refuse_a_lag_in_one_line_and_take_a_factor():
-    from heavecomp.controllers import CONTROLLERS, ControllerConfig
-
-    p = paper_a("stribeck")
-    for mpc in ("linear-mpc", "nonlinear-mpc"):
-        with pytest.raises(ParameterError) as err:
-            CONTROLLERS[mpc](p, ControllerConfig.from_params(p, horizon=3),
-                             effects=[SensorLag(channel="wob", time_constant=0.5)])
-        msg = str(err.value)
-        assert "\n" not in msg and msg.startswith("effect sensor_lag") and "lag" in msg, msg
-        ctrl = CONTROLLERS[mpc](p, ControllerConfig.from_params(p, horizon=3),
-                                effects=[SensorLag(channel="wob", factor=1.05)])
-        assert ctrl.model.Ad.shape[0] == 4
-
-
 def test_a_file_round_trips_its_sensor_lag():
     fx = [("sensor_lag", {"channel": "pressure", "factor": 0.98, "time_constant": 0.25, "delay": 0.05})]
     back = loads(dumps(paper_a().replace(effects=fx)))

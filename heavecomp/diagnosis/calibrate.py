@@ -412,8 +412,36 @@ def to_toml(cal: Calibrated, source: str = "") -> str:
     return dumps(cal.params, header=header)
 
 
+def from_log(nominal, diagnosis: dict, run=None) -> Calibrated:
+    """The calibrated model ``diagnose`` writes: :func:`calibrate`, then, given the log, what only the log
+    can fit (a drift's start state, :func:`start_state`; a reading's own dynamics,
+    :func:`reading_dynamics`; a carried open-search term's replayed shrink, :func:`discovered_shrink`).
+
+    Parameters
+    ----------
+    nominal : CMCParams
+        The parameter set the diagnosis was run against.
+    diagnosis : dict
+        ``diagnosis.json`` content (:func:`calibrate`).
+    run : MeasuredRun, optional
+        The log as the diagnosis read it (None: :func:`calibrate` alone).
+    """
+    try:
+        cal = calibrate(nominal, diagnosis)
+    except InputError as exc:  # e.g. a refitted value outside its table's possible range: the nominal, and why
+        cal = Calibrated(nominal, verdict=diagnosis["verdict"]["effect"],
+                         why=[f"diagnosis verdict: {diagnosis['verdict']['effect']} -- its values cannot be written "
+                              f"into a valid parameter file ({exc}); this is the nominal file"])
+    if run is not None and cal.changes:
+        cal = start_state(cal, run, diagnosis)
+        cal = reading_dynamics(cal, run, nominal, diagnosis)
+        if any("component_shrink" in c for c in cal.changes):  # a carried open-search term: measured by replay
+            cal = discovered_shrink(cal, run, nominal, diagnosis)
+    return cal
+
+
 def write(nominal, diagnosis: dict, out_dir, source: str = "", run=None) -> Calibrated:
-    """Write ``out_dir/calibrated.toml`` and return the :class:`Calibrated` model.
+    """Write ``out_dir/calibrated.toml`` (the model of :func:`from_log`) and return it.
 
     Parameters
     ----------
@@ -426,22 +454,11 @@ def write(nominal, diagnosis: dict, out_dir, source: str = "", run=None) -> Cali
     source : str
         The measured log's name, for the header comment (empty: not named).
     run : MeasuredRun, optional
-        The log as the diagnosis read it; given, the state a drifting effect had reached at the log's
-        start is fitted (:func:`start_state`).
+        The log as the diagnosis read it (:func:`from_log`).
     """
     from pathlib import Path
 
-    try:
-        cal = calibrate(nominal, diagnosis)
-    except InputError as exc:  # e.g. a refitted value outside its table's possible range: the nominal, and why
-        cal = Calibrated(nominal, verdict=diagnosis["verdict"]["effect"],
-                         why=[f"diagnosis verdict: {diagnosis['verdict']['effect']} -- its values cannot be written "
-                              f"into a valid parameter file ({exc}); this is the nominal file"])
-    if run is not None and cal.changes:
-        cal = start_state(cal, run, diagnosis)
-        cal = reading_dynamics(cal, run, nominal, diagnosis)
-        if any("component_shrink" in c for c in cal.changes):  # a carried open-search term: measured by replay
-            cal = discovered_shrink(cal, run, nominal, diagnosis)
+    cal = from_log(nominal, diagnosis, run)
     (Path(out_dir) / FILE).write_text(to_toml(cal, source), encoding="utf-8")
     return cal
 
