@@ -252,10 +252,10 @@ def _add_discovered(out: Calibrated, d: dict, add) -> bool:
         return _carry(out, add, "discovered_term", {f: float(d["coefficients"][f]) for f in feats}, d,
                       "the open search's term on the friction residual")
     hooked = HT.carried(comp, feats)
-    if hooked is not None and ("x" not in feats or "x_mean" in d.get("levels", {})):
+    levels = d.get("levels", {})
+    if hooked is not None and all(k in levels for k in HT.levels_needed(feats)):
         vals = {f: float(d["coefficients"][f]) for f in feats}
-        if "x" in feats:
-            vals["x_mean"] = float(d["levels"]["x_mean"])
+        vals.update({k: float(levels[k]) for k in HT.levels_needed(feats)})  # the constants its features are centred on
         return _carry(out, add, hooked.name, vals, d, f"the open search's term on the {comp} residual, at the "
                                                        f"{hooked.hook} hook")
     reading = _sensor_term(d)
