@@ -131,7 +131,7 @@ def public(nominal, name, values) -> dict:
     return dict(values)
 
 
-def at_bounds(name, values, tol=VerdictPolicy.bound_tol) -> list:
+def at_bounds(name, values, tol=VerdictPolicy.bound_tol, params=None) -> list:
     """Fitted parameters of candidate ``name`` that sit at a bound of their search range
     (within ``tol`` of the range, on the fit's own scale: log where the candidate fits in log);
     not those whose bounds are the ends of their physical range (``cls.fit.limits``: a share of 0 or 1).
@@ -146,9 +146,12 @@ def at_bounds(name, values, tol=VerdictPolicy.bound_tol) -> list:
         Fitted parameter values [SI] of the candidate.
     tol : float [-]
         Share of the search range (on the fit's scale) counted as at a bound.
+    params : CMCParams, optional
+        The parameter set the fit ran against: its search box (:meth:`Effect.search_box`, a refit's box
+        anchored to the file's ``[anchor]``); None: the fields' bounds.
     """
     cls = get(name)
-    lo, hi = cls.bounds_x()
+    lo, hi = cls.search_box(params)
     out = []
     for f, a, b in zip(cls.fields(), lo, hi):
         v = values.get(f.name)
@@ -158,8 +161,12 @@ def at_bounds(name, values, tol=VerdictPolicy.bound_tol) -> list:
         span = tol * (b - a)
         side = "upper" if x >= b - span else "lower" if x <= a + span else None
         if side:
-            out.append({"parameter": f.name, "value": float(v), "side": side,
-                        "bound": float(f.metadata["bounds"][1 if side == "upper" else 0]), "unit": f.metadata["unit"]})
+            bound = float(f.metadata["bounds"][1 if side == "upper" else 0])
+            edge = b if side == "upper" else a
+            if not math.isclose(edge, math.log(bound) if f.name in cls.fit.log and bound > 0 else bound):
+                bound = math.exp(edge) if f.name in cls.fit.log else edge  # an anchored box
+            out.append({"parameter": f.name, "value": float(v), "side": side, "bound": bound,
+                        "unit": f.metadata["unit"]})
     if cls is ParameterMismatch:  # the names the verdict's parameters use ("table.key"), values as multipliers
         names = {f.name: key for f, (key, _, _) in zip(cls.fields(), MISMATCH_KEYS)}
         for o in out:
@@ -211,7 +218,7 @@ def score(ctx, name, fitted: Fit, pred, pred_pert) -> CandidateFit:
     return CandidateFit(name, public(ctx.replay.nominal, name, fitted.values), fitted.sigma,
                         channel_scores(ctx.mse_before, mse_a), float(expl), float(expl_plain), float(expl_pert), k,
                         float(expl - P.penalty * k), fitted.wall_time, fitted.values, pred,
-                        tuple(at_bounds(name, fitted.values, tol=P.bound_tol)))
+                        tuple(at_bounds(name, fitted.values, tol=P.bound_tol, params=ctx.replay.nominal)))
 
 
 def candidate_class(ctx, name) -> type:
@@ -361,7 +368,7 @@ def fit_replayed(ctx, cls, start=None, fixed=(), *, search=Search(), hint=None) 
     P = ctx.policy
     t_end = ctx.split["fit"][1]
     x0 = cls.to_x(start) if start else cls.x0()
-    lo, hi = cls.bounds_x()
+    lo, hi = cls.search_box(ctx.replay.nominal)  # a refit of a calibrated file: about its [anchor]
     x0 = np.clip(x0, lo + 1e-9, hi - 1e-9)
     seen = {}  # residual by (span, parameter vector): e.g. Nelder-Mead's optimum is evaluated again for its Jacobian
 

@@ -233,6 +233,12 @@ class Effect:
         return x
 
     @classmethod
+    def search_box(cls, params):
+        """Bounds of the fit vector on the parameter set ``params`` the fit runs against: the fields'
+        bounds (:meth:`bounds_x`); a candidate whose box depends on the file overrides it."""
+        return cls.bounds_x()
+
+    @classmethod
     def bounds_x(cls):
         lo, hi = [], []
         for f in cls.fields():
