@@ -386,6 +386,10 @@ def fit_replayed(ctx, cls, start=None, fixed=(), *, search=Search(), hint=None) 
         r = stepwise(fun, x0 if start else cls.x0(), lo, hi, budget, t_grid, P.refit_release, search, release,
                      noise_cost(ctx), P.refit_f)
         return Fit(cls.from_x(r.x), sigma(cls, r), int(r.nfev), float(2 * r.cost))
+    later = np.array([f.name in cls.fit.released_last for f in cls.fields()])
+    if start is None and later.any():
+        r = _fit_then_release(fun, x0, lo, hi, ~later, budget, t_grid, search, hint)
+        return Fit(cls.from_x(r.x), sigma(cls, r), int(r.nfev), float(2 * r.cost))
     if start is None:
         x0 = _start(cls, fun, x0, lo, hi, t_grid, search.grid, hint)
     if x0.size <= 2:
@@ -395,6 +399,46 @@ def fit_replayed(ctx, cls, start=None, fixed=(), *, search=Search(), hint=None) 
         if start is None:
             r = rescan(cls, fun, r, lo, hi, ctx.replay.nominal, search)
     return Fit(cls.from_x(r.x), sigma(cls, r), int(r.nfev), float(2 * r.cost))
+
+
+def _fit_then_release(fun, x0, lo, hi, keep, budget, t_grid, search, hint):
+    """The fit of the parameters ``keep`` with the others held at ``x0`` (as :func:`fit_replayed` fits
+    that smaller candidate: coarse start grid, Nelder-Mead for up to two), then every parameter
+    released by least squares from that optimum (``cls.fit.released_last``).  Least squares only takes
+    steps that lower the cost, so the result costs no more on the fit part than the smaller fit.
+
+    Parameters
+    ----------
+    fun : callable
+        Residual vector of a full fit vector (``fun(x)`` or ``fun(x, t_stop)``).
+    x0 : numpy.ndarray
+        Start; the held parameters stay at their values here in the first stage.
+    lo, hi : numpy.ndarray
+        Bounds of the full fit vector.
+    keep : numpy.ndarray of bool
+        The parameters fitted in the first stage.
+    budget : int
+        Function evaluations of each stage.
+    t_grid : float [s]
+        Span of the start grid's evaluations.
+    search : Search
+        Search effort (``grid``, ``n_jobs``).
+    hint : numpy.ndarray or None
+        Equation-error start as a full fit vector.
+    """
+    def part(xs, *t_stop):
+        x = x0.copy()
+        x[keep] = xs
+        return fun(x, *t_stop)
+
+    xs = _start(None, part, x0[keep], lo[keep], hi[keep], t_grid, search.grid, None if hint is None else hint[keep])
+    r1 = (nelder_mead(part, xs, lo[keep], hi[keep], budget) if keep.sum() <= 2
+          else least_squares(part, xs, lo[keep], hi[keep], budget, search.n_jobs))
+    x1 = x0.copy()
+    x1[keep] = r1.x
+    r = least_squares(fun, np.clip(x1, lo + 1e-9, hi - 1e-9), lo, hi, budget, search.n_jobs)
+    r.nfev = int(r.nfev) + int(r1.nfev)
+    return r
 
 
 def effective_samples(r) -> float:

@@ -92,6 +92,10 @@ class FitSpec:
     them over their search box for a second start."""
     linear: bool = False
     """A channel reading affine in its parameters (fitted by linear least squares)."""
+    released_last: tuple = ()
+    """Parameters held at their defaults while the others are fitted as before (coarse start grid and
+    Nelder-Mead for two), then released together from that optimum by least squares: a parameter that
+    refines the others' law never leaves the fit on the fit part worse than the fit without it."""
 
 
 class Effect:
