@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import pytest
 
 from heavecomp.diagnosis.calibrate import calibrate, to_toml
@@ -160,3 +162,35 @@ def test_a_named_verdicts_search_form_is_carried_in_place_of_the_named_law():
     form = dict(form, features=["a"], coefficients={"a": -9e4})
     cal = calibrate(NOM, _diag("flow_loss", {"resistance": 1.14e5}, form=form))
     assert cal.params.effects == (("flow_loss", {"resistance": 1.14e5}),) and cal.expected_shrink == 0.6
+
+
+def test_a_refit_is_anchored_to_the_first_file_so_a_re_diagnosis_cannot_step_past_its_bound():
+    """Spent 590029 (a seal that warms): the refit landed at 0.2 x the file's F_S (23 -> 4.6 kN) and the
+    re-diagnosis of that file at 0.2 x again (0.92 kN).  The calibrated file records the values it was
+    refitted from ([anchor]); a refit of it searches 0.2-5 x of those, so F_S cannot go below 4.6 kN, and
+    a refit at that edge is flagged at its (anchored) bound."""
+    from heavecomp.diagnosis.fitting import at_bounds
+    from heavecomp.effects.candidates import ParameterMismatch as PM
+
+    fs = NOM.friction.static_force
+    first = _round_trip(calibrate(NOM, _diag("parameter_mismatch", {"friction.static_force": 0.2 * fs,
+                                                                    "friction.coulomb_force": 0.2 * fs})))
+    assert first.extra["anchor"].static_force == fs
+    names = [f.name for f in PM.fields()]
+    j = names.index("static_force")
+    lo, hi = PM.search_box(first)
+    assert math.exp(lo[j]) * first.friction.static_force == pytest.approx(first.friction.static_force)
+    assert math.exp(hi[j]) * first.friction.static_force == pytest.approx(5 * fs)
+    lo0, _ = PM.search_box(NOM)  # the nominal (no anchor): 0.2 x of its own value
+    assert math.exp(lo0[j]) == pytest.approx(0.2)
+    # a second refit that lands on the anchored edge is flagged there, with the bound as a multiplier of this file
+    vals = {f.name: 1.0 for f in PM.fields()}
+    hit = at_bounds("parameter_mismatch", vals, params=first)
+    assert [(h["parameter"], h["side"]) for h in hit] == [("friction.static_force", "lower")]
+    assert hit[0]["bound"] == pytest.approx(1.0)
+    assert at_bounds("parameter_mismatch", vals) == []  # unanchored, 1 x is mid-box
+    # a third file keeps the first anchor, not the second file's values
+    second = _round_trip(calibrate(first, _diag("parameter_mismatch", {"friction.viscous_coefficient":
+                                                                       2 * NOM.friction.viscous_coefficient})))
+    assert second.extra["anchor"].static_force == fs
+    assert second.extra["anchor"].viscous_coefficient == NOM.friction.viscous_coefficient

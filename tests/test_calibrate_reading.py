@@ -109,3 +109,35 @@ def test_a_discovered_flow_line_term_is_carried_at_the_line_hook_and_round_trips
     cal = calibrate(nom, dict(diag, verdict=dict(diag["verdict"], discovered=dict(d, features=["t"],
                                                                                  coefficients={"t": 5.0}))))
     assert cal.changes == [] and "has no model form" in to_toml(cal)
+
+
+def test_a_discovered_string_term_in_the_stretch_is_carried_with_its_centre_and_round_trips(tmp_path):
+    """590030's kind of term (stretch cubed about its median, a sign term) is carried as ``string_term``: the
+    hook recovers the stretch z_h + s - y_b from the tension it is handed, so the term added is the search's
+    feature of the plant's own stretch; without the recorded median it is not carried."""
+    from heavecomp.params import paper_a
+    from heavecomp.plants.cmc import plant_vectors, tension
+
+    nom = paper_a()
+    d = {"component": "string_formation", "features": ["sign_v_neg", "rel_cubed"], "shrink": 0.52,
+         "coefficients": {"sign_v_neg": 4.1e3, "rel_cubed": 8.3e9}, "term": "...",
+         "levels": {"x_mean": 0.002, "rel_median": 0.004}}
+    diag = {"verdict": {"effect": "discovered", "confidence": "low", "shrink": 0.1, "shrink_channel": "wob",
+                        "component": "string_formation", "discovered": d},
+            "split": {"fit": [0, 100], "validate": [100, 150]}}
+    cal = calibrate(nom, diag)
+    assert [(c["name"], c["role"]) for c in cal.changes] == [("string_term", "plant")]
+    assert cal.changes[0]["parameters"]["rel_median"] == 0.004
+    (tmp_path / FILE).write_text(to_toml(cal), encoding="utf-8")
+    assert cli("params", tmp_path / FILE, "-o", tmp_path / "checked.toml").returncode == 0
+    (e,) = spec.plant_effects(spec.load(tmp_path / FILE))
+    PP = plant_vectors(nom).PP
+    s, v, yb, vb, zh, dzh = 0.3, -0.2, 0.05, 0.1, 0.4, 0.3
+    T = tension(s, v, yb, vb, zh, dzh, PP)
+    dv = dzh + v - vb                                    # shortening: the sign term takes 4.1 kN off
+    stretch = zh + s - yb
+    assert e.string(dv, T, (), PP, *e.prm) == pytest.approx(T - 4.1e3 + 8.3e9 * (stretch - 0.004) ** 3, rel=1e-12)
+    # no recorded centre (a diagnosis before levels.rel_median): the term cannot be placed, the nominal kept
+    bare = dict(d, levels={"x_mean": 0.002})
+    cal = calibrate(nom, dict(diag, verdict=dict(diag["verdict"], discovered=bare)))
+    assert cal.changes == [] and "has no model form" in to_toml(cal)

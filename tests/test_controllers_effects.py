@@ -113,6 +113,7 @@ def test_the_carried_terms_of_a_calibrated_file_build_both_mpcs(mpc):
 
     nominal = _mpc(mpc, [], horizon=3).model.Ad
     for eff, slope in ((LineTerm(v=2e5), True), (GasTerm(v=1e5), True), (StringTerm(v=2e4), True),
+                       (StringTerm(rel=3e5, rel_cubed=8e9, rel_median=0.01, sign_v_neg=4e3), True),
                        (DiscoveredTerm(v=1e3), False)):
         Ad = _mpc(mpc, [eff], horizon=3).model.Ad
         assert Ad.shape == nominal.shape

@@ -250,3 +250,26 @@ def test_misread_start_channel_is_recovered(name, values, once):
     key = "offset" if name == "sensor_offset" else "factor"
     assert row["parameters"][key] == pytest.approx(values[key], rel=0.05)
     assert row["explained"] > 0.8
+
+
+def test_a_parameter_released_last_starts_from_the_smaller_fits_optimum_and_refines_it():
+    """``FitSpec.released_last`` (asymmetric_friction's growth speed): the other parameters are fitted first
+    with it held (a cost with a side minimum that least squares from the start falls into, the start grid
+    does not), then it is released from that optimum: the result is the global optimum, and costs no more
+    than the smaller fit."""
+    from heavecomp.diagnosis.fitting import Search, _fit_then_release, least_squares
+
+    def fun(x, t_stop=None):
+        a, b, c = x
+        # a: a deep minimum at 0.8 behind a bump, a shallow one at 0.15 near the start; c refines b's law
+        well = 1.0 - 0.9 * math.exp(-((a - 0.8) / 0.15) ** 2) - 0.3 * math.exp(-((a - 0.15) / 0.1) ** 2)
+        return np.array([well, b - 0.4, 0.3 * (c - 2.0)])
+
+    x0, lo, hi = np.array([0.1, 0.0, 1.0]), np.array([0.0, -1.0, 0.1]), np.array([1.0, 1.0, 5.0])
+    keep = np.array([True, True, False])
+    plain = least_squares(fun, x0, lo, hi, 200)
+    assert plain.x[0] < 0.5  # from the start, least squares settles in the shallow minimum
+    r = _fit_then_release(fun, x0, lo, hi, keep, 200, 1.0, Search(grid=7), None)
+    assert r.x[:2] == pytest.approx([0.8, 0.4], abs=0.03)
+    assert r.x[2] == pytest.approx(2.0, abs=0.2)  # released from 1 (the wrapper's tolerances are loose)
+    assert r.cost < plain.cost

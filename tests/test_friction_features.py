@@ -111,8 +111,8 @@ def test_asymmetric_friction_columns_are_the_kernel_term_while_sliding():
     sliding = v != 0
     J, a = 12.0, -0.2
     FP = np.zeros(len(laws.FP_NAMES))
-    FP[laws.VS] = 0.01  # the breakaway share's speed scale (b = 1: not used)
-    kernel = np.array([AsymmetricFriction.jump(0, abs(vi), 0.0, J, 0.0, np.sign(vi), (), FP, a, 1.0) * np.sign(vi)
+    FP[laws.VS] = 0.01  # the friction law's Stribeck speed (b = 1: no growth speed used)
+    kernel = np.array([AsymmetricFriction.jump(0, abs(vi), 0.0, J, 0.0, np.sign(vi), (), FP, a, 1.0, 0.01) * np.sign(vi)
                        for vi in v[sliding]])
     assert np.allclose(kernel, J * np.sign(v[sliding]) + a * J * cols["asymmetric_friction"][sliding], rtol=1e-12)
     assert np.array_equal(cols["asymmetric_viscous"], np.abs(v))
@@ -129,3 +129,20 @@ def test_position_friction_column_is_the_band_of_the_kernel_on_the_travelled_spa
     assert abs(c[0]) < 1e-6 and abs(c[-1]) < 1e-6                # far outside the band
     assert np.count_nonzero(np.abs(c) > 0.5) == pytest.approx(0.2 * 400, abs=2)   # width 20 % of 0.4 m
     assert all(len(s) == 2 for s in PositionFriction.feature_grid)
+
+
+def test_asymmetric_friction_grows_over_its_own_fitted_speed_not_the_friction_laws():
+    """With a symmetric breakaway (b = 0) the asymmetry reaches 1 - 1/e of itself at |v| = v_g, whatever the
+    friction law's Stribeck speed (spent 590009: a lip whose asymmetry grows after a reversal more slowly than
+    the borrowed 0.01 m/s allowed)."""
+    from heavecomp.effects.asymmetric_friction import AsymmetricFriction
+
+    FP = np.zeros(len(laws.FP_NAMES))
+    FP[laws.VS] = 0.01
+    J, a, vg = 10.0, 0.3, 0.2
+    at_vg = AsymmetricFriction.jump(0, vg, 0.0, J, 0.0, 1.0, (), FP, a, 0.0, vg)
+    assert at_vg == pytest.approx(J * (1.0 + a * (1.0 - np.exp(-1.0))), rel=1e-12)
+    # at ten Stribeck speeds the borrowed scale would have grown it fully; v_g = 0.2 m/s has not
+    mid = AsymmetricFriction.jump(0, 0.1, 0.0, J, 0.0, -1.0, (), FP, a, 0.0, vg)
+    assert mid == pytest.approx(J * (1.0 - a * (1.0 - np.exp(-0.5))), rel=1e-12)
+    assert AsymmetricFriction.jump(0, 0.0, 0.0, J, 0.0, 1.0, (), FP, a, 0.0, vg) == J  # symmetric at rest

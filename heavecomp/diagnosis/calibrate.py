@@ -10,7 +10,9 @@ verdict                           calibrated.toml
 ================================  ============================================================
 a plant effect (``string_damping``,  an ``[[effects]]`` entry with the fitted values (the plant
 ``dwell_stiction``, ...)            changes: ``simulate``, ``analyse``, the MPCs use it)
-``parameter_mismatch``            the refitted values in their tables (F_C clipped to F_S, as the fit)
+``parameter_mismatch``            the refitted values in their tables (F_C clipped to F_S, as the fit),
+                                  and ``[anchor]``: the values they were refitted from (kept from the
+                                  file when it has one), the centre of a re-diagnosis' refit box
 a sensor effect (``sensor_gain``,   an ``[[effects]]`` entry that corrects how a log is read
 ``sensor_offset``, ``sensor_delay``,  (``load_run`` undoes it); the plant is left as it is
 ``heave_reference``)
@@ -46,7 +48,7 @@ import numpy as np
 from heavecomp.diagnosis.estimator import GapDiagnoser
 from heavecomp.diagnosis.data import MeasuredRun, load_run
 from heavecomp.diagnosis import replay as R
-from heavecomp.effects.candidates import MISMATCH_KEYS
+from heavecomp.effects.candidates import MISMATCH_KEYS, ParameterMismatch
 from heavecomp.effects.discovered_term import COMPONENT as DISCOVERED_COMPONENT
 from heavecomp.effects.discovered_term import FEATURES as DISCOVERED_FEATURES
 from heavecomp.effects import hook_term as HT
@@ -140,6 +142,8 @@ def _mismatch(nominal, parameters: dict):
             old = getattr(getattr(nominal, table), key)
             changes.append({"kind": "parameter", "name": f"{table}.{key}", "from": float(old), "to": value,
                             "ratio": value / old if old else math.nan})
+    if upd:  # the values the refit started from: a re-diagnosis refits within a box about them, not about these
+        upd["anchor"] = ParameterMismatch.anchor_of(nominal)
     return nominal.replace(**upd), changes
 
 
@@ -280,10 +284,10 @@ def _plant_term(d: dict) -> tuple | None:
         return ("discovered_term", {f: float(d["coefficients"][f]) for f in feats},
                 "the open search's term on the friction residual")
     hooked = HT.carried(comp, feats)
-    if hooked is not None and ("x" not in feats or "x_mean" in d.get("levels", {})):
+    levels = d.get("levels", {})
+    if hooked is not None and all(k in levels for k in HT.levels_needed(feats)):
         vals = {f: float(d["coefficients"][f]) for f in feats}
-        if "x" in feats:
-            vals["x_mean"] = float(d["levels"]["x_mean"])
+        vals.update({k: float(levels[k]) for k in HT.levels_needed(feats)})  # the constants its features are centred on
         return hooked.name, vals, f"the open search's term on the {comp} residual, at the {hooked.hook} hook"
     return None
 

@@ -131,7 +131,7 @@ def public(nominal, name, values) -> dict:
     return dict(values)
 
 
-def at_bounds(name, values, tol=VerdictPolicy.bound_tol) -> list:
+def at_bounds(name, values, tol=VerdictPolicy.bound_tol, params=None) -> list:
     """Fitted parameters of candidate ``name`` that sit at a bound of their search range
     (within ``tol`` of the range, on the fit's own scale: log where the candidate fits in log);
     not those whose bounds are the ends of their physical range (``cls.fit.limits``: a share of 0 or 1).
@@ -146,9 +146,12 @@ def at_bounds(name, values, tol=VerdictPolicy.bound_tol) -> list:
         Fitted parameter values [SI] of the candidate.
     tol : float [-]
         Share of the search range (on the fit's scale) counted as at a bound.
+    params : CMCParams, optional
+        The parameter set the fit ran against: its search box (:meth:`Effect.search_box`, a refit's box
+        anchored to the file's ``[anchor]``); None: the fields' bounds.
     """
     cls = get(name)
-    lo, hi = cls.bounds_x()
+    lo, hi = cls.search_box(params)
     out = []
     for f, a, b in zip(cls.fields(), lo, hi):
         v = values.get(f.name)
@@ -158,8 +161,12 @@ def at_bounds(name, values, tol=VerdictPolicy.bound_tol) -> list:
         span = tol * (b - a)
         side = "upper" if x >= b - span else "lower" if x <= a + span else None
         if side:
-            out.append({"parameter": f.name, "value": float(v), "side": side,
-                        "bound": float(f.metadata["bounds"][1 if side == "upper" else 0]), "unit": f.metadata["unit"]})
+            bound = float(f.metadata["bounds"][1 if side == "upper" else 0])
+            edge = b if side == "upper" else a
+            if not math.isclose(edge, math.log(bound) if f.name in cls.fit.log and bound > 0 else bound):
+                bound = math.exp(edge) if f.name in cls.fit.log else edge  # an anchored box
+            out.append({"parameter": f.name, "value": float(v), "side": side, "bound": bound,
+                        "unit": f.metadata["unit"]})
     if cls is ParameterMismatch:  # the names the verdict's parameters use ("table.key"), values as multipliers
         names = {f.name: key for f, (key, _, _) in zip(cls.fields(), MISMATCH_KEYS)}
         for o in out:
@@ -211,7 +218,7 @@ def score(ctx, name, fitted: Fit, pred, pred_pert) -> CandidateFit:
     return CandidateFit(name, public(ctx.replay.nominal, name, fitted.values), fitted.sigma,
                         channel_scores(ctx.mse_before, mse_a), float(expl), float(expl_plain), float(expl_pert), k,
                         float(expl - P.penalty * k), fitted.wall_time, fitted.values, pred,
-                        tuple(at_bounds(name, fitted.values, tol=P.bound_tol)))
+                        tuple(at_bounds(name, fitted.values, tol=P.bound_tol, params=ctx.replay.nominal)))
 
 
 def candidate_class(ctx, name) -> type:
@@ -361,7 +368,7 @@ def fit_replayed(ctx, cls, start=None, fixed=(), *, search=Search(), hint=None) 
     P = ctx.policy
     t_end = ctx.split["fit"][1]
     x0 = cls.to_x(start) if start else cls.x0()
-    lo, hi = cls.bounds_x()
+    lo, hi = cls.search_box(ctx.replay.nominal)  # a refit of a calibrated file: about its [anchor]
     x0 = np.clip(x0, lo + 1e-9, hi - 1e-9)
     seen = {}  # residual by (span, parameter vector): e.g. Nelder-Mead's optimum is evaluated again for its Jacobian
 
@@ -379,6 +386,10 @@ def fit_replayed(ctx, cls, start=None, fixed=(), *, search=Search(), hint=None) 
         r = stepwise(fun, x0 if start else cls.x0(), lo, hi, budget, t_grid, P.refit_release, search, release,
                      noise_cost(ctx), P.refit_f)
         return Fit(cls.from_x(r.x), sigma(cls, r), int(r.nfev), float(2 * r.cost))
+    later = np.array([f.name in cls.fit.released_last for f in cls.fields()])
+    if start is None and later.any():
+        r = _fit_then_release(fun, x0, lo, hi, ~later, budget, t_grid, search, hint)
+        return Fit(cls.from_x(r.x), sigma(cls, r), int(r.nfev), float(2 * r.cost))
     if start is None:
         x0 = _start(cls, fun, x0, lo, hi, t_grid, search.grid, hint)
     if x0.size <= 2:
@@ -388,6 +399,46 @@ def fit_replayed(ctx, cls, start=None, fixed=(), *, search=Search(), hint=None) 
         if start is None:
             r = rescan(cls, fun, r, lo, hi, ctx.replay.nominal, search)
     return Fit(cls.from_x(r.x), sigma(cls, r), int(r.nfev), float(2 * r.cost))
+
+
+def _fit_then_release(fun, x0, lo, hi, keep, budget, t_grid, search, hint):
+    """The fit of the parameters ``keep`` with the others held at ``x0`` (as :func:`fit_replayed` fits
+    that smaller candidate: coarse start grid, Nelder-Mead for up to two), then every parameter
+    released by least squares from that optimum (``cls.fit.released_last``).  Least squares only takes
+    steps that lower the cost, so the result costs no more on the fit part than the smaller fit.
+
+    Parameters
+    ----------
+    fun : callable
+        Residual vector of a full fit vector (``fun(x)`` or ``fun(x, t_stop)``).
+    x0 : numpy.ndarray
+        Start; the held parameters stay at their values here in the first stage.
+    lo, hi : numpy.ndarray
+        Bounds of the full fit vector.
+    keep : numpy.ndarray of bool
+        The parameters fitted in the first stage.
+    budget : int
+        Function evaluations of each stage.
+    t_grid : float [s]
+        Span of the start grid's evaluations.
+    search : Search
+        Search effort (``grid``, ``n_jobs``).
+    hint : numpy.ndarray or None
+        Equation-error start as a full fit vector.
+    """
+    def part(xs, *t_stop):
+        x = x0.copy()
+        x[keep] = xs
+        return fun(x, *t_stop)
+
+    xs = _start(None, part, x0[keep], lo[keep], hi[keep], t_grid, search.grid, None if hint is None else hint[keep])
+    r1 = (nelder_mead(part, xs, lo[keep], hi[keep], budget) if keep.sum() <= 2
+          else least_squares(part, xs, lo[keep], hi[keep], budget, search.n_jobs))
+    x1 = x0.copy()
+    x1[keep] = r1.x
+    r = least_squares(fun, np.clip(x1, lo + 1e-9, hi - 1e-9), lo, hi, budget, search.n_jobs)
+    r.nfev = int(r.nfev) + int(r1.nfev)
+    return r
 
 
 def effective_samples(r) -> float:

@@ -160,6 +160,23 @@ def candidate_component(effect, values, prescreened) -> str:
     return prescreened.get(effect, {}).get("component") or get(effect).component()
 
 
+def _centres(sig: dict) -> dict:
+    """The constants :func:`heavecomp.diagnosis.equation_error.library` centres its ``x`` and ``rel``
+    features on (``x_mean`` [m], ``rel_median`` [m]), for the signals ``sig`` has.
+
+    Parameters
+    ----------
+    sig : dict
+        The component's signals (:meth:`~heavecomp.diagnosis.components.ComponentResiduals.signals_for`).
+    """
+    out = {}
+    if sig.get("x") is not None:
+        out["x_mean"] = float(np.nanmean(sig["x"]))
+    if sig.get("rel") is not None:
+        out["rel_median"] = float(np.nanmedian(sig["rel"]))
+    return out
+
+
 def discover(cr, fitmask, valmask, policy):
     """The open search (:func:`heavecomp.diagnosis.equation_error.open_search`) on the components with
     a gap (the ``discover_components`` largest), the best held-out shrink; None when nothing beats noise.
@@ -189,8 +206,9 @@ def discover(cr, fitmask, valmask, policy):
         d = EE.open_search(cr.residual[c], sig, fm, vm, component=c,
                            features=None if own is None else EE.library(sig, own))
         if d is not None and (best is None or d["shrink"] > best["shrink"]):
-            # the constant of the x feature (x - mean x), for the calibrated model's term at its hook
-            best = dict(d, unit=CR.UNITS[c], levels={"x_mean": float(np.nanmean(sig["x"]))} if "x" in sig else {})
+            # the constants of the x and rel features (x - mean x, rel - median rel: equation_error.library),
+            # for the calibrated model's term at its hook
+            best = dict(d, unit=CR.UNITS[c], levels=_centres(sig))
     return best
 
 

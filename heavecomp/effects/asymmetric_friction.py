@@ -8,7 +8,6 @@ import numpy as np
 
 from heavecomp.effects.base import Effect, FitSpec
 from heavecomp.effects.features import need
-from heavecomp.friction.laws import VS
 from heavecomp.params.core import q
 
 
@@ -25,10 +24,13 @@ class AsymmetricFriction(Effect):
 
     Whether the breakaway force is as asymmetric as the sliding friction depends on the seal: a
     lip that tilts over only once the rod moves gives a symmetric breakaway and an asymmetry that
-    builds up with speed.  g = 1 - (1 - b) exp(-|v| / v_S) (v_S the friction law's Stribeck
-    speed) carries the share ``breakaway`` b of the asymmetry at rest (b = 1: the whole jump
-    scaled in every state; b = 0: a symmetric breakaway).  The equation error, which sees the
-    sliding friction only, fits ``a`` alone; the replay fits both.
+    builds up with speed.  g = 1 - (1 - b) exp(-|v| / v_g) carries the share ``breakaway`` b of
+    the asymmetry at rest (b = 1: the whole jump scaled in every state; b = 0: a symmetric
+    breakaway) and grows to the whole over the speed ``growth_speed`` v_g, fitted: a lip that
+    tilts over slowly after a reversal spreads the growth over a wider speed range than the
+    friction law's Stribeck speed (which v_g used to be; its default 0.01 m/s is paper A's v_S).
+    The equation error, which sees the sliding friction only, fits ``a`` alone; the replay fits
+    all three.
     """
 
     name = "asymmetric_friction"
@@ -36,6 +38,10 @@ class AsymmetricFriction(Effect):
         candidate=True,
         # a breakaway share of 0 or 1 is a physical answer (the search bounds are its range)
         limits=("breakaway",),
+        # the speed over which the asymmetry grows spans decades (a lagged lip to an instant one)
+        log=("growth_speed",),
+        # a growth speed refines the two-parameter law (a, b): fitted from its optimum, never worse on the fit part
+        released_last=("growth_speed",),
         # units of the feature coefficients [SI]
         feature_units={"asymmetric_friction": "N", "asymmetric_pressure_friction": "N/Pa", "asymmetric_viscous": "N s/m"},
     )
@@ -47,6 +53,8 @@ class AsymmetricFriction(Effect):
                              doc="relative friction excess extending (+) over retracting (-): J (1 + a sign(v))")
         breakaway: float = q(1.0, "-", bounds=(0.0, 1.0), symbol="b",
                              doc="share of the asymmetry the static limit carries (0: symmetric breakaway)")
+        growth_speed: float = q(0.01, "m/s", bounds=(1e-4, 1.0), symbol="v_g",
+                                doc="speed over which the asymmetry grows from its breakaway share to the whole")
 
     @classmethod
     def features(cls, sig, shape=None):
@@ -74,13 +82,13 @@ class AsymmetricFriction(Effect):
         return cols
 
     @staticmethod
-    def jump(code, a, p, J, s, d, x, FP, asymmetry, breakaway):
-        grown = 1.0 - (1.0 - breakaway) * np.exp(-np.maximum(a, 0.0) / (FP[VS] + 1e-9))
+    def jump(code, a, p, J, s, d, x, FP, asymmetry, breakaway, growth_speed):
+        grown = 1.0 - (1.0 - breakaway) * np.exp(-np.maximum(a, 0.0) / growth_speed)
         return J * (1.0 + asymmetry * d * grown)
 
     @classmethod
     def null(cls, plant):
-        return {"asymmetry": 0.0, "breakaway": 1.0}
+        return {"asymmetry": 0.0, "breakaway": 1.0, "growth_speed": 0.01}
 
 
 EFFECT = AsymmetricFriction

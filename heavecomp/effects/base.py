@@ -92,6 +92,10 @@ class FitSpec:
     them over their search box for a second start."""
     linear: bool = False
     """A channel reading affine in its parameters (fitted by linear least squares)."""
+    released_last: tuple = ()
+    """Parameters held at their defaults while the others are fitted as before (coarse start grid and
+    Nelder-Mead for two), then released together from that optimum by least squares: a parameter that
+    refines the others' law never leaves the fit on the fit part worse than the fit without it."""
 
 
 class Effect:
@@ -231,6 +235,12 @@ class Effect:
             at = np.array([f.name in cls.fit.limits for f in cls.fields()])
             x = np.where(at, np.clip(x, lo + 1e-9, hi - 1e-9), x)
         return x
+
+    @classmethod
+    def search_box(cls, params):
+        """Bounds of the fit vector on the parameter set ``params`` the fit runs against: the fields'
+        bounds (:meth:`bounds_x`); a candidate whose box depends on the file overrides it."""
+        return cls.bounds_x()
 
     @classmethod
     def bounds_x(cls):

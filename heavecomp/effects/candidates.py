@@ -103,6 +103,41 @@ class ParameterMismatch(Effect):
         return params.replace(**ch)
 
     @classmethod
+    def search_box(cls, params):
+        """The multipliers' bounds on ``params``, anchored to its ``[anchor]`` values when it has them (a
+        calibrated file whose refit moved the nominal values: :class:`heavecomp.params.cmc.Anchor`).
+
+        The multipliers scale the file's values, so a box of 0.2-5 x about a file that is itself a refit
+        lets every re-diagnosis step another 5 x (a drift refitted as a constant: 23 -> 4.6 -> 0.92 kN).
+        Anchored, the box is 0.2-5 x of the first file's value, written as multipliers of this file's
+        (each widened to hold 1: the file's own value stays a valid start).
+        """
+        lo, hi = cls.bounds_x()
+        anchor = params.extra.get("anchor") if params is not None else None
+        if anchor is None:
+            return lo, hi
+        for j, (f, (_, table, key)) in enumerate(zip(cls.fields(), MISMATCH_KEYS)):
+            a, base = getattr(anchor, f.name, None), getattr(getattr(params, table), key)
+            if not a or not base:
+                continue
+            shift = np.log(a / base) if f.name in cls.fit.log else 0.0
+            lo[j], hi[j] = min(lo[j] + shift, 0.0), max(hi[j] + shift, 0.0)
+        return lo, hi
+
+    @classmethod
+    def anchor_of(cls, params) -> dict:
+        """The ``[anchor]`` table a calibrated file of ``params`` carries: ``params``' own anchor where it
+        has one, else its values of the refitted parameters (the first file's)."""
+        old = params.extra.get("anchor")
+        out = {}
+        for f, (_, table, key) in zip(cls.fields(), MISMATCH_KEYS):
+            v = getattr(old, f.name, None) if old is not None else None
+            v = getattr(getattr(params, table), key) if v is None else v
+            if v is not None:
+                out[f.name] = float(v)
+        return out
+
+    @classmethod
     def effective(cls, params, values) -> dict:
         """The same model with the clip written into the multipliers: F_C's multiplier lowered to
         what :meth:`apply` uses (min(F_C, F_S)).  A scan of F_S then keeps the fitted Coulomb force

@@ -14,11 +14,15 @@ effect              hook         residual (unit)              features carried (
                                                               (v the stroke velocity, p the pressure)
 ``gas_term``        gas spring   gas law, rest (Pa)           ``const``, ``x`` (the stroke less ``x_mean``),
                                                               ``v``, ``v_abs_v``, ``abs_v``
-``string_term``     string       lower-mass balance (N)       ``const``, ``v``, ``v_abs_v``, ``abs_v``
-                                                              (v the string's relative velocity dz_h + v - v_b)
+``string_term``     string       lower-mass balance (N)       ``const``, ``v``, ``v_abs_v``, ``abs_v``,
+                                                              ``sign_v_pos``, ``sign_v_neg`` (v the string's
+                                                              relative velocity dz_h + v - v_b), ``rel``,
+                                                              ``rel_abs_rel``, ``rel_cubed`` (the stretch
+                                                              less ``rel_median``)
 ==================  ===========  ===========================  ==============================================
 
-A feature the hook cannot compute (time, lags, stroke bands, the string's stretch) is not carried:
+A feature the hook cannot compute (time, lags, stroke bands, the stretch's dead band and saturation, whose
+widths are not recorded) is not carried:
 :func:`carried` says which.  Not diagnosis candidates and not in the registry's library composition.
 """
 
@@ -30,6 +34,7 @@ import numpy as np
 
 from heavecomp.effects.base import Effect
 from heavecomp.params.core import q
+from heavecomp.plants.cmc import CDS, KDS, T0
 
 _V = dict(bounds=(-1e12, 1e12))
 
@@ -88,12 +93,22 @@ class GasTerm(_Term):
 
 
 class StringTerm(_Term):
-    """T_ds -> T_ds + c_0 + c_v dv + c_vv dv|dv| + c_a |dv| (the string_formation residual's term)."""
+    """T_ds -> T_ds + c_0 + c_v dv + c_vv dv|dv| + c_a |dv| + c_+ [dv>0] - c_- [dv<0]
+    + c_r e + c_rr e|e| + c_rrr e^3, e = rel - rel_m (the string_formation residual's term).
+
+    ``rel`` is the string's stretch z_h + s - y_b [m], the displacement the open search's ``rel`` features
+    are taken of (:func:`heavecomp.diagnosis.equation_error.library`, centred on their median ``rel_m``).
+    The hook is handed the tension, not the stretch: it recovers the stretch by inverting the nominal
+    string law T = T_0 + k_ds rel + c_ds dv (:func:`heavecomp.plants.cmc.tension`), rel = (T - T_0 - c_ds
+    dv) / k_ds.  That is exact when no other string effect precedes this one at the hook (a calibrated
+    file adds one term there); a preceding one's tension is read as stretch.
+    """
 
     name = "string_term"
     hook = "string"
     component_name = "string_formation"
-    optional = ("const", "v", "v_abs_v", "abs_v")
+    optional = ("const", "v", "v_abs_v", "abs_v", "sign_v_pos", "sign_v_neg", "rel", "rel_abs_rel", "rel_cubed",
+                "rel_median")
 
     @dataclass(frozen=True)
     class Params:
@@ -101,10 +116,23 @@ class StringTerm(_Term):
         v: float = q(0.0, "N s/m", symbol="c_v", doc="tension added per relative velocity", **_V)
         v_abs_v: float = q(0.0, "N s^2/m^2", symbol="c_vv", doc="tension added per dv|dv|", **_V)
         abs_v: float = q(0.0, "N s/m", symbol="c_a", doc="tension added per |dv|", **_V)
+        sign_v_pos: float = q(0.0, "N", symbol="c_+", doc="tension added while the string extends (dv > 0)", **_V)
+        sign_v_neg: float = q(0.0, "N", symbol="c_-", doc="tension taken off while the string shortens (dv < 0; "
+                                                         "feature sign(dv)*(dv<0))", **_V)
+        rel: float = q(0.0, "N/m", symbol="c_r", doc="tension added per m of stretch from rel_median", **_V)
+        rel_abs_rel: float = q(0.0, "N/m^2", symbol="c_rr", doc="tension added per e|e| (e the stretch from "
+                                                                "rel_median)", **_V)
+        rel_cubed: float = q(0.0, "N/m^3", symbol="c_rrr", doc="tension added per e^3 (e the stretch from "
+                                                               "rel_median)", **_V)
+        rel_median: float = q(0.0, "m", bounds=(-100.0, 100.0), symbol="rel_m",
+                              doc="the stretch the rel features are taken from (the log's median stretch)")
 
     @staticmethod
-    def string(dv, T, x, PP, c0, cv, cvv, ca):
-        return T + c0 + cv * dv + cvv * dv * np.abs(dv) + ca * np.abs(dv)
+    def string(dv, T, x, PP, c0, cv, cvv, ca, cp, cn, cr, crr, crrr, rm):
+        e = (T - PP[T0] - PP[CDS] * dv) / PP[KDS] - rm  # the stretch from rel_m, by the nominal string law
+        sv = np.sign(dv)
+        return (T + c0 + cv * dv + cvv * dv * np.abs(dv) + ca * np.abs(dv) + cp * np.maximum(sv, 0.0)
+                + cn * np.minimum(sv, 0.0) + cr * e + crr * e * np.abs(e) + crrr * e * e * e)
 
 
 
@@ -126,8 +154,24 @@ def carried(component: str, features) -> type | None:
     cls = BY_COMPONENT.get(component)
     if cls is None or not features:
         return None
-    names = {f.name for f in cls.fields()} - {"x_mean"}
+    names = {f.name for f in cls.fields()} - set(LEVELS.values())
     return cls if all(f in names for f in features) else None
+
+
+#: feature -> the constant it is centred on (a parameter of the carrying effect, recorded by the open
+#: search in ``verdict.discovered.levels``)
+LEVELS = {"x": "x_mean", "rel": "rel_median", "rel_abs_rel": "rel_median", "rel_cubed": "rel_median"}
+
+
+def levels_needed(features) -> set:
+    """The centring constants (:data:`LEVELS`) the open search's ``features`` are taken from.
+
+    Parameters
+    ----------
+    features : sequence of str
+        The open search's feature names.
+    """
+    return {LEVELS[f] for f in features if f in LEVELS}
 
 
 EFFECT = LineTerm

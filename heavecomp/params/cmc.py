@@ -472,6 +472,33 @@ def active(params: CMCParams) -> Active:
     return params.extra.get("active") or Active()
 
 
+@dataclass(frozen=True, kw_only=True)
+class Anchor:
+    """``[anchor]`` (optional; ``heavecomp diagnose`` writes it into a ``calibrated.toml`` whose
+    ``parameter_mismatch`` refit moved the nominal values): the values of the file the first diagnosis
+    was run against.  A later diagnosis of a file that has it refits these parameters within a search box
+    about them (the refit's 0.2-5 x and so on of *these*, not of the file's own values), so that a
+    re-diagnosis does not step another factor past the first refit's bound each time.  A key left out
+    anchors to the file's own value.  Ignored by every command but ``diagnose``.
+    """
+
+    gas_stiffness: float = q(None, "N/m", bounds=(1e3, 1e8), symbol="k_gas,0", doc="compensator.gas_stiffness "
+                                                                                      "of the first file")
+    static_force: float = q(None, "N", bounds=(0.0, 5e6), symbol="F_S,0", doc="friction.static_force of the "
+                                                                                "first file")
+    coulomb_force: float = q(None, "N", bounds=(0.0, 5e6), symbol="F_C,0", doc="friction.coulomb_force of the "
+                                                                                "first file")
+    viscous_coefficient: float = q(None, "N s/m", bounds=(0.0, 1e8), symbol="C_v,0",
+                                   doc="friction.viscous_coefficient of the first file")
+    drill_string_stiffness: float = q(None, "N/m", bounds=(1e4, 1e8), symbol="k_ds,0",
+                                      doc="drill_string.stiffness of the first file")
+    formation_stiffness: float = q(None, "N/m", bounds=(5e3, 1e8), symbol="k_F,0",
+                                   doc="formation.stiffness of the first file")
+
+
+OPTIONAL_EXTRA["anchor"] = lambda table: from_table(Anchor, table, "anchor")
+
+
 def _measurement(table):
 
     return measurement.from_table(table)
