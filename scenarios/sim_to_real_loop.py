@@ -52,10 +52,11 @@ EFFECTS = {
 }
 #: the benchmark law each entry withholds (default: the entry's own name)
 LAW = {"gas_stiffness_mismatch": "parameter_mismatch", "string_stiffness_mismatch": "parameter_mismatch"}
-#: first seed of the loop's next runs (620000+: fresh, used by no tuning or scoring set; the committed report's
-#: run used 600000+, and 110-117 and 570000-572999 were looked at while the parameter_mismatch refit was built
-#: and rebuilt; a full run refuses a spent seed, :data:`heavecomp.benchmark.seeds.SPENT`)
-SEED0 = 620000
+#: first seed of the loop's next runs (640000+: fresh, used by no tuning or scoring set; the committed report's
+#: run used 620000+, an earlier one 600000+, and 110-117 and 570000-572999 were looked at while the
+#: parameter_mismatch refit was built and rebuilt; a full run refuses a spent seed,
+#: :data:`heavecomp.benchmark.seeds.SPENT`)
+SEED0 = 640000
 #: the parameter a ``parameter_mismatch`` entry's draw must move: the benchmark draws two of gas stiffness,
 #: Coulomb force, string and formation stiffness (+-30-50 %); the entry takes the first seed from
 #: ``SEED0 + len(EFFECTS)`` whose draw moves it (chosen by the parameter drawn, never by its size or the

@@ -28,7 +28,9 @@ SPENT = (
     (570000, 573000, "sim_to_real_loop: scored and studied while the parameter_mismatch refit was rebuilt"),
     (580000, 590000, "monitor validation: scoring"),
     (590000, 591000, "calibration validation: third scoring run (reports/calibration_validation/report.md), then studied"),
-    (600000, 601000, "sim_to_real_loop: scored (reports/sim_to_real_loop/)"),
+    (600000, 601000, "sim_to_real_loop: scored (reports/sim_to_real_loop/ of session 10)"),
+    (610000, 611000, "calibration validation: fourth scoring run (reports/calibration_validation/report.md)"),
+    (620000, 621000, "sim_to_real_loop: scored (reports/sim_to_real_loop/)"),
 )
 
 
