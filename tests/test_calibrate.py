@@ -194,3 +194,23 @@ def test_a_refit_is_anchored_to_the_first_file_so_a_re_diagnosis_cannot_step_pas
                                                                        2 * NOM.friction.viscous_coefficient})))
     assert second.extra["anchor"].static_force == fs
     assert second.extra["anchor"].viscous_coefficient == NOM.friction.viscous_coefficient
+
+
+def test_a_re_diagnosis_term_is_added_to_the_files_own_term_not_put_in_its_place():
+    """The component equations include the file's own memoryless terms, so a re-diagnosis' open-search term
+    is what the file's term leaves: it is added to that term (same centre), never put in its place (the
+    file's rel coefficient used to be lost); taken from another centre it cannot be summed into one entry,
+    and the file's term is kept with the reason written."""
+    first = NOM.replace(effects=[("string_term", {"rel": 2e5, "rel_median": 0.01})])
+
+    def again(median):
+        return _diag("discovered", discovered={"component": "string_formation", "features": ["rel_cubed"],
+                                               "coefficients": {"rel_cubed": 3e9}, "term": "3e9*(rel-m)^3",
+                                               "levels": {"rel_median": median}, "shrink": 0.3})
+
+    (e,) = spec.plant_effects(_round_trip(calibrate(first, again(0.01))))
+    assert e.name == "string_term" and e.values["rel"] == 2e5 and e.values["rel_cubed"] == 3e9
+    cal = calibrate(first, again(0.02))
+    (e,) = spec.plant_effects(_round_trip(cal))
+    assert e.values["rel"] == 2e5 and e.values["rel_cubed"] == 0.0 and e.values["rel_median"] == 0.01
+    assert cal.changes == [] and "cannot be added" in to_toml(cal)

@@ -89,3 +89,24 @@ def test_the_equations_are_the_parameter_files():
     rv = np.sqrt(np.mean((R * v[mid]) ** 2))
     assert np.sqrt(np.mean((nominal[mid] + R * v[mid]) ** 2)) < 0.05 * rv  # nominal: the drop -R v is left
     assert np.sqrt(np.mean(filed[mid] ** 2)) < 0.05 * rv  # the file's: nothing is left
+
+
+def test_the_equations_compose_the_files_effects_as_the_stepper_does():
+    """Two effects at the string hook act in the file's order in the stepper and the replay
+    (``composition_for``); the component equations use the same composition, so a string term's stretch
+    (recovered from the tension it is handed) is the replay's, not another order's (the order used to be
+    the library's, which put the hook term last)."""
+    from heavecomp.effects.compose import composition_for
+    from heavecomp.effects.spec import plant_effects
+
+    p = paper_a().replace(effects=[("string_term", {"rel": 2e5, "rel_median": 0.0}),
+                                   ("string_damping", {"damping": 5e5})])
+    fx, EP, _ = CR.file_hooks(p)
+    eff = plant_effects(p)
+    comp = composition_for(eff)
+    PP = plant_vectors(p).PP
+    args = (0.1, 0.5, 0.0, 0.0, 0.0, 0.0)  # s, v, yb, vb, zh, dzh: a stretch and a relative velocity
+    T_eq = fx["tension_fx"](*args, np.zeros(4), PP, EP)
+    T_stepper = comp.functions["tension_fx"](*args, np.zeros(4), PP, comp.ep(eff))
+    T_nominal = composition_for([]).functions["tension_fx"](*args, np.zeros(4), PP, composition_for([]).ep([]))
+    assert T_eq == pytest.approx(T_stepper, rel=1e-12) and abs(T_eq - T_nominal) > 1e3

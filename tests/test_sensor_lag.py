@@ -156,9 +156,23 @@ def test_the_diagnosis_replay_reads_the_files_lag_on_the_model_side(lagged_run):
     no_lift = build(run, tr.nominal.replace(effects=[("sensor_gain", {"channel": "stroke", "factor": FACTOR})]))
     # measured: lifted -0.126 m, the lagged log's -0.254 m, the true stroke -0.154 m
     assert abs(rp.initial.stroke - true[0]) < 0.5 * abs(no_lift.initial.stroke - true[0])
+    # a candidate that reads the stroke by a factor of 1 (fitted in every re-diagnosis) starts where the
+    # file's replay starts, from the stroke lifted back, with no shift of the heave reference
+    shift, starts = rp.start_for([("sensor_gain", {"channel": "stroke", "factor": 1.0})])
+    assert shift == pytest.approx(0.0, abs=1e-9) and starts[0][0] == pytest.approx(rp.starts[0][0], abs=1e-9)
 
 
 def test_a_file_round_trips_its_sensor_lag():
     fx = [("sensor_lag", {"channel": "pressure", "factor": 0.98, "time_constant": 0.25, "delay": 0.05})]
     back = loads(dumps(paper_a().replace(effects=fx)))
     assert list(back.effects) == fx and [e.name for e in spec.reading_effects(back)] == ["sensor_lag"]
+
+
+def test_a_lag_on_the_heave_is_refused_in_one_line():
+    """The heave is the replay's input: nothing predicts it, so no lag can be read on the model side; the file
+    is refused (exit 2 from the command) instead of its lag being dropped with a 'corrected' note."""
+    fx = [("sensor_lag", {"channel": "heave", "factor": 1.0, "time_constant": 2.0})]
+    with pytest.raises(ParameterError) as exc:
+        spec.reading_effects(loads(dumps(paper_a().replace(effects=fx))))
+    msg = str(exc.value)
+    assert "\n" not in msg and "sensor_lag" in msg and "heave" in msg, msg

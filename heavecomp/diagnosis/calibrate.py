@@ -171,8 +171,8 @@ def calibrate(nominal, diagnosis: dict) -> Calibrated:
         return out
     specs = list(nominal.effects)
 
-    def add(name, values):
-        _add_effect(specs, out, name, values)
+    def add(name, values, stack=None):
+        return _add_effect(specs, out, name, values, stack)
 
     params = nominal
     if eff == "parameter_mismatch":
@@ -212,8 +212,12 @@ def _unchanged(v: dict) -> str:
             + (f" (the gap lives in {v['component']})" if v.get("component") else ""))
 
 
-def _add_effect(specs: list, out: Calibrated, name: str, values: dict) -> None:
+def _add_effect(specs: list, out: Calibrated, name: str, values: dict, stack=None) -> bool:
     """Add (or replace, when the file had it) the effect ``name`` with ``values`` in ``specs``.
+
+    A term found on the residual the file's own term leaves (``stack``: its features; the component
+    equations include the file's memoryless effects, :func:`heavecomp.diagnosis.components.file_hooks`)
+    is added to the file's entry of the same effect instead of replacing it (:func:`_stacked`).
 
     Parameters
     ----------
@@ -225,14 +229,49 @@ def _add_effect(specs: list, out: Calibrated, name: str, values: dict) -> None:
         Effect name.
     values : dict
         Its fitted parameters [SI] (a channel effect's ``channel`` included).
+    stack : collection of str, optional
+        The coefficients of a term to add to the file's own entry (None: a refit replaces it).
+
+    Returns
+    -------
+    bool
+        False when a term cannot be added to the file's entry exactly (nothing is changed).
     """
+    same = [i for i, (n, vals) in enumerate(specs) if n == name and vals.get("channel") == values.get("channel")]
+    if same and stack is not None:
+        values = _stacked(specs[same[0]][1], values, stack)
+        if values is None:
+            return False
     spec, ch = _effect_change(name, values)
-    same = [i for i, (n, vals) in enumerate(specs) if n == name and vals.get("channel") == spec[1].get("channel")]
-    if same:  # the file had this effect: the diagnosis refitted it
+    if same:  # the file had this effect: the diagnosis refitted it (or added to its term)
         specs[same[0]] = spec
     else:
         specs.append(spec)
     out.changes.append(ch)
+    return True
+
+
+def _stacked(old: dict, new: dict, features) -> dict | None:
+    """The file's term ``old`` plus the term ``new`` found on what it leaves: their ``features``'
+    coefficients added, every other value (a centre or a level a feature is taken from) kept; None when
+    one of those differs (two terms centred apart cannot be summed into one entry exactly).
+
+    Parameters
+    ----------
+    old, new : dict
+        The file's entry and the new term's values [SI].
+    features : collection of str
+        The new term's coefficient names.
+    """
+    out = dict(old)
+    for k, v in new.items():
+        if k in features:
+            out[k] = float(old.get(k, 0.0)) + float(v)
+        elif k in old and old[k] != v:
+            return None
+        else:
+            out[k] = v
+    return out
 
 
 def _add_discovered(out: Calibrated, d: dict, add) -> bool:
@@ -340,7 +379,11 @@ def _carry(out: Calibrated, add, name: str, values: dict, what: str, d: dict, le
     lead : str
         The comment's start (empty: a ``discovered`` verdict's).
     """
-    add(name, values)
+    if not add(name, values, stack=set(d.get("features", []))):
+        out.why.append(f"{lead or 'diagnosis verdict: discovered'} -- {what}, {d.get('term', '')}: the file carries "
+                       f"{name} already, taken from other centres or levels, so the two cannot be added into one "
+                       "entry exactly; the file's term is kept and this one is not carried")
+        return False
     out.changes[-1]["component_shrink"] = float(d.get("shrink", 0.0))
     out.expected_shrink = 0.0
     out.why.append(f"{lead or 'diagnosis verdict: discovered'} -- {what}, {d.get('term', '')}, carried as effect {name} (it "
@@ -675,7 +718,7 @@ def reading_dynamics(cal: Calibrated, run, nominal, diagnosis: dict, policy=None
     def plant(readers):  # the calibrated plant's replay of the log read through ``readers`` (its start from it)
         fx = reading_effects(base.replace(effects=readers))
         cols, _ = correct(fx, t, dict(run.columns))
-        lagged = tuple(e for e in fx if getattr(e, "model_side", False))  # started as the file's replay starts
+        lagged = tuple(e for e in fx if e.model_side)  # started as the file's replay starts
         return _replay(base, R.unlagged(MeasuredRun(t, cols, run.source), lagged))[c]
 
     first = plant(mine)
@@ -784,7 +827,7 @@ def held_out_shrink(raw, fixed, calibrated, nominal, diagnosis: dict) -> dict:
     t = raw.t
     pred = cal[ch]
     for e in reading_effects(calibrated):  # read the calibrated prediction as the rig's sensors do
-        if getattr(e, "channel", None) == ch and getattr(e, "model_side", False):
+        if getattr(e, "channel", None) == ch and e.model_side:
             pred = e.read_back(t, pred)  # the replay read it through the sensor's lag already
         elif getattr(e, "channel", None) == ch:
             # a reading term may read the string top's motion: the calibrated replay's (heave + stroke)

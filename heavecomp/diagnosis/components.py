@@ -51,7 +51,6 @@ above its noise).
 from __future__ import annotations
 
 import dataclasses
-import functools
 import logging
 import math
 
@@ -62,8 +61,7 @@ from heavecomp.diagnosis.data import ANGLES, fill_gaps, lowpass_zero_phase, nois
 from heavecomp.diagnosis.policy import VerdictPolicy
 from heavecomp.effects import sensor_term as ST
 from heavecomp.effects.base import COMPONENTS
-from heavecomp.effects.compose import Composition
-from heavecomp.effects.registry import library
+from heavecomp.effects.compose import composition_for
 from heavecomp.effects.spec import plant_effects
 from heavecomp.effects.features import rest_durations
 from heavecomp.errors import DataError
@@ -96,11 +94,6 @@ def _dilate(t, flag, width):
     return np.convolve(flag.astype(float), np.ones(2 * n + 1), mode="same") > 0
 
 
-@functools.lru_cache(maxsize=16)
-def _composition(classes):
-    return Composition(classes)
-
-
 def file_hooks(params):
     """The hook functions of ``params``' own plant effects (its ``[[effects]]``) that the equations can
     evaluate on measured signals: (composition functions, EP, the effects left out), or None with none.
@@ -122,9 +115,7 @@ def file_hooks(params):
         log.debug("component residuals: effects with a state of their own left out of the equations: %s", skipped)
     if not use:
         return None
-    order = list(library())
-    classes = tuple(sorted({type(e) for e in use}, key=lambda c: order.index(c.name) if c.name in order else 1e9))
-    comp = _composition(classes)
+    comp = composition_for(use)  # as the stepper and the replay compose them (the file's order at a hook)
     return comp.functions, comp.ep(use), skipped
 
 

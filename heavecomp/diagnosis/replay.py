@@ -132,7 +132,7 @@ class Replay:
             return 0.0, self.starts
         key = tuple((cls.name, tuple(sorted(v.items()))) for cls, v in fixes)
         if key not in self.cache:
-            run = self.run
+            run = unlagged(self.run, self.file_readers)  # as the replay's own start (build): the file's lags lifted back
             cols = dict(run.columns)
             for cls, v in fixes:
                 c, y = v["channel"], cols[v["channel"]]
@@ -191,7 +191,7 @@ def build(run, nominal, *, stuck_speed=S.STUCK_SPEED, segment=None, reinit=1.5, 
     """
     h, n_steps = grid(run, nominal)
     spline = heave_filtered(run)
-    readers = tuple(e for e in reading_effects(nominal) if getattr(e, "model_side", False))
+    readers = tuple(e for e in reading_effects(nominal) if e.model_side)
     initial = S.estimate(unlagged(run, readers), nominal, spline, stuck_speed=stuck_speed, noise=noise)
     hs = heave_samples(run, h, n_steps, reference=initial.heave_reference, spline=spline)
     plant = plant_vectors(nominal)
@@ -203,7 +203,7 @@ def build(run, nominal, *, stuck_speed=S.STUCK_SPEED, segment=None, reinit=1.5, 
                   tuple(plant_effects(nominal)), readers)
 
 
-#: s of the log's start a sensor lag is lifted from for the start estimate (:func:`_unlagged`)
+#: s of the log's start a sensor lag is lifted from for the start estimate (:func:`unlagged`)
 UNLAG_SPAN = 30.0
 #: Hz, the zero-phase low-pass of that lift (the lag's inverse differentiates: the start estimate needs no more)
 UNLAG_CUTOFF = 1.0

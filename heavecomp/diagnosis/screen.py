@@ -278,7 +278,6 @@ def named_form(cr, effect, fitmask, valmask):
     form = EE.open_search(r, sig, fm, vm, component=comp, features={n: lib[n] for n in names})
     if form is None or form["bic"] >= named["bic"]:
         return None
-    levels = {"x_mean": float(np.nanmean(sig["x"]))} if "x" in sig else {}
-    return dict(form, unit=CR.UNITS[comp], levels=levels, replaces=effect,
+    return dict(form, unit=CR.UNITS[comp], levels=_centres(sig), replaces=effect,
                 named={"shrink": float(named["shrink"]), "bic": float(named["bic"]),
                        "coefficients": named["coefficients"]})

@@ -126,6 +126,9 @@ class Effect:
     adds_stiction: bool = False
     kind: str = "plant"
     fit: FitSpec = FitSpec()
+    #: True for a reading whose dynamics are read on the model side (the replay's prediction read through
+    #: them, :mod:`heavecomp.effects.sensor_lag`), never undone on the log
+    model_side: bool = False
     # hook methods (staticmethods in subclasses); None: the effect does not act there
     gas = line = string = jump = static = rates = initial = steady = None
 
@@ -313,7 +316,7 @@ class ChannelEffect(Effect):
         vals = "".join(f", {k}={v!r}" for k, v in self.values.items())
         return f"{type(self).__name__}(channel={self.channel!r}{vals})"
 
-    def static(self):
+    def static_map(self):
         """The same reading with its :attr:`dynamic_params` at their :meth:`null` values (itself when it
         has none): its static map."""
         if not self.dynamic_params:

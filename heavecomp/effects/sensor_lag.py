@@ -87,6 +87,21 @@ class SensorLag(ChannelEffect):
                          doc="transport delay after the lag (negative, by up to a log sample: the log's time "
                              "stamps come late, e.g. a sample-and-hold stamped at the end of its interval)")
 
+    def __init__(self, channel: str = "wob", **values):
+        """A lagged reading of ``channel`` (``wob``, ``stroke`` or ``pressure``).
+
+        Parameters
+        ----------
+        channel : str
+            The channel read through the sensor; ``heave`` (the model's input) is refused.
+        **values : float
+            ``factor`` [-], ``time_constant`` [s], ``delay`` [s].
+        """
+        if channel == "heave":  # the heave is the replay's input: no prediction of it to read through a lag
+            raise ParameterError("effect sensor_lag: channel 'heave' is the model's input, which has no prediction "
+                                 "to read through a lag; channels: wob, stroke, pressure")
+        super().__init__(channel=channel, **values)
+
     @classmethod
     def null(cls, plant):
         return {"factor": 1.0, "time_constant": 0.0, "delay": 0.0}
