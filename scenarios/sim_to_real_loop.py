@@ -198,7 +198,7 @@ def loop_one(key: str, *, seed: int, log_duration: float, loop_duration: float, 
     run = tr.to_run()
     d.fit(run)
     v = d.verdict_
-    cal = from_log(nominal, d.to_json(), run)  # what diagnose writes into calibrated.toml
+    cal = from_log(nominal, d.to_json(), run, d.verdict_policy())  # what diagnose writes into calibrated.toml
     cal_fx = check(cal.params)  # plant effects and reading corrections, as instances
     cal_what = _describe(cal.params.effects)
     if cal.params.replace(effects=()) != nominal.replace(effects=()):

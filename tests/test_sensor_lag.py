@@ -90,6 +90,11 @@ def test_a_reading_verdict_is_written_with_the_sensors_lag_and_round_trips(lagge
     got = replay_shrink(path, back, tr.nominal, {**diag, "calibrated": cal.block()})
     assert got["shrink"] == pytest.approx(cal.expected_shrink, rel=0.1)
     assert got["shrink"] > 0.9  # the sign flip and its lag: what the nominal misses on the stroke
+    # a diagnosis whose policy switches the reading's dynamics off writes the verdict's reading as it is
+    from heavecomp.diagnosis.policy import VerdictPolicy
+
+    off = write(tr.nominal, diag, d, run=run, policy=VerdictPolicy(reading_dynamics_gain=0.0))
+    assert [c["name"] for c in off.changes] == ["sensor_gain"]
 
 
 def test_a_re_diagnosis_reading_is_not_stacked_on_the_files_lag(lagged_run):

@@ -112,7 +112,8 @@ def run(args) -> int:
     _record_measurement(Path(args.out) / "diagnosis.json", run_.measurement, span.to_json())
     from heavecomp.report.calibrated import write_calibrated  # calibrated.toml, its json block, "What next"
 
-    cal = write_calibrated(params, args.out, run_path=args.run, params_path=args.params, run=run_)
+    cal = write_calibrated(params, args.out, run_path=args.run, params_path=args.params, run=run_,
+                           policy=d.verdict_policy())
     from heavecomp.report.provenance import finish
     from heavecomp.commands._output import final
 

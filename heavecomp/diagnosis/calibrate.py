@@ -459,7 +459,7 @@ def to_toml(cal: Calibrated, source: str = "") -> str:
     return dumps(cal.params, header=header)
 
 
-def from_log(nominal, diagnosis: dict, run=None) -> Calibrated:
+def from_log(nominal, diagnosis: dict, run=None, policy=None) -> Calibrated:
     """The calibrated model ``diagnose`` writes: :func:`calibrate`, then, given the log, what only the log
     can fit (a drift's start state, :func:`start_state`; a reading's own dynamics,
     :func:`reading_dynamics`; a carried open-search term's replayed shrink, :func:`discovered_shrink`).
@@ -472,6 +472,8 @@ def from_log(nominal, diagnosis: dict, run=None) -> Calibrated:
         ``diagnosis.json`` content (:func:`calibrate`).
     run : MeasuredRun, optional
         The log as the diagnosis read it (None: :func:`calibrate` alone).
+    policy : VerdictPolicy, optional
+        The diagnosis' policy (its ``reading_dynamics_gain``; None: the defaults).
     """
     try:
         cal = calibrate(nominal, diagnosis)
@@ -481,13 +483,13 @@ def from_log(nominal, diagnosis: dict, run=None) -> Calibrated:
                               f"into a valid parameter file ({exc}); this is the nominal file"])
     if run is not None and cal.changes:
         cal = start_state(cal, run, diagnosis)
-        cal = reading_dynamics(cal, run, nominal, diagnosis)
+        cal = reading_dynamics(cal, run, nominal, diagnosis, policy)
         if any("component_shrink" in c for c in cal.changes):  # a carried open-search term: measured by replay
             cal = discovered_shrink(cal, run, nominal, diagnosis)
     return cal
 
 
-def write(nominal, diagnosis: dict, out_dir, source: str = "", run=None) -> Calibrated:
+def write(nominal, diagnosis: dict, out_dir, source: str = "", run=None, policy=None) -> Calibrated:
     """Write ``out_dir/calibrated.toml`` (the model of :func:`from_log`) and return it.
 
     Parameters
@@ -502,10 +504,12 @@ def write(nominal, diagnosis: dict, out_dir, source: str = "", run=None) -> Cali
         The measured log's name, for the header comment (empty: not named).
     run : MeasuredRun, optional
         The log as the diagnosis read it (:func:`from_log`).
+    policy : VerdictPolicy, optional
+        The diagnosis' policy (:func:`from_log`).
     """
     from pathlib import Path
 
-    cal = from_log(nominal, diagnosis, run)
+    cal = from_log(nominal, diagnosis, run, policy)
     (Path(out_dir) / FILE).write_text(to_toml(cal, source), encoding="utf-8")
     return cal
 

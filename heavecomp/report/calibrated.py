@@ -83,7 +83,7 @@ def what_next(cal: Calibrated, out_dir, *, run_path: str = "LOG", params_path: s
     return lines
 
 
-def write_calibrated(params, out_dir, *, run_path: str, params_path: str, run=None) -> Calibrated:
+def write_calibrated(params, out_dir, *, run_path: str, params_path: str, run=None, policy=None) -> Calibrated:
     """Write ``out_dir/calibrated.toml`` from ``out_dir/diagnosis.json``, add the ``calibrated`` block to
     ``diagnosis.json`` and the "What next" section to ``report.md``; returns the :class:`Calibrated`.
 
@@ -100,13 +100,15 @@ def write_calibrated(params, out_dir, *, run_path: str, params_path: str, run=No
     run : MeasuredRun, optional
         The log as the diagnosis read it (a drifting effect's start state is fitted on it,
         :func:`heavecomp.diagnosis.calibrate.start_state`).
+    policy : VerdictPolicy, optional
+        The diagnosis' policy (None: the defaults).
     """
     out = Path(out_dir)
     jpath = out / "diagnosis.json"
     d = json.loads(jpath.read_text(encoding="utf-8"))
     # the fitted values without the unit declarations the writer put beside them (provenance strips those
     # when the run folder is finished, after this)
-    cal = write(params, strip_declared(d), out, source=f"{run_path} against {params_path}", run=run)
+    cal = write(params, strip_declared(d), out, source=f"{run_path} against {params_path}", run=run, policy=policy)
     d["calibrated"] = cal.block(FILE)
     jpath.write_text(json.dumps(d, indent=2) + "\n", encoding="utf-8")
     md = out / "report.md"
