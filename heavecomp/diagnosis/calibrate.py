@@ -703,7 +703,7 @@ def reading_dynamics(cal: Calibrated, run, nominal, diagnosis: dict, policy=None
         ``cal`` itself when no reading of a verdict's channel is replaced, else the new model.
     """
     gain = (policy or DEFAULT_POLICY).reading_dynamics_gain
-    new = [e for e in cal.params.effects if e not in list(nominal.effects)]
+    new = _added(cal, nominal)
     chans = {v.get("channel") for n, v in new if n in DYNAMIC_READINGS} & set(R.CH) & set(run.columns)
     if gain <= 0 or len(chans) != 1:
         return cal
@@ -720,10 +720,9 @@ def reading_dynamics(cal: Calibrated, run, nominal, diagnosis: dict, policy=None
     val = (t >= float(split["validate"][0])) & np.isfinite(y)
 
     def plant(readers):  # the calibrated plant's replay of the log read through ``readers`` (its start from it)
-        fx = reading_effects(base.replace(effects=readers))
-        cols, _ = correct(fx, t, dict(run.columns))
+        read, fx = _read_through_file(run, base, readers)
         lagged = tuple(e for e in fx if e.model_side)  # started as the file's replay starts
-        return _replay(base, R.unlagged(MeasuredRun(t, cols, run.source), lagged))[c]
+        return _replay(base, R.unlagged(read, lagged))[c]
 
     first = plant(mine)
     now = first
@@ -746,9 +745,7 @@ def reading_dynamics(cal: Calibrated, run, nominal, diagnosis: dict, policy=None
     params = base.replace(effects=list(base.effects) + [spec])
     changes = [ch for ch in cal.changes if not (ch.get("kind") == "effect" and ch.get("role") == "reading"
                                                and ch["parameters"].get("channel") == c)] + [change]
-    readers = reading_effects(params.replace(effects=[spec]))
-    cols, _ = correct(readers, t, dict(run.columns))
-    shr = held_out_shrink(run, MeasuredRun(t, cols, run.source), params, nominal, diagnosis)
+    shr = held_out_shrink(run, _read_through_file(run, params, [spec])[0], params, nominal, diagnosis)
     why = (f"reading dynamics: the {c} sensor read with its own dynamics (sensor_lag: factor {got['factor']:.4g}, "
            f"first-order lag {got['time_constant']:.3g} s, delay {got['delay']:.3g} s, fitted on the fit part of {c} "
            f"alone) in place of {', '.join(n for n, _ in mine)}: held-out {c} rms {rms_now:.4g} -> {rms_then:.4g}; "
@@ -759,6 +756,20 @@ def reading_dynamics(cal: Calibrated, run, nominal, diagnosis: dict, policy=None
 
 
 # ------------------------------------------------------------------------------------ replay
+def _added(cal: Calibrated, nominal) -> list:
+    """The ``[[effects]]`` entries the calibrated model adds to (or changes in) the file it was fitted on."""
+    return [e for e in cal.params.effects if e not in list(nominal.effects)]
+
+
+def _read_through_file(run, params, effects):
+    """The log ``run`` (read with the file the diagnosis ran against) read as a file ``params`` with the
+    ``[[effects]]`` ``effects`` reads it: their readings undone (:func:`heavecomp.effects.spec.correct`);
+    returns (that run, the reading effects as instances)."""
+    fx = reading_effects(params.replace(effects=effects))
+    cols, _ = correct(fx, run.t, dict(run.columns))
+    return MeasuredRun(run.t, cols, run.source), fx
+
+
 def _replay(params, run):
     """The diagnosis' replay of ``run`` (a :class:`~heavecomp.diagnosis.data.MeasuredRun`) with the model
     ``params`` (its plant effects included): channel -> array at the run's times."""
@@ -864,10 +875,8 @@ def discovered_shrink(cal: Calibrated, run, nominal, diagnosis: dict) -> Calibra
     diagnosis : dict
         ``diagnosis.json`` content.
     """
-    new = [e for e in cal.params.effects if e not in list(nominal.effects)]
-    readers = reading_effects(cal.params.replace(effects=new))
-    cols, _ = correct(readers, run.t, dict(run.columns))
-    got = held_out_shrink(run, MeasuredRun(run.t, cols, run.source), cal.params, nominal, diagnosis)
+    got = held_out_shrink(run, _read_through_file(run, cal.params, _added(cal, nominal))[0], cal.params, nominal,
+                          diagnosis)
     why = (f"the carried term's held-out shrink of the {got['channel']} replay, measured by replaying the log: "
            f"{got['shrink']:.3f}")
     return Calibrated(cal.params, cal.changes, list(cal.why) + [why], got["shrink"], cal.verdict,

@@ -431,12 +431,11 @@ def _fit_then_release(fun, x0, lo, hi, keep, budget, t_grid, search, hint):
         x[keep] = xs
         return fun(x, *t_stop)
 
-    xs = _start(None, part, x0[keep], lo[keep], hi[keep], t_grid, search.grid, None if hint is None else hint[keep])
-    r1 = (nelder_mead(part, xs, lo[keep], hi[keep], budget) if keep.sum() <= 2
-          else least_squares(part, xs, lo[keep], hi[keep], budget, search.n_jobs))
     x1 = x0.copy()
-    x1[keep] = r1.x
-    r = least_squares(fun, np.clip(x1, lo + 1e-9, hi - 1e-9), lo, hi, budget, search.n_jobs)
+    x1[keep] = _start(None, part, x0[keep], lo[keep], hi[keep], t_grid, search.grid,
+                      None if hint is None else hint[keep])
+    r1 = _refit_subset(fun, x1, np.flatnonzero(keep), lo, hi, budget, search.n_jobs)
+    r = least_squares(fun, np.clip(r1.x, lo + 1e-9, hi - 1e-9), lo, hi, budget, search.n_jobs)
     r.nfev = int(r.nfev) + int(r1.nfev)
     return r
 

@@ -212,8 +212,8 @@ def discover(cr, fitmask, valmask, policy):
     return best
 
 
-def _as_feature(col, lib) -> tuple | None:
-    """(library feature name, sign) of a column that is ``+-`` a library feature, or None."""
+def _as_feature(col, lib) -> str | None:
+    """The library feature a column is (up to its sign: the search fits the coefficient), or None."""
     col = np.asarray(col, float)
     for n, (f, _) in lib.items():
         ok = np.isfinite(col) & np.isfinite(f)
@@ -221,7 +221,7 @@ def _as_feature(col, lib) -> tuple | None:
             continue
         for sign in (1.0, -1.0):
             if np.allclose(col[ok], sign * f[ok], rtol=1e-9, atol=1e-12 * float(np.max(np.abs(f[ok])))):
-                return n, sign
+                return n
     return None
 
 
@@ -274,7 +274,7 @@ def named_form(cr, effect, fitmask, valmask):
     mapped = [_as_feature(col, lib) for col in base.values()]
     if any(m is None for m in mapped):
         return None
-    names = [n for n in lib if n in {m[0] for m in mapped} | set(found["features"])]
+    names = [n for n in lib if n in set(mapped) | set(found["features"])]
     form = EE.open_search(r, sig, fm, vm, component=comp, features={n: lib[n] for n in names})
     if form is None or form["bic"] >= named["bic"]:
         return None

@@ -301,7 +301,7 @@ class ChannelEffect(Effect):
     apply = None
     #: parameters of a reading's dynamics around a static map that carries something of its own (a
     #: factor): a finite-state, time-invariant model (the controllers') reads the channel through the
-    #: static map, with these at their :meth:`null` values (:meth:`static`), and says what it leaves
+    #: static map, with these at their :meth:`null` values (:meth:`static_map`), and says what it leaves
     #: out.  Empty: the whole reading must be static, else the model refuses it.
     dynamic_params: tuple = ()
 
@@ -323,6 +323,31 @@ class ChannelEffect(Effect):
             return self
         null = self.null(None)
         return type(self)(channel=self.channel, **{**self.values, **{k: null[k] for k in self.dynamic_params}})
+
+    def undo_reading(self, t, y, cols=None):
+        """The true channel from the reading ``y`` at times ``t``: an affine reading (``fit.linear``)
+        inverted exactly, a pure delay shifted back (unknown past the log's end: NaN); an effect with an
+        explicit correction overrides this (``cols``: the log's channels, for a reading that reads them).
+
+        Parameters
+        ----------
+        t : numpy.ndarray [s]
+            Times of the reading.
+        y : numpy.ndarray [unit of the channel]
+            The reading.
+        cols : dict, optional
+            The log's channels by name.
+        """
+        if self.linear:  # affine reading y_meas = a0(t) + a1(t) y: invert it
+            a0 = self.apply(t, t, np.zeros_like(y), *self.prm)
+            a1 = self.apply(t, t, np.ones_like(y), *self.prm) - a0
+            if np.any(np.abs(a1) < 1e-12):
+                raise ParameterError(f"effect {self.name} on {self.channel}: a reading factor of 0 cannot be undone")
+            return (y - a0) / a1
+        if set(self.values) == {"delay"}:  # y_meas(t) = y(t - t_d): y(t) = y_meas(t + t_d), unknown past the end
+            d = float(self.values["delay"])
+            return np.interp(t + d, t, y, right=np.nan)
+        raise ParameterError(f"effect {self.name}: no inverse of its reading is known; it cannot correct a log")
 
     def measure(self, t, tg, y, motion=None):
         """The recorded channel at times ``t`` from the true ``y`` on the grid ``tg`` (``motion``: the

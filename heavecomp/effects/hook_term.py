@@ -28,6 +28,7 @@ widths are not recorded) is not carried:
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -42,6 +43,10 @@ _V = dict(bounds=(-1e12, 1e12))
 class _Term(Effect):
     """Base of a hook term: every parameter optional, all 0 adds nothing."""
 
+    def __init_subclass__(cls, **kw):
+        super().__init_subclass__(**kw)
+        cls.optional = tuple(f.name for f in dataclasses.fields(cls.Params))  # every parameter
+
     @classmethod
     def null(cls, plant):
         return {f.name: 0.0 for f in cls.fields()}
@@ -53,7 +58,6 @@ class LineTerm(_Term):
     name = "line_term"
     hook = "line"
     component_name = "flow_line"
-    optional = ("const", "v", "v_abs_v", "abs_v", "p")
 
     @dataclass(frozen=True)
     class Params:
@@ -75,7 +79,6 @@ class GasTerm(_Term):
     name = "gas_term"
     hook = "gas_spring"
     component_name = "gas_spring"
-    optional = ("const", "x", "x_mean", "v", "v_abs_v", "abs_v")
 
     @dataclass(frozen=True)
     class Params:
@@ -107,8 +110,6 @@ class StringTerm(_Term):
     name = "string_term"
     hook = "string"
     component_name = "string_formation"
-    optional = ("const", "v", "v_abs_v", "abs_v", "sign_v_pos", "sign_v_neg", "rel", "rel_abs_rel", "rel_cubed",
-                "rel_median")
 
     @dataclass(frozen=True)
     class Params:

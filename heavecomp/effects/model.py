@@ -140,12 +140,13 @@ def _static_affine(e):
     """(g, o) of a channel effect that reads g y + o (memoryless, time-invariant), else ParameterError.
     A reading with :attr:`~heavecomp.effects.base.ChannelEffect.dynamic_params` is read through its static
     map (:meth:`~heavecomp.effects.base.ChannelEffect.static_map`), and what is left out is logged."""
-    left = {k: e.values[k] for k in e.dynamic_params if e.values[k] != e.static_map().values[k]}
+    static = e.static_map()
+    left = {k: e.values[k] for k in e.dynamic_params if e.values[k] != static.values[k]}
     if left:
         log.warning("effect %s on %s: the casadi model (linearise, MPC) reads its static map; its %s "
                     "is left out: the controller's model has no state for a reading's dynamics",
                     e.name, e.channel, ", ".join(f"{k}={v:g}" for k, v in left.items()))
-        e = e.static_map()
+        e = static
     t = _PROBE_T
     o = e.measure(t, t, np.zeros_like(t))
     g = e.measure(t, t, np.ones_like(t)) - o

@@ -15,7 +15,7 @@ the registry's library composition: the calibrated model writes it
 (:func:`heavecomp.diagnosis.calibrate.reading_dynamics`) when a reading verdict's channel is read better
 with its dynamics.
 
-Where it acts.  The factor and the delay are undone on the log (:meth:`SensorLag.undo`: exactly, as
+Where it acts.  The factor and the delay are undone on the log (:meth:`SensorLag.undo_reading`: exactly, as
 ``sensor_gain`` and ``sensor_delay`` are); the lag is **not**: inverting it is a differentiator that
 amplifies the log's noise.  It is read on the model side instead: every replay of the diagnosis reads its
 prediction of the channel through the lag (:meth:`SensorLag.lag`, ``model_side``), so the corrected log and
@@ -123,7 +123,7 @@ class SensorLag(ChannelEffect):
 
     def read_back(self, t, y_lagged):
         """The recorded channel from the lagged one at times ``t``: ``g y_l(t - t_d)`` (the log-side part,
-        :meth:`undo`'s inverse).
+        :meth:`undo_reading`'s inverse).
 
         Parameters
         ----------
@@ -135,9 +135,9 @@ class SensorLag(ChannelEffect):
         t = np.asarray(t, dtype=float)
         return float(self.values["factor"]) * np.interp(t - float(self.values["delay"]), t, y_lagged)
 
-    def undo(self, t, y):
+    def undo_reading(self, t, y, cols=None):
         """The log-side correction: the lagged channel ``y_l(t) = y_meas(t + t_d) / g`` from the reading
-        ``y`` (its last t_d seconds unknown: NaN).
+        ``y`` (its last t_d seconds unknown: NaN); the lag is read on the model side.
 
         Parameters
         ----------
@@ -145,6 +145,8 @@ class SensorLag(ChannelEffect):
             Times of the reading.
         y : numpy.ndarray [unit of the channel]
             The reading.
+        cols : dict, optional
+            The log's channels (unused).
         """
         g = float(self.values["factor"])
         if abs(g) < 1e-12:

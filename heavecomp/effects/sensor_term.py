@@ -162,6 +162,24 @@ class SensorTerm(ChannelEffect):
                 m = m + v[c] * feature(f, y, v, motion)
         return m
 
+    def undo_reading(self, t, y, cols=None):
+        """The true channel from the reading ``y`` (:meth:`undo`), the string top's motion (heave +
+        stroke) read from the log's ``cols`` when it has both.
+
+        Parameters
+        ----------
+        t : numpy.ndarray [s]
+            Times of the reading (unused: the correction is memoryless).
+        y : numpy.ndarray [unit of the channel]
+            The reading.
+        cols : dict, optional
+            The log's channels by name.
+        """
+        motion = None
+        if cols is not None and "heave" in cols and "stroke" in cols:
+            motion = np.asarray(cols["heave"], dtype=float) + np.asarray(cols["stroke"], dtype=float)
+        return self.undo(y, motion)
+
     def undo(self, y, motion=None):
         """The true channel from the reading ``y``: ``y - m(y)``."""
         y = np.asarray(y, float)

@@ -173,29 +173,6 @@ def effects_for(params, effects=None) -> list:
     return plant_effects(params) if effects is None else resolve(effects)
 
 
-def _undo_channel(e: ChannelEffect, t, y, cols=None):
-    """The true channel from the reading ``y`` at times ``t`` of the channel effect ``e`` (``cols``: the
-    log's channels, for a reading term that reads the string top's motion, heave + stroke)."""
-    prm = e.prm
-    if isinstance(e, SensorTerm):  # an explicit correction of the reading
-        motion = None
-        if cols is not None and "heave" in cols and "stroke" in cols:
-            motion = np.asarray(cols["heave"], dtype=float) + np.asarray(cols["stroke"], dtype=float)
-        return e.undo(y, motion)
-    if isinstance(e, SensorLag):  # its factor and delay; its lag is read on the model side (model_side)
-        return e.undo(t, y)
-    if getattr(e, "linear", False):  # affine reading y_meas = a0(t) + a1(t) y: invert it
-        a0 = e.apply(t, t, np.zeros_like(y), *prm)
-        a1 = e.apply(t, t, np.ones_like(y), *prm) - a0
-        if np.any(np.abs(a1) < 1e-12):
-            raise ParameterError(f"effect {e.name} on {e.channel}: a reading factor of 0 cannot be undone")
-        return (y - a0) / a1
-    if set(e.values) == {"delay"}:  # y_meas(t) = y(t - t_d): y(t) = y_meas(t + t_d), unknown past the log's end
-        d = float(e.values["delay"])
-        return np.interp(t + d, t, y, right=np.nan)
-    raise ParameterError(f"effect {e.name}: no inverse of its reading is known; it cannot correct a log")
-
-
 def correct(effects, t, columns: dict) -> tuple[dict, list]:
     """Undo the reading effects ``effects`` (instances) on the measured ``columns`` at times ``t`` [s].
 
@@ -225,7 +202,7 @@ def correct(effects, t, columns: dict) -> tuple[dict, list]:
         if isinstance(e, ChannelEffect):
             if e.channel not in cols:
                 raise ParameterError(f"effect {e.name}: channel {e.channel!r} is not in the log")
-            cols[e.channel] = _undo_channel(e, t, np.asarray(cols[e.channel], dtype=float), cols)
+            cols[e.channel] = e.undo_reading(t, np.asarray(cols[e.channel], dtype=float), cols)
             notes.append(f"{e.channel} corrected for {e!r}")
         elif isinstance(e, HeaveEffect):
             v = e.values
