@@ -132,7 +132,7 @@ def test_missing_mnemonic_unknown_unit_and_depth_index_are_one_line_errors(tmp_p
     logs.write_witsml(f, {"DEPT": np.arange(60.0), **{k: v[:60] for k, v in ch.items() if k != "TIME"}},
                       {**units, "DEPT": "m"}, index="DEPT")
     f.write_text(f.read_text().replace("elapsed time", "measured depth"))
-    _refused(f, r"indexed by 'measured depth' \(index curve 'DEPT'\): a time index is needed")
+    _refused(f, r"column 'DEPT' \(the WITSML index curve\) is 'measured depth': a time index is needed")
     f = tmp_path / "v2.xml"
     f.write_text('<?xml version="1.0"?><ChannelSet xmlns="http://www.energistics.org/energyml/data/witsmlv2" '
                  'schemaVersion="2.0"/>')
@@ -145,7 +145,7 @@ def test_las_depth_index_is_refused(tmp_path, example):
     f = tmp_path / "depth.las"
     logs.write_las(f, {"DEPT": 1000.0 + np.arange(60.0), **{k: v[:60] for k, v in ch.items() if k != "TIME"}},
                    {**units, "DEPT": "M"}, index="DEPT")
-    _refused(f, r"LAS log indexed by depth \('DEPT', M\): a time index is needed")
+    _refused(f, r"column 'DEPT' \(the LAS index curve, M\) is a depth: a time index is needed")
 
 
 def test_a_bad_log_stops_diagnose_with_one_line_exit_2(tmp_path, example):
@@ -178,3 +178,13 @@ def test_witsml_and_las_logs_diagnose_to_the_csv_verdict(tmp_path, example):
         assert d["verdict"]["effect"] == csv["verdict"]["effect"], (log.name, d["verdict"], csv["verdict"])
         assert d["verdict"]["confidence"] == csv["verdict"]["confidence"], log.name
         assert d["measurement"]["format"] in ("witsml 1.4.1.1", "las 2.0")
+
+
+def test_fleet_finds_witsml_and_las_logs_in_a_folder(tmp_path, example):
+    from heavecomp.campaign.fleet import find_logs
+
+    write_witsml_run(tmp_path / "day1.xml", example)
+    write_las_run(tmp_path / "day2.las", example)
+    (tmp_path / "notes.md").write_text("not a log")
+    _root, found = find_logs(tmp_path)
+    assert sorted(p.name for p in found) == ["day1.xml", "day2.las"]

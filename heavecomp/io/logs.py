@@ -133,9 +133,9 @@ def witsml_table(raw: bytes, src: str, info: dict):
     index = _text(lg, "indexCurve")
     info["index_type"] = index_type
     if index_type not in TIME_INDEX:
-        raise DataError(f"{src}: WITSML log indexed by {index_type or 'an undeclared index type'!r} "
-                        f"(index curve {index!r}): a time index is needed (date time or elapsed time); "
-                        "export the log by time")
+        raise DataError(f"{src}: column {index!r} (the WITSML index curve) is "
+                        f"{index_type or 'of an undeclared index type'!r}: a time index is needed (date time or "
+                        "elapsed time); export the log by time")
     curves = {}
     for ci in lg:
         if _tag(ci) == "logCurveInfo":
@@ -214,10 +214,10 @@ def las_table(text: str, src: str, info: dict, unit_kind=lambda u: None):
     index, iunit = mnemonics[0], (units[0] or "").strip()
     kind = unit_kind(iunit)
     if index.upper().split(":")[0] in DEPTH_MNEMONICS or kind == "length":
-        raise DataError(f"{src}: LAS log indexed by depth ({index!r}, {iunit or 'no unit'}): a time index is "
-                        "needed; export the log by time")
+        raise DataError(f"{src}: column {index!r} (the LAS index curve, {iunit or 'no unit'}) is a depth: a time "
+                        "index is needed; export the log by time")
     if index.upper().split(":")[0] not in TIME_MNEMONICS and kind != "time":
-        raise DataError(f"{src}: LAS index curve {index!r} ({iunit or 'no unit'}) is not a time; a time index "
+        raise DataError(f"{src}: column {index!r} (the LAS index curve, {iunit or 'no unit'}) is not a time; a time index "
                         f"({', '.join(TIME_MNEMONICS)} in s, ms, min or h) is needed")
     cols = []
     for c in las.curves:
