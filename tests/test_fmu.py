@@ -69,3 +69,26 @@ def test_active_file_gets_a_force_input_and_bad_out_is_refused(tmp_path):
         assert 'name="u_active"' in z.read("modelDescription.xml").decode()
     r = run("export-fmu", src, "--out", tmp_path / "a.zip")
     assert r.returncode == 2 and "ends in .fmu" in r.stderr and r.stderr.count("\n") == 1
+
+
+def test_active_force_acts_as_in_simulate(tmp_path):
+    """The [active] input is the actuator force simulate takes: the stepped WOB equals simulate's with the
+    same constant force, on the same heave (given with its rates)."""
+    from heavecomp.params import load
+    from heavecomp.simulate import excitation, simulate
+    from heavecomp.simulate.core import default_dt
+    from heavecomp.simulate.cosim import CoSimulator
+
+    p = load(_file(tmp_path, "\n[active]\nu_max = 50e3\n"))
+    sp = 0.5 * default_dt(p, 20.0)
+    hs = excitation.sine(0.8, 9.0, 0.0, 120.0, sp)
+    u = 30e3
+    ref = simulate(p, 120.0, rate=20.0, heave=hs, u_active=u)
+    free = simulate(p, 120.0, rate=20.0, heave=hs)
+    sim = CoSimulator(p)
+    k = np.arange(ref["t"].size) * int(round(0.05 / sp))
+    w = [sim.outputs["wob"]] + [sim.step(ti, 0.05, hs.z[j], u, hs.dz[j], hs.ddz[j])["wob"]
+                                for ti, j in zip(ref["t"][:-1], k[:-1])]
+    std = np.std(ref["wob"])
+    assert np.max(np.abs(np.subtract(w, ref["wob"]))[1:]) < 0.01 * std
+    assert abs(np.mean(ref["wob"]) - np.mean(free["wob"])) > 0.1 * u  # the force matters: the check can fail
