@@ -33,6 +33,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "campaign": ("heavecomp.commands.campaign", "run a sea-state campaign: WOB exceedance over a scatter diagram"),
     "stickslip": ("heavecomp.commands.stickslip", "paper B pneumatic cylinder: stick-slip analysis, simulation, map"),
     "identify": ("heavecomp.commands.identify", "identify from measured data: EMPS axis (+ residual diagnosis) or seal friction vs pressure"),
+    "export-fmu": ("heavecomp.commands.export_fmu", "write the CMC of a parameter file as a co-simulation FMU (FMI 3.0): heave in, WOB out"),
 }
 
 

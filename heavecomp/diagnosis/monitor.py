@@ -86,6 +86,7 @@ from heavecomp.diagnosis.data import MeasuredRun, noise_floor
 from heavecomp.diagnosis.estimator import GapDiagnoser
 from heavecomp.diagnosis.structure import equation_channels
 from heavecomp.effects.base import COMPONENTS
+from heavecomp.io.arrays import monitor_dataset
 from heavecomp.errors import DataError
 
 log = logging.getLogger(__name__)
@@ -200,6 +201,17 @@ class MonitorResult:
     sensors: list
     duration: float
     skipped: dict = dataclasses.field(default_factory=dict)
+
+    def to_xarray(self, **attrs):
+        """The result as an ``xarray.Dataset`` over ``segment`` (x ``component``) and ``change``
+        (:func:`heavecomp.io.arrays.monitor_dataset`; units in each variable's ``attrs``).
+
+        Parameters
+        ----------
+        **attrs : str
+            Dataset attributes (e.g. ``source``).
+        """
+        return monitor_dataset(self.to_json(), attrs)
 
     def to_json(self) -> dict:
         extra = {"skipped": self.skipped} if self.skipped else {}
