@@ -818,6 +818,33 @@ def replay_shrink(path, calibrated, nominal, diagnosis: dict, *, columns=None, u
     return dict(out, reported=reported, agreement=agree)
 
 
+def as_recorded(params, t, pred: dict, channel: str, heave) -> np.ndarray:
+    """A replay's prediction of ``channel`` read as the rig's sensors read it under the file ``params``: its
+    reading effects applied (a model-side lag read back, a gain, offset or delay applied), so that it compares
+    with the log as it was recorded.
+
+    Parameters
+    ----------
+    params : CMCParams
+        The file the replay ran under (its ``[[effects]]`` readings).
+    t : numpy.ndarray [s]
+        The run's times.
+    pred : dict
+        The replay's channels (:meth:`heavecomp.diagnosis.replay.Replay.simulate`).
+    channel : str
+        The channel read.
+    heave : numpy.ndarray [m]
+        The heave the replay was driven by (a reading term may read the string top's motion, heave + stroke).
+    """
+    out = pred[channel]
+    for e in reading_effects(params):
+        if getattr(e, "channel", None) == channel and e.model_side:
+            out = e.read_back(t, out)  # the replay read it through the sensor's lag already
+        elif getattr(e, "channel", None) == channel:
+            out = e.measure(t, t, out, motion=heave + pred["stroke"])
+    return out
+
+
 def held_out_shrink(raw, fixed, calibrated, nominal, diagnosis: dict) -> dict:
     """Held-out shrink of the calibrated model on a log read twice (:func:`replay_shrink`).
 
@@ -840,13 +867,7 @@ def held_out_shrink(raw, fixed, calibrated, nominal, diagnosis: dict) -> dict:
     nom = _replay(nominal, raw)
     cal = _replay(calibrated, fixed)
     t = raw.t
-    pred = cal[ch]
-    for e in reading_effects(calibrated):  # read the calibrated prediction as the rig's sensors do
-        if getattr(e, "channel", None) == ch and e.model_side:
-            pred = e.read_back(t, pred)  # the replay read it through the sensor's lag already
-        elif getattr(e, "channel", None) == ch:
-            # a reading term may read the string top's motion: the calibrated replay's (heave + stroke)
-            pred = e.measure(t, t, pred, motion=fixed["heave"] + cal["stroke"])
+    pred = as_recorded(calibrated, t, cal, ch, fixed["heave"])
     lo = float(diagnosis["split"]["validate"][0])
     y = raw[ch]
     m = (t >= lo) & np.isfinite(y) & np.isfinite(pred)
@@ -883,5 +904,5 @@ def discovered_shrink(cal: Calibrated, run, nominal, diagnosis: dict) -> Calibra
                       verdict_shrink=float(diagnosis["verdict"].get("shrink", 0.0)))
 
 
-__all__ = ["Calibrated", "calibrate", "discovered_shrink", "fit_reading", "held_out_shrink", "reading_dynamics",
+__all__ = ["Calibrated", "as_recorded", "calibrate", "discovered_shrink", "fit_reading", "held_out_shrink", "reading_dynamics",
            "replay_shrink", "to_toml", "write"]
