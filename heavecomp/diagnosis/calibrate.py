@@ -206,9 +206,10 @@ def _unchanged(v: dict) -> str:
     """
     if v["effect"] == "none":
         return ("diagnosis verdict: none -- the log agrees with this model within the measurement noise "
-                "(and the replay's response to the heave noise); nothing to change: this is the nominal file")
+                "(and the replay's response to the heave noise); nothing to change: this is the file the diagnosis ran "
+                "against, unchanged")
     return (f"diagnosis verdict: inconclusive -- {v.get('note', 'no candidate explains the gap')}; "
-            "nothing is changed: this is the nominal file"
+            "nothing is changed: this is the file the diagnosis ran against, unchanged"
             + (f" (the gap lives in {v['component']})" if v.get("component") else ""))
 
 
@@ -303,7 +304,7 @@ def _add_discovered(out: Calibrated, d: dict, add) -> bool:
                    f"{d.get('component', '?')} residual, {d.get('term', '')}, has no model form at its hook "
                    f"(discovered_term carries the friction features {', '.join(DISCOVERED_FEATURES)}, sensor_term "
                    "a channel's misreading with its levels, line_term / gas_term / string_term the memoryless "
-                   "features of their hook); nothing is changed: this is the nominal file")
+                   "features of their hook); nothing is changed: this is the file the diagnosis ran against, unchanged")
     out.expected_shrink = 0.0
     return False
 
@@ -480,7 +481,7 @@ def from_log(nominal, diagnosis: dict, run=None, policy=None) -> Calibrated:
     except InputError as exc:  # e.g. a refitted value outside its table's possible range: the nominal, and why
         cal = Calibrated(nominal, verdict=diagnosis["verdict"]["effect"],
                          why=[f"diagnosis verdict: {diagnosis['verdict']['effect']} -- its values cannot be written "
-                              f"into a valid parameter file ({exc}); this is the nominal file"])
+                              f"into a valid parameter file ({exc}); this is the file the diagnosis ran against, unchanged"])
     if run is not None and cal.changes:
         cal = start_state(cal, run, diagnosis)
         cal = reading_dynamics(cal, run, nominal, diagnosis, policy)

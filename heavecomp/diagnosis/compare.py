@@ -169,7 +169,8 @@ def replay_files(log, params, *, names=None, columns=None, units=None, split=0.6
             first = (raw, sp, run)
         elif raw.t.size != first[0].t.size:
             raise InputError(f"{name} reads {raw.t.size} samples of the log, {names[0]} {first[0].t.size}: "
-                             "give the files the same [measurement] mapping (or --columns/--units)")
+                             "give the files the same [measurement] mapping, or the mapping for all of them",
+                             option=("columns", "units"))
         ctx = R.prepare(run, P, split=split, settle=settle, stuck_speed=d.stuck_speed, segment=d.segment,
                         reinit=d.reinit, input_draws=d.input_draws, policy=VerdictPolicy())
         pred = {c: as_recorded(P, run.t, ctx.nominal_pred, c, run["heave"]) for c in ctx.channels}
@@ -190,4 +191,47 @@ def replay_files(log, params, *, names=None, columns=None, units=None, split=0.6
                             sp.to_json() or {"start": 0.0, "end": raw.duration}, chans, run0.measurement or {})
 
 
-__all__ = ["ModelReplay", "ReplayComparison", "replay_files"]
+def against_log(t, channels: dict, log, params, *, split=0.67, settle=None) -> dict | None:
+    """A simulation driven by a measured log's heave (``[heave] kind = "file"``) compared with the log's own
+    output channels: per channel the rms of simulation minus log after the settling window and on the
+    diagnosis' held-out part (the last ``1 - split`` of the log) [SI].  The log is read as recorded (its
+    ``[measurement]`` mapping, no reading effect undone: the simulation records its channels through the
+    file's reading effects already).  None when the heave file holds none of wob, stroke, pressure.
+
+    Parameters
+    ----------
+    t : numpy.ndarray [s]
+        The simulation's output times (from 0 at the log's first sample).
+    channels : dict
+        The simulation's channels {wob, stroke, pressure: array} [SI].
+    log : str or Path
+        The heave file, a measured run.
+    params : CMCParams
+        The simulated file (its ``[measurement]`` mapping).
+    split : float [-]
+        Fraction of the log in the fit part (the diagnosis' default).
+    settle : float [s] or None
+        Start-up window left out (None: the diagnosis' default).
+    """
+    try:
+        raw = load_run(log, params.replace(effects=[]))
+    except InputError:
+        return None  # a heave record, not a measured run: nothing to compare with
+    chans = R.present(raw)
+    if not chans:
+        return None
+    sp = R.split_of(raw, split, settle)
+    tl = raw.t - raw.t[0]
+    inside = tl <= t[-1] + 1e-9
+    out = {"log": str(log), "channel": chans[0], "split": sp, "rms": {}, "rms_validate": {},
+           "units": {c: UNITS[c] for c in chans}}
+    for c in chans:
+        y = raw[c]
+        pred = np.interp(tl, t, channels[c])
+        for key, mask in (("rms", tl >= sp["settle"]), ("rms_validate", tl >= sp["validate"][0])):
+            m = mask & inside & np.isfinite(y)
+            out[key][c] = float(np.sqrt(np.mean((pred[m] - y[m]) ** 2))) if m.any() else math.nan
+    return out
+
+
+__all__ = ["ModelReplay", "ReplayComparison", "against_log", "replay_files"]
