@@ -78,28 +78,31 @@ def run(args) -> int:
     span = SP.parse(args.span)
     files = [load(p, heave_file=False) for p in args.params]  # every file checked before the log is read
     cmp = replay_files(args.run, files, names=args.params, columns=columns, units=units, split=args.split,
-                       settle=args.settle, span=span,
+                       settle=args.settle, span=span, window=window,
                        progress=None if args.quiet else lambda f, m: print(f"replay: {m}", file=sys.stderr, flush=True))
-    if window is not None:
-        end = float(cmp.t[-1])
-        lo = 0.0 if window[0] is None else window[0]
-        hi = end if window[1] is None else min(window[1], end)
-        if lo >= end:
-            raise InputError(f"--window: START {lo:g} s is past the replayed span's end ({end:.6g} s)")
-        window = (lo, hi)
     out = Path(final(args))
     best = cmp.ranking()[0]
     cmds = [command("heavecomp", "diagnose", args.run, "--params", best, "--out", out / "diagnosis_best",
                     columns=columns, units=units)]
-    d = write_report(cmp, args.out, window=window, commands=cmds)
+    d = write_report(cmp, args.out, window=cmp.window, commands=cmds)
     finish(args.out, json_files=("replay.json",), params_file=None, measured_run=str(Path(args.run).resolve()),
            params_files=[str(Path(p).resolve()) for p in args.params])
+    _contract_units(Path(args.out) / "replay.json", d["units"])
     pc = d["channel"]
     by = {m["params"]: m for m in d["models"]}
     print("; ".join(f"{n}: {pc} gap/noise held-out {by[n]['gap_to_noise_validate'][pc]:.2f}, shrink "
                     f"{by[n]['shrink_validate']:+.2f}" for n in d["ranking"])
           + f" -> {out / 'replay.json'}")
     return 0
+
+
+def _contract_units(path, units: dict) -> None:
+    """Put the contract's ``units`` blocks (``units.rms`` ...) back beside the provenance's unit of every key."""
+    import json
+
+    d = json.loads(path.read_text(encoding="utf-8"))
+    d["units"] = {**d.get("units", {}), **units}
+    path.write_text(json.dumps(d, indent=2) + "\n", encoding="utf-8")
 
 
 def _window(text):

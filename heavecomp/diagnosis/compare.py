@@ -76,6 +76,8 @@ class ReplayComparison:
     span: dict
     channels: tuple
     measurement: dict
+    #: the figure's zoom (start, end) [s] within the span, checked against it (None: the whole span)
+    window: tuple | None = None
 
     @property
     def primary(self) -> str:
@@ -123,7 +125,7 @@ def _read(log, params, name, columns, units, span):
 
 
 def replay_files(log, params, *, names=None, columns=None, units=None, split=0.67, settle=None, span=None,
-                 progress=None) -> ReplayComparison:
+                 window=None, progress=None) -> ReplayComparison:
     """Replay the log ``log`` under each parameter file of ``params`` as the diagnosis does (module docstring).
 
     Parameters
@@ -143,6 +145,9 @@ def replay_files(log, params, *, names=None, columns=None, units=None, split=0.6
     span : tuple (start, end) [s] or None
         The stretch replayed (:func:`heavecomp.diagnosis.span.parse`); None: the diagnosis' default
         (a log up to 1200 s whole, a longer one its last 600 s).
+    window : tuple (start, end) [s] or None
+        A zoom of the replayed span for the figure (either end None: the span's), checked against the span
+        before any replay; None: the whole span.
     progress : callable(fraction, message), optional
 
     Returns
@@ -167,6 +172,7 @@ def replay_files(log, params, *, names=None, columns=None, units=None, split=0.6
         raw = run if not reading_effects(P) else _read(log, P.replace(effects=[]), name, columns, units, span)[0]
         if first is None:
             first = (raw, sp, run)
+            window = _window(window, float(run.t[-1]))
         elif raw.t.size != first[0].t.size:
             raise InputError(f"{name} reads {raw.t.size} samples of the log, {names[0]} {first[0].t.size}: "
                              "give the files the same [measurement] mapping, or the mapping for all of them",
@@ -188,7 +194,18 @@ def replay_files(log, params, *, names=None, columns=None, units=None, split=0.6
     if progress:
         progress(1.0, "done")
     return ReplayComparison(raw.source, raw.t, {c: raw[c] for c in ("heave",) + chans}, models, split_,
-                            sp.to_json() or {"start": 0.0, "end": raw.duration}, chans, run0.measurement or {})
+                            sp.to_json(), chans, run0.measurement or {}, window)
+
+
+def _window(window, end: float):
+    """``window`` (start, end) [s] (either None) within a span ending at ``end`` [s]; one-line error."""
+    if window is None:
+        return None
+    lo = 0.0 if window[0] is None else float(window[0])
+    hi = end if window[1] is None else min(float(window[1]), end)
+    if lo >= end:
+        raise InputError(f"window START {lo:g} s is past the replayed span's end ({end:.6g} s)", option="window")
+    return (lo, hi)
 
 
 def against_log(t, channels: dict, log, params, *, split=0.67, settle=None) -> dict | None:
