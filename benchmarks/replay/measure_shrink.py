@@ -23,6 +23,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -30,6 +31,7 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT))  # this tree's heavecomp, not an installed one
 LABELS = ("string_damping", "pressure_friction", "flow_loss", "parameter_mismatch", "sensor_gain")
 #: the two seas of part 2 (JONSWAP)
 SEAS = ({"hs": 2.0, "tp": 10.0}, {"hs": 3.0, "tp": 13.0})
@@ -38,7 +40,7 @@ SEAS = ({"hs": 2.0, "tp": 10.0}, {"hs": 3.0, "tp": 13.0})
 def heavecomp(*args) -> str:
     """``python -m heavecomp ARGS`` from this tree, as a user runs it; its stdout (exit 0 required)."""
     r = subprocess.run([sys.executable, "-m", "heavecomp", *map(str, args)], cwd=ROOT, capture_output=True,
-                       text=True, env={**__import__("os").environ, "PYTHONPATH": str(ROOT)})
+                       text=True, env={**os.environ, "PYTHONPATH": str(ROOT)})
     if r.returncode:
         raise RuntimeError(f"heavecomp {' '.join(map(str, args))}: exit {r.returncode}: {r.stderr.strip()[-400:]}")
     return r.stdout
