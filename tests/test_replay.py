@@ -120,7 +120,7 @@ def test_simulate_with_the_logs_heave_gives_the_replays_held_out_error(tmp_path,
     assert main(["replay", str(log), "--params", str(nom), "--out", str(tmp_path / "r"), *flags]) == 0
     sim = json.loads((tmp_path / "s" / "metrics.json").read_text())
     rep = json.loads((tmp_path / "r" / "replay.json").read_text())
-    assert "low-passed" in sim["heave_input"]["preprocessing"]
+    assert "low-passed" in sim["heave"]["preprocessing"]
     a, b = sim["against_log"]["rms_validate"]["wob"], rep["models"][0]["rms_validate"]["wob"]
     assert abs(a - b) <= 0.1 * b, (a, b)
     assert sim["against_log"]["split"]["validate"][0] == pytest.approx(rep["split"]["validate"][0])

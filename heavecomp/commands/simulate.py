@@ -133,9 +133,9 @@ def _heave_file(args, params):
 
 
 def _against_log(res, params, metrics_path) -> str:
-    """With a measured heave (``[heave] kind = "file"``): how the heave was pre-processed and, when the file
-    is a measured run, the simulation's error against its output channels
-    (:func:`heavecomp.diagnosis.compare.against_log`), added to ``metrics.json``; returns the summary's words."""
+    """With a heave file (``[heave] kind = "file"``) that is a measured run: the simulation's error against its
+    output channels (:func:`heavecomp.diagnosis.compare.against_log`), added to ``metrics.json``; returns the
+    summary's words."""
     import json
 
     heave = params.heave
@@ -145,10 +145,8 @@ def _against_log(res, params, metrics_path) -> str:
 
     from heavecomp.diagnosis.compare import against_log
     from heavecomp.report.diagnosis import CH_UNITS
-    from heavecomp.simulate.excitation import PREPROCESSING
 
-    d = json.loads(metrics_path.read_text(encoding="utf-8"))
-    d["heave_input"] = {"kind": "file", "path": heave.path, "preprocessing": PREPROCESSING}
+    d = json.loads(metrics_path.read_text(encoding="utf-8"))  # its "heave" block says how the heave was pre-processed
     ch = {c: res[c] for c in ("wob", "stroke", "pressure")}
     got = against_log(res["t"], ch, Path(params.base_dir or ".") / heave.path, params)
     words = ""

@@ -20,7 +20,7 @@ from heavecomp.io.series import gaps
 from heavecomp.io.series import read_series, short
 from heavecomp.signals import HEAVE_CUTOFF, flat_zero_phase
 
-#: what a heave file goes through before it drives the plant (metrics.json ``heave_input``); the diagnosis'
+#: what a heave file goes through before it drives the plant (metrics.json ``heave.preprocessing``); the diagnosis'
 #: replay differs only in its start (docs/diagnosis.md, "Replay a log under several files")
 PREPROCESSING = (f"gap-filled, made uniform, zero-phase low-passed at {HEAVE_CUTOFF:g} Hz as the diagnosis' replay; "
                  "the run starts at rest at the operating point with the first filtered sample as the heave "
