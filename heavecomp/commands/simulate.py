@@ -147,7 +147,7 @@ def _against_log(res, params, metrics_path) -> str:
     from heavecomp.report.diagnosis import CH_UNITS
 
     d = json.loads(metrics_path.read_text(encoding="utf-8"))  # its "heave" block says how the heave was pre-processed
-    ch = {c: res[c] for c in ("wob", "stroke", "pressure")}
+    ch = {c: res[c] for c in ("heave", "wob", "stroke", "pressure")}
     got = against_log(res["t"], ch, Path(params.base_dir or ".") / heave.path, params)
     words = ""
     if got is not None:

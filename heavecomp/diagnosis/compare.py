@@ -212,15 +212,17 @@ def against_log(t, channels: dict, log, params, *, split=0.67, settle=None) -> d
     """A simulation driven by a measured log's heave (``[heave] kind = "file"``) compared with the log's own
     output channels: per channel the rms of simulation minus log after the settling window and on the
     diagnosis' held-out part (the last ``1 - split`` of the log) [SI].  The log is read as recorded (its
-    ``[measurement]`` mapping, no reading effect undone: the simulation records its channels through the
-    file's reading effects already).  None when the heave file holds none of wob, stroke, pressure.
+    ``[measurement]`` mapping, no reading effect undone) and the simulation as the rig's sensors read it under
+    the file (its ``[[effects]]`` readings applied: ``simulate`` records the plant's true channels), as
+    :func:`replay_files` compares.  None when the heave file holds none of wob, stroke, pressure.
 
     Parameters
     ----------
     t : numpy.ndarray [s]
         The simulation's output times (from 0 at the log's first sample).
     channels : dict
-        The simulation's channels {wob, stroke, pressure: array} [SI].
+        The simulation's channels {heave, wob, stroke, pressure: array} [SI] (its heave and stroke: the string
+        top's motion a reading may read).
     log : str or Path
         The heave file, a measured run.
     params : CMCParams
@@ -242,9 +244,16 @@ def against_log(t, channels: dict, log, params, *, split=0.67, settle=None) -> d
     inside = tl <= t[-1] + 1e-9
     out = {"log": str(log), "channel": chans[0], "split": sp, "rms": {}, "rms_validate": {},
            "units": {c: UNITS[c] for c in chans}}
+    read = [e for e in reading_effects(params) if getattr(e, "channel", None) in chans]
+    motion = np.asarray(channels["heave"]) + np.asarray(channels["stroke"]) if read else None
     for c in chans:
         y = raw[c]
         pred = np.interp(tl, t, channels[c])
+        mine = [e for e in read if e.channel == c]
+        if mine:  # the file's readings (a gain, a lag, ...): the simulation read as the rig's sensors read it
+            pred = mine[0].measure(tl, t, channels[c], motion=motion)
+            for e in mine[1:]:
+                pred = e.measure(tl, tl, pred, motion=np.interp(tl, t, motion))
         for key, mask in (("rms", tl >= sp["settle"]), ("rms_validate", tl >= sp["validate"][0])):
             m = mask & inside & np.isfinite(y)
             out[key][c] = float(np.sqrt(np.mean((pred[m] - y[m]) ** 2))) if m.any() else math.nan
