@@ -126,3 +126,21 @@ def test_simulate_with_the_logs_heave_gives_the_replays_held_out_error(tmp_path,
     assert sim["against_log"]["split"]["validate"][0] == pytest.approx(rep["split"]["validate"][0])
     assert b > 3 * rep["models"][0]["noise_floor"]["wob"]  # a real gap, not noise against noise
     assert math.isfinite(a) and np.isfinite(list(sim["against_log"]["rms"].values())).all()
+
+
+def test_against_log_reads_the_simulation_through_the_files_sensors(nominal_log):
+    """A calibrated ``sensor_gain`` on wob: ``simulate`` records the plant's true WOB, the log holds what the sensor
+    read; the comparison reads the simulation through the file's reading (before: the calibrated file's error was
+    the nominal's, shrink 0)."""
+    from heavecomp.diagnosis.compare import against_log
+    from heavecomp.diagnosis.data import load_run
+    from heavecomp.effects.spec import load
+
+    log, nom = nominal_log
+    p = load(nom)
+    run = load_run(log, p)
+    true = {c: run[c] / (1.1 if c == "wob" else 1.0) for c in ("heave", "wob", "stroke", "pressure")}
+    gain = p.replace(effects=[("sensor_gain", {"channel": "wob", "factor": 1.1})])
+    read = against_log(run.t, true, log, gain)["rms_validate"]["wob"]
+    plain = against_log(run.t, true, log, p)["rms_validate"]["wob"]
+    assert read < 1.0 < 0.05 * plain, (read, plain)
