@@ -21,8 +21,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                         "pre-processed as the diagnosis' replay; a log with a wob column also gets the WOB error "
                         "against it, on its held-out part (metrics.json against_log)")
     p.add_argument("--columns", default=None, metavar="t=NAME,...",
-                   help="with a heave file: map contract columns to the file's, e.g. t=Time,heave=MRU_heave,wob=WOB "
-                        "(overrides [measurement] columns)")
+                   help="with a heave file (--heave-file, or [heave] kind = \"file\"): map contract columns to the "
+                        "file's, e.g. t=Time,heave=MRU_heave,wob=WOB (overrides [measurement] columns)")
     p.add_argument("--units", default=None, metavar="t=ms,...",
                    help="with a heave file: declare units, e.g. t=ms,stroke=mm (overrides [measurement] units)")
     p.add_argument("--rate", type=float, default=20.0, metavar="HZ", help="output sample rate [Hz] (default 20)")
@@ -119,9 +119,10 @@ def _heave_file(args, params):
     columns, units = check_spec(parse_mapping(args.columns, "--columns"), parse_mapping(args.units, "--units"),
                                 "cli")
     if args.heave_file is None:
-        if columns or units:
-            raise InputError("--columns/--units need --heave-file LOG (they map the log's columns)")
-        return params
+        if (columns or units) and (params.heave is None or params.heave.kind != "file"):
+            raise InputError("--columns/--units map a heave file's columns: give --heave-file LOG (or a parameter "
+                             "file with [heave] kind = \"file\")")
+        return used(params, columns, units)
     path = str(Path(args.heave_file).resolve())
     gone = {k: None for k in ("amplitude", "period", "hs", "tp", "gamma", "seed", "ramp")}
     params = used(params.replace(heave={**gone, "kind": "file", "path": path}), columns, units)
