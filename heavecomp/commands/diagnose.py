@@ -111,11 +111,14 @@ def run(args) -> int:
     write_report(d, args.out, title=f"Sim-to-real gap diagnosis — {run_.source}")
     _record_measurement(Path(args.out) / "diagnosis.json", run_.measurement, span.to_json())
     from heavecomp.report.calibrated import write_calibrated  # calibrated.toml, its json block, "What next"
-
-    cal = write_calibrated(params, args.out, run_path=args.run, params_path=args.params, run=run_,
-                           policy=d.verdict_policy())
-    from heavecomp.report.provenance import finish
     from heavecomp.commands._output import final
+
+    from heavecomp.params.measurement import used
+
+    # calibrated.toml records the mapping the log was read with: its re-diagnosis needs no flags
+    cal = write_calibrated(used(params, columns, units), args.out, run_path=args.run, params_path=args.params, run=run_,
+                           policy=d.verdict_policy(), shown_dir=final(args), columns=columns, units=units)
+    from heavecomp.report.provenance import finish
 
     finish(args.out, params=params, json_files=("diagnosis.json",), heave_used=False, measured_run=str(Path(args.run).resolve()))
     v = d.verdict_

@@ -51,6 +51,7 @@ def run(args) -> int:
     from heavecomp.effects.spec import load  # the file with its [[effects]] checked
     from heavecomp.report.monitor import write_report, write_segment_diagnoses
     from heavecomp.report.provenance import finish
+    from heavecomp.commands._output import final
 
     columns, units = check_spec(parse_mapping(args.columns, "--columns"), parse_mapping(args.units, "--units"),
                                 "cli")
@@ -93,5 +94,5 @@ def run(args) -> int:
     print(f"{len(eff)} effect change(s), {len(ops)} operating change(s), {len(res.segments)} segment(s)"
           + "".join(f"; {c['component']} at {c['t']:.0f} s" for c in eff[:5])
           + "".join(f"; segment {i}: {res.segments[i]['verdict']['effect']}" for i in diagnoses)
-          + f" -> {args.out}/monitor.json")
+          + f" -> {Path(final(args)) / 'monitor.json'}")
     return 0
