@@ -112,7 +112,17 @@ def check(params) -> list:
     params : CMCParams
         Parameters whose ``effects`` (the file's ``[[effects]]`` specs) are read.
     """
-    return [build(name, values, f"effects[{i}]") for i, (name, values) in enumerate(getattr(params, "effects", ()))]
+    out, seen = [], {}
+    for i, (name, values) in enumerate(getattr(params, "effects", ())):
+        e = build(name, values, f"effects[{i}]")
+        key = (name, getattr(e, "channel", None))
+        if key in seen:  # applied twice, a WOB gain of 1.08 read as 1.1664: one entry per effect (and channel)
+            on = f" on {key[1]!r}" if key[1] else ""
+            raise ParameterError(f"effects[{i}]: duplicates effects[{seen[key]}] ({name}{on}); one entry per effect"
+                                 f"{' and channel' if key[1] else ''}: write the combined value in one entry")
+        seen[key] = i
+        out.append(e)
+    return out
 
 
 def load(path, *, heave_file=True):
