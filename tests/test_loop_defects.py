@@ -327,3 +327,13 @@ def test_analyse_says_what_it_kept_linearised_or_left_out(tmp_path):
     r = run("analyse", f, "--out", tmp_path / "b", "--points", 50, "--sliding-velocity", 0.1)
     s = json.loads((tmp_path / "b" / "analysis.json").read_text())
     assert {e["item"]: e["role"] for e in s["effects"]}["effects[0] pressure_friction"] == "linearised"
+
+
+def test_a_reading_that_depends_on_the_string_tops_motion_runs_in_the_closed_loop(tmp_path):
+    """A calibrated ``sensor_term`` with a ``*_motion`` term reads z_h + s: the loop hands it the true motion
+    (it raised "they need the heave and stroke with the reading" once the loop took the file's readings)."""
+    f = _rig(tmp_path, "k2.toml", '[[effects]]\nname = "sensor_term"\nchannel = "wob"\nc_top = -1.72e4\n'
+                                  'c_top_motion = 6.88e5\ntop_level = 1.246e5\nmotion_top = -0.064\n')
+    r = run("simulate", f, "--duration", 10, "--controller", "pid", "--out", tmp_path / "o")
+    assert r.returncode == 0, r.stderr
+    assert np.isfinite(json.loads((tmp_path / "o" / "metrics.json").read_text())["wob_std"])

@@ -332,9 +332,10 @@ def _channel_readers(sensor_fx, n_rows: int, Tc: float):
 
     def reads(k, y):
         out = np.array(y, dtype=float)
+        motion = np.array([y[0] + y[3]])  # the string top's motion z_h + s (a sensor_term's *_motion features)
         for e, j, hist in stages:
             hist[k] = out[j]
-            out[j] = e.measure(tg[k:k + 1], tg[:k + 1], hist[:k + 1])[0]
+            out[j] = e.measure(tg[k:k + 1], tg[:k + 1], hist[:k + 1], motion=motion)[0]
         return out
 
     return reads
