@@ -337,3 +337,15 @@ def test_a_reading_that_depends_on_the_string_tops_motion_runs_in_the_closed_loo
     r = run("simulate", f, "--duration", 10, "--controller", "pid", "--out", tmp_path / "o")
     assert r.returncode == 0, r.stderr
     assert np.isfinite(json.loads((tmp_path / "o" / "metrics.json").read_text())["wob_std"])
+
+
+def test_the_equation_error_of_a_component_that_never_moves_is_no_runtime_warning():
+    """A calm log never slides: the friction component's fit rows are empty, and numpy warned "Degrees of
+    freedom <= 0" three times on the terminal (D8's calm log)."""
+    import warnings
+
+    from heavecomp.diagnosis.equation_error import _lstsq
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert _lstsq(np.zeros((0, 2)), np.zeros(0)).shape == (2,)
