@@ -323,7 +323,7 @@ def test_analyse_says_what_it_kept_linearised_or_left_out(tmp_path):
     s = json.loads((tmp_path / "a" / "analysis.json").read_text())
     roles = {e["item"]: e["role"] for e in s["effects"]}
     assert roles["effects[0] pressure_friction"] == "left out" and "describing" in s["effects"][1]["why"]
-    assert "| effects[1] string_damping | kept |" in (tmp_path / "a" / "report.md").read_text()
+    assert "- effects[1] string_damping: **kept**" in (tmp_path / "a" / "report.md").read_text()
     r = run("analyse", f, "--out", tmp_path / "b", "--points", 50, "--sliding-velocity", 0.1)
     s = json.loads((tmp_path / "b" / "analysis.json").read_text())
     assert {e["item"]: e["role"] for e in s["effects"]}["effects[0] pressure_friction"] == "linearised"

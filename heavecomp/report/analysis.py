@@ -308,8 +308,7 @@ def report_markdown(s: dict, source: str = "") -> str:
     ]
     if s.get("effects"):
         lines += ["What the linear model holds of the file (friction law and `[[effects]]`):", "",
-                  "| item | role | why |", "|---|---|---|",
-                  *[f"| {r['item']} | {r['role']} | {r['why']} |" for r in s["effects"]], ""]
+                  *[f"- {r['item']}: **{r['role']}** ({r['why']})" for r in s["effects"]], ""]
     for key, label in (("viscous", "viscous friction only"), ("sliding", "sliding linearisation")):
         if key in s:
             v = s[key]
