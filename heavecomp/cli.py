@@ -141,7 +141,8 @@ def main(argv: list[str] | None = None) -> int:
         The command's code: 0 on success, 2 for bad input (one line on stderr), the no-space code of
         :mod:`heavecomp.report.output` for a disk that filled, 130 when interrupted.
     """
-    words = list(sys.argv[1:] if argv is None else argv)
+    words = _negative_values(list(sys.argv[1:] if argv is None else argv))
+    argv = words
     parser, modules = build_parser(next((w for w in words if not w.startswith("-")), ""))
     _Parser.argv = words
     invocation.COMMAND = ["heavecomp", *_Parser.argv]
@@ -179,6 +180,21 @@ def main(argv: list[str] | None = None) -> int:
 
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
+
+
+def _negative_values(words: list) -> list:
+    """``--span -5:10`` -> ``--span=-5:10``: argparse reads a value that starts with ``-`` and is no plain
+    negative number as an option ("expected one argument"), so the command's own check, which names the
+    option and the rule, never saw it."""
+    import re
+
+    out = []
+    for w in words:
+        if out and out[-1].startswith("--") and "=" not in out[-1] and re.match(r"^-\.?\d", w):
+            out[-1] = f"{out[-1]}={w}"
+        else:
+            out.append(w)
+    return out
 
 
 #: library option names whose flag is not ``--<name>``

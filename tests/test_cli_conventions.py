@@ -59,8 +59,10 @@ def test_quiet_silences_summary_but_not_errors(paper_a_toml, tmp_path):
     assert bad.returncode == 2 and "--points" in bad.stderr
 
 
-def test_params_quiet_keeps_the_toml_on_stdout(paper_a_toml):
-    r = _run("params", str(paper_a_toml), "--quiet")
+def test_params_quiet_checks_a_file_silently_and_keeps_a_built_in_set_on_stdout(paper_a_toml):
+    r = _run("params", str(paper_a_toml), "--quiet")  # a check: the exit code is the answer (U12)
+    assert r.returncode == 0 and r.stdout == "" and r.stderr == ""
+    r = _run("params", "paper_a", "--quiet")  # the TOML asked for is the output, not a summary
     assert r.returncode == 0 and "[compensator]" in r.stdout and r.stderr == ""
 
 

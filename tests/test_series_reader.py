@@ -246,7 +246,7 @@ def test_duplicate_column_names_are_refused(tmp_path, nominal, capsys, header, f
 
 @pytest.mark.parametrize("n,dt,fragment", [(10, 0.1, "need at least 50 samples"), (49, 0.1, "need at least 50"),
                                            (120, 0.1, "the run spans 11.9 s; diagnose needs at least 60 s"),
-                                           (200, 0.25, "the run spans 49.8 s")])
+                                           (250, 0.2, "the run spans 49.8 s")])  # 5 Hz: over paper A's 4.4 Hz floor
 def test_too_short_run_is_one_line(tmp_path, nominal, capsys, n, dt, fragment):
     """50-200 samples used to end in an IndexError or a 'medium confidence' verdict from 5 s of data."""
     cols = _si(n=n, dt=dt)

@@ -9,6 +9,8 @@ import numpy as np
 from heavecomp.analysis.frequency import WAVE_BAND
 from heavecomp.analysis.linear import linearise_details
 from heavecomp.analysis.frequency import dc_gain, drift_states, frequency_grid, frozen, modes, response_table
+from heavecomp.effects.registry import resolve
+from heavecomp.effects.spec import check
 
 
 def analyse(params, *, n_points: int = 1000, omega_min: float = 1e-3, omega_max: float | None = None,
@@ -94,4 +96,74 @@ def analyse(params, *, n_points: int = 1000, omega_min: float = 1e-3, omega_max:
                               "damping_ratios": ms["damping_ratios"], "k_eff_dc": -dc_gain(Ls.sys, hold=dv)}
         curves[f"sliding at {sliding_velocity:g} m/s"] = (
             w, -(ts["wob_per_heave_mag"] * np.exp(1j * np.radians(ts["wob_per_heave_phase_deg"]))))
+    summary["effects"] = accounting(params, sliding_velocity, effects)
     return {"summary": summary, "table": table, "curves": curves}
+
+
+#: how to bring seal friction (the law and its effects) into a linear analysis
+FRICTION_HINT = ("--sliding-velocity V (m/s) linearises the friction law and the seal-friction effects about sliding "
+                 "at V (heavecomp.analysis.linear.linearise(params, friction='sliding', velocity=V)); the "
+                 "amplitude-dependent describing function of the law is "
+                 "heavecomp.analysis.describing.describing_response(params, heave_amplitude, omega)")
+
+
+def accounting(params, sliding_velocity: float | None = None, effects=None) -> list[dict]:
+    """What the analysis did with the friction law and each of the file's ``[[effects]]``: ``kept`` (in the
+    frictionless model, k_eff_dc and the modes), ``linearised`` (only in the sliding linearisation) or
+    ``left out`` (with why, and how to include it).  A calibrated file whose changes are all seal friction or
+    readings gives the nominal's frictionless numbers: this says so instead of nothing.
+
+    Parameters
+    ----------
+    params : CMCParams
+        The parameter set.
+    sliding_velocity : float [m/s], optional
+        The sliding linearisation's velocity (None: none was made).
+    effects : sequence, optional
+        As :func:`analyse` (None: the file's ``[[effects]]``).
+
+    Returns
+    -------
+    list of dict
+        ``item`` (``friction law`` or ``effects[i] NAME``), ``role`` and ``why`` per entry.
+    """
+    sliding = sliding_velocity is not None and params.friction.model != "none"
+    rows = []
+    f = params.friction
+    if f.model != "none":
+        law = f"friction law ({f.model}, F_S = {f.static_force / 1e3:.4g} kN, F_C = {f.coulomb_force / 1e3:.4g} kN)"
+        rows.append({"item": law, "role": "linearised" if sliding else "left out",
+                     "why": (f"linearised about sliding at {sliding_velocity:g} m/s (section 'sliding')" if sliding else
+                             "seal friction is no part of the frictionless model: k_eff_dc and the modes do not "
+                             f"depend on it; {FRICTION_HINT}")})
+    fx = check(params) if effects is None else resolve(effects)
+    for i, e in enumerate(fx):
+        item = (f"effects[{i}] {e.name}" if effects is None else e.name) + (
+            f" on {e.channel}" if getattr(e, "channel", None) else "")
+        if e.kind != "plant":
+            role, why = "left out", ("a reading (how the rig's sensors misread a log), not the plant: it changes no "
+                                     "transfer function of the rig")
+        elif e.hook == "seal_friction":
+            role, why = (("linearised", f"seal friction, linearised about sliding at {sliding_velocity:g} m/s")
+                         if sliding else ("left out", f"seal friction, no part of the frictionless model; {FRICTION_HINT}"
+                                          " (the describing function takes the law only)"))
+        else:
+            role, why = "kept", f"at the {e.hook} hook of the linearised model"
+        rows.append({"item": item, "role": role, "why": why})
+    return rows
+
+
+def accounting_line(rows) -> str:
+    """One line of :func:`accounting` for the terminal (empty without friction or effects).
+
+    Parameters
+    ----------
+    rows : list of dict
+        :func:`accounting`'s rows (``analysis.json``'s ``effects``).
+    """
+    if not rows:
+        return ""
+    parts = [f"{r['item']}: {r['role']}" for r in rows]
+    hint = "; to include seal friction: --sliding-velocity V" if any(
+        r["role"] == "left out" and "seal friction" in r["why"] for r in rows) else ""
+    return "kept, linearised or left out: " + "; ".join(parts) + hint

@@ -81,6 +81,11 @@ def run(args) -> int:
 
     modes = "; ".join(f"{n} {w:.3f} rad/s (zeta {z:.4f})"
                       for n, w, f, T, z in mode_rows(s["natural_frequencies"], s["damping_ratios"]))
+    from heavecomp.analysis.summary import accounting_line
+
+    said = accounting_line(s.get("effects"))
+    if said:
+        print(said)
     print(f"k_eff_dc {s['k_eff_dc'] / 1e3:.3f} kN/m (eq. 14: {s['k_eff_eq14'] / 1e3:.3f}), natural frequencies: "
           f"{modes} -> {final(args)}")
     return 0

@@ -60,9 +60,12 @@ def run(args) -> int:
 
         h = default_dt(params)
         check_default_step(params, h, eigen_rate)
+        if getattr(args, "quiet", False) and not args.output:
+            return 0  # a check asked quietly: the exit code is the answer (the TOML is written with -o)
         if not getattr(args, "quiet", False):
             print(f"{args.source}: valid (k_eff = {params.k_eff:.6g} N/m, p_0 = {params.p0:.6g} Pa, "
-                  f"V_0 = {params.gas_volume:.4g} m^3, default step {h:.3g} s)", file=sys.stderr)
+                  f"V_0 = {params.gas_volume:.4g} m^3, default step {h:.3g} s){_effects_line(params)}",
+                  file=sys.stderr)
     else:
         raise ParameterError(f"{args.source}: not a built-in set nor a file{did_you_mean(args.source, SETS)}; "
                              f"built-in sets: {', '.join(SETS)}")
@@ -75,6 +78,19 @@ def run(args) -> int:
     else:
         sys.stdout.write(text)
     return 0
+
+
+def _effects_line(params) -> str:
+    """``; [[effects]]: string_damping (plant), sensor_gain on wob (reading)`` for a file that has effects: what
+    every command then simulates (the plant effects) and how a log is read (the reading effects)."""
+    from heavecomp.effects.spec import check
+
+    fx = check(params)
+    if not fx:
+        return ""
+    words = [f"{e.name}{f' on {e.channel}' if getattr(e, 'channel', None) else ''} "
+             f"({'plant' if e.kind == 'plant' else 'reading'})" for e in fx]
+    return f"; {len(fx)} [[effects]]: {', '.join(words)}"
 
 
 def _heave_path_for(params, output):

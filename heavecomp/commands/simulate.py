@@ -36,6 +36,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--controller-option", action="append", default=[], metavar="KEY=VALUE",
                    help="controller setting (repeatable), e.g. horizon=30, q_wob=1e-6, model_frame=stroke, "
                         "nlp_solver=ipopt; names: heavecomp.controllers.ControllerConfig (docs/control.md)")
+    p.add_argument("--controller-params", default=None, metavar="DESIGN.toml",
+                   help="design the controller on this file (its model and [[effects]]) and run it against the plant "
+                        "of PARAMS.toml (its [[effects]] the true plant and sensors; its [active] the actuator), e.g. "
+                        "the nominal's controller on the calibrated rig (docs/control.md)")
     p.add_argument("--no-noise", action="store_true",
                    help="closed loop: exact measurements (default: Gaussian sensor noise, stroke 1 mm, "
                         "pressure 5 kPa, WOB 0.5 kN, heave 5 mm)")
@@ -80,7 +84,7 @@ def run(args) -> int:
     if args.controller != "passive":
         return _run_closed_loop(args, params, Progress)
     for flag, given in (("--controller-option", args.controller_option), ("--no-noise", args.no_noise),
-                        ("--perfect-preview", args.perfect_preview)):
+                        ("--perfect-preview", args.perfect_preview), ("--controller-params", args.controller_params)):
         if given:
             from heavecomp.errors import InputError
 
@@ -172,12 +176,14 @@ def _run_closed_loop(args, params, Progress) -> int:
 
     output_every(args.rate, active(params).control_rate)  # bad --rate fails before the run
     options = parse_options(args.controller_option)
+    plant_fx, ctrl, design_name = _plant_and_controller(args, params, options)
     bar = Progress(f"simulate {args.duration:g} s, {args.controller}")
-    res = simulate_closed_loop(params, args.controller, args.duration, dt=args.dt, progress=bar,
+    res = simulate_closed_loop(params, ctrl, args.duration, dt=args.dt, progress=bar, effects=plant_fx,
                                noise=None if args.no_noise else Noise(),
-                               preview="perfect" if args.perfect_preview else "predicted", **options)
+                               preview="perfect" if args.perfect_preview else "predicted")
+    design = f", designed on {design_name}" if args.controller_params else ""
     m = write_closed_loop_outputs(res, args.out, title=f"WOB — {Path(args.params).name}, friction: "
-                                  f"{params.friction.model}, controller: {args.controller}", rate=args.rate)
+                                  f"{params.friction.model}, controller: {args.controller}{design}", rate=args.rate)
     from heavecomp.report.provenance import finish
     from heavecomp.commands._output import final
 
@@ -186,6 +192,49 @@ def _run_closed_loop(args, params, Progress) -> int:
           f"|u_active| max {m['u_active_max'] / 1e3:.1f} kN, solve p50/p99 {m['solve_time_ms_p50']:.2f}/"
           f"{m['solve_time_ms_p99']:.2f} ms, fallbacks {m['fallbacks']} -> {final(args)}")
     return 0
+
+
+def _plant_and_controller(args, params, options):
+    """``(the true plant's effects, the controller, the design file's name)`` of a closed-loop run.
+
+    The plant is PARAMS.toml with all its ``[[effects]]`` but the heave's: its plant terms at their hooks and its
+    reading effects on the measurements the controller receives (the rig's sensors misread so).  The controller
+    is designed on ``--controller-params`` (default the same file): its parameters, its plant effects in the
+    model and its reading effects in how it reads them (docs/control.md: a ``sensor_lag`` is read through its
+    factor with a warning, a bare ``sensor_delay`` is refused); the actuator (``[active]``) is the plant's.
+    """
+    import dataclasses
+    import logging
+    from pathlib import Path
+
+    from heavecomp.controllers.registry import make, takes_effects
+    from heavecomp.effects.spec import check, load
+    from heavecomp.errors import ParameterError
+    from heavecomp.params.cmc import active
+
+    log = logging.getLogger("heavecomp")
+    fx = check(params)
+    for i, e in enumerate(fx):
+        if e.kind == "heave":  # the closed loop runs one heave for the plant and the controller's measurement
+            log.warning("%s: effects[%d] %s: the heave the compensator sees is not modelled in the closed loop; the "
+                        "plant runs on the heave as measured", Path(args.params).name, i, e.name)
+    plant_fx = [e for e in fx if e.kind != "heave"]
+    design, design_name = params, Path(args.params).name
+    if args.controller_params:
+        design_name = Path(args.controller_params).name
+        design = load(args.controller_params, heave_file=False)
+        if design.extra.get("active") and active(design) != active(params):
+            log.warning("%s: [active] differs from %s's; the actuator is the plant's", design_name,
+                        Path(args.params).name)
+        design = design.replace(active=dataclasses.asdict(active(params)))
+    model_fx = check(design) if takes_effects(args.controller) else None
+    try:
+        ctrl = make(args.controller, design, effects=model_fx, **options)
+    except ParameterError as exc:
+        if model_fx is None or str(exc).startswith(design_name):
+            raise
+        raise ParameterError(f"{design_name} [[effects]]: {exc}") from None
+    return plant_fx, ctrl, design_name
 
 
 #: bytes per value of timeseries.csv, a low estimate (``%.10g`` and a comma take 8-18)

@@ -80,7 +80,7 @@ def _scales(X):
     """Per-column scale for a standardised least squares: the spread, or for a constant column (an
     intercept, or a decimated column of ones whose spread is rounding) its size -- dividing by a
     ~1e-16 spread would swamp every other coefficient."""
-    s = X.std(axis=0)
+    s = X.std(axis=0) if X.shape[0] else np.zeros(X.shape[1])  # no rows (a calm log never slides): no spread
     size = np.max(np.abs(X), axis=0) if X.shape[0] else np.ones(X.shape[1])
     flat = s <= 1e-9 * np.maximum(size, 1e-300)
     s[flat] = np.where(size[flat] > 0, size[flat], 1.0)

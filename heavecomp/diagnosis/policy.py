@@ -179,6 +179,16 @@ class VerdictPolicy:
     that only fits the noise differently (a few per cent) leaves the verdict's law in the file.  It never
     changes a verdict: it acts after it, on the calibrated file only."""
 
+    min_samples_per_mode: float = 2.5
+    """Least samples per period of the rig's fastest mode (the frictionless two-mass rig of the parameter file,
+    :func:`heavecomp.params.plausibility.natural_frequencies`) a log must have: below, that mode aliases onto
+    the waves and the noise floor (estimated from the sample-to-sample scatter) swallows it, so a log is
+    refused naming its rate (:func:`heavecomp.diagnosis.quality.assess`, diagnose, monitor, fleet).  Nyquist is
+    2; 2.5 leaves room for a logger's anti-alias filter (which passes up to ~0.4 of its rate).  What it
+    guards against: a 1 Hz log of paper A with string damping 2e5 N s/m (modes 0.44 and 1.76 Hz) read ``none``
+    with confidence high and a 38 kN WOB noise floor (true 0.4 kN), while the same run at 5 and 10 Hz reads
+    ``string_damping``, high (reproducers 2026-12, D1): paper A's floor is 4.4 Hz."""
+
     def to_json(self) -> dict:
         """Every field by name (JSON-ready): what the tuning report hashes."""
         return dataclasses.asdict(self)

@@ -51,7 +51,9 @@ import math
 import numpy as np
 
 from heavecomp.errors import DataError
-from heavecomp.params.plausibility import natural_frequencies
+from heavecomp.diagnosis.policy import DEFAULT as POLICY
+from heavecomp.io.series import UNITS
+from heavecomp.params.plausibility import HEAVE_MIN, natural_frequencies
 
 log = logging.getLogger(__name__)
 
@@ -295,10 +297,12 @@ def assess(run, params=None, *, rows=None) -> Quality:
     q = Quality()
     cols = {c: np.array(run[c], dtype=float) for c in CHANNELS if c in run.columns}  # the channels the log has
     t, cols = _torn_and_spikes(q, t, cols, line)
+    _sample_rate(t, params, src)
     T_wave = mean_period(t, cols["heave"])
     _frozen(q, t, cols, T_wave, line, src)
-    _magnitudes(q, cols, params, src)
-    _time_base(q, t, cols.get("wob"), T_wave, params)
+    _magnitudes(q, cols, params, src, wob_from=(getattr(run, "measurement", None) or {}).get("wob_from"))
+    if not _still(q, cols["heave"]):
+        _time_base(q, t, cols.get("wob"), T_wave, params)
     _clock_skew(q, t, cols)
     q.exclude = {c: np.array(sorted(s), dtype=int) for c, s in q.exclude.items() if s}
     return q
@@ -383,7 +387,40 @@ def _frozen(q: Quality, t, cols: dict, T_wave: float, line, src: str) -> None:
                                "excluded, confidence low")
 
 
-def _magnitudes(q: Quality, cols: dict, params, src: str) -> None:
+def _still(q: Quality, z) -> bool:
+    """A heave at its sensor's noise level (no sea): said as such (confidence low), not as a time base at the
+    wrong scale, which its noise's "period" suggested.  The heave's significant height 4 std under
+    ``HEAVE_MIN`` (:mod:`heavecomp.params.plausibility`: what a motion reference unit resolves) is no heave.
+
+    Parameters
+    ----------
+    q : Quality
+        The findings so far, extended in place.
+    z : numpy.ndarray
+        Heave samples [m].
+    """
+    h = 4.0 * float(np.nanstd(z))
+    if h >= HEAVE_MIN:
+        return False
+    _issue(q, "no_heave", "heave", f"no heave motion: its significant height (4 std) is {1e3 * h:.3g} mm, under the "
+                                   f"{100 * HEAVE_MIN:g} cm a motion reference unit resolves (a calm sea): nothing moved "
+                                   "the compensator, the log shows the sensors' noise; confidence low")
+    return True
+
+
+def _hook_load_unit(wm: float, wob_from: dict) -> str:
+    """``; it looks like t`` when the hook load, read in another force unit, would give a WOB near the
+    string weight less the set-point (empty otherwise)."""
+    sw = float(wob_from.get("string_weight_N", math.nan))
+    hl = sw - wm  # the hook load as read [N]
+    for unit in ("kn", "t", "kip", "klbf", "lbf"):
+        kind, factor, _ = UNITS[unit]
+        if kind == "force" and hl > 0 and abs(hl * factor / sw - 1.0) < 0.5:
+            return f"; it looks like {unit if unit != 'kn' else 'kN'}: declare its unit, hook_load={unit if unit != 'kn' else 'kN'}"
+    return ""
+
+
+def _magnitudes(q: Quality, cols: dict, params, src: str, wob_from: dict | None = None) -> None:
     """Channel magnitudes no rig makes (refused), and a WOB mean far from the set-point (confidence low).
 
     Parameters
@@ -421,15 +458,49 @@ def _magnitudes(q: Quality, cols: dict, params, src: str) -> None:
                         f"the suspended weight (M_c + m_b) g = {weight:.4g} N")
     wm = float(np.nanmean(w))
     mbg = ds.lower_mass * G
+    if (wm >= mbg or wm <= 0) and wob_from:  # the WOB is the string weight less the hook load: name those
+        raise DataError(f"{src}: column 'hook_load': the WOB it gives (measurement.string_weight "
+                        f"{wob_from.get('string_weight_N', math.nan):.4g} N - hook_load) has mean {wm:.4g} N, "
+                        + (f"above the lower mass's weight m_b g = {mbg:.4g} N" if wm > 0 else "not positive")
+                        + f" (nominal W_0 = {W0:.4g} N): the hook load in another unit, or measurement.string_weight "
+                        f"wrong{_hook_load_unit(wm, wob_from)}", option="units")
     if wm >= mbg or wm <= 0:
         raise DataError(f"{src}: column 'wob': mean {wm:.4g} N is "
                         + (f"above the lower mass's weight m_b g = {mbg:.4g} N (the drill string would push; "
                            f"nominal W_0 = {W0:.4g} N) — wrong unit or unit declaration (kN as t?)" if wm > 0 else
-                           "not positive (the bit is off bottom; nominal W_0 = {W0:.4g} N)")
+                           f"not positive (the bit is off bottom; nominal W_0 = {W0:.4g} N)")
                         + " or wrong parameter file?")
     if not W0 / WOB_MEAN_FACTOR <= wm <= W0 * WOB_MEAN_FACTOR:
         _issue(q, "wob_setpoint", "wob", f"mean {wm:.4g} N is {wm / W0:.2f} x the set-point W_0 = {W0:.4g} N: "
                                         "another operating point than the parameter file's (or a unit): confidence low")
+
+
+def _sample_rate(t, params, src: str) -> None:
+    """Refuse a log sampled too slowly for the rig's fastest mode (``VerdictPolicy.min_samples_per_mode``
+    samples a period): its mode aliases onto the waves, and the diagnosis and the monitor would read the
+    aliased motion as noise (a 1 Hz log with string damping read ``none``, high).
+
+    Parameters
+    ----------
+    t : numpy.ndarray
+        Times [s].
+    params : CMCParams or None
+        The nominal parameters (the rig's modes); None: no check.
+    src : str
+        The log's name, for the message.
+    """
+    if params is None or t.size < 2:
+        return
+    modes = [float(f) for f in natural_frequencies(params)[0] if f > 0]
+    if not modes:
+        return
+    rate = 1.0 / float(np.median(np.diff(t)))
+    floor = POLICY.min_samples_per_mode * max(modes)
+    if rate < floor:
+        raise DataError(f"{src}: column 't': sampled at {rate:.3g} Hz, below the {floor:.3g} Hz the rig's fastest "
+                        f"mode needs ({max(modes):.3g} Hz from the parameter file, {POLICY.min_samples_per_mode:g} "
+                        "samples a period): that mode aliases onto the waves and would be read as noise; log at "
+                        f"{floor:.3g} Hz or faster")
 
 
 def _time_base(q: Quality, t, w, T_wave: float, params) -> None:

@@ -34,8 +34,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from heavecomp.effects.base import Effect
+from heavecomp.errors import ParameterError
 from heavecomp.params.core import q
-from heavecomp.plants.cmc import CDS, KDS, T0
+from heavecomp.params.plausibility import STROKE_MAX
+from heavecomp.plants.cmc import CDS, KDS, T0, plant_vector
 
 _V = dict(bounds=(-1e12, 1e12))
 
@@ -50,6 +52,52 @@ class _Term(Effect):
     @classmethod
     def null(cls, plant):
         return {f.name: 0.0 for f in cls.fields()}
+
+    #: what the term's value is at its hook: "pressure" [Pa] (times the plunger area, a force) or "force" [N]
+    acts_as = "pressure"
+
+    def _added(self, params, values) -> np.ndarray:
+        """What the term adds at its hook [Pa or N] over the rig's operating envelope (see :meth:`check_size`)."""
+        raise NotImplementedError
+
+    def check_size(self, params, where: str = "effects") -> None:
+        """Refuse a term whose largest force over the rig's operating envelope would move the stroke past the
+        longest stroke built: the term's own bounds (+-1e12) are the open search's, not the rig's, and a
+        ``line_term`` ``const = 1e12`` Pa simulated to a 1.2e10 m stroke with exit 0.
+
+        The term is taken at rest at its own centre: the pressure at p_0, the stroke at ``x_mean``, the stretch at
+        ``rel_median``, the velocity 0 either way: what is left is its constant and its direction-dependent
+        (Coulomb-like) part, a force that shifts the stroke.  A velocity feature is damping (a diagnosis finds
+        ``line_term`` ``v_abs_v`` ~ -3e6 Pa s^2/m^2, a turbulent drop) and a stretch or stroke feature a stiffer
+        spring (``rel_cubed`` ~ 8e9 N/m^3 on a stretch of cm), not a shift: if one is large or active enough to
+        make the stepper run away, its divergence names the effect (:mod:`heavecomp.simulate.core`).
+        The force (a pressure times the plunger area) moves the stroke by F / k_eff on the
+        rig's springs in series (paper A eq. 14); more than ``STROKE_MAX`` is no compensator.  One line naming
+        ``where``.key (the parameter whose term is largest alone) and the numbers.
+
+        Parameters
+        ----------
+        params : CMCParams
+            The plant the term is added to.
+        where : str
+            The entry's place in the file (``effects[0]``).
+        """
+        scale = params.area if self.acts_as == "pressure" else 1.0
+        limit = params.k_eff * STROKE_MAX
+        big = float(np.max(np.abs(self._added(params, self.values)))) * scale
+        if not big > limit:  # NaN-safe: an overflow (inf) is refused too
+            if np.isfinite(big):
+                return
+        null = self.null(None)
+        alone = {k: float(np.max(np.abs(self._added(params, {**null, k: v})))) * scale
+                 for k, v in self.values.items() if v != null.get(k) and k not in LEVELS.values()}
+        key = max(alone, key=lambda k: alone[k]) if alone else next(iter(self.values))
+        unit = next((f.metadata.get("unit", "") for f in self.fields() if f.name == key), "")
+        raise ParameterError(
+            f"{where}.{key} = {self.values[key]:g} {unit}: the {self.name} adds {big:.3g} N at the {self.hook} "
+            f"hook at rest, which would move the stroke {big / params.k_eff:.3g} m on its "
+            f"springs (k_eff {params.k_eff:.4g} N/m), past the longest stroke built ({STROKE_MAX:g} m): no rig has it "
+            "and the simulation runs away")
 
 
 class LineTerm(_Term):
@@ -70,6 +118,10 @@ class LineTerm(_Term):
     @staticmethod
     def line(v, p, x, PP, c0, cv, cvv, ca, cp):
         return p + c0 + cv * v + cvv * v * np.abs(v) + ca * np.abs(v) + cp * p
+
+    def _added(self, params, values):
+        v, p = _envelope(), params.p0
+        return self.line(v, p, None, None, *values.values()) - p
 
 
 
@@ -92,6 +144,10 @@ class GasTerm(_Term):
     @staticmethod
     def gas(s, v, p, x, PP, c0, cx, xm, cv, cvv, ca):
         return p + c0 + cx * (s - xm) + cv * v + cvv * v * np.abs(v) + ca * np.abs(v)
+
+    def _added(self, params, values):
+        v, p = _envelope(), params.p0
+        return self.gas(values["x_mean"], v, p, None, None, *values.values()) - p
 
 
 
@@ -134,6 +190,21 @@ class StringTerm(_Term):
         sv = np.sign(dv)
         return (T + c0 + cv * dv + cvv * dv * np.abs(dv) + ca * np.abs(dv) + cp * np.maximum(sv, 0.0)
                 + cn * np.minimum(sv, 0.0) + cr * e + crr * e * np.abs(e) + crrr * e * e * e)
+
+    acts_as = "force"
+
+    def _added(self, params, values):
+        PP = plant_vector(params)
+        dv = _envelope()
+        T = PP[T0] + PP[CDS] * dv + PP[KDS] * values["rel_median"]  # the stretch at rel_median: e = 0
+        return self.string(dv, T, None, PP, *values.values()) - T
+
+
+def _envelope() -> np.ndarray:
+    """Velocities at rest [m/s]: 0 and a vanishing one either way (a direction-dependent term's sign).  The
+    velocity terms are damping there, not a force (a dissipative one holds the stroke, an active one makes
+    the stepper run away, and its divergence names the effect)."""
+    return np.array([-1e-12, 0.0, 1e-12])
 
 
 

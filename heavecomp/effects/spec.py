@@ -101,7 +101,17 @@ def build(name: str, values: dict, where: str = "effects") -> Effect:
             unit = f.metadata.get("unit", "")
             raise ParameterError(f"{where}.{key}: missing required key of effect {name!r}"
                                  + (f" [{unit}]" if unit and unit != "-" else ""))
-    return cls(channel=channel, **checked) if issubclass(cls, ChannelEffect) else cls(**checked)
+    for key in ("factor", "scale"):  # a reading of zero carries nothing: there is no misreading to undo
+        if checked.get(key) == 0.0 and issubclass(cls, (ChannelEffect, HeaveEffect)):
+            what = ("the compensator would see no heave motion at all" if issubclass(cls, HeaveEffect) else
+                    f"the {channel} channel would read 0 whatever the rig does (a dead sensor is a missing column)")
+            raise ParameterError(f"{where}.{key} = 0: {what}; a reading's {key} is non-zero (1: read right)")
+    try:
+        e = cls(channel=channel, **checked) if issubclass(cls, ChannelEffect) else cls(**checked)
+    except ParameterError as exc:  # the effect's own check across its values: said with the entry's place
+        raise ParameterError(f"{where}: {exc}") from None
+    e.where = where  # the entry's place in the file, for messages that come later (a channel the log lacks)
+    return e
 
 
 def check(params) -> list:
@@ -112,7 +122,19 @@ def check(params) -> list:
     params : CMCParams
         Parameters whose ``effects`` (the file's ``[[effects]]`` specs) are read.
     """
-    return [build(name, values, f"effects[{i}]") for i, (name, values) in enumerate(getattr(params, "effects", ()))]
+    out, seen = [], {}
+    for i, (name, values) in enumerate(getattr(params, "effects", ())):
+        e = build(name, values, f"effects[{i}]")
+        key = (name, getattr(e, "channel", None))
+        if key in seen:  # applied twice, a WOB gain of 1.08 read as 1.1664: one entry per effect (and channel)
+            on = f" on {key[1]!r}" if key[1] else ""
+            raise ParameterError(f"effects[{i}]: duplicates effects[{seen[key]}] ({name}{on}); one entry per effect"
+                                 f"{' and channel' if key[1] else ''}: write the combined value in one entry")
+        seen[key] = i
+        if hasattr(e, "check_size"):  # a term bounded by the open search's range, not the rig's
+            e.check_size(params, f"effects[{i}]")
+        out.append(e)
+    return out
 
 
 def load(path, *, heave_file=True):
@@ -201,7 +223,8 @@ def correct(effects, t, columns: dict) -> tuple[dict, list]:
     for e in effects:
         if isinstance(e, ChannelEffect):
             if e.channel not in cols:
-                raise ParameterError(f"effect {e.name}: channel {e.channel!r} is not in the log")
+                raise ParameterError(f"{getattr(e, 'where', 'effects')} ({e.name}): channel {e.channel!r} is not in "
+                                     "the log: remove the entry, or map the log's column to it")
             cols[e.channel] = e.undo_reading(t, np.asarray(cols[e.channel], dtype=float), cols)
             notes.append(f"{e.channel} corrected for {e!r}")
         elif isinstance(e, HeaveEffect):

@@ -1015,6 +1015,7 @@ def _converted(header, chunks, scalars, info, src, required, optional, columns, 
         for w in warnings:
             log.warning("%s: %s", src, w)
     origin = None  # the first timestamp [ns]
+    t_origin = None  # a clock's first reading in the time column's own unit (epoch ms), 0 for elapsed time
     dropped: set = set()
     first = True
     for cols, lines in chunks:
@@ -1049,6 +1050,17 @@ def _converted(header, chunks, scalars, info, src, required, optional, columns, 
                     conversions[:] = [c for c in conversions if not c.startswith("t: ")]
                     conversions.insert(0, f"t: {kind}")
                     used_units["t"] = "timestamp"
+            elif name == "t" and name in scale:
+                # a clock (epoch ms, 1.7e12) scaled to s before its origin is taken off keeps ~2e-7 s of rounding
+                # in every interval (a false "non-uniform sampling" of a 25 Hz log): the origin comes off first,
+                # in the column's own unit, where integer milliseconds are exact
+                factor = scale[name][0]
+                if t_origin is None and arr.size:
+                    t_origin = float(arr[0]) if abs(float(arr[0]) * factor) > MAX_SPAN_S else 0.0
+                    if t_origin and first:
+                        conversions.append(f"t: a clock ({t_origin:.13g} {used_units.get('t')} at the first sample) "
+                                           "-> s from the first sample")
+                arr = (arr - (t_origin or 0.0)) * factor
             elif name in scale:
                 factor, offset = scale[name]
                 arr = arr * factor + offset

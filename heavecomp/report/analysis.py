@@ -306,6 +306,9 @@ def report_markdown(s: dict, source: str = "") -> str:
         "![Bode plot](bode.png)",
         "",
     ]
+    if s.get("effects"):
+        lines += ["What the linear model holds of the file (friction law and `[[effects]]`):", "",
+                  *[f"- {r['item']}: **{r['role']}** ({r['why']})" for r in s["effects"]], ""]
     for key, label in (("viscous", "viscous friction only"), ("sliding", "sliding linearisation")):
         if key in s:
             v = s[key]

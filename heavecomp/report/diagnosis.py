@@ -253,9 +253,14 @@ def _initial_state_lines(diag) -> list:
     st = getattr(diag, "initial_", None)
     if st is None:
         return []
-    return [f"\nReplay started from the state estimated from the first {st.window:g} s: stroke {st.stroke:+.4f} m, "
-            f"stroke velocity {st.stroke_velocity:+.4f} m/s ({'stuck' if st.stuck else 'sliding'}), lower mass "
-            f"{1e3 * st.lower_displacement:+.2f} mm, WOB {st.wob / 1e3:.1f} kN, heave reference "
+    assumed = set(getattr(st, "assumed", ()) or ())
+    # a channel the log lacks is assumed at its operating-point value, never reported as if measured
+    stroke = ("stroke 0 m and at rest (assumed: no stroke channel)" if "stroke" in assumed else
+              f"stroke {st.stroke:+.4f} m, stroke velocity {st.stroke_velocity:+.4f} m/s "
+              f"({'stuck' if st.stuck else 'sliding'})")
+    wob = "WOB W_0 (assumed: no WOB channel)" if "wob" in assumed else f"WOB {st.wob / 1e3:.1f} kN"
+    return [f"\nReplay started from the state estimated from the first {st.window:g} s: {stroke}, lower mass "
+            f"{1e3 * st.lower_displacement:+.2f} mm, {wob}, heave reference "
             f"{st.heave_reference:+.4f} m ({'at rest at the operating point' if st.at_rest else 'not at rest'})."]
 
 

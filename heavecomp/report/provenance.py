@@ -53,6 +53,7 @@ UNITS: dict[str, str] = {
     "amplitude": "m", "period": "s", "ramp": "s", "hs": "m", "tp": "s", "gamma": "-", "seed": "-",
     "u_active_max": "N", "u_active_rms": "N", "fallbacks": "count", "violations_u_max": "count",
     "violations_rate": "count", "control_rate": "Hz", "solver_failures": "count", "wob_std_passive": "N",
+    "sample_time_missed": "-", "solve_time_share_over_interval": "-",
     # analyse
     "k_eff_dc": "N/m", "dc_gain_heave_to_wob": "N/m", "natural_frequencies": "rad/s", "natural_periods": "s",
     "damping_ratios": "-", "damped_natural_frequencies": "rad/s", "poles": "rad/s", "wave_band_rad_s": "rad/s",

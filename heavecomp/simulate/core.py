@@ -342,6 +342,11 @@ def run_kernel(plant, hs, h, n_steps, out_every, *, u_active=0.0, progress=None,
                                   f"({hs.info.get('source', hs.info.get('kind', 'heave'))}) accelerates at "
                                   f"{spike[0]:.3g} m/s^2 at t = {spike[1]:g} s, beyond the {HEAVE_ACCEL_MAX:g} m/s^2 "
                                   f"a rig floor can reach: check the heave input for a spike or a gap there")
+        if effects:  # the terms the file adds are the likeliest cause: name them, not only the step
+            names = ", ".join(dict.fromkeys(getattr(e, "name", str(e)) for e in effects))
+            raise SimulationError(f"the stepper diverged near t = {t_div:g} s (non-finite state) with the effects "
+                                  f"{names} at the plant's hooks: check their sizes ([[effects]]), or reduce the step "
+                                  f"dt (now {h:g} s)", option="dt")
         raise SimulationError(f"the stepper diverged near t = {t_div:g} s (non-finite state); "
                               f"reduce the step dt (now {h:g} s) or check the parameters", option="dt")
     spike = heave_accel_outlier(hs, data[-1, 0] if len(data) else 0.0)
