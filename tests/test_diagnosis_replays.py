@@ -68,3 +68,24 @@ def test_the_refit_releases_only_what_the_equation_error_leaves_room_for(diagnos
     for k in left:
         table, key = k.split(".")
         assert row["parameters"][k] == getattr(getattr(nominal, table), key)
+
+
+@pytest.mark.slow
+def test_draws_only_in_contention_give_the_ranking_all_draws_give(diagnosed, monkeypatch):
+    """The heave-noise draws spent only on the candidates in contention (here the best, the runner-up and
+    one joint partner): their scores and order, and the verdict, are those of the same diagnosis with
+    every candidate drawn for."""
+    tr, d0 = diagnosed
+    run = tr.to_run()
+    d = GapDiagnoser(d0.nominal, candidates=d0.candidates, n_jobs=2, second=1).fit(run)
+    drawn = {r["effect"] for r in d.candidates_ if r.get("explained_perturbed_heave") is not None}
+
+    def every(self, ctx, names, results):
+        return {n: [ctx.simulate([(n, results[n][0].values)], hs=hs) for hs in ctx.hs_pert] for n in names}
+
+    monkeypatch.setattr(GapDiagnoser, "_contention", every)
+    full = GapDiagnoser(d.nominal, candidates=d.candidates, n_jobs=2, second=1).fit(run)
+    assert drawn < {f.effect for f in full.fits_}  # some were left out ...
+    read = 2 + d.second
+    assert [(f.effect, f.score) for f in d.fits_[:read]] == [(f.effect, f.score) for f in full.fits_[:read]]
+    assert d.verdict_ == full.verdict_  # ... and the verdict is the same, to the last digit
