@@ -193,7 +193,9 @@ class Replay:
                 done.add(c)
         res["t"] = t
         res["_grid"] = out
-        if whole is not None and n == self.n_steps:
+        if whole is not None and n == self.n_steps and len(config) <= 1:
+            # the nominal and single candidates: their whole replays are kept anyway (ReplayContext,
+            # CandidateFit.pred), so the memo adds no memory (a joint configuration is not kept)
             self.whole[whole] = res
         return res
 
