@@ -4,7 +4,8 @@
    library's effect composition, the campaign's parallel batch) are compiled into
    ``heavecomp/_numba_cache`` beside the sources (:mod:`heavecomp.simulate.cache`), so the first
    ``heavecomp diagnose`` / ``simulate`` / ``campaign`` after ``pip install -e .`` loads machine
-   code instead of compiling it (about 2 minutes of CPU here, once).  Done for an editable
+   code instead of compiling it (about 2 minutes of CPU here, once).  Each is compiled in a process
+   of its own, on every core, while step 2 runs (issue 32); one line says what and how long.  Done for an editable
    install (or ``build_ext --inplace``), where the runtime imports these very sources; a wheel
    copied elsewhere compiles on first use, with a notice.  HEAVECOMP_NO_WARM=1 skips it.
 2. The optional ahead-of-time build of the nominal stepper (numba.pycc; heavecomp/simulate/_aot.py).
@@ -25,10 +26,13 @@ from setuptools.command.build_ext import build_ext
 
 HERE = Path(__file__).resolve().parent
 
-WARM = ("from heavecomp.simulate import stepper; from heavecomp.campaign import batch; "
-        "import logging; logging.basicConfig(level=logging.WARNING, format='%(message)s'); "
-        "names = stepper.compile_all(progress=lambda n: print('heavecomp: compiling the ' + n, flush=True)); "
-        "batch.compile_batch(); print('heavecomp: compiled ' + ', '.join(names) + ', campaign batch')")
+#: the install-time compiles, each in a process of its own (each fills its own cache folder), the longest
+#: first: {name: python source}; stepper.install_steps() names the steppers'
+_LOG = "import logging; logging.basicConfig(level=logging.WARNING, format='%(message)s'); "
+WARM = {"library effects stepper": _LOG + "from heavecomp.simulate import stepper; "
+                                          "stepper.install_steps()['library effects stepper']()",
+        "nominal stepper": _LOG + "from heavecomp.simulate import stepper; stepper.install_steps()['nominal stepper']()",
+        "campaign batch": _LOG + "from heavecomp.campaign import batch; batch.compile_batch()"}
 
 
 class AOTExtension(Extension):
@@ -40,14 +44,19 @@ class AOTExtension(Extension):
 
 class OptionalBuildExt(build_ext):
     def run(self):
-        super().run()
+        warm = None
         if os.environ.get("HEAVECOMP_NO_WARM"):
-            return
-        if not (getattr(self, "editable_mode", False) or self.inplace):
+            pass
+        elif not (getattr(self, "editable_mode", False) or self.inplace):
             print("heavecomp: numba's cache is warmed for editable installs only; "
                   "the first run compiles the stepper (with a notice)", file=sys.stderr)
-            return
-        warm_cache()
+        else:
+            warm = Warming()  # in the background, on every core, while the ahead-of-time build runs here
+        try:
+            super().run()
+        finally:
+            if warm is not None:
+                warm.wait()
 
     def build_extension(self, ext):
         if not isinstance(ext, AOTExtension):
@@ -69,23 +78,63 @@ class OptionalBuildExt(build_ext):
                   "the JIT will be used", file=sys.stderr)
 
 
-def warm_cache():
-    """Compile the JIT steppers into the cache beside the sources (a fresh process: numba's cache
-    folder is set when heavecomp's kernels are imported)."""
-    env = dict(os.environ)
-    env["PYTHONPATH"] = os.pathsep.join([str(HERE)] + [p for p in env.get("PYTHONPATH", "").split(os.pathsep) if p])
-    import resource
+class Warming:
+    """Compile the JIT steppers into the cache beside the sources: each step of :data:`WARM` in a fresh
+    process of its own (numba's cache folder is set when heavecomp's kernels are imported), as many at
+    once as the machine has cores, in the background (a thread starts the next as one ends); :meth:`wait`
+    reports the time the compiles took."""
 
-    t0, r0 = time.perf_counter(), resource.getrusage(resource.RUSAGE_CHILDREN)
-    try:
-        subprocess.run([sys.executable, "-c", WARM], cwd=str(HERE), env=env, check=True)
-        r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
-        cpu = r1.ru_utime - r0.ru_utime + r1.ru_stime - r0.ru_stime
-        print(f"heavecomp: numba's cache warmed in {time.perf_counter() - t0:.0f} s ({cpu:.0f} s of CPU)",
-              file=sys.stderr)
-    except Exception as exc:  # noqa: BLE001 - the first run compiles instead
-        print(f"heavecomp: numba's cache not warmed ({type(exc).__name__}: {exc}); "
-              "the first run compiles the stepper", file=sys.stderr)
+    def __init__(self):
+        import resource
+        import threading
+
+        self.env = dict(os.environ)
+        self.env["PYTHONPATH"] = os.pathsep.join([str(HERE)] + [p for p in self.env.get("PYTHONPATH", "").split(os.pathsep)
+                                                                 if p])
+        self.cores = max(1, min(len(WARM), os.cpu_count() or 1))
+        self.failed = []
+        self.t0, self.r0 = time.perf_counter(), resource.getrusage(resource.RUSAGE_CHILDREN)
+        self.t1 = self.t0
+        print(f"heavecomp: compiling the steppers ({', '.join(WARM)}) into numba's cache, {self.cores} at a time, "
+              "once: about 2 minutes of CPU (1-2 min on 2 cores)", file=sys.stderr, flush=True)
+        self.thread = threading.Thread(target=self._run, daemon=True)
+        self.thread.start()
+
+    def _run(self):
+        todo, running = list(WARM), []
+        while todo or running:
+            while todo and len(running) < self.cores:
+                name = todo.pop(0)
+                try:
+                    running.append((name, subprocess.Popen([sys.executable, "-c", WARM[name]], cwd=str(HERE),
+                                                           env=self.env)))
+                except OSError as exc:  # the first run compiles instead
+                    self.failed.append(f"{name} ({exc})")
+            done = [(n, p) for n, p in running if p.poll() is not None]
+            if not done:
+                time.sleep(0.2)
+            for name, proc in done:
+                running.remove((name, proc))
+                if proc.returncode != 0:
+                    self.failed.append(f"{name} (exit {proc.returncode})")
+        self.t1 = time.perf_counter()
+
+    def wait(self):
+        import resource
+
+        self.thread.join()
+        r = resource.getrusage(resource.RUSAGE_CHILDREN)
+        cpu = r.ru_utime - self.r0.ru_utime + r.ru_stime - self.r0.ru_stime
+        if self.failed:
+            print(f"heavecomp: numba's cache not warmed for {', '.join(self.failed)}; the first run compiles it "
+                  "(with a notice)", file=sys.stderr)
+        print(f"heavecomp: numba's cache warmed in {self.t1 - self.t0:.0f} s ({cpu:.0f} s of CPU) on {self.cores} "
+              f"cores; with the ahead-of-time build beside it, {time.perf_counter() - self.t0:.0f} s", file=sys.stderr)
+
+
+def warm_cache():
+    """Compile the JIT steppers into the cache beside the sources (:class:`Warming`) and wait."""
+    Warming().wait()
 
 
 setup(ext_modules=[AOTExtension()], cmdclass={"build_ext": OptionalBuildExt})

@@ -307,9 +307,9 @@ class GapDiagnoser(GapEstimator):
         results = {}
 
         def fit_and_replay(name):
-            # the fit, then its held-out replays (plain and heave-perturbed) in the same worker
+            # the fit, then its held-out replay in the same worker (the heave-noise draws: contention())
             fitted = self._fit_one(ctx, name)
-            return (fitted,) + ctx.held_out([(name, fitted.values)])
+            return fitted, ctx.simulate([(name, fitted.values)])
 
         def finish(name, got):
             results[name] = got
@@ -325,8 +325,57 @@ class GapDiagnoser(GapEstimator):
         else:
             for n in names:
                 finish(n, fit_and_replay(n))
-        fits = [F.score(ctx, n, *results[n]) for n in names]
+        pert = self._contention(ctx, names, results)
+        fits = [F.score(ctx, n, *results[n], pert.get(n)) for n in names]
         return sorted(fits, key=lambda r: -r.score)
+
+    def _contention(self, ctx, names, results) -> dict:
+        """The heave-noise draws' replays of the candidates still in contention: {name: replays}.
+
+        A candidate's score is the smaller of its replay's explained share and the draws' median, less its
+        penalty, so its replay alone bounds it from above (:func:`~heavecomp.diagnosis.fitting.upper_score`).
+        The verdict reads the best, the runner-up, the ``second`` best-ranked joint partners (no two
+        output candidates) and the best of each component holding ``second_share`` of the equation-error
+        gap (:func:`heavecomp.diagnosis.joint.partners`).  Candidates are drawn for in the order of their
+        bound until every one not drawn for has a bound below the score of each candidate those reads
+        would take: the rest cannot be among them, so the ranking the verdict reads is the one all draws
+        would give.  Those not drawn for are scored on their replay (``explained_perturbed`` None)."""
+        P = self.verdict_policy()
+        upper = {n: F.upper_score(ctx, n, *results[n]) for n in names}
+        order = sorted(names, key=lambda n: -upper[n])
+        final, pert = {}, {}
+        shares = self.where_["components"]
+        comps = {c for c, x in shares.items() if x >= P.second_share}
+
+        def comp(n):
+            return S.candidate_component(n, results[n][0].values, self.prescreen_)
+
+        def settled(nxt) -> bool:
+            ranked = sorted(final, key=lambda n: -final[n])  # stable: the order drawn at ties
+            if not ranked:
+                return False
+            best_output = get(ranked[0]).kind == "output"
+            allowed = [n for n in ranked[1:] if not (best_output and get(n).kind == "output")]
+            read = ranked[:2] + allowed[:self.second]
+            if len(ranked) < 2 or len(allowed) < self.second:
+                return False
+            if min(final[n] for n in read) <= upper[nxt]:
+                return False
+            # the best of each component with a share of the gap: settled within that component
+            c = comp(nxt)
+            if c in comps:
+                own = [final[n] for n in final if comp(n) == c]
+                if not own or max(own) <= upper[nxt]:
+                    return False
+            return True
+
+        for i, n in enumerate(order):
+            if all(settled(m) for m in order[i:]):
+                break
+            cfg = [(n, results[n][0].values)]
+            pert[n] = ctx.map(lambda hs, cfg=cfg: ctx.simulate(cfg, hs=hs), ctx.hs_pert)
+            final[n] = F.score(ctx, n, *results[n], pert[n]).score
+        return pert
 
     def _fit_one(self, ctx, name, start=None, fixed=()) -> F.Fit:
         """One candidate's fit, from its equation-error start where it has one."""
@@ -334,7 +383,8 @@ class GapDiagnoser(GapEstimator):
         hint = None
         if cls.kind != "output" and start is None:
             hint = S.equation_error_start(self.components_, self.prescreen_.get(name), cls)
-        return F.fit(ctx, name, start, fixed, search=self._search(), hint=hint)
+        room = (self.prescreen_.get(name) or {}).get("room") if cls.kind == "nominal" and start is None else None
+        return F.fit(ctx, name, start, fixed, search=self._search(), hint=hint, room=room)
 
     def _decide(self, ctx, fits, P) -> dict:
         """The verdict (:func:`heavecomp.diagnosis.verdict.decide`), after the evidence it reads: the

@@ -31,7 +31,7 @@ import numpy as np
 
 from heavecomp.diagnosis import equation_error as EE
 from heavecomp.diagnosis.policy import VerdictPolicy
-from heavecomp.diagnosis.replay import CH
+from heavecomp.diagnosis.replay import CH, sorted_config
 from heavecomp.diagnosis.stepper import CHANNELS as SC
 from heavecomp.effects.candidates import MISMATCH_KEYS, ParameterMismatch, get
 
@@ -201,24 +201,48 @@ def score(ctx, name, fitted: Fit, pred, pred_pert) -> CandidateFit:
         The candidate's fit on the fit part.
     pred : dict
         Its whole replay ({channel: array} [SI], :meth:`ReplayContext.simulate`).
-    pred_pert : list of dict
-        Its replays on the heave-noise draws (:attr:`ReplayContext.hs_pert`).
+    pred_pert : list of dict or None
+        Its replays on the heave-noise draws (:attr:`ReplayContext.hs_pert`); None: not drawn (the
+        explained share is the replay's, ``explained_perturbed`` None).
     """
     P = ctx.policy
     mse_a = ctx.mse(pred, ctx.valmask)
     expl_plain = ctx.explained(ctx.mse_before, mse_a)
     # robustness: the same comparison with the heave-perturbed replay; a gain that comes
-    # from lucky stick-event timing does not survive it, a real effect does
-    expl_pert = ctx.explained_perturbed(pred_pert)
-    expl = min(expl_plain, expl_pert)
+    # from lucky stick-event timing does not survive it, a real effect does.  None: not drawn (out of
+    # contention, its replay's own score below every candidate the verdict reads: the draws only lower it)
+    expl_pert = None if pred_pert is None else ctx.explained_perturbed(pred_pert)
+    expl = expl_plain if expl_pert is None else min(expl_plain, expl_pert)
     if not math.isfinite(expl):  # the fitted model diverged on held-out data
         log.warning("diagnose: %s diverged on the held-out data", name)
         expl = P.diverged_explained
     k = n_params(ctx, name, fitted)  # optional parameters held at null are not counted
     return CandidateFit(name, public(ctx.replay.nominal, name, fitted.values), fitted.sigma,
-                        channel_scores(ctx.mse_before, mse_a), float(expl), float(expl_plain), float(expl_pert), k,
+                        channel_scores(ctx.mse_before, mse_a), float(expl), float(expl_plain),
+                        None if expl_pert is None else float(expl_pert), k,
                         float(expl - P.penalty * k), fitted.wall_time, fitted.values, pred,
                         tuple(at_bounds(name, fitted.values, tol=P.bound_tol, params=ctx.replay.nominal)))
+
+
+def upper_score(ctx, name, fitted: Fit, pred) -> float:
+    """The highest score candidate ``name`` can reach (:func:`score`) from its replay ``pred`` alone: its
+    explained share on the replay less the parsimony penalty (the heave-noise draws can only lower it).
+
+    Parameters
+    ----------
+    ctx : heavecomp.diagnosis.replay.ReplayContext
+        The prepared run.
+    name : str
+        Candidate effect name.
+    fitted : Fit
+        The candidate's fit.
+    pred : dict
+        Its whole replay.
+    """
+    e = ctx.explained(ctx.mse_before, ctx.mse(pred, ctx.valmask))
+    if not math.isfinite(e):
+        e = ctx.policy.diverged_explained
+    return float(e - ctx.policy.penalty * n_params(ctx, name, fitted))
 
 
 def candidate_class(ctx, name) -> type:
@@ -277,7 +301,7 @@ def fit_cost(ctx, name) -> float:
     return per_replay * (40.0 if cls.n_params() <= 2 else 100.0)
 
 
-def fit(ctx, name, start=None, fixed=(), *, search=Search(), hint=None) -> Fit:
+def fit(ctx, name, start=None, fixed=(), *, search=Search(), hint=None, room=None) -> Fit:
     """Fit candidate ``name`` (optionally jointly after the ``fixed`` configurations) on the fit part,
     from ``start`` (parameter values; None: the default start, the coarse grid and the equation-error
     start ``hint``, a fit vector) with the strategy its kind asks for.
@@ -296,10 +320,13 @@ def fit(ctx, name, start=None, fixed=(), *, search=Search(), hint=None) -> Fit:
         Search effort (evaluations, grid and scan points, threads).
     hint : numpy.ndarray, optional
         Equation-error start as a fit vector (``cls.to_x``); None: none.
+    room : sequence of int, optional
+        A nominal candidate's parameters the equation error leaves room for (the stepwise refit releases
+        only those, :func:`heavecomp.diagnosis.screen.mismatch_room`); None: every one.
     """
     cls = candidate_class(ctx, name)
     t0 = time.perf_counter()
-    out = _fit_once(ctx, cls, start, fixed, search, hint)
+    out = _fit_once(ctx, cls, start, fixed, search, hint, room=room)
     if cls.kind in READING_KINDS:
         for _ in range(ctx.policy.reading_reweight):
             out = _fit_once(reweighted(ctx, list(fixed) + [(cls.name, out.values)]), cls, out.values, fixed, search,
@@ -311,14 +338,14 @@ def fit(ctx, name, start=None, fixed=(), *, search=Search(), hint=None) -> Fit:
 READING_KINDS = ("output", "heave")
 
 
-def _fit_once(ctx, cls, start, fixed, search, hint, channel=None) -> Fit:
+def _fit_once(ctx, cls, start, fixed, search, hint, channel=None, room=None) -> Fit:
     """One fit of ``cls`` with the strategy its kind asks for (``channel``: an output effect's channel
     held, else every channel tried)."""
     if cls.kind == "output" and cls.fit.linear:
         return fit_linear_output(ctx, cls, fixed, channel)
     if cls.kind == "output":
         return fit_delay_output(ctx, cls, fixed, channel)
-    return fit_replayed(ctx, cls, start, fixed, search=search, hint=hint)
+    return fit_replayed(ctx, cls, start, fixed, search=search, hint=hint, room=room)
 
 
 def reweighted(ctx, config):
@@ -347,7 +374,7 @@ def reweighted(ctx, config):
 
 
 # ------------------------------------------------------------------ through the replay
-def fit_replayed(ctx, cls, start=None, fixed=(), *, search=Search(), hint=None) -> Fit:
+def fit_replayed(ctx, cls, start=None, fixed=(), *, search=Search(), hint=None, room=None) -> Fit:
     """A plant or nominal candidate fitted through the replay (see the module docstring).
 
     Parameters
@@ -364,6 +391,8 @@ def fit_replayed(ctx, cls, start=None, fixed=(), *, search=Search(), hint=None) 
         Search effort (evaluations, grid and scan points, threads).
     hint : numpy.ndarray, optional
         Equation-error start as a fit vector (``cls.to_x``); None: none.
+    room : sequence of int, optional
+        A nominal candidate's parameters its stepwise refit may release (:func:`stepwise`'s ``eligible``).
     """
     P = ctx.policy
     t_end = ctx.split["fit"][1]
@@ -373,9 +402,10 @@ def fit_replayed(ctx, cls, start=None, fixed=(), *, search=Search(), hint=None) 
     seen = {}  # residual by (span, parameter vector): e.g. Nelder-Mead's optimum is evaluated again for its Jacobian
 
     def fun(x, t_stop=t_end):
-        key = (t_stop, np.asarray(x, dtype=float).tobytes())
+        config = list(fixed) + [(cls.name, cls.from_x(x))]
+        key = (t_stop, sorted_config(config))  # the replay's input: two vectors may give the same parameters
         if key not in seen:
-            seen[key] = ctx.resid_vec(ctx.simulate(list(fixed) + [(cls.name, cls.from_x(x))], t_stop))
+            seen[key] = ctx.resid_vec(ctx.simulate(config, t_stop))
         return seen[key].copy()
 
     # a joint fit starts from the candidate's own fit, next to its optimum: a share of the budget
@@ -384,7 +414,7 @@ def fit_replayed(ctx, cls, start=None, fixed=(), *, search=Search(), hint=None) 
     if cls.kind == "nominal":  # a nominal refit releases only the parameters the fit part asks for
         release = None if start is None else np.flatnonzero(x0 != cls.x0())
         r = stepwise(fun, x0 if start else cls.x0(), lo, hi, budget, t_grid, P.refit_release, search, release,
-                     noise_cost(ctx), P.refit_f)
+                     noise_cost(ctx), P.refit_f, room)
         return Fit(cls.from_x(r.x), sigma(cls, r), int(r.nfev), float(2 * r.cost))
     later = np.array([f.name in cls.fit.released_last for f in cls.fields()])
     if start is None and later.any():
@@ -481,7 +511,7 @@ def noise_cost(ctx) -> float:
 
 
 def stepwise(fun, x0, lo, hi, budget, t_grid, release_share, search=Search(), release=None, floor=0.0,
-             f_crit=0.0):
+             f_crit=0.0, eligible=None):
     """Forward stepwise refit of a nominal parameter set (``parameter_mismatch``): from the nominal
     ``x0``, the parameters are released one at a time.  The first step scans each parameter alone
     (the others held; ``search.grid`` points over 10-90 % of its range, the cost on the first
@@ -552,6 +582,9 @@ def stepwise(fun, x0, lo, hi, budget, t_grid, release_share, search=Search(), re
         share is taken of never drops under it.
     f_crit : float [-]
         Critical value of the partial F-test (``VerdictPolicy.refit_f``); 0: the share alone.
+    eligible : sequence of int, optional
+        The parameters the search may release (the others stay at ``x0``: the equation error leaves no
+        room for them, :func:`heavecomp.diagnosis.screen.mismatch_room`); None: every one.
     """
     S = _Stepwise(fun, np.asarray(x0, dtype=float).copy(), lo, hi, budget, search.n_jobs, release_share, floor,
                   f_crit)
@@ -562,11 +595,13 @@ def stepwise(fun, x0, lo, hi, budget, t_grid, release_share, search=Search(), re
         best.nfev = S.nfev
         return best
     active: list = []
+    pool = list(range(x.size)) if eligible is None else [int(j) for j in eligible]
+    S.pool = pool
     floating = 0  # swaps left to try after the last release (the floating step)
     for _ in range(4 * x.size):  # releases, drops and swaps (each drop or swap lowers a count or the cost)
-        if len(active) == x.size or not floating and S.noise_left(best):
+        if len(active) == len(pool) or not floating and S.noise_left(best):
             break
-        rest = [j for j in range(x.size) if j not in active]
+        rest = [j for j in pool if j not in active]
         J = S.jacobian(best, rest) if active else None  # one Jacobian at the current best, for the predictions
         if floating and len(active) > 1:
             floating -= 1
@@ -594,7 +629,7 @@ def stepwise(fun, x0, lo, hi, budget, t_grid, release_share, search=Search(), re
             break
         active.append(j)
         best = got
-        floating = x.size if len(active) > 1 else 0
+        floating = len(pool) if len(active) > 1 else 0
     best.nfev = S.nfev
     return best
 
@@ -608,6 +643,7 @@ class _Stepwise:
         self.fun, self.x0, self.lo, self.hi, self.budget, self.n_jobs = fun, x0, lo, hi, budget, n_jobs
         self.release_share, self.floor, self.f_crit = release_share, floor, f_crit
         self.nfev = 0
+        self.pool = list(range(x0.size))  # the parameters the search may release
 
     def cost(self, x) -> float:
         """Fit cost (sum of squares) at ``x``."""
@@ -665,8 +701,8 @@ class _Stepwise:
     def scanned_picks(self, t_grid, n):
         """The first release's two picks: the best single-parameter scans (:func:`_best_scans`; from the
         nominal the linearised fit is poorest, e.g. a stiffness 40 % off)."""
-        self.nfev += self.x0.size * n
-        return _best_scans(self.fun, self.x0, self.lo, self.hi, t_grid, n)[:2]
+        self.nfev += len(self.pool) * n
+        return _best_scans(self.fun, self.x0, self.lo, self.hi, t_grid, n, self.pool)[:2]
 
     def probed_picks(self, best, active, rest, J):
         """A later release's two picks: each parameter of ``rest`` at the point the linearised JOINT
@@ -715,12 +751,12 @@ class _Stepwise:
         return (act, got) if got.cost < best.cost else None
 
 
-def _best_scans(fun, x, lo, hi, t_grid, n):
-    """Each parameter of ``x`` scanned alone (``n`` points over 10-90 % of its range, the others
-    held, the cost on the first ``t_grid`` s), lowest cost first: (its index, ``x`` with it at its
-    best point)."""
+def _best_scans(fun, x, lo, hi, t_grid, n, pool=None):
+    """Each parameter of ``x`` (of ``pool``; None: all) scanned alone (``n`` points over 10-90 % of its
+    range, the others held, the cost on the first ``t_grid`` s), lowest cost first: (its index, ``x``
+    with it at its best point)."""
     out = []
-    for j in range(x.size):
+    for j in (range(x.size) if pool is None else pool):
         for v in _grid_axis(lo[j], hi[j], n):
             xx = x.copy()
             xx[j] = v
@@ -797,15 +833,17 @@ def _scan_refine(obj, xs, **options):
 
 
 def _start(cls, fun, x0, lo, hi, t_grid, grid, hint):
-    """The start of a fit: the equation-error start ``hint`` when it costs less on the first
-    ``t_grid`` s than the default; with <= 2 parameters the best point of a coarse grid (stick-slip
-    makes the cost rough) when it costs less still (the grid only picks the start)."""
+    """The start of a fit: the equation-error start ``hint`` (a linear least-squares fit of the component
+    residual, blind to stick timing) when it costs less on the first ``t_grid`` s than the default, and
+    then no grid (issue 32: start where the equations point); else, with <= 2 parameters, the best point
+    of a coarse grid (stick-slip makes the cost rough) when it costs less still (the grid only picks the
+    start)."""
     if hint is not None:
-        # the component residual's fit (blind to stick timing) as a start, where it fixes every
-        # parameter and its cost on the grid span is lower
+        # the component residual's fit as a start, where it fixes every parameter and its cost on the
+        # grid span is lower
         x_ee = np.clip(hint, lo + 1e-9, hi - 1e-9)
         if float(np.sum(fun(x_ee, t_grid) ** 2)) < float(np.sum(fun(x0, t_grid) ** 2)):
-            x0 = x_ee
+            return x_ee
     k = x0.size
     if k <= 2:
         axes = [_grid_axis(lo[i], hi[i], grid if k == 1 else max(3, (grid + 3) // 2)) for i in range(k)]

@@ -14,7 +14,9 @@ from __future__ import annotations
 
 import concurrent.futures as cf
 import dataclasses
+import hashlib
 import math
+import threading
 
 import numpy as np
 
@@ -36,6 +38,69 @@ from heavecomp.signals import flat_zero_phase
 CH = ("wob", "stroke", "pressure")
 #: seed of the heave-noise draws of the input-noise envelope (the same draws on every run)
 NOISE_SEED = 12345
+#: cost of one step of the library composition's stepper (every effect's hooks and states compiled in) in
+#: steps of the plain stepper (benchmarks/diagnosis/README.md: ~1.5, measured on the bench case)
+LIBRARY_STEP_COST = 1.5
+
+
+class Ledger:
+    """Every replay a :class:`Replay` runs: a digest of its inputs (the configuration, the replayed span
+    and the heave it is driven by) and its cost in plain-stepper steps, in the order run (thread-safe).
+
+    A diagnosis prepares one replay per log; ``duplicates`` lists the inputs replayed more than once (a
+    replay whose result was already at hand), ``steps`` the replayed work (benchmarks/diagnosis)."""
+
+    def __init__(self):
+        self.rows = []
+        self._lock = threading.Lock()
+        self._heave = {}  # id(heave samples) -> (the samples, their digest): each array hashed once
+
+    def heave_digest(self, hs) -> str:
+        """Digest of heave samples ``hs`` (z, dz, ddz, the angle), computed once per object."""
+        got = self._heave.get(id(hs))
+        if got is None or got[0] is not hs:
+            h = hashlib.blake2b(digest_size=12)
+            for a in (hs.z, hs.dz, hs.ddz) + tuple(hs.angle or ()):
+                h.update(np.ascontiguousarray(a).tobytes())
+            h.update(repr((hs.spacing, hs.kink)).encode())
+            got = (hs, h.hexdigest())
+            with self._lock:
+                self._heave[id(hs)] = got
+        return got[1]
+
+    def key(self, config, n_steps, hs) -> str:
+        """Digest of a replay's inputs: ``config`` over ``n_steps`` steps driven by ``hs``."""
+        return hashlib.blake2b(repr((sorted_config(config), int(n_steps), self.heave_digest(hs))).encode(),
+                               digest_size=12).hexdigest()
+
+    def add(self, config, n_steps, hs, cost) -> str:
+        """Record one replay of ``config`` over ``n_steps`` steps driven by ``hs``; ``cost`` per step."""
+        key = self.key(config, n_steps, hs)
+        with self._lock:
+            self.rows.append((key, int(n_steps), float(cost), tuple(n for n, _ in config)))
+        return key
+
+    @property
+    def count(self) -> int:
+        return len(self.rows)
+
+    @property
+    def steps(self) -> float:
+        """Replayed steps, in plain-stepper steps."""
+        return float(sum(r[1] * r[2] for r in self.rows))
+
+    def duplicates(self) -> dict:
+        """{digest: times run} of the inputs replayed more than once."""
+        seen = {}
+        for k, *_ in self.rows:
+            seen[k] = seen.get(k, 0) + 1
+        return {k: n for k, n in seen.items() if n > 1}
+
+
+def sorted_config(config) -> tuple:
+    """A configuration ``[(effect name, values), ...]`` as a hashable, order-free-within-values tuple."""
+    return tuple((n, tuple(sorted((k, float(v) if isinstance(v, (int, float, np.floating)) else v)
+                                  for k, v in dict(v).items()))) for n, v in config)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -64,6 +129,11 @@ class Replay:
     file_readers: tuple = ()
     #: segment starts per stroke/WOB reading (:meth:`start_for`), filled as configurations ask
     cache: dict = dataclasses.field(default_factory=dict, compare=False, repr=False)
+    #: every replay run (:class:`Ledger`): a digest of its inputs and its cost
+    ledger: Ledger = dataclasses.field(default_factory=Ledger, compare=False, repr=False)
+    #: whole replays driven by the replay's own heave, by the digest of their inputs: a shorter replay of
+    #: the same configuration is their prefix (:meth:`simulate`), not run again
+    whole: dict = dataclasses.field(default_factory=dict, compare=False, repr=False)
 
     @property
     def t(self) -> np.ndarray:
@@ -76,6 +146,12 @@ class Replay:
         moves the start (:meth:`start_for`).  Returns {channel: array, ``stroke_velocity``, ``stuck``,
         ``t``, ``_grid`` (the stepper's output)}."""
         hs = self.hs if hs is None else hs
+        hs_in = hs
+        # a configuration already replayed whole on this heave: its prefix is this replay, bit for bit (the
+        # same steps from the same start; a reading, which may filter, is read here as always)
+        whole = self.ledger.key(config, self.n_steps, hs) if hs is self.hs and not self.file_readers else None
+        if whole is not None and whole in self.whole and not any(get(n).kind == "output" for n, _ in config):
+            return self._prefix(self.whole[whole], t_end)
         plant = self.plant
         # the parameter file's own plant effects ([[effects]], e.g. a calibrated model) are part of the
         # model in every replay; a candidate of the same effect refits it
@@ -100,6 +176,7 @@ class Replay:
         comp = (composition_for(effects) if file_fx else library_composition() if effects else composition(()))
         EP = comp.ep(effects)
         n = self.n_steps if t_end is None else min(self.n_steps, int(math.ceil(t_end / self.h)) + 2)
+        self.ledger.add(config, n, hs_in, 1.0 if not comp.classes else LIBRARY_STEP_COST)
         out = run_segments(plant, comp, EP, hs, self.h, self.bounds, starts, n + 1)
         tg = out[:, 0]
         t = self.t if t_end is None else self.t[self.t <= tg[-1]]
@@ -116,7 +193,22 @@ class Replay:
                 done.add(c)
         res["t"] = t
         res["_grid"] = out
+        if whole is not None and n == self.n_steps and len(config) <= 1:
+            # the nominal and single candidates: their whole replays are kept anyway (ReplayContext,
+            # CandidateFit.pred), so the memo adds no memory (a joint configuration is not kept)
+            self.whole[whole] = res
         return res
+
+    def _prefix(self, res, t_end) -> dict:
+        """The replay ``res`` (whole) up to ``t_end`` [s], as :meth:`simulate` returns it for ``t_end``."""
+        if t_end is None:
+            return dict(res)
+        n = min(self.n_steps, int(math.ceil(t_end / self.h)) + 2)
+        out = res["_grid"][: n + 1]
+        m = int(np.count_nonzero(self.t <= out[-1, 0]))
+        got = {c: (v[:m] if isinstance(v, np.ndarray) and v.shape[:1] == self.t.shape else v) for c, v in res.items()}
+        got["_grid"] = out
+        return got
 
     def start_for(self, readings):
         """Shift of the heave reference [m] and segment starts for a configuration whose ``readings``

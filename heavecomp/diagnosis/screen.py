@@ -27,19 +27,25 @@ from heavecomp.errors import ParameterError
 #: component of each parameter table of parameter_mismatch
 TABLE_COMPONENT = {"compensator": "gas_spring", "friction": "friction", "drill_string": "string_formation",
                    "formation": "string_formation"}
+#: parameter_mismatch parameters no equation-error residual sees: the static friction force acts at
+#: breakaway, where the top-mass balance is blind (as dwell_stiction and friction_lag: always released)
+UNSEEN = ("static_force",)
 
 
 def prescreen(cr, shares, fitmask, valmask, names, policy) -> dict:
     """Per candidate: its component, the component's gap over noise and floor
     (:meth:`~heavecomp.diagnosis.components.ComponentResiduals.gap`), its equation-error fit on the
     component residual where it has one (:func:`heavecomp.diagnosis.equation_error.rank_effects`),
-    and whether it is replayed: a plant candidate whose component shows no gap
+    and whether it is replayed: a plant candidate (or a heave reading, at ``heave_input``) whose component
+    shows no gap
     (<= ``prescreen_gap``, or under ``prescreen_share`` of the whole gap: what a large gap elsewhere
     leaks into it; only components in :data:`heavecomp.diagnosis.components.SCREENED` and candidates
     their residual sees, ``Effect.fit.screened``) and whose equation-error columns shrink nothing held out
     (< :data:`heavecomp.diagnosis.equation_error.MIN_SHRINK`) is not.  Output and nominal candidates
     (a channel delay, the six-parameter refit) are always replayed, and so is every candidate when
-    none would be.  ``shares``: the equation-error shares of the gap (``where.components``).
+    none would be; the refit releases only the parameters the equation error leaves room for
+    (:func:`mismatch_room`: ``room``, ``left_out``).  ``shares``: the equation-error shares of the gap
+    (``where.components``).
 
     Parameters
     ----------
@@ -61,7 +67,7 @@ def prescreen(cr, shares, fitmask, valmask, names, policy) -> dict:
     for n in names:
         t0 = time.perf_counter()
         cls = get(n)
-        comp = cls.component() if cls.kind == "plant" else ("sensors" if cls.kind == "output" else "")
+        comp = cls.component() if cls.kind in ("plant", "heave") else ("sensors" if cls.kind == "output" else "")
         ee = None
         if comp in cr.residual and seen.get(comp, True):
             ranked = EE.rank_effects(cr.residual[comp], cr.signals_for(comp), [cls], fm, vm, component=comp)
@@ -69,13 +75,57 @@ def prescreen(cr, shares, fitmask, valmask, names, policy) -> dict:
         small = gap.get(comp, 0.0) <= policy.prescreen_gap or shares.get(comp, 0.0) < policy.prescreen_share
         quiet = (comp in CR.SCREENED and seen.get(comp, True) and cls.fit.screened and small
                  and (ee is None or ee["shrink"] < EE.MIN_SHRINK))
-        replay = not (cls.kind == "plant" and quiet)
+        replay = not (cls.kind in ("plant", "heave") and quiet)
         out[n] = {"component": comp, "component_gap": float(gap.get(comp, math.nan)), "replay": replay,
                   "equation_error": ee, "wall_time": time.perf_counter() - t0}
     if not any(o["replay"] for o in out.values()):
         for o in out.values():
             o["replay"] = True
+    for n, o in out.items():
+        if get(n).kind == "nominal" and o["replay"]:
+            o.update(mismatch_room(gap, shares, seen, out, policy))
     return out
+
+
+def mismatch_room(gap, shares, seen, screened, policy) -> dict:
+    """Which parameters of ``parameter_mismatch`` its stepwise refit may release: those whose component's
+    equation error leaves room for them (``room``, indices in field order) and, for the others, the
+    evidence that left them out (``left_out``: {parameter: why}).  A parameter is left out when its
+    component is screened (:data:`heavecomp.diagnosis.components.SCREENED`, observable) and shows no gap
+    of its own, by the pre-screen's own test (gap <= ``prescreen_gap`` noise variances or under
+    ``prescreen_share`` of the whole; no candidate of the component, ``screened``, shrinks its held-out
+    residual by :data:`heavecomp.diagnosis.equation_error.MIN_SHRINK`): a gas stiffness that is off shows in
+    the gas law's residual, a string stiffness in the lower-mass balance, a Coulomb or viscous force in the
+    sliding top-mass balance.  The static friction force (:data:`UNSEEN`) acts at breakaway, which no
+    residual sees: it is always released.
+
+    Parameters
+    ----------
+    gap : dict
+        Equation-error gap per component [noise variances] (:meth:`ComponentResiduals.gap`).
+    shares : dict
+        Equation-error share of the gap [-] per component (``where.components``).
+    seen : dict
+        Whether each component is observable (:meth:`ComponentResiduals.observable`).
+    screened : dict
+        The plant candidates' :func:`prescreen` entries (their equation-error fits).
+    policy : heavecomp.diagnosis.policy.VerdictPolicy
+        Decision thresholds (``prescreen_gap``, ``prescreen_share``).
+    """
+    room, left = [], {}
+    for i, (f, (key, table, _)) in enumerate(zip(ParameterMismatch.fields(), MISMATCH_KEYS)):
+        comp = TABLE_COMPONENT[table]
+        small = gap.get(comp, 0.0) <= policy.prescreen_gap or shares.get(comp, 0.0) < policy.prescreen_share
+        ee = [o["equation_error"]["shrink"] for n, o in screened.items()
+              if o["component"] == comp and o["equation_error"] is not None and get(n).fit.screened]
+        if (f.name not in UNSEEN and comp in CR.SCREENED and seen.get(comp, True) and small
+                and all(x < EE.MIN_SHRINK for x in ee)):
+            left[key] = (f"its component {comp} shows no gap of its own (gap {gap.get(comp, 0.0):.3g} noise "
+                         f"variances, {100 * shares.get(comp, 0.0):.1f} % of the whole; equation-error shrink "
+                         f"under {EE.MIN_SHRINK:g})")
+        else:
+            room.append(i)
+    return {"room": room, "left_out": left}
 
 
 def equation_error_start(cr, pre, cls):

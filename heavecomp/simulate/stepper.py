@@ -282,13 +282,22 @@ def compile_all(progress=None) -> list[str]:
     progress : callable or None
         Called as ``progress(name)`` before each compile (None: not called).
     """
-    from heavecomp.simulate import _kernel
-
-    steps = [("nominal stepper", lambda: _jit_kernel(None)),
-             ("heave interpolation", lambda: _kernel.heave_at(0.0, 0.005, np.zeros(8), np.zeros(8), np.zeros(8))),
-             ("library effects stepper", lambda: _jit_kernel(library_composition()))]
-    for name, step in steps:
+    steps = install_steps()
+    for name, step in steps.items():
         if progress is not None:
             progress(name)
         step()
-    return [name for name, _ in steps]
+    return list(steps)
+
+
+def install_steps() -> dict:
+    """The install-time compiles of :func:`compile_all`, by name: each fills its own cache folder, so
+    ``setup.py`` runs each in a process of its own, on every core."""
+    from heavecomp.simulate import _kernel
+
+    def nominal():
+        _jit_kernel(None)
+        _kernel.heave_at(0.0, 0.005, np.zeros(8), np.zeros(8), np.zeros(8))  # the heave interpolation
+
+    return {"nominal stepper": nominal, "library effects stepper": lambda: _jit_kernel(library_composition())}
+

@@ -1,0 +1,91 @@
+"""Replays a diagnosis runs (issue 32): none twice with the same inputs, and only what the equation
+error leaves room for.
+
+Every replay of a diagnosis goes through its one prepared :class:`heavecomp.diagnosis.replay.Replay`,
+which records a digest of its inputs (configuration, replayed span, heave samples) in its ledger.
+"""
+
+import pytest
+
+from heavecomp.benchmark import benchmark_case, generate
+from heavecomp.diagnosis.estimator import GapDiagnoser
+from heavecomp.effects.candidates import MISMATCH_KEYS
+
+
+@pytest.fixture(scope="module")
+def diagnosed():
+    tr = generate(benchmark_case("flow_loss", seed=11, duration=120.0, rate=50.0))
+    d = GapDiagnoser(tr.nominal, candidates=["flow_loss", "string_damping", "sensor_offset", "parameter_mismatch"],
+                     n_jobs=2).fit(tr.to_run())
+    return tr, d
+
+
+@pytest.mark.slow
+def test_no_replay_is_run_twice_with_the_same_inputs(diagnosed):
+    _, d = diagnosed
+    ledger = d.context_.replay.ledger
+    assert ledger.count > 20  # the nominal, the noise draws, every fit's replays: all recorded
+    assert ledger.duplicates() == {}
+
+
+def test_the_ledger_tells_inputs_apart():
+    """Two replays differing only in a parameter's last digit, or in the heave they are driven by, are
+    different inputs; the same ones are a duplicate."""
+    from heavecomp.diagnosis.replay import Ledger
+    from heavecomp.simulate.excitation import HeaveSamples
+    import numpy as np
+
+    z = np.linspace(0.0, 1.0, 50)
+    a, b = HeaveSamples(0.01, z, z, z), HeaveSamples(0.01, z + 1e-12, z, z)
+    L = Ledger()
+    L.add([("flow_loss", {"resistance": 1.0})], 100, a, 1.5)
+    L.add([("flow_loss", {"resistance": 1.0 + 1e-15})], 100, a, 1.5)
+    L.add([("flow_loss", {"resistance": 1.0})], 100, b, 1.5)
+    L.add([("flow_loss", {"resistance": 1.0})], 99, a, 1.5)
+    assert L.duplicates() == {}
+    L.add([("flow_loss", {"resistance": 1.0})], 100, HeaveSamples(0.01, z.copy(), z, z), 1.5)
+    assert list(L.duplicates().values()) == [2]
+    assert L.steps == pytest.approx(1.5 * (4 * 100 + 99))
+
+
+@pytest.mark.slow
+def test_the_refit_releases_only_what_the_equation_error_leaves_room_for(diagnosed):
+    """On a withheld flow loss the friction, gas and string components show no gap of their own: the
+    six-parameter refit may release only the static friction force (breakaway: no residual sees it);
+    the others are listed with the evidence and stay exactly nominal."""
+    _, d = diagnosed
+    pre = d.prescreen_["parameter_mismatch"]
+    assert d.where_["components"]["flow_line"] > 0.9
+    keys = [k for k, _, _ in MISMATCH_KEYS]
+    left = set(pre["left_out"])
+    assert "friction.static_force" not in left
+    assert {"friction.coulomb_force", "friction.viscous_coefficient"} <= left
+    assert [keys[i] for i in pre["room"]] == [k for k in keys if k not in left]
+    for k in left:
+        assert "shows no gap of its own" in pre["left_out"][k]
+    row = next(r for r in d.candidates_ if r["effect"] == "parameter_mismatch")
+    nominal = d.nominal
+    for k in left:
+        table, key = k.split(".")
+        assert row["parameters"][k] == getattr(getattr(nominal, table), key)
+
+
+@pytest.mark.slow
+def test_draws_only_in_contention_give_the_ranking_all_draws_give(diagnosed, monkeypatch):
+    """The heave-noise draws spent only on the candidates in contention (here the best, the runner-up and
+    one joint partner): their scores and order, and the verdict, are those of the same diagnosis with
+    every candidate drawn for."""
+    tr, d0 = diagnosed
+    run = tr.to_run()
+    d = GapDiagnoser(d0.nominal, candidates=d0.candidates, n_jobs=2, second=1).fit(run)
+    drawn = {r["effect"] for r in d.candidates_ if r.get("explained_perturbed_heave") is not None}
+
+    def every(self, ctx, names, results):
+        return {n: [ctx.simulate([(n, results[n][0].values)], hs=hs) for hs in ctx.hs_pert] for n in names}
+
+    monkeypatch.setattr(GapDiagnoser, "_contention", every)
+    full = GapDiagnoser(d.nominal, candidates=d.candidates, n_jobs=2, second=1).fit(run)
+    assert drawn < {f.effect for f in full.fits_}  # some were left out ...
+    read = 2 + d.second
+    assert [(f.effect, f.score) for f in d.fits_[:read]] == [(f.effect, f.score) for f in full.fits_[:read]]
+    assert d.verdict_ == full.verdict_  # ... and the verdict is the same, to the last digit
