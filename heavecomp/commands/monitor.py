@@ -41,6 +41,7 @@ def run(args) -> int:
     import time
     from pathlib import Path
 
+    from heavecomp.commands._output import final
     from heavecomp.diagnosis import monitor as M
     from heavecomp.diagnosis.data import load_run
     from heavecomp.errors import InputError
@@ -79,5 +80,5 @@ def run(args) -> int:
     print(f"{len(eff)} effect change(s), {len(ops)} operating change(s), {len(res.segments)} segment(s)"
           + "".join(f"; {c['component']} at {c['t']:.0f} s" for c in eff[:5])
           + "".join(f"; segment {i}: {res.segments[i]['verdict']['effect']}" for i in diagnoses)
-          + f" -> {args.out}/monitor.json")
+          + f" -> {Path(final(args)) / 'monitor.json'}")
     return 0

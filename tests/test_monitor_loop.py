@@ -1,0 +1,77 @@
+"""The monitor and the fleet as one user's loop runs them (issue 31 item 4): the monitor measures the gap as
+the diagnosis does, refuses or shortens what it cannot learn, bounds its block from physics, follows a drift
+as one change, and the fleet ranks its logs by the gap."""
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from heavecomp.diagnosis import monitor as M
+
+
+def _nominal_log(duration, rate, seed=5, changes=()):
+    """A generated log of the nominal plant (the project's own generator: JONSWAP sea, the generator's noise)."""
+    from heavecomp.benchmark.long_logs import long_log
+
+    tr = long_log(list(changes), seed=seed, duration=duration, rate=rate)
+    return tr
+
+
+@pytest.mark.parametrize("rate", [5.0, 25.0])
+def test_gap_to_noise_of_a_nominal_log_is_about_one_at_any_rate(rate):
+    """A 10-minute log of the nominal plant itself: every component's gap/noise about 1, at 5 and 25 Hz (it
+    read 2.1 in the gas law and the lower-mass balance at 25 Hz: the segment's median WOB taken as its set-point,
+    and no nominal-replay floor, whose share of the noise grows with the rate)."""
+    tr = _nominal_log(600.0, rate)
+    res = M.monitor(tr.to_run(), tr.nominal)
+    gaps = [g for s in res.segments for g in s["gap_to_noise"].values()]
+    assert gaps and all(0.7 <= g <= 1.5 for g in gaps), res.segments
+
+
+def _with_wob_step(tr, at, step):
+    from heavecomp.diagnosis.data import MeasuredRun
+
+    run = tr.to_run()
+    cols = dict(run.columns)
+    cols["wob"] = np.where(run.t >= at, cols["wob"] + step, cols["wob"])
+    return MeasuredRun(run.t, cols, source="wob step")
+
+
+def test_a_log_too_short_for_the_reference_learns_a_shorter_one_says_so_and_finds_a_wob_step():
+    """D5: a 130 s log with a 30 kN WOB step at 104 s (a load cell that steps, 75x its noise): the 300 s
+    reference of a long log never ended, and the step passed without a word."""
+    tr = _nominal_log(130.0, 10.0)
+    res = M.monitor(_with_wob_step(tr, 104.0, 3e4), tr.nominal)
+    eff = [c for c in res.changes if c["kind"] == "effect"]
+    assert eff and all(c["t"] >= 100.0 for c in eff) and eff[0]["component"] == "sensors"
+    d = res.to_json()
+    assert d["notes"] and "reference" in d["notes"][0] and d["method"]["learn_blocks"] < M.LEARN
+    # the same log without the step: the shorter reference raises nothing
+    clean = M.monitor(tr.to_run(), tr.nominal)
+    assert not clean.changes
+
+
+def test_block_is_bounded_by_the_wave_period_the_rate_and_the_log(tmp_path, capsys):
+    """D3: --block 0.1 s gave 79 effect changes on a clean log, 1e6 s reported 0 changes without a word,
+    1e-300 a traceback; each is refused in one line naming --block (exit 2), before any output."""
+    from heavecomp.cli import main
+    from heavecomp.params import save
+
+    tr = _nominal_log(150.0, 10.0)
+    prm = tmp_path / "p.toml"
+    save(tr.nominal, prm)
+    log = tr.to_csv(tmp_path / "log.csv")
+    lo, hi = M.block_bounds(tr.to_run())
+    # half of the sea's mean wave period (JONSWAP, Tp 8-12 s), and 12 blocks of the 150 s log
+    assert 2.5 < lo < 6.0 and math.isclose(hi, 150.0 / M.MIN_BLOCKS, rel_tol=0.01)
+    for bad in ("0.1", "1e6", "1e-300"):
+        rc = main(["monitor", str(log), "--params", str(prm), "--out", str(tmp_path / "o"), "--block", bad])
+        err = [x for x in capsys.readouterr().err.strip().splitlines() if not x.startswith("[")]
+        assert rc == 2 and len(err) == 1 and "--block" in err[0] and "Traceback" not in err[0], err
+        assert not (tmp_path / "o").exists()
+    rc = main(["monitor", str(log), "--params", str(prm), "--out", str(tmp_path / "o"), "--block", "10"])
+    out = capsys.readouterr().out.strip().splitlines()
+    # D9: the result line names the final folder, not the staging one
+    assert rc == 0 and out[-1].endswith(f"{tmp_path / 'o' / 'monitor.json'}") and ".partial" not in out[-1]
