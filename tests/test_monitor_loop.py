@@ -75,3 +75,55 @@ def test_block_is_bounded_by_the_wave_period_the_rate_and_the_log(tmp_path, caps
     out = capsys.readouterr().out.strip().splitlines()
     # D9: the result line names the final folder, not the staging one
     assert rc == 0 and out[-1].endswith(f"{tmp_path / 'o' / 'monitor.json'}") and ".partial" not in out[-1]
+
+
+def _friction_log(path, nominal, scale, seed, duration=300.0, rate=10.0):
+    """A log of the nominal plant with its seal friction (static and Coulomb levels) ``scale`` x the file's
+    from start to end, simulated by the project's stepper, with the generator's noise (2 mm, 2 mm, 2 kPa, 400 N)."""
+    from heavecomp.simulate import simulate
+
+    f = nominal.friction
+    p = nominal.replace(friction={"static_force": scale * f.static_force, "coulomb_force": scale * f.coulomb_force})
+    r = simulate(p, duration, rate=rate)
+    rng = np.random.default_rng(seed)
+    t = np.asarray(r["t"], float)
+    cols = [t] + [np.asarray(r[k], float) + rng.normal(0.0, s, t.size)
+                  for k, s in (("heave", 2e-3), ("stroke", 2e-3), ("pressure", 2e3), ("wob", 400.0))]
+    np.savetxt(path, np.column_stack(cols), delimiter=",", header="t,heave,stroke,pressure,wob", comments="",
+               fmt="%.10g")
+    return path
+
+
+@pytest.mark.slow
+def test_fleet_ranks_logs_by_their_gap_and_ends_in_the_command_to_diagnose_the_worst(tmp_path, capsys):
+    """U5: a rig whose seal friction is 30 % high all through looked like a nominal one in every table and
+    figure of the fleet (it showed changes only).  Now every log carries its gap/noise per component, the
+    logs are ranked by it, and the report ends in the diagnose command of the one that stands out."""
+    import csv
+
+    from heavecomp.cli import main
+    from heavecomp.params import save
+    from heavecomp.params.sets import paper_a
+
+    nominal = paper_a("stribeck")
+    (tmp_path / "logs").mkdir()
+    prm = save(nominal, tmp_path / "p.toml")
+    for i, scale in enumerate((1.0, 1.3, 1.0)):
+        _friction_log(tmp_path / "logs" / f"rig{i}.csv", nominal, scale, seed=i)
+    out = tmp_path / "f"
+    assert main(["fleet", str(tmp_path / "logs"), "--params", str(prm), "--out", str(out), "--workers", "1"]) == 0
+    printed = capsys.readouterr().out
+    with open(out / "fleet.csv", newline="") as fh:
+        rows = {r["log"]: r for r in csv.DictReader(fh)}
+    assert rows["rig1"]["gap rank [-]"] == "1" and rows["rig1"]["gap component"] == "friction"
+    assert float(rows["rig1"]["gap level [-]"]) >= M.GAP_NOTABLE
+    assert all(float(rows[k]["gap level [-]"]) < M.GAP_NOTABLE for k in ("rig0", "rig2"))
+    assert float(rows["rig1"]["friction gap/noise [-]"]) > 1.5 * float(rows["rig0"]["friction gap/noise [-]"])
+    with open(out / "segments.csv", newline="") as fh:
+        seg = [r for r in csv.DictReader(fh) if r["log"] == "rig1"]
+    assert seg and float(seg[0]["friction gap/noise [-]"]) >= M.GAP_NOTABLE
+    report = (out / "report.md").read_text()
+    cmd = report.split("## What next")[1]
+    assert "heavecomp diagnose" in cmd and "rig1.csv" in cmd and "rig0.csv" not in cmd and str(out) + "-rig1" in cmd
+    assert "rig1" in printed and "heavecomp diagnose" in printed
+    assert json.loads((out / "fleet.json").read_text())["what_next"]

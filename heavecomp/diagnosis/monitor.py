@@ -174,6 +174,10 @@ BAND_EQUATION = "top_mass"
 THRESHOLD_BAND, JUMP_BAND = 10.0, math.inf
 RIDGE = 1e-6  #: relative ridge of a block's normalised normal equations (features of unit scale) [-]
 OP_CHANNELS = ("heave", "stroke", "pressure", "wob")
+#: a log whose gap level (its largest component gap/noise over the whole log) reaches this is worth a diagnosis
+#: (the fleet's "What next"): logs of the nominal plant itself read 1.00-1.4 from 5 to 50 Hz, 10 min and 2 h
+#: (benchmarks/monitor/gap_levels.py); a seal friction 30 % high throughout reads ~2-4 [-]
+GAP_NOTABLE = 1.5
 MIN_DURATION = 120.0  #: shortest log monitored [s]: a reference stretch of LEARN blocks and as many to compare
 #: fewest blocks a log must hold to be monitored (MIN_DURATION at the default BLOCK): the upper bound of a
 #: block (:func:`block_bounds`) [-]
@@ -223,11 +227,20 @@ class MonitorResult:
     learn: int = LEARN
     #: what the reader should know of how the log was monitored (a shortened reference, ...)
     notes: list = dataclasses.field(default_factory=list)
+    #: {component: gap/noise over the whole log} (:func:`segment_gap` over every block) [-]
+    gap: dict = dataclasses.field(default_factory=dict)
+
+    def gap_level(self) -> dict:
+        """The log's gap level: its largest component gap/noise over the whole log (:func:`gap_level`)."""
+        return gap_level(self.gap)
 
     def to_json(self) -> dict:
         extra = {"skipped": self.skipped} if self.skipped else {}
         if self.notes:
             extra["notes"] = list(self.notes)
+        if self.gap:
+            extra["gap_to_noise"] = dict(self.gap)
+            extra["gap_level"] = self.gap_level()
         return {**extra, "schema": SCHEMA, "changes": self.changes, "segments": self.segments,
                 "sensors": list(self.sensors), "block_s": self.block, "duration_s": self.duration,
                 "noise": self.noise,
@@ -1015,6 +1028,22 @@ def segment_gap(sums, a, b) -> dict:
     return {c: math.sqrt(1.0 + g) for c, g in CR.gap_of(z, floor).items()}
 
 
+def gap_level(gap) -> dict:
+    """``{"gap_to_noise": largest component gap/noise, "component": its component}`` of a log's (or a
+    segment's) ``gap_to_noise`` (None values when there is none): how far the log is from the model, the
+    fleet's ranking key.
+
+    Parameters
+    ----------
+    gap : {component: float}
+        gap/noise per component [-].
+    """
+    if not gap:
+        return {"gap_to_noise": None, "component": None}
+    c = max(gap, key=lambda k: gap[k])
+    return {"gap_to_noise": float(gap[c]), "component": c}
+
+
 def segments(changes, block_t, block, op, sums, duration) -> list:
     """The stationary stretches between changes (boundaries at the changes' onsets), each with its
     operating point (medians of the block means) and gap_to_noise.
@@ -1199,7 +1228,7 @@ def monitor(run, params, *, block=BLOCK, chunk=CHUNK, threshold=THRESHOLD, thres
     segs = segments(changes, block_t, block, op, sums, run.duration)
     return MonitorResult(block_t, block, sums.stats(), op, sums, changes, segs,
                          {k: float(v) for k, v in noise.items() if k in sensors}, sensors, run.duration, skipped,
-                         learn, notes)
+                         learn, notes, segment_gap(sums, 0, block_t.size))
 
 
 # ---------------------------------------------------------------------------- --diagnose: one verdict per segment
