@@ -127,3 +127,31 @@ def test_fleet_ranks_logs_by_their_gap_and_ends_in_the_command_to_diagnose_the_w
     assert "heavecomp diagnose" in cmd and "rig1.csv" in cmd and "rig0.csv" not in cmd and str(out) + "-rig1" in cmd
     assert "rig1" in printed and "heavecomp diagnose" in printed
     assert json.loads((out / "fleet.json").read_text())["what_next"]
+
+
+def test_resume_recomputes_a_log_whose_result_is_torn_or_swapped(tmp_path):
+    """D4: a torn monitor.json beside an intact task.json was taken over on --resume and reported done with no
+    data; a monitor.json replaced by another log's too.  task.json now lists each file's digest."""
+    from heavecomp.campaign import fleet as F
+    from heavecomp.params import save
+    from heavecomp.report.fleet import run_and_report
+
+    (tmp_path / "logs").mkdir()
+    for i in (1, 2, 3):
+        tr = _nominal_log(150.0, 10.0, seed=i)
+        tr.to_csv(tmp_path / "logs" / f"log{i}.csv")
+    prm = save(tr.nominal, tmp_path / "p.toml")
+    tasks = F.plan(tmp_path / "logs", prm)
+    out = tmp_path / "out"
+    run_and_report(tasks, out, F.Settings(), workers=1)
+    runs = {k: F.read_task(out / F.RESULTS / k)["fleet_run"] for k in ("log1", "log2", "log3")}
+    mon2 = out / F.RESULTS / "log2" / "monitor.json"
+    mon2.write_bytes(mon2.read_bytes()[:50])  # torn
+    (out / F.RESULTS / "log3" / "monitor.json").write_bytes((out / F.RESULTS / "log1" / "monitor.json").read_bytes())
+    info, summary = run_and_report(tasks, out, F.Settings(), workers=1)
+    assert (info.n_computed, info.n_skipped) == (2, 1)
+    after = {k: F.read_task(out / F.RESULTS / k)["fleet_run"] for k in ("log1", "log2", "log3")}
+    assert after["log1"] == runs["log1"] and after["log2"] != runs["log2"] and after["log3"] != runs["log3"]
+    rows = {r["log"]: r for r in summary["fleet"]}
+    assert rows["log2"]["status"] == "done" and rows["log2"]["segments [-]"] != ""
+    assert json.loads(mon2.read_text())["segments"]
