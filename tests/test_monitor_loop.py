@@ -155,3 +155,29 @@ def test_resume_recomputes_a_log_whose_result_is_torn_or_swapped(tmp_path):
     rows = {r["log"]: r for r in summary["fleet"]}
     assert rows["log2"]["status"] == "done" and rows["log2"]["segments [-]"] != ""
     assert json.loads(mon2.read_text())["segments"]
+
+
+@pytest.mark.slow
+def test_monitor_diagnose_writes_each_segment_as_diagnose_span_does_with_progress(tmp_path, capsys):
+    """U6: monitor --diagnose ended in a reduced segment_<i>/diagnosis.json, no calibrated.toml, report or
+    figures, and was silent for ~90 s while it diagnosed."""
+    from heavecomp.benchmark.long_logs import long_log
+    from heavecomp.cli import main
+    from heavecomp.params import save
+
+    tr = long_log([(300.0, "pressure_friction")], seed=11, duration=480.0, rate=10.0, size=8.0)
+    log = tr.to_csv(tmp_path / "log.csv")
+    prm = save(tr.nominal, tmp_path / "p.toml")
+    out = tmp_path / "m"
+    assert main(["monitor", str(log), "--params", str(prm), "--out", str(out), "--diagnose", "--jobs", "1"]) == 0
+    cap = capsys.readouterr()
+    mon = json.loads((out / "monitor.json").read_text())
+    done = [i for i, s in enumerate(mon["segments"]) if (s.get("verdict") or {}).get("folder")]
+    assert done, mon["segments"]
+    seg = out / f"segment_{done[0]}"
+    for f in ("diagnosis.json", "report.md", "report.html", "calibrated.toml"):
+        assert (seg / f).is_file(), f
+    assert list(seg.glob("*.png"))
+    assert json.loads((seg / "diagnosis.json").read_text())["span"]["start_s"] == pytest.approx(
+        mon["segments"][done[0]]["start"])
+    assert f"segment {done[0]}:" in cap.err and "--span" in (out / "report.md").read_text()

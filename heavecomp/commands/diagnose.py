@@ -67,7 +67,6 @@ def run(args) -> int:
 
     from heavecomp.diagnosis.data import load_run
     from heavecomp.diagnosis.estimator import GapDiagnoser, check_memory
-    from heavecomp.report.diagnosis import write_report
     from heavecomp.errors import InputError
     from heavecomp.io.series import check_spec, parse_mapping
     from heavecomp.effects.spec import load  # the file with its [[effects]] checked
@@ -108,22 +107,49 @@ def run(args) -> int:
 
     d = GapDiagnoser(params, cands, split=args.split, settle=args.settle, n_jobs=args.jobs, progress=progress)
     d.fit(run_)
-    write_report(d, args.out, title=f"Sim-to-real gap diagnosis — {run_.source}")
-    _record_measurement(Path(args.out) / "diagnosis.json", run_.measurement, span.to_json())
-    from heavecomp.report.calibrated import write_calibrated  # calibrated.toml, its json block, "What next"
-
-    cal = write_calibrated(params, args.out, run_path=args.run, params_path=args.params, run=run_,
-                           policy=d.verdict_policy())
-    from heavecomp.report.provenance import finish
+    cal = write_outputs(d, args.out, params=params, run=run_, run_path=args.run, params_path=args.params, span=span)
     from heavecomp.commands._output import final
 
-    finish(args.out, params=params, json_files=("diagnosis.json",), heave_used=False, measured_run=str(Path(args.run).resolve()))
     v = d.verdict_
     extra = f", second effect {v['second_effect']['effect']}" if v.get("second_effect") else ""
     print(f"verdict: {v['effect']} (confidence {v['confidence']}), held-out shrink {v['shrink']:.2f} "
           f"on {v.get('shrink_channel', 'wob')}{extra} -> {Path(final(args)) / 'diagnosis.json'}, calibrated model "
           f"({len(cal.changes)} change{'s' if len(cal.changes) != 1 else ''}) -> {Path(final(args)) / 'calibrated.toml'}")
     return 0
+
+
+def write_outputs(d, out, *, params, run, run_path, params_path, span=None):
+    """What ``heavecomp diagnose`` writes into its folder ``out`` for a fitted diagnosis ``d``:
+    ``diagnosis.json`` with how the log was read and the span analysed, ``report.md`` and its figures,
+    ``calibrated.toml`` with its "What next", and the provenance stamp and ``report.html``
+    (:func:`heavecomp.report.provenance.finish`).  ``heavecomp monitor --diagnose`` writes each diagnosed
+    segment with it.  Returns the :class:`heavecomp.report.calibrated.Calibrated`.
+
+    Parameters
+    ----------
+    d : heavecomp.diagnosis.GapDiagnoser
+        Fitted on ``run``.
+    out : str or Path
+        The folder (created).
+    params : CMCParams
+        The nominal parameters it was diagnosed against.
+    run : MeasuredRun
+        The log (or its span) as the diagnosis read it.
+    run_path, params_path : str
+        The log and the parameter file as the user named them.
+    span : heavecomp.diagnosis.span.Span, optional
+        The stretch of the log analysed.
+    """
+    from heavecomp.report.calibrated import write_calibrated  # calibrated.toml, its json block, "What next"
+    from heavecomp.report.diagnosis import write_report
+    from heavecomp.report.provenance import finish
+
+    write_report(d, out, title=f"Sim-to-real gap diagnosis — {run.source}")
+    _record_measurement(Path(out) / "diagnosis.json", run.measurement, span.to_json() if span is not None else None)
+    cal = write_calibrated(params, out, run_path=run_path, params_path=params_path, run=run, policy=d.verdict_policy())
+    finish(out, params=params, json_files=("diagnosis.json",), heave_used=False,
+           measured_run=str(Path(run_path).resolve()))
+    return cal
 
 
 def _record_measurement(path: Path, measurement: dict, span: dict | None = None) -> None:

@@ -1267,7 +1267,8 @@ def segment_run(run, start, end) -> MeasuredRun:
                        source=f"{run.source} [{start:.0f}-{end:.0f} s]", measurement=dict(run.measurement))
 
 
-def diagnose_segments(result, run, params, *, candidates=None, n_jobs=1, span=DIAGNOSE_SPAN, progress=None) -> dict:
+def diagnose_segments(result, run, params, *, candidates=None, n_jobs=1, span=DIAGNOSE_SPAN, progress=None,
+                      each=None) -> dict:
     """Diagnose every segment of ``result`` (:func:`monitor`) that carries a gap (:func:`carries_gap`) with
     :class:`heavecomp.diagnosis.estimator.GapDiagnoser` on that segment (at most its first ``span`` s).
 
@@ -1290,6 +1291,10 @@ def diagnose_segments(result, run, params, *, candidates=None, n_jobs=1, span=DI
     span : float [s]
         Longest part of a segment diagnosed.
     progress : callable (fraction, message), optional
+        Called as each segment starts and as its diagnosis goes (the candidates' fits, named by segment).
+    each : callable (index, GapDiagnoser, MeasuredRun, (start, end)), optional
+        Called with each fitted diagnosis, the segment's run and its span [s, log time], as it is done
+        (``heavecomp monitor --diagnose`` writes the segment's folder with it, as ``diagnose --span`` does).
 
     Returns
     -------
@@ -1307,11 +1312,18 @@ def diagnose_segments(result, run, params, *, candidates=None, n_jobs=1, span=DI
             continue
         if progress:
             progress(n / len(todo), f"diagnosing segment {i} ({a:.0f}-{b:.0f} s)")
-        d = GapDiagnoser(params, candidates, n_jobs=n_jobs)
-        d.fit(segment_run(run, a, b))
+        inner = None
+        if progress:
+            def inner(frac, msg, n=n, i=i):
+                progress((n + frac) / len(todo), f"segment {i}: {msg}")
+        d = GapDiagnoser(params, candidates, n_jobs=n_jobs, progress=inner)
+        sub = segment_run(run, a, b)
+        d.fit(sub)
         v = d.verdict_
         seg["verdict"] = {"effect": v["effect"], "confidence": v.get("confidence"), "component": v.get("component"),
                           "shrink": v.get("shrink"), "span": [float(a), float(b)]}
         out[i] = d.to_json()
+        if each is not None:
+            each(i, d, sub, (float(a), float(b)))
         log.info("segment %d (%.0f-%.0f s): %s (%s)", i, a, b, v["effect"], v.get("confidence"))
     return out

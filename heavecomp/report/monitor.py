@@ -107,7 +107,7 @@ def write_segment_diagnoses(diagnoses, out) -> list:
     return paths
 
 
-def report_markdown(res, source="", figure="timeline.png") -> str:
+def report_markdown(res, source="", figure="timeline.png", diagnosed=()) -> str:
     """The monitor's ``report.md``: the changes, the segments (with their verdicts) and the method.
 
     Parameters
@@ -117,6 +117,9 @@ def report_markdown(res, source="", figure="timeline.png") -> str:
         Name of the log, for the title.
     figure : str
         File name of the timeline figure, relative to the report.
+    diagnosed : sequence of str
+        Lines on the diagnosed segments' folders and the ``diagnose --span`` command of each (the command's
+        :func:`diagnosed_lines`).
     """
     lines = [f"# Monitor — {source}" if source else "# Monitor", "",
              f"{res.duration / 3600:.2f} h of log, sensors {', '.join(res.sensors)}; statistic blocks of "
@@ -131,6 +134,13 @@ def report_markdown(res, source="", figure="timeline.png") -> str:
               "docs/monitoring.md, isolability per sensor set).", ""]
     if sk.get("operating_point"):
         lines += [f"**Operating point:** {sk['operating_point']}.", ""]
+    for note in getattr(res, "notes", None) or []:
+        lines += [f"**Note:** {note}.", ""]
+    gap = getattr(res, "gap", None)
+    if gap:
+        c = max(gap, key=lambda k: gap[k])
+        lines += [f"Gap over the whole log: largest in `{c}`, {gap[c]:.2f}x the noise (1.00: at the noise; "
+                  "measured as `heavecomp diagnose` measures it, the nominal replay's floor subtracted).", ""]
     lines += ["## Changes", ""]
     if res.changes:
         lines.append(md_table(["detected t [s]", "onset [s]", "component", "size [noise σ]", "kind"],
@@ -157,7 +167,35 @@ def report_markdown(res, source="", figure="timeline.png") -> str:
               + ", ".join(f"{c} {UNITS[c]}" for c in COMPONENTS) + ".", "",
               "Method: component residuals (equation error) in windows, a two-sided CUSUM per component on the "
               "log of its block statistic (docs/monitoring.md)."]
+    if diagnosed:
+        lines += ["", "## Diagnosed segments", "", *diagnosed]
     return "\n".join(lines) + "\n"
+
+
+def diagnosed_lines(spans, log, params, out) -> list:
+    """The report's lines on each diagnosed segment: its folder (what ``heavecomp diagnose --span`` writes:
+    ``diagnosis.json``, ``report.md``/``.html``, the figures, ``calibrated.toml``) and the command that
+    diagnoses that span again.
+
+    Parameters
+    ----------
+    spans : {int: (float, float)}
+        Segment index -> the span diagnosed [s, log time].
+    log, params : str
+        The log and the parameter file as the user named them.
+    out : str or Path
+        The monitor's output folder as the user named it.
+    """
+    import shlex
+
+    lines = []
+    for i, (a, b) in sorted(spans.items()):
+        folder = Path(out) / f"segment_{i}"
+        cmd = " ".join(shlex.quote(w) for w in ("heavecomp", "diagnose", str(log), "--params", str(params),
+                                                 "--span", f"{a:.0f}:{b:.0f}", "--out", str(folder)))
+        lines += [f"- segment {i}, {a:.0f}-{b:.0f} s: [`{folder.name}/report.md`]({folder.name}/report.md), "
+                  f"`{folder.name}/calibrated.toml`; the same diagnosis: `{cmd}`"]
+    return lines
 
 
 def _verdict(segment) -> str:
@@ -169,7 +207,7 @@ def _verdict(segment) -> str:
     return f"{v['effect']} ({v.get('confidence')}; {v.get('component') or '-'})"
 
 
-def write_report(res, out, *, source="", extra=None) -> Path:
+def write_report(res, out, *, source="", extra=None, diagnosed=()) -> Path:
     """``monitor.json``, ``timeline.png`` and ``report.md`` in ``out`` (the HTML comes with the provenance
     stamp, :func:`heavecomp.report.provenance.finish`).
 
@@ -182,11 +220,13 @@ def write_report(res, out, *, source="", extra=None) -> Path:
         Name of the log, for the title.
     extra : dict, optional
         Keys added to ``monitor.json``.
+    diagnosed : sequence of str
+        The report's lines on the diagnosed segments (:func:`diagnosed_lines`).
     """
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     write_json(res, out / "monitor.json", extra)
     save(timeline_figure(res), out / "timeline.png")
     p = out / "report.md"
-    p.write_text(report_markdown(res, source), encoding="utf-8")
+    p.write_text(report_markdown(res, source, diagnosed=diagnosed), encoding="utf-8")
     return p
