@@ -181,3 +181,16 @@ def test_monitor_diagnose_writes_each_segment_as_diagnose_span_does_with_progres
     assert json.loads((seg / "diagnosis.json").read_text())["span"]["start_s"] == pytest.approx(
         mon["segments"][done[0]]["start"])
     assert f"segment {done[0]}:" in cap.err and "--span" in (out / "report.md").read_text()
+
+
+@pytest.mark.slow
+def test_a_slow_drift_is_one_change_with_a_rate():
+    """Issue 30 item 2: a gas leak the monitor follows was a series of alarms (11 in 50 min on a tuning log),
+    one every relearning; it is one change, drift true, with its rate per hour and the span it covers."""
+    tr = _nominal_log(2400.0, 10.0, seed=3, changes=[(600.0, "gas_leak")])
+    res = M.monitor(tr.to_run(), tr.nominal)
+    eff = [c for c in res.changes if c["kind"] == "effect"]
+    assert len(eff) == 1 and eff[0]["drift"] and eff[0]["component"] == "gas_spring"
+    d = eff[0]
+    assert 600.0 <= d["t"] < d["until"] and d["alarms"] >= M.DRIFT_ALARMS and d["rate_unit"] == "noise sigma/h"
+    assert math.isfinite(d["rate"]) and abs(d["rate"]) > 1.0 and np.sign(d["rate"]) == d["direction"]

@@ -138,6 +138,12 @@ BLANK = 2  #: blocks on each side of an operating change left out of the compone
 #: block at the noise level, z a mean of about 2 x CUTOFF x BLOCK independent squares, is ~sqrt(2/20)/2
 SIGMA_MIN = 0.15
 REFERENCE = 30  #: blocks before an onset the naming compares with [-]
+#: a chain of at least this many effect alarms on one series, in one direction, each starting within DRIFT_LINK
+#: blocks of the previous alarm, is one drift (:func:`merge_drifts`): a gas leak of the tuning set (350004-like,
+#: 1.5e-6 /s) raised 11 alarms in 50 min, 170-210 s apart (RELEARN blocks, then the sum's climb); two alarms
+#: can be a step and its relearning [-]
+DRIFT_ALARMS = 3
+DRIFT_LINK = RELEARN + 6  #: blocks from one alarm to the next one's onset within a drift [-]
 #: features of the equations' own split (components.SPLIT) left out of the block coefficients: within
 #: one block the time ``t`` is the constant again
 NOT_PER_BLOCK = ("t",)
@@ -955,9 +961,61 @@ def component_changes(sums, block_t, block, op_bounds, *, threshold=THRESHOLD, l
             continue
         b, j, onset, size = hit
         comp, moved = _attribute_change(sums, names, comps, eqs, u, j, onset, b, start)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            sign = np.nanmean(u[onset:b + 1, j]) - np.nanmean(u[max(start, onset - REFERENCE):onset, j])
         out.append({"t": float(block_t[b] + block), "component": comp, "size_to_noise": size, "kind": "effect",
-                    "onset": float(block_t[onset]), "equations": sorted(moved), "column": names[j]})
+                    "onset": float(block_t[onset]), "equations": sorted(moved), "column": names[j],
+                    "direction": 1 if not sign < 0 else -1})
         start = b + 1
+    return merge_drifts(out, u, names, block_t, block)
+
+
+def merge_drifts(changes, u, names, block_t, block) -> list:
+    """Effect alarms that follow one drift, as one change.  A slowly growing effect (a gas leak) is alarmed,
+    the CUSUM restarts, relearns for :data:`RELEARN` blocks and alarms again, on the same series in the same
+    direction, as long as the drift goes on: a chain of :data:`DRIFT_ALARMS` or more such alarms, each
+    starting within :data:`DRIFT_LINK` blocks of the previous alarm, is one change (``kind`` ``effect``, at
+    the first alarm and onset) with ``drift`` true, ``until`` [s] (the last alarm), ``alarms`` (how many it
+    merges), ``rate`` [noise sigmas per hour] (the least-squares slope of the standardised series from the
+    onset to the last alarm; the sign of its direction) and ``rate_unit``; the component is the one most of
+    its alarms named.
+
+    Parameters
+    ----------
+    changes : list of dict
+        The effect alarms in time order (:func:`component_changes`).
+    u : array (blocks, series)
+        The standardised series (:func:`columns`).
+    names : list of str
+        Their names.
+    block_t : array [s]
+    block : float [s]
+    """
+    out, i = [], 0
+    while i < len(changes):
+        k = i + 1
+        while (k < len(changes) and changes[k]["column"] == changes[i]["column"]
+               and changes[k]["direction"] == changes[i]["direction"]
+               and changes[k]["onset"] - changes[k - 1]["t"] <= DRIFT_LINK * block):
+            k += 1
+        chain = changes[i:k]
+        if len(chain) < DRIFT_ALARMS:
+            out.extend(chain)
+            i = k
+            continue
+        first, last = chain[0], chain[-1]
+        j = names.index(first["column"])
+        a, b = int(np.searchsorted(block_t, first["onset"])), int(np.searchsorted(block_t, last["t"] - block)) + 1
+        y, x = u[a:b, j], (block_t[a:b] + 0.5 * block) / 3600.0
+        ok = np.isfinite(y)
+        rate = float(np.polyfit(x[ok], y[ok], 1)[0]) if ok.sum() >= 3 else math.nan
+        comps = [c["component"] for c in chain]
+        merged = dict(first, component=max(set(comps), key=lambda c: (comps.count(c), -comps.index(c))),
+                      equations=sorted({e for c in chain for e in c["equations"]}), drift=True, until=last["t"],
+                      alarms=len(chain), rate=rate, rate_unit="noise sigma/h")
+        out.append(merged)
+        i = k
     return out
 
 

@@ -27,7 +27,8 @@ FLEET_COLUMNS = {"log": "-", "status": "-", "reason": "-", "duration [h]": "h", 
                  **{f"{c} gap/noise [-]": "-" for c in COMPONENTS}}
 #: ``changes.csv``: one row per change
 CHANGE_COLUMNS = {"log": "-", "kind": "-", "t [s]": "s", "onset [s]": "s", "component": "-",
-                  "size [noise sigma]": "-", "equations": "-", "WOB step [kN]": "kN", "pressure step [MPa]": "MPa"}
+                  "size [noise sigma]": "-", "equations": "-", "WOB step [kN]": "kN", "pressure step [MPa]": "MPa",
+                  "drift until [s]": "s", "drift rate [noise sigma/h]": "1/h"}
 #: ``segments.csv``: one row per segment
 SEGMENT_COLUMNS = {"log": "-", "segment": "-", "start [s]": "s", "end [s]": "s", "WOB set-point [kN]": "kN",
                    "static stroke [m]": "m", "static pressure [MPa]": "MPa", "verdict": "-", "confidence": "-",
@@ -111,12 +112,15 @@ def collect(out_dir, keys) -> dict:
                             "equations": " ".join(c.get("equations") or []),
                             "WOB step [kN]": "" if c.get("wob_step") is None else round(c["wob_step"] * 1e-3, 2),
                             "pressure step [MPa]": "" if c.get("pressure_step") is None else
-                            round(c["pressure_step"] * 1e-6, 4)})
+                            round(c["pressure_step"] * 1e-6, 4),
+                            "drift until [s]": round(c["until"], 1) if c.get("drift") else "",
+                            "drift rate [noise sigma/h]": round(c["rate"], 2) if c.get("drift") else ""})
         row.update({"duration [h]": round(mon["duration_s"] / 3600.0, 3), "sensors": " ".join(mon["sensors"]),
                     "segments [-]": len(mon["segments"]), "effect changes [-]": len(eff),
                     "operating changes [-]": len(ops),
                     "changes (t [s] component size [noise sigma])": "; ".join(
-                        f"{c['t']:.0f} {c['component']} {c['size_to_noise']:.1f}" for c in eff),
+                        f"{c['t']:.0f} {c['component']} {c['size_to_noise']:.1f}"
+                        + (f" drift to {c['until']:.0f} s" if c.get("drift") else "") for c in eff),
                     "operating changes (t [s] WOB step [kN])": "; ".join(
                         f"{c['t']:.0f} {(c.get('wob_step') or 0.0) * 1e-3:+.1f}" for c in ops),
                     "verdicts (segment: effect, confidence, group)": "; ".join(verdicts)})

@@ -145,7 +145,7 @@ def report_markdown(res, source="", figure="timeline.png", diagnosed=()) -> str:
     if res.changes:
         lines.append(md_table(["detected t [s]", "onset [s]", "component", "size [noise σ]", "kind"],
                               [[f"{c['t']:.0f}", f"{c['onset']:.0f}", c["component"], f"{c['size_to_noise']:.1f}",
-                                c["kind"]] for c in res.changes]))
+                                _kind(c)] for c in res.changes]))
     else:
         lines.append("No change: every component's residual stayed at its level over the whole log.")
     lines += ["", "`size`: the mean shift of the component's standardised block statistic between onset and "
@@ -196,6 +196,15 @@ def diagnosed_lines(spans, log, params, out) -> list:
         lines += [f"- segment {i}, {a:.0f}-{b:.0f} s: [`{folder.name}/report.md`]({folder.name}/report.md), "
                   f"`{folder.name}/calibrated.toml`; the same diagnosis: `{cmd}`"]
     return lines
+
+
+def _kind(change) -> str:
+    """A change's kind as the report shows it: a drift (:func:`heavecomp.diagnosis.monitor.merge_drifts`)
+    with its end and rate."""
+    if change.get("drift"):
+        return (f"{change['kind']}: drift to {change['until']:.0f} s ({change['alarms']} alarms), "
+                f"{change['rate']:+.1f} {change['rate_unit']}")
+    return change["kind"]
 
 
 def _verdict(segment) -> str:
