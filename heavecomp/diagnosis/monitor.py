@@ -648,6 +648,13 @@ def _add_chunk(sums, cr, blocks, loc, feats, xs) -> None:
                     np.add.reduceat(np.where(ok & np.isfinite(fpart), fpart * fpart, 0.0), at)
 
 
+#: the nominal replay's floor (:func:`nominal_replay`) is replayed on an operating segment's first chunk and every
+#: FLOOR_EVERY-th after it; the chunks between take the last replayed chunk's floor per sample (it is set by the
+#: sea state, which the 30-min reference follows too).  Every chunk: 2 h at 10 Hz monitored in 7.4 s, 24 h ~90 s
+#: against the benchmark's 60 s; every third: ~1/3 of the replays' cost [-]
+FLOOR_EVERY = 3
+
+
 def nominal_replay(sub, params, heave_reference) -> dict:
     """The nominal model's replay of one chunk ``sub`` as the diagnosis replays a log
     (:func:`heavecomp.diagnosis.replay.build`: its heave pre-processing, its start-state estimate from the
@@ -768,7 +775,8 @@ def component_blocks(run, params, edges, op_bounds, op, noise, *, block=BLOCK, c
         prm = segment_point(params, median_wob(s0, s1), w_first)
         zref = segment_heave_reference(op, s0, s1, prm)
         xs = float(np.nanmedian(op["stroke"][s0:s1])) if np.isfinite(op["stroke"][s0:s1]).any() else 0.0
-        for a, b in _chunks(s0, s1, per):
+        floor_ms = None  # the segment's last replayed floor: mean square per analysed sample {(c, e): value}
+        for n_chunk, (a, b) in enumerate(_chunks(s0, s1, per)):
             i0, i1 = edges[a], edges[b]
             j0 = int(np.searchsorted(t, t[i0] - pad))
             j1 = int(np.searchsorted(t, t[i1 - 1] + pad, side="right"))
@@ -778,8 +786,9 @@ def component_blocks(run, params, edges, op_bounds, op, noise, *, block=BLOCK, c
                                          for k in OP_CHANNELS}, source=run.source)
             own = MeasuredRun(t[j0:j1], {k: run[k][j0:j1] for k in OP_CHANNELS if k in run.columns},
                               source=run.source)
+            replay = floor_ms is None or n_chunk % FLOOR_EVERY == 0
             cr = CR.residuals(sub, prm, heave_reference=zref, noise=noise,
-                              floor_channels=nominal_replay(own, prm, zref))
+                              floor_channels=nominal_replay(own, prm, zref) if replay else None)
             if equations is not None:
                 cr.equations = {e: r for e, r in cr.equations.items() if e in equations}
             if sums is None:
@@ -787,6 +796,12 @@ def component_blocks(run, params, edges, op_bounds, op, noise, *, block=BLOCK, c
             if STROKE_BANDS > 1 and BAND_EQUATION in cr.equations and BAND_EQUATION not in sums.band_sum:
                 _open_bands(sums, cr, nb, xs)
             _add_chunk(sums, cr, slice(a, b), edges[a:b + 1] - j0, feats, xs)
+            if replay:
+                floor_ms = {k: float(v[a:b].sum()) / max(float(sums.count[k[1]][a:b].sum()), 1.0)
+                            for k, v in sums.floor.items()}
+            else:  # between replays: the last replayed chunk's floor per sample, over this chunk's samples
+                for k, ms in floor_ms.items():
+                    sums.floor[k][a:b] = ms * sums.count[k[1]][a:b]
             done += b - a
             if progress:
                 progress(done / max(nb, 1), f"component residuals to {t[i1 - 1]:.0f} s")
