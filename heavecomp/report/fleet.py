@@ -23,7 +23,7 @@ FLEET_COLUMNS = {"log": "-", "status": "-", "reason": "-", "duration [h]": "h", 
                  "verdicts (segment: effect, confidence, group)": "-",
                  # how far each log is from the model (issue 31): the monitor's gap/noise over the whole log, per
                  # component, its largest (the gap level) and the log's rank by it (1: the farthest)
-                 "gap level [-]": "-", "gap component": "-", "gap rank [-]": "-",
+                 "gap level [-]": "-", "gap component": "-", "gap rank [-]": "-", "notes": "-",
                  **{f"{c} gap/noise [-]": "-" for c in COMPONENTS}}
 #: ``changes.csv``: one row per change
 CHANGE_COLUMNS = {"log": "-", "kind": "-", "t [s]": "s", "onset [s]": "s", "component": "-",
@@ -124,7 +124,7 @@ def collect(out_dir, keys) -> dict:
                     "operating changes (t [s] WOB step [kN])": "; ".join(
                         f"{c['t']:.0f} {(c.get('wob_step') or 0.0) * 1e-3:+.1f}" for c in ops),
                     "verdicts (segment: effect, confidence, group)": "; ".join(verdicts)})
-        row.update(log_gap(mon))
+        row.update(log_gap(mon), notes="; ".join(mon.get("notes") or []))
         fleet.append(row)
     rank_by_gap(fleet)
     return {"logs": logs, "fleet": fleet, "changes": changes, "segments": segments}
@@ -327,7 +327,7 @@ def report_markdown(summary, run_info, *, source="", figure="timeline.png", comm
              f"({run_info['executor']}, {run_info['workers']} workers). Each log's own result: "
              f"`{RESULTS}/<log>/monitor.json` (and `segment_<i>/diagnosis.json` when diagnosed).", "",
              f"![changes per log]({figure})", "", "## Per log", ""]
-    keep = [k for k in FLEET_COLUMNS if k not in ("reason", "sensors")]
+    keep = [k for k in FLEET_COLUMNS if k not in ("reason", "sensors", "notes") and "gap/noise" not in k]
     lines.append(md_table(keep, [[r[k] if r[k] != "" else "-" for k in keep] for r in summary["fleet"]]))
     bad = [r for r in summary["fleet"] if r["status"] != "done"]
     if bad:
