@@ -705,7 +705,8 @@ def segment_point(params, w_segment, w_first):
 
 
 def segment_heave_reference(op, a, b, params) -> float:
-    """The heave reference of an operating segment (blocks a..b) [m]: the median over its blocks of the
+    """The heave reference of an operating segment (its reference stretch, blocks a..b) [m]: the median over
+    those blocks of the
     heave the quasi-static string balance implies (:func:`heavecomp.diagnosis.start.string_balance_heave`,
     the diagnosis' own start estimate of it) from the block means of heave, stroke and WOB (a missing
     stroke: 0; a missing WOB: the set-point).  The segment's median heave is not it: the string is stiff
@@ -730,7 +731,7 @@ def segment_heave_reference(op, a, b, params) -> float:
 
 
 def component_blocks(run, params, edges, op_bounds, op, noise, *, block=BLOCK, chunk=CHUNK, pad=PAD,
-                     progress=None, equations=None) -> BlockSums:
+                     progress=None, equations=None, learn=LEARN) -> BlockSums:
     """Block sums of the equation residuals and their component parts (pass 2), chunk by chunk, each
     operating segment with its own operating point.
 
@@ -756,6 +757,9 @@ def component_blocks(run, params, edges, op_bounds, op, noise, *, block=BLOCK, c
     equations : sequence of str, optional
         The equations to follow (default: every one); a channel the log lacks is given a constant
         stand-in (:func:`_stand_in`) that only the equations left out read.
+    learn : int
+        Blocks of a segment's reference stretch: its heave reference is read over them
+        (:func:`segment_heave_reference`), so a later change of the WOB's reading does not move it.
     """
     nb = edges.size - 1
     t = run.t
@@ -773,7 +777,7 @@ def component_blocks(run, params, edges, op_bounds, op, noise, *, block=BLOCK, c
         if s1 <= s0:
             continue
         prm = segment_point(params, median_wob(s0, s1), w_first)
-        zref = segment_heave_reference(op, s0, s1, prm)
+        zref = segment_heave_reference(op, s0, min(s1, s0 + learn), prm)
         xs = float(np.nanmedian(op["stroke"][s0:s1])) if np.isfinite(op["stroke"][s0:s1]).any() else 0.0
         floor_ms = None  # the segment's last replayed floor: mean square per analysed sample {(c, e): value}
         for n_chunk, (a, b) in enumerate(_chunks(s0, s1, per)):
@@ -1101,6 +1105,30 @@ def segment_gap(sums, a, b) -> dict:
     return {c: math.sqrt(1.0 + g) for c, g in CR.gap_of(z, floor).items()}
 
 
+def block_gap(sums) -> dict:
+    """{component: array over blocks}: each block's gap/noise, computed as :func:`segment_gap` computes a
+    segment's (the nominal replay's floor subtracted), NaN where a block analysed nothing: the timeline's
+    rows.
+
+    Parameters
+    ----------
+    sums : BlockSums
+    """
+    nb = next(iter(sums.count.values())).size
+    gap = {c: np.zeros(nb) for c in COMPONENTS}
+    seen = np.zeros(nb, bool)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        for (c, e), sq in sums.parts.items():
+            n = sums.count[e]
+            ok = n > 0
+            seen |= ok
+            z = np.where(ok, sq / np.maximum(n, 1), 0.0) / sums.noise[e] ** 2
+            f = np.where(ok, sums.floor[(c, e)] / np.maximum(n, 1), 0.0) / sums.noise[e] ** 2 \
+                if (c, e) in sums.floor else 0.0
+            gap[c] += np.maximum(z - (1.0 if CR.OWN[e] == c else 0.0) - f, 0.0)
+    return {c: np.where(seen, np.sqrt(1.0 + g), np.nan) for c, g in gap.items()}
+
+
 def gap_level(gap) -> dict:
     """``{"gap_to_noise": largest component gap/noise, "component": its component}`` of a log's (or a
     segment's) ``gap_to_noise`` (None values when there is none): how far the log is from the model, the
@@ -1293,7 +1321,7 @@ def monitor(run, params, *, block=BLOCK, chunk=CHUNK, threshold=THRESHOLD, thres
     else:
         op_changes, op_bounds = [], []
     sums = component_blocks(run, params, edges, op_bounds, op, noise, block=block, chunk=chunk, progress=progress,
-                            equations=use)
+                            equations=use, learn=learn)
     eff = [e for e in component_changes(sums, block_t, block, op_bounds, threshold=threshold, learn=learn,
                                         jump_eq=JUMP_EQ_SHORT if note else JUMP_EQ)
            if not absorbed(e, op_changes)]

@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from heavecomp.diagnosis.components import UNITS
+from heavecomp.diagnosis.monitor import block_gap
 from heavecomp.effects.base import COMPONENTS
 from heavecomp.report.figures import _plt, save
 from heavecomp.report.scenario import _clean as clean
@@ -15,8 +16,9 @@ from heavecomp.report.scenario import md_table
 
 
 def timeline_figure(res, *, title=""):
-    """One row per component: the block statistic as rms over noise (sqrt of the block's mean square
-    of the component's parts over the noise variance) against time, on a log scale; the block-mean
+    """One row per component: each block's gap/noise (:func:`heavecomp.diagnosis.monitor.block_gap`: as the
+    segments' and the diagnosis' gap, the nominal replay's floor subtracted; 1: at the noise, dotted)
+    against time, on a log scale; the block-mean
     WOB on top; effect changes as solid red lines, operating changes dashed.
 
     Parameters
@@ -33,9 +35,12 @@ def timeline_figure(res, *, title=""):
     tb = (res.t_blocks + 0.5 * res.block) * scale
     axes[0].plot(tb, res.op["wob"] * 1e-3, color="k", lw=0.8)
     axes[0].set_ylabel("WOB\nblock mean [kN]")
+    gaps = block_gap(res.sums) if getattr(res, "sums", None) is not None else \
+        {c: np.sqrt(np.maximum(res.stats[c], 1e-6)) for c in COMPONENTS}
     for ax, c in zip(axes[1:], COMPONENTS):
-        ax.semilogy(tb, np.sqrt(np.maximum(res.stats[c], 1e-6)), lw=0.7)
-        ax.set_ylabel(f"{c}\nrms/noise [-]", fontsize=8)
+        ax.semilogy(tb, gaps[c], lw=0.7)
+        ax.axhline(1.0, color="0.6", lw=0.6, ls=":")
+        ax.set_ylabel(f"{c}\ngap/noise [-]", fontsize=8)
     for ch in res.changes:
         op = ch["kind"] == "operating"
         for ax in axes:
@@ -45,7 +50,8 @@ def timeline_figure(res, *, title=""):
             ax.annotate(f"{ch['size_to_noise']:.1f} σ", (ch["t"] * scale, 1), xycoords=("data", "axes fraction"),
                         va="top", fontsize=7, color="tab:red")
     axes[-1].set_xlabel(f"time [{unit}]")
-    axes[0].set_title(title or "Component residuals over time (red: effect change, orange dashed: operating change)",
+    axes[0].set_title(title or "Gap over noise per component and block (red: effect change, orange dashed: "
+                      "operating change)",
                       fontsize=10)
     fig.tight_layout()
     return fig
