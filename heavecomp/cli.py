@@ -28,11 +28,13 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "params": ("heavecomp.commands.params", "write or check a parameter file (built-in sets: paper_a, ...)"),
     "analyse": ("heavecomp.commands.analyse", "linear analysis: k_eff_dc, natural frequencies, heave -> WOB frequency response"),
     "diagnose": ("heavecomp.commands.diagnose", "sim-to-real gap diagnosis of a measured run (which unmodelled effect)"),
+    "replay": ("heavecomp.commands.replay", "replay a measured log under one or more parameter files as the diagnosis does: gap/noise per file, the log against each model"),
     "monitor": ("heavecomp.commands.monitor", "monitor a long log: when and where the sim-to-real gap appears or changes"),
     "fleet": ("heavecomp.commands.fleet", "monitor (and diagnose) a folder of logs: one summary of segments, components and verdicts per log"),
     "campaign": ("heavecomp.commands.campaign", "run a sea-state campaign: WOB exceedance over a scatter diagram"),
     "stickslip": ("heavecomp.commands.stickslip", "paper B pneumatic cylinder: stick-slip analysis, simulation, map"),
     "identify": ("heavecomp.commands.identify", "identify from measured data: EMPS axis (+ residual diagnosis) or seal friction vs pressure"),
+    "export-fmu": ("heavecomp.commands.export_fmu", "write the CMC of a parameter file as a co-simulation FMU (FMI 3.0): heave in, WOB out"),
 }
 
 

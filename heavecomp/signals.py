@@ -35,6 +35,10 @@ import numpy as np
 from heavecomp.errors import DataError, InputError
 from heavecomp.errors import ParameterError
 
+#: zero-phase FIR low-pass cut-off of a measured heave [Hz] (paper B's method; waves < 0.7 Hz): the diagnosis'
+#: replay and ``simulate`` with a heave file pre-process a measured heave the same way
+HEAVE_CUTOFF = 0.8
+
 log = logging.getLogger(__name__)
 
 FLAT_TRANSITION = 0.75  #: transition band of :func:`flat_zero_phase` as a fraction of its cut-off [-] (0.5-1.1 Hz for the heave)

@@ -135,6 +135,22 @@ def test_what_next_names_the_change_the_file_and_the_commands():
     assert "**wob** sensor misreads" in text
     text = "\n".join(what_next(calibrate(NOM, _diag("none")), "out", params_path="rig.toml"))
     assert "Nothing to change in `rig.toml`" in text
+    # issue 31: after `none` no re-diagnosis or calibration check is offered, and the file is not "the nominal"
+    assert "heavecomp diagnose" not in text and "rediagnosis" not in text and "the nominal file" not in text
+    assert sum(line.startswith("heavecomp ") for line in text.splitlines()) == 2
+
+
+def test_what_next_commands_carry_the_logs_mapping_quoted():
+    """issue 31: a command that reads the log with the file the diagnosis ran against carries --columns/--units
+    (the re-diagnosis reads calibrated.toml's [measurement]); paths with spaces are quoted."""
+    from heavecomp.report.calibrated import what_next
+
+    par = {"compensator.gas_stiffness": 0.6 * NOM.compensator.gas_stiffness}
+    text = "\n".join(what_next(calibrate(NOM, _diag("parameter_mismatch", par)), "my out", run_path="rig log.csv",
+                               params_path="rig.toml", columns={"t": "TIME_MS"}, units={"t": "ms"}))
+    assert ("heavecomp replay 'rig log.csv' --params rig.toml --params 'my out/calibrated.toml' --out 'my out/replay' "
+            "--columns t=TIME_MS --units t=ms") in text
+    assert "heavecomp diagnose 'rig log.csv' --params 'my out/calibrated.toml' --out 'my out/rediagnosis'\n" in text
 
 
 def test_a_static_force_refitted_below_the_nominal_coulomb_force_clips_it_as_the_fit_does():

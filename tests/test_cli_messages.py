@@ -72,8 +72,13 @@ def test_simulate_heave_file_error_suggests_no_flag_simulate_lacks(paper_a_toml,
     p.write_text(text[:start] + '[heave]\nkind = "file"\npath = "heave.csv"\n' + text[end:])
     code, err = _cli(["simulate", p, "--duration", "5", "--out", tmp_path / "o"], capsys)
     assert code == 2 and "missing column 'heave'" in err
-    assert "--columns" not in err and "[measurement] columns" in err  # simulate has no --columns
+    assert "--columns heave=NAME" in err  # simulate maps a heave file's columns (issue 31: --heave-file)
     assert not (tmp_path / "o").exists()
+    assert main(["simulate", str(p), "--duration", "5", "--out", str(tmp_path / "o"), "--columns",
+                 "heave=elevation,t=time", "--quiet"]) == 0
+    code, err = _cli(["simulate", paper_a_toml, "--duration", "5", "--out", tmp_path / "o2", "--columns", "heave=z"],
+                     capsys)
+    assert code == 2 and "give --heave-file LOG" in err
 
 
 @pytest.fixture(scope="module")

@@ -49,7 +49,7 @@ W0 = P.operating_point.wob_setpoint
 ROOT = Path(__file__).resolve().parents[1]
 TIME_BUDGET_S = 60.0       #: per file, in-process (generous: the shared CI machine is slow)
 RSS_BUDGET_MB = 3000.0     #: peak resident memory of the test process
-FILE_PROBLEMS = ("binary file", "empty file", "corrupt compressed", "cannot read", "not found")
+FILE_PROBLEMS = ("binary file", "empty file", "corrupt compressed", "cannot read", "not found", "not well-formed XML")
 COUNTS = {"runs_accepted": 0, "runs_refused": 0, "heave_accepted": 0, "heave_refused": 0}
 
 TEXT_FORMATS = ("csv", "semicolon_comma", "tab", "spaces", "gz", "bz2", "xz", "zip")
@@ -505,3 +505,95 @@ def test_subprocess_odd_logs_one_line(tmp_path, content):
     assert r.returncode == 2, r.stderr
     msg = _one_line(r.stderr, "diagnose")
     assert _names_something(msg), msg
+
+
+# ---------------------------------------------------------------- drilling logs (WITSML 1.4.1.1, LAS 2.0)
+#: rig units of a drilling log: contract column -> [(unit, SI per unit)]
+LOG_UNITS = {"heave": [("m", 1.0), ("ft", 0.3048), ("in", 0.0254)], "stroke": [("m", 1.0), ("in", 0.0254), ("mm", 1e-3)],
+             "pressure": [("psi", 6894.757), ("kPa", 1e3), ("bar", 1e5)],
+             "wob": [("klbf", 4448.22), ("kkgf", 9806.65), ("kN", 1e3), ("daN", 10.0)]}
+LOG_MNEMONICS = {"heave": ("HEAVE", "MRU_HEAVE", "RIG_HEAVE"), "stroke": ("CMC_POS", "CMC_STROKE"),
+                 "pressure": ("CMC_PRES", "COMP_PRES"), "wob": ("WOB", "SWOB")}
+LOG_DEFECTS = ("none",) * 6 + ("nulls", "unknown_unit", "missing_heave", "depth_index", "truncated")
+
+
+@st.composite
+def drilling_logs(draw):
+    """(Table of raw bytes, expected SI columns or None): a WITSML or LAS log in rig units."""
+    from heavecomp.io import logs
+
+    kind = draw(st.sampled_from(["witsml", "witsml_datetime", "las"]))
+    dt = draw(st.sampled_from([0.1, 0.2]))
+    n = int(draw(st.floats(65.0, 120.0)) / dt)
+    rng = np.random.default_rng(draw(st.integers(0, 2 ** 16)))
+    t = np.arange(n) * dt
+    z = draw(st.floats(0.1, 2.0)) * np.sin(2 * np.pi * t / draw(st.floats(6.0, 16.0)) + rng.uniform(0, 6))
+    si = {"t": t, "heave": z, "stroke": -0.9 * z + 2e-3 * rng.normal(size=n), "pressure": P.p0 + 3e5 * z,
+          "wob": W0 + 3e4 * z + 400 * rng.normal(size=n)}
+    defect = draw(st.sampled_from(LOG_DEFECTS))
+    channels, units, expected = {"TIME": t}, {"TIME": "s"}, {k: v.copy() for k, v in si.items()}
+    refuse = None
+    for c in ("heave", "stroke", "pressure", "wob"):
+        m = draw(st.sampled_from(LOG_MNEMONICS[c]))
+        u, f = draw(st.sampled_from(LOG_UNITS[c]))
+        channels[m], units[m] = si[c] / f, u
+        expected[c] = channels[m] * f
+    mn = {c: next(m for m in channels if m in LOG_MNEMONICS.get(c, ())) for c in LOG_MNEMONICS}
+    if defect == "nulls":
+        idx = rng.choice(np.arange(5, n - 5), size=max(1, n // 200), replace=False)
+        channels[mn["wob"]] = channels[mn["wob"]].copy()
+        channels[mn["wob"]][idx] = np.nan
+        expected["wob"][idx] = np.nan
+    elif defect == "unknown_unit":
+        units[mn["wob"]], refuse = "klbs", "unknown unit 'klbs'"
+    elif defect == "missing_heave":
+        del channels[mn["heave"]]
+        refuse = "missing column 'heave'"
+    elif defect == "depth_index":
+        channels = {"DEPT": 1000.0 + t, **{k: v for k, v in channels.items() if k != "TIME"}}
+        units["DEPT"] = "m"
+        refuse = "a time index is needed"
+    expected["t"] = t
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as d:
+        f = Path(d) / "log"
+        index = "DEPT" if defect == "depth_index" else "TIME"
+        if kind == "las":
+            logs.write_las(f, channels, units, index=index)
+        else:
+            logs.write_witsml(f, channels, units, index=index, null="-999.25" if defect == "nulls" else None,
+                              start="2026-11-02T06:00:00Z" if kind == "witsml_datetime" and index == "TIME" else None)
+            if defect == "depth_index":
+                f.write_text(f.read_text().replace("elapsed time", "measured depth"))
+        raw = f.read_bytes()
+    if defect == "truncated":
+        raw = raw[: int(len(raw) * 0.6)]
+        refuse = "not well-formed XML" if kind != "las" else "row "
+        if kind == "las":  # a LAS file cut mid-row: lasio reads the rows before it; the torn row is short
+            refuse, expected = None, None
+    tab = Table(header=[], cols=[], raw=raw, refuse=refuse)
+    return tab, (None if refuse is not None else expected), kind == "las" and defect == "truncated"
+
+
+@fuzz(10)
+@given(case=drilling_logs())
+def test_fuzz_drilling_logs(case, tmp_path_factory, capsys):
+    """WITSML and LAS logs in rig units: read to the SI run they were made from, or one line naming the
+    column (unknown unit, missing mnemonic), the index (depth) or the file (not well-formed)."""
+    pytest.importorskip("lasio")
+    tab, expected, torn_las = case
+    if torn_las:  # either accepted or one line: the torn LAS row is a reader's judgement, not an oracle's
+        tmp = tmp_path_factory.mktemp("run")
+        nominal = tmp / "nominal.toml"
+        nominal.write_text(dumps(P))
+        path = write_table(tab, tmp / "run.csv")
+        with mock.patch("heavecomp.diagnosis.estimator.GapDiagnoser", _Probe):
+            try:
+                rc = main(["diagnose", str(path), "--params", str(nominal), "--out", str(tmp / "o"), "--quiet"])
+            except _Reached:
+                rc = 0
+        err = capsys.readouterr().err
+        assert rc == 0 or (rc == 2 and len(err.strip().splitlines()) == 1), err
+        return
+    check_run_promise(tab, expected, tmp_path_factory.mktemp("run"), capsys)

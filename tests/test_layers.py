@@ -64,7 +64,8 @@ KNOWN_UPWARD = {
 }
 
 #: third-party libraries that take long to import; modules loading one at top are imported lazily
-HEAVY_LIBRARIES = {"numba", "casadi", "control", "osqp", "pandas", "pyarrow", "matplotlib", "scipy", "dask"}
+HEAVY_LIBRARIES = {"numba", "casadi", "control", "osqp", "pandas", "pyarrow", "matplotlib", "scipy", "dask",
+                   "lasio", "xarray", "pythonfmu3", "fmpy"}
 #: compiled modules without Python source (the ahead-of-time numba kernel setup.py may build)
 COMPILED = {"heavecomp.simulate._cmc_aot"}
 

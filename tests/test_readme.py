@@ -95,7 +95,7 @@ CLAIMS = {
 }
 
 #: numbers in the prose that are settings, citations or definitions, not results
-NOT_RESULTS = ("ICCAS 2012", "eq. 7", "eq. 4", "eq. 14", "eqs. 1-7", "Kagawa 1999", "Python ≥ 3.11",
+NOT_RESULTS = ("WITSML 1.4.1.1", "LAS 2.0", "FMI 3.0", "ICCAS 2012", "eq. 7", "eq. 4", "eq. 14", "eqs. 1-7", "Kagawa 1999", "Python ≥ 3.11",
                "1 m, 12 s heave", "~5 s on 2 cores", "40x40 simulations", "Figs. 7-8", "Fig. 3",
                "exit code 2", "80 t / 30 t masses", "k_ds = 2.08 MN/m", "printed 208 kN/m", "n < 1",
                "mass ≤ 0", "v_S ≤ 0", "--map 40", "two hours", "3600", "600", "--rate 20", "--duration 60",

@@ -339,7 +339,9 @@ def test_heave_file_in_a_rig_shape(tmp_path):
     p = load(_heave_params(tmp_path, f, {"columns": {"t": "Zeit", "heave": "MRU Heave"},
                                          "units": {"t": "ms", "heave": "mm"}}))
     hs = make_heave(p.heave, 100.0, 0.05, p.base_dir, measurement=p.extra["measurement"])
-    np.testing.assert_allclose(hs.z[::2][:1000], (z - z[0])[:1000], atol=1e-5)
+    # the heave is read in mm and ms and low-passed as the diagnosis' replay does (flat pass band: a 11 s wave
+    # passes to within its 0.04 % ripple, 0.3 mm of 0.8 m)
+    np.testing.assert_allclose(hs.z[::2][:1000], (z - z[0])[:1000], atol=5e-4)
 
 
 @pytest.mark.parametrize("content,fragment", [

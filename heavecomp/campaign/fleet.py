@@ -63,7 +63,7 @@ RESULTS = "logs"  #: folder of the per-log results inside the output folder
 TASK = "task.json"  #: a log result's status and fingerprint
 #: file name endings of logs found in a folder (the reader recognises formats by content; compressed
 #: text logs end in one of these plus .gz, .bz2, .xz or .zip)
-LOG_SUFFIXES = (".csv", ".txt", ".tsv", ".dat", ".parquet", ".mat")
+LOG_SUFFIXES = (".csv", ".txt", ".tsv", ".dat", ".parquet", ".mat", ".xml", ".las")  # .xml: WITSML 1.4.1.1
 COMPRESSED = (".gz", ".bz2", ".xz", ".zip")
 MANIFEST_KEYS = ("params", "columns", "units", "logs")
 LOG_KEYS = ("params", "columns", "units")

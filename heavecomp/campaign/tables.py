@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 from heavecomp.campaign.execute import TABLE, read_table
 from heavecomp.errors import ParameterError
+from heavecomp.io.arrays import campaign_dataset
 
 #: columns holding whole numbers (stored as float64 by the CSV reader)
 INT_COLUMNS = ("sea_state", "seed", "n_samples", "n_band_exits", "n_cycles", "n_stick", "n_breakaway", "n_reversal")
@@ -90,6 +91,21 @@ def runs_frame(table):
     df = pd.DataFrame(data)
     df.attrs["units"] = {k: UNITS.get(k, "") for k in df.columns}
     return df
+
+
+def to_xarray(table, *, name: str | None = None):
+    """The runs as an ``xarray.Dataset`` (:func:`heavecomp.io.arrays.campaign_dataset`): dimensions
+    ``sea_state`` (coordinates ``hs``, ``tp``, ``probability``), ``regime`` (friction regime), ``variant``,
+    ``seed``; one variable per scalar column of :func:`runs_frame`, its unit in ``attrs["units"]``.
+
+    Parameters
+    ----------
+    table : str or os.PathLike or dict
+        As :func:`runs_frame`'s.
+    name : str, optional
+        The campaign's name (``attrs["campaign"]``).
+    """
+    return campaign_dataset(runs_frame(table), UNITS, {"campaign": name} if name else None)
 
 
 def histograms_frame(table: dict, deviation_max: float, bins: int):

@@ -16,6 +16,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("campaign", metavar="CAMPAIGN.toml",
                    help="campaign definition (docs/campaign.md); 'default' = the built-in illustrative campaign")
     p.add_argument("--out", required=True, metavar="DIR", help="results folder (rerun into it to resume)")
+    p.add_argument("--format", choices=("netcdf",), default=None,
+                   help="also write the results as a labelled array, DIR/campaign.nc (netCDF 3: xarray.Dataset with "
+                        "coordinates and units; needs heavecomp[arrays])")
     p.add_argument("--workers", type=int, default=None, metavar="N",
                    help="local worker processes (default: all cores)")
     p.add_argument("--scheduler", default=None, metavar="ADDRESS",
@@ -57,12 +60,21 @@ def run(args) -> int:
     if args.workers is not None and args.workers < 1:
         raise InputError(f"--workers must be >= 1, got {args.workers}")
     logging.basicConfig(level=logging.WARNING, format="%(message)s")
+    if args.format:  # the library first: one line before any run, not after the campaign
+        from heavecomp.io.arrays import xarray
+
+        xarray()
     camp = spec.default() if args.campaign == "default" else spec.load(args.campaign)
     bar = Progress(f"campaign {camp.settings.name}")
     info, st = run_and_report(camp, args.out, workers=args.workers, scheduler=args.scheduler,
                               progress=lambda done, total: bar(done / total if total else 1.0))
     from heavecomp.report.provenance import finish
 
+    if args.format:
+        from heavecomp.campaign.tables import to_xarray
+        from heavecomp.io.arrays import write
+
+        write(to_xarray(info.table_path, name=camp.settings.name), Path(info.out_dir) / "campaign.nc")
     finish(info.out_dir, json_files=("metrics.json", "statistics.json"), params_file="campaign.toml",
            csv_files=("runs.csv",))
     print(f"{info.n_simulated} runs simulated, {info.n_skipped} resumed, {info.wall_time:.1f} s "

@@ -107,9 +107,10 @@ def run(args) -> int:
 
     d = GapDiagnoser(params, cands, split=args.split, settle=args.settle, n_jobs=args.jobs, progress=progress)
     d.fit(run_)
-    cal = write_outputs(d, args.out, params=params, run=run_, run_path=args.run, params_path=args.params, span=span)
     from heavecomp.commands._output import final
 
+    cal = write_outputs(d, args.out, params=params, run=run_, run_path=args.run, params_path=args.params, span=span,
+                        columns=columns, units=units, shown_dir=final(args))
     v = d.verdict_
     extra = f", second effect {v['second_effect']['effect']}" if v.get("second_effect") else ""
     print(f"verdict: {v['effect']} (confidence {v['confidence']}), held-out shrink {v['shrink']:.2f} "
@@ -118,7 +119,8 @@ def run(args) -> int:
     return 0
 
 
-def write_outputs(d, out, *, params, run, run_path, params_path, span=None):
+def write_outputs(d, out, *, params, run, run_path, params_path, span=None, columns=None, units=None,
+                  shown_dir=None):
     """What ``heavecomp diagnose`` writes into its folder ``out`` for a fitted diagnosis ``d``:
     ``diagnosis.json`` with how the log was read and the span analysed, ``report.md`` and its figures,
     ``calibrated.toml`` with its "What next", and the provenance stamp and ``report.html``
@@ -139,14 +141,21 @@ def write_outputs(d, out, *, params, run, run_path, params_path, span=None):
         The log and the parameter file as the user named them.
     span : heavecomp.diagnosis.span.Span, optional
         The stretch of the log analysed.
+    columns, units : dict, optional
+        The mapping the log was read with (``--columns``/``--units``): ``calibrated.toml`` records it, so its
+        re-diagnosis needs no flags.
+    shown_dir : str, optional
+        The folder as the user named it (the printed commands name it; default ``out``).
     """
+    from heavecomp.params.measurement import used
     from heavecomp.report.calibrated import write_calibrated  # calibrated.toml, its json block, "What next"
     from heavecomp.report.diagnosis import write_report
     from heavecomp.report.provenance import finish
 
     write_report(d, out, title=f"Sim-to-real gap diagnosis — {run.source}")
     _record_measurement(Path(out) / "diagnosis.json", run.measurement, span.to_json() if span is not None else None)
-    cal = write_calibrated(params, out, run_path=run_path, params_path=params_path, run=run, policy=d.verdict_policy())
+    cal = write_calibrated(used(params, columns, units), out, run_path=run_path, params_path=params_path, run=run,
+                           policy=d.verdict_policy(), shown_dir=str(shown_dir or out), columns=columns, units=units)
     finish(out, params=params, json_files=("diagnosis.json",), heave_used=False,
            measured_run=str(Path(run_path).resolve()))
     return cal

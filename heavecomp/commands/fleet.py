@@ -33,6 +33,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="local worker processes, one log each at a time (default: all cores)")
     p.add_argument("--scheduler", default=None, metavar="ADDRESS",
                    help="run on a Dask distributed scheduler, e.g. tcp://10.0.0.5:8786 (needs heavecomp[cluster])")
+    p.add_argument("--format", choices=("netcdf",), default=None,
+                   help="also write the results as a labelled array, DIR/fleet.nc (netCDF 3: xarray.Dataset with "
+                        "coordinates and units; needs heavecomp[arrays])")
     p.add_argument("--resume", action="store_true",
                    help="keep the logs already finished in --out (by an interrupted run, or a complete one) "
                         "with the same log, parameters and settings; compute the rest")
@@ -75,6 +78,10 @@ def run(args) -> int:
         raise InputError(f"--block must be > 0 s, got {args.block}")
     if args.workers is not None and args.scheduler:
         raise InputError("--workers and --scheduler: give one (the Dask scheduler has its own workers)")
+    if args.format:  # the library first: one line before any log is read
+        from heavecomp.io.arrays import xarray
+
+        xarray()
     logging.basicConfig(level=logging.WARNING, format="%(message)s")
     columns, units = check_spec(parse_mapping(args.columns, "--columns"), parse_mapping(args.units, "--units"), "cli")
     tasks = F.plan(args.logs, args.params, manifest=args.manifest, columns=columns, units=units)
@@ -99,6 +106,11 @@ def run(args) -> int:
     for p in work.iterdir():  # results of logs no longer in the fleet, or interrupted writes
         if p.name not in keep:
             shutil.rmtree(p, ignore_errors=True)
+    if args.format:
+        from heavecomp.io.arrays import write
+        from heavecomp.report.fleet import to_xarray
+
+        write(to_xarray(summary, source=str(args.logs)), Path(args.out) / "fleet.nc")
     finish(args.out, json_files=("fleet.json",), params_file=None)
     failed = [r for r in summary["fleet"] if r["status"] != "done"]
     n_eff = sum(c["kind"] == "effect" for c in summary["changes"])

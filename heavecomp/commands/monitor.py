@@ -27,6 +27,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="diagnose each segment that starts at an effect change (the gap diagnosis on its first "
                         "600 s; segments[].verdict in monitor.json, segment_<i>/diagnosis.json)")
     p.add_argument("--jobs", type=int, default=1, metavar="N", help="candidates fitted concurrently by --diagnose")
+    p.add_argument("--format", choices=("netcdf",), default=None,
+                   help="also write the results as a labelled array, DIR/monitor.nc (netCDF 3: xarray.Dataset with "
+                        "coordinates and units; needs heavecomp[arrays])")
 
 
 def run(args) -> int:
@@ -58,6 +61,10 @@ def run(args) -> int:
         raise InputError(f"--block must be > 0 s, got {args.block}")
     if args.jobs < 1:
         raise InputError(f"--jobs must be >= 1, got {args.jobs}")
+    if args.format:  # the library first: one line before the log is read
+        from heavecomp.io.arrays import xarray
+
+        xarray()
     run_ = load_run(args.run, params, columns=columns, units=units)
     if run_.duration < M.MIN_DURATION:
         raise InputError(f"{run_.source}: column 't': the log spans {run_.duration:.3g} s; monitor needs at least "
@@ -78,7 +85,8 @@ def run(args) -> int:
 
         spans[i] = ab
         write_outputs(d, Path(args.out) / f"segment_{i}", params=params, run=sub, run_path=args.run,
-                      params_path=args.params, span=SP.choose(run_.duration, ab, min_duration=M.DIAGNOSE_MIN))
+                      params_path=args.params, span=SP.choose(run_.duration, ab, min_duration=M.DIAGNOSE_MIN),
+                      columns=columns, units=units, shown_dir=str(Path(final(args)) / f"segment_{i}"))
         print(f"segment {i} ({ab[0]:.0f}-{ab[1]:.0f} s): {d.verdict_['effect']} (confidence "
               f"{d.verdict_.get('confidence')}) -> {Path(final(args)) / f'segment_{i}'}", file=sys.stderr, flush=True)
 
@@ -88,6 +96,13 @@ def run(args) -> int:
         res.segments[i]["verdict"]["folder"] = f"segment_{i}"
     write_report(res, args.out, source=run_.source, extra={"measurement": run_.measurement} if run_.measurement else None,
                  diagnosed=diagnosed_lines(spans, args.run, args.params, final(args)))
+    if args.format:  # from monitor.json as written (the segments' verdicts included)
+        import json
+
+        from heavecomp.io.arrays import monitor_dataset, write
+
+        mon = json.loads((Path(args.out) / "monitor.json").read_text(encoding="utf-8"))
+        write(monitor_dataset(mon, {"source": str(run_.source)}), Path(args.out) / "monitor.nc")
     finish(args.out, params=params, json_files=("monitor.json",), heave_used=False, measured_run=str(Path(args.run).resolve()))
     for e, chans in res.skipped.get("equations", {}).items():
         print(f"left out the {e} residual: the log has no {', '.join(chans)} channel", file=sys.stderr)

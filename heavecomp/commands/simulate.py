@@ -16,6 +16,15 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("params", metavar="PARAMS.toml", help="CMC parameter file (contract: docs/contracts/parameter-file.md)")
     p.add_argument("--duration", type=float, required=True, metavar="S", help="simulated time [s]")
     p.add_argument("--out", required=True, metavar="DIR", help="output folder")
+    p.add_argument("--heave-file", default=None, metavar="LOG",
+                   help="drive the plant with a measured heave (the [heave] table becomes kind = \"file\"), "
+                        "pre-processed as the diagnosis' replay; a log with a wob column also gets the WOB error "
+                        "against it, on its held-out part (metrics.json against_log)")
+    p.add_argument("--columns", default=None, metavar="t=NAME,...",
+                   help="with a heave file (--heave-file, or [heave] kind = \"file\"): map contract columns to the "
+                        "file's, e.g. t=Time,heave=MRU_heave,wob=WOB (overrides [measurement] columns)")
+    p.add_argument("--units", default=None, metavar="t=ms,...",
+                   help="with a heave file: declare units, e.g. t=ms,stroke=mm (overrides [measurement] units)")
     p.add_argument("--rate", type=float, default=20.0, metavar="HZ", help="output sample rate [Hz] (default 20)")
     p.add_argument("--dt", type=float, default=None, metavar="S",
                    help="RK4 step [s] (default: h * fastest plant rate <= 0.6, at most 50 ms)")
@@ -64,7 +73,7 @@ def run(args) -> int:
     from heavecomp.report.simulation import write_outputs
     from heavecomp.simulate import simulate
 
-    params = load(args.params)
+    params = _heave_file(args, load(args.params, heave_file=args.heave_file is None))
     if args.friction:
         params = params.replace(friction={"model": args.friction})
     _need_space(args)
@@ -89,11 +98,67 @@ def run(args) -> int:
     from heavecomp.report.provenance import finish
     from heavecomp.commands._output import final
 
+    log_line = _against_log(res, params, Path(args.out) / "metrics.json")
     finish(args.out, params=params, csv_files=("timeseries.csv",))
     print(f"WOB mean {m['wob_mean'] / 1e3:.2f} kN, std {m['wob_std'] / 1e3:.2f} kN, "
-          f"peak-to-peak {m['wob_p2p'] / 1e3:.2f} kN, stuck {100 * m['stick_fraction']:.1f} % of the time "
-          f"-> {final(args)}")
+          f"peak-to-peak {m['wob_p2p'] / 1e3:.2f} kN, stuck {100 * m['stick_fraction']:.1f} % of the time"
+          f"{log_line} -> {final(args)}")
     return 0
+
+
+def _heave_file(args, params):
+    """``params`` with ``--heave-file`` as its ``[heave]`` (kind ``file``) and ``--columns``/``--units`` over its
+    ``[measurement]``; the flags' one-line errors before any work."""
+    from pathlib import Path
+
+    from heavecomp.errors import InputError
+    from heavecomp.io.series import check_spec, parse_mapping
+    from heavecomp.params.cmc import check_heave_path
+    from heavecomp.params.measurement import used
+
+    columns, units = check_spec(parse_mapping(args.columns, "--columns"), parse_mapping(args.units, "--units"),
+                                "cli")
+    if args.heave_file is None:
+        if (columns or units) and (params.heave is None or params.heave.kind != "file"):
+            raise InputError("--columns/--units map a heave file's columns: give --heave-file LOG (or a parameter "
+                             "file with [heave] kind = \"file\")")
+        return used(params, columns, units)
+    path = str(Path(args.heave_file).resolve())
+    gone = {k: None for k in ("amplitude", "period", "hs", "tp", "gamma", "seed", "ramp")}
+    params = used(params.replace(heave={**gone, "kind": "file", "path": path}), columns, units)
+    try:
+        check_heave_path(params.heave, None)
+    except InputError as exc:
+        raise InputError(str(exc).replace("heave.path", "--heave-file", 1)) from None
+    return params
+
+
+def _against_log(res, params, metrics_path) -> str:
+    """With a heave file (``[heave] kind = "file"``) that is a measured run: the simulation's error against its
+    output channels (:func:`heavecomp.diagnosis.compare.against_log`), added to ``metrics.json``; returns the
+    summary's words."""
+    import json
+
+    heave = params.heave
+    if heave is None or heave.kind != "file":
+        return ""
+    from pathlib import Path
+
+    from heavecomp.diagnosis.compare import against_log
+    from heavecomp.report.diagnosis import CH_UNITS
+
+    d = json.loads(metrics_path.read_text(encoding="utf-8"))  # its "heave" block says how the heave was pre-processed
+    ch = {c: res[c] for c in ("heave", "wob", "stroke", "pressure")}
+    got = against_log(res["t"], ch, Path(params.base_dir or ".") / heave.path, params)
+    words = ""
+    if got is not None:
+        d["against_log"] = got
+        c = got["channel"]
+        unit, sc = CH_UNITS[c]
+        words = (f"; {c} error against the log {got['rms'][c] * sc:.3g} {unit}, held-out "
+                 f"{got['rms_validate'][c] * sc:.3g} {unit} (after {got['split']['validate'][0]:.0f} s)")
+    metrics_path.write_text(json.dumps(d, indent=2) + "\n", encoding="utf-8")
+    return words
 
 
 def _run_closed_loop(args, params, Progress) -> int:

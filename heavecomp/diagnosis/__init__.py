@@ -4,6 +4,7 @@
 >>> run = load_run("run.csv", nominal)                           # doctest: +SKIP
 >>> d = GapDiagnoser(nominal, split=0.67).fit(run)               # doctest: +SKIP
 >>> d.verdict_, d.candidates_, d.where_, d.to_json()             # doctest: +SKIP
+>>> replay_files("run.csv", ["nominal.toml", "diag/calibrated.toml"]).ranking()  # doctest: +SKIP
 
 Parts: :mod:`~heavecomp.diagnosis.replay` (the run prepared once), :mod:`~heavecomp.diagnosis.fitting`
 (the fitting strategies), :mod:`~heavecomp.diagnosis.screen` (equation error: pre-screen, open search),
@@ -16,5 +17,6 @@ Heavy modules (numba, scipy) load on first use.
 from heavecomp.diagnosis.data import MeasuredRun, check_run, load_run
 from heavecomp.diagnosis.estimator import GapDiagnoser
 from heavecomp.diagnosis.policy import VerdictPolicy
+from heavecomp.diagnosis.compare import ReplayComparison, replay_files
 
-__all__ = ["GapDiagnoser", "VerdictPolicy", "load_run", "check_run", "MeasuredRun"]
+__all__ = ["GapDiagnoser", "VerdictPolicy", "load_run", "check_run", "MeasuredRun", "ReplayComparison", "replay_files"]

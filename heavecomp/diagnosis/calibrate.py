@@ -206,9 +206,10 @@ def _unchanged(v: dict) -> str:
     """
     if v["effect"] == "none":
         return ("diagnosis verdict: none -- the log agrees with this model within the measurement noise "
-                "(and the replay's response to the heave noise); nothing to change: this is the nominal file")
+                "(and the replay's response to the heave noise); nothing to change: this is the file the diagnosis ran "
+                "against, unchanged")
     return (f"diagnosis verdict: inconclusive -- {v.get('note', 'no candidate explains the gap')}; "
-            "nothing is changed: this is the nominal file"
+            "nothing is changed: this is the file the diagnosis ran against, unchanged"
             + (f" (the gap lives in {v['component']})" if v.get("component") else ""))
 
 
@@ -303,7 +304,7 @@ def _add_discovered(out: Calibrated, d: dict, add) -> bool:
                    f"{d.get('component', '?')} residual, {d.get('term', '')}, has no model form at its hook "
                    f"(discovered_term carries the friction features {', '.join(DISCOVERED_FEATURES)}, sensor_term "
                    "a channel's misreading with its levels, line_term / gas_term / string_term the memoryless "
-                   "features of their hook); nothing is changed: this is the nominal file")
+                   "features of their hook); nothing is changed: this is the file the diagnosis ran against, unchanged")
     out.expected_shrink = 0.0
     return False
 
@@ -480,7 +481,7 @@ def from_log(nominal, diagnosis: dict, run=None, policy=None) -> Calibrated:
     except InputError as exc:  # e.g. a refitted value outside its table's possible range: the nominal, and why
         cal = Calibrated(nominal, verdict=diagnosis["verdict"]["effect"],
                          why=[f"diagnosis verdict: {diagnosis['verdict']['effect']} -- its values cannot be written "
-                              f"into a valid parameter file ({exc}); this is the nominal file"])
+                              f"into a valid parameter file ({exc}); this is the file the diagnosis ran against, unchanged"])
     if run is not None and cal.changes:
         cal = start_state(cal, run, diagnosis)
         cal = reading_dynamics(cal, run, nominal, diagnosis, policy)
@@ -818,6 +819,33 @@ def replay_shrink(path, calibrated, nominal, diagnosis: dict, *, columns=None, u
     return dict(out, reported=reported, agreement=agree)
 
 
+def as_recorded(params, t, pred: dict, channel: str, heave) -> np.ndarray:
+    """A replay's prediction of ``channel`` read as the rig's sensors read it under the file ``params``: its
+    reading effects applied (a model-side lag read back, a gain, offset or delay applied), so that it compares
+    with the log as it was recorded.
+
+    Parameters
+    ----------
+    params : CMCParams
+        The file the replay ran under (its ``[[effects]]`` readings).
+    t : numpy.ndarray [s]
+        The run's times.
+    pred : dict
+        The replay's channels (:meth:`heavecomp.diagnosis.replay.Replay.simulate`).
+    channel : str
+        The channel read.
+    heave : numpy.ndarray [m]
+        The heave the replay was driven by (a reading term may read the string top's motion, heave + stroke).
+    """
+    out = pred[channel]
+    for e in reading_effects(params):
+        if getattr(e, "channel", None) == channel and e.model_side:
+            out = e.read_back(t, out)  # the replay read it through the sensor's lag already
+        elif getattr(e, "channel", None) == channel:
+            out = e.measure(t, t, out, motion=heave + pred["stroke"])
+    return out
+
+
 def held_out_shrink(raw, fixed, calibrated, nominal, diagnosis: dict) -> dict:
     """Held-out shrink of the calibrated model on a log read twice (:func:`replay_shrink`).
 
@@ -840,13 +868,7 @@ def held_out_shrink(raw, fixed, calibrated, nominal, diagnosis: dict) -> dict:
     nom = _replay(nominal, raw)
     cal = _replay(calibrated, fixed)
     t = raw.t
-    pred = cal[ch]
-    for e in reading_effects(calibrated):  # read the calibrated prediction as the rig's sensors do
-        if getattr(e, "channel", None) == ch and e.model_side:
-            pred = e.read_back(t, pred)  # the replay read it through the sensor's lag already
-        elif getattr(e, "channel", None) == ch:
-            # a reading term may read the string top's motion: the calibrated replay's (heave + stroke)
-            pred = e.measure(t, t, pred, motion=fixed["heave"] + cal["stroke"])
+    pred = as_recorded(calibrated, t, cal, ch, fixed["heave"])
     lo = float(diagnosis["split"]["validate"][0])
     y = raw[ch]
     m = (t >= lo) & np.isfinite(y) & np.isfinite(pred)
@@ -883,5 +905,5 @@ def discovered_shrink(cal: Calibrated, run, nominal, diagnosis: dict) -> Calibra
                       verdict_shrink=float(diagnosis["verdict"].get("shrink", 0.0)))
 
 
-__all__ = ["Calibrated", "calibrate", "discovered_shrink", "fit_reading", "held_out_shrink", "reading_dynamics",
+__all__ = ["Calibrated", "as_recorded", "calibrate", "discovered_shrink", "fit_reading", "held_out_shrink", "reading_dynamics",
            "replay_shrink", "to_toml", "write"]

@@ -55,7 +55,7 @@ ZREF_WINDOW = (5.0, 30.0)
 MAX_MISSING = 0.2  #: largest tolerated fraction of missing samples per column
 MAX_GAP = 2.0      #: longest heave dropout (or hole in the time column) bridged by interpolation [s]
 MIN_SAMPLES = 50   #: fewest samples of a run
-HEAVE_CUTOFF = 0.8  #: zero-phase FIR low-pass cut-off for the heave [Hz] (paper B's method; waves < 0.7 Hz)
+from heavecomp.signals import HEAVE_CUTOFF  # noqa: E402 - the heave low-pass cut-off [Hz], shared with simulate
 
 
 @dataclasses.dataclass

@@ -88,6 +88,7 @@ from heavecomp.diagnosis.estimator import GapDiagnoser
 from heavecomp.diagnosis.start import string_balance_heave
 from heavecomp.diagnosis.structure import equation_channels
 from heavecomp.effects.base import COMPONENTS
+from heavecomp.io.arrays import monitor_dataset
 from heavecomp.errors import DataError, InputError
 
 log = logging.getLogger(__name__)
@@ -239,6 +240,17 @@ class MonitorResult:
     def gap_level(self) -> dict:
         """The log's gap level: its largest component gap/noise over the whole log (:func:`gap_level`)."""
         return gap_level(self.gap)
+
+    def to_xarray(self, **attrs):
+        """The result as an ``xarray.Dataset`` over ``segment`` (x ``component``) and ``change``
+        (:func:`heavecomp.io.arrays.monitor_dataset`; units in each variable's ``attrs``).
+
+        Parameters
+        ----------
+        **attrs : str
+            Dataset attributes (e.g. ``source``).
+        """
+        return monitor_dataset(self.to_json(), attrs)
 
     def to_json(self) -> dict:
         extra = {"skipped": self.skipped} if self.skipped else {}

@@ -45,6 +45,7 @@ import numpy as np
 
 from heavecomp.errors import DataError, InputError
 from heavecomp.errors import did_you_mean
+from heavecomp.io import logs as _logs
 
 log = logging.getLogger(__name__)
 
@@ -68,6 +69,10 @@ UNITS = {
     "n": ("force", 1.0, 0.0), "kn": ("force", 1e3, 0.0), "mn": ("force", 1e6, 0.0),
     "t": ("force", 9810.0, 0.0), "tonnes": ("force", 9810.0, 0.0), "kip": ("force", 4448.22, 0.0),
     "lbf": ("force", 4.44822, 0.0), "klbf": ("force", 4448.22, 0.0),
+    # rig units of drilling logs (WITSML / LAS, docs/contracts/measured-run.md): kilogram-force and its
+    # thousand (kkgf, a metric tonne-force by the standard g = 9.80665), decanewton, kpsi, sec
+    "kgf": ("force", 9.80665, 0.0), "kkgf": ("force", 9806.65, 0.0), "dan": ("force", 10.0, 0.0),
+    "kpsi": ("pressure", 6894757.0, 0.0), "sec": ("time", 1.0, 0.0),
     "rad": ("angle", 1.0, 0.0), "mrad": ("angle", 1e-3, 0.0), "deg": ("angle", np.pi / 180.0, 0.0),
 }
 #: header spellings of the contract names (after normalisation: lower case, single spaces)
@@ -804,6 +809,11 @@ def _table(path: Path, src: str, info: dict, warnings: list, kinds: list, encodi
         return header, iter([(cols, np.arange(cols[0].size) + 1)]), scalars
     if comp:
         info["compression"] = comp
+    kind = _logs.sniff(head)
+    if kind is not None:  # a drilling log (WITSML 1.4.1.1, LAS 2.0): read whole, mapped by mnemonic
+        raw, _ = _decompress(_read_bytes(path, src), src)
+        return _logs.table(raw, kind, src, info, lambda b: _decode(b, src, warnings),
+                           lambda u: UNITS.get(u.strip().lower(), (None,))[0])
     if head[:4] == b"PAR1" or b"\x00" in head:  # compressed Parquet, UTF-16 or binary: read whole
         raw, _ = _decompress(_read_bytes(path, src), src)
         if raw[:4] == b"PAR1":
@@ -975,15 +985,19 @@ def _chunks(path, src, required, optional, columns, units, encoding, warnings, s
     kinds: list = []
     header, chunks, scalars = _table(path, src, info, warnings, kinds, encoding, head)
     stream = scalars.pop("_stream", None)
+    notes: list = []
+    if "_mnemonics" in scalars:  # a drilling log: its default mnemonic table under the user's mapping
+        columns, notes = _logs.mapping(scalars.pop("_mnemonics"), columns, required, optional)
     try:
         yield from _converted(header, chunks, scalars, info, src, required, optional, columns, units, warnings,
-                              kinds, state)
+                              kinds, state, notes)
     finally:
         if stream is not None:
             stream.close()
 
 
-def _converted(header, chunks, scalars, info, src, required, optional, columns, units, warnings, kinds, state):
+def _converted(header, chunks, scalars, info, src, required, optional, columns, units, warnings, kinds, state,
+               notes=()):
     """The chunks' columns mapped, converted to SI and checked (see :func:`iter_chunks`); ``state`` as
     :func:`_chunks`'s (kept out of ``info``, the ``measurement`` every caller sees)."""
     decimal = info.get("decimal", ".")
@@ -993,6 +1007,7 @@ def _converted(header, chunks, scalars, info, src, required, optional, columns, 
     info["columns"] = {name: str(header[j]) for name, j in chosen.items()}
     info["units"] = used_units
     info["conversions"] = conversions
+    conversions[:0] = notes  # a drilling log's mnemonic -> contract column lines
     if scalars:
         info["mat_scalars"] = sorted(k for k, v in scalars.items()
                                      if isinstance(v, np.ndarray) and v.size == 1 and v.dtype.kind in "iuf")

@@ -60,6 +60,28 @@ def from_table(table) -> Measurement:
     return Measurement(columns=cols, units=units, string_weight=None if w is None else float(w))
 
 
+def used(params, columns=None, units=None):
+    """``params`` with the ``[measurement]`` a log was read with: its own table with ``columns`` / ``units``
+    (e.g. a command's ``--columns``/``--units``) over it key by key, as the readers merge them.  A file
+    written from it (``calibrated.toml``) then reads the same log with no flags.
+
+    Parameters
+    ----------
+    params : CMCParams
+        The parameter set.
+    columns, units : dict or None
+        Contract name -> the log's column / unit.
+    """
+    import dataclasses
+
+    old = params.extra.get("measurement") or Measurement()
+    new = Measurement(columns={**old.columns, **(columns or {})}, units={**old.units, **(units or {})},
+                      string_weight=old.string_weight)
+    if new == Measurement():
+        return params
+    return dataclasses.replace(params, extra={**params.extra, "measurement": new})
+
+
 def to_table(m: Measurement) -> dict:
     """The TOML table of ``m`` (only non-empty keys).
 

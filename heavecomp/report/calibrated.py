@@ -9,6 +9,7 @@ from pathlib import Path
 
 from heavecomp.diagnosis.calibrate import FILE, Calibrated, write
 from heavecomp.effects.spec import field_units
+from heavecomp.report.commands import command
 from heavecomp.report.provenance import strip_declared
 
 
@@ -23,27 +24,35 @@ def _value(name: str, key: str, value) -> str:
     return f"{key} = {value:.4g}" + (f" {unit}" if unit and unit != "-" else "")
 
 
-def what_next(cal: Calibrated, out_dir, *, run_path: str = "LOG", params_path: str = "NOMINAL.toml") -> list[str]:
+def what_next(cal: Calibrated, out_dir, *, run_path: str = "LOG", params_path: str = "NOMINAL.toml",
+              columns=None, units=None, duration: float = 600.0) -> list[str]:
     """Markdown lines of the "What next" section: what to change (the parameter, the effect, or
-    nothing), the calibrated file, and the exact commands that use it.
+    nothing), the calibrated file, and the exact commands that use it -- each one runs as printed from the
+    folder the diagnosis was run in (the final output folder, the log's ``--columns``/``--units``).
 
     Parameters
     ----------
     cal : Calibrated
         The calibrated model (:func:`heavecomp.diagnosis.calibrate.calibrate`).
     out_dir : str or Path
-        The run folder holding ``calibrated.toml`` (paths in the commands are under it).
+        The output folder as the user named it (paths in the commands are under it; never the staging folder).
     run_path : str
-        The measured log as the user named it, for the re-diagnosis command.
+        The measured log as the user named it, for the commands that read it.
     params_path : str
-        The nominal parameter file as the user named it.
+        The parameter file the diagnosis ran against, as the user named it.
+    columns, units : dict, optional
+        The log's mapping as given on the command line (carried by the commands that read the log with
+        ``params_path``; ``calibrated.toml`` records it in its ``[measurement]`` table).
+    duration : float [s]
+        The diagnosed span's length: the simulations run as long as the log.
     """
     out = Path(out_dir)
     f = (out / FILE).as_posix()
+    dur = f"{max(1.0, math.floor(duration)):g}"
     lines = ["", "## What next", ""]
     if not cal.changes:
         lines.append(f"Nothing to change in `{params_path}`: {cal.why[0] if cal.why else 'no change'}. "
-                     f"`{f}` is that file, unchanged.")
+                     f"`{f}` is a copy of it.")
     params = sorted((c for c in cal.changes if c["kind"] == "parameter"), key=lambda c: -abs(math.log(c["ratio"])))
     moved = [c for c in params if abs(c["ratio"] - 1.0) >= SMALL]
     for c in moved:
@@ -64,26 +73,39 @@ def what_next(cal: Calibrated, out_dir, *, run_path: str = "LOG", params_path: s
         else:
             lines.append(f"- Add the effect **`{c['name']}`** to the model: "
                          + ", ".join(_value(c["name"], k, v) for k, v in c["parameters"].items()) + ".")
-    if cal.changes:
-        lines += ["", f"`{f}` is `{params_path}` with these changes (expected held-out shrink of the gap "
-                      f"{cal.expected_shrink:.2f}); every command reads it:"]
-    else:
-        lines += ["", "Commands that use it:"]
+    if not cal.changes:  # the file stays: what is left to do with it is to use it
+        lines += ["", f"Commands that use it (the controller on the rig as this file describes it; the log "
+                      f"followed for a change):", "", "```",
+                  command("heavecomp", "simulate", params_path, "--duration", dur, "--controller", "linear-mpc",
+                          "--out", (out / "mpc").as_posix()),
+                  command("heavecomp", "monitor", run_path, "--params", params_path, "--out",
+                          (out / "monitor").as_posix(), columns=columns, units=units),
+                  "```"]
+        return lines
+    lines += ["", f"`{f}` is `{params_path}` with these changes (expected held-out shrink of the gap "
+                  f"{cal.expected_shrink:.2f}); it records the log's column mapping and units "
+                  "(`[measurement]`), and every command reads it:"]
     lines += ["", "```",
-              f"heavecomp params {f}",
-              f"heavecomp simulate {f} --duration 600 --out {(out / 'calibrated_sim').as_posix()}",
-              f"heavecomp analyse {f} --out {(out / 'calibrated_analysis').as_posix()}",
-              f"heavecomp simulate {f} --duration 600 --controller linear-mpc "
-              f"--out {(out / 'calibrated_mpc').as_posix()}",
-              f"heavecomp diagnose {run_path} --params {f} --out {(out / 'rediagnosis').as_posix()}",
-              "```"]
-    if cal.changes:
-        lines += ["", "The last one checks the calibration: the re-diagnosis should read `none`, or a gap smaller by "
-                      "at least the expected shrink."]
+              command("heavecomp", "params", f, "-q"),
+              command("heavecomp", "replay", run_path, "--params", params_path, "--params", f, "--out",
+                      (out / "replay").as_posix(), columns=columns, units=units),
+              command("heavecomp", "simulate", f, "--heave-file", run_path, "--duration", dur, "--out",
+                      (out / "calibrated_sim").as_posix()),
+              command("heavecomp", "analyse", f, "--out", (out / "calibrated_analysis").as_posix()),
+              command("heavecomp", "simulate", f, "--duration", dur, "--controller", "linear-mpc",
+                      "--out", (out / "calibrated_mpc").as_posix()),
+              command("heavecomp", "diagnose", run_path, "--params", f, "--out", (out / "rediagnosis").as_posix()),
+              "```",
+              "", "The replay shows the log under both files (the calibrated one should shrink the held-out gap by "
+                  "the expected shrink; on a log from another day or sea state it is the test of the calibration); "
+                  "the simulation drives the calibrated file with the log's own heave and reports its WOB error "
+                  "against the log; the last command re-diagnoses: it should read `none`, or a gap smaller by at "
+                  "least the expected shrink."]
     return lines
 
 
-def write_calibrated(params, out_dir, *, run_path: str, params_path: str, run=None, policy=None) -> Calibrated:
+def write_calibrated(params, out_dir, *, run_path: str, params_path: str, run=None, policy=None, shown_dir=None,
+                     columns=None, units=None) -> Calibrated:
     """Write ``out_dir/calibrated.toml`` from ``out_dir/diagnosis.json``, add the ``calibrated`` block to
     ``diagnosis.json`` and the "What next" section to ``report.md``; returns the :class:`Calibrated`.
 
@@ -102,6 +124,11 @@ def write_calibrated(params, out_dir, *, run_path: str, params_path: str, run=No
         :func:`heavecomp.diagnosis.calibrate.start_state`).
     policy : VerdictPolicy, optional
         The diagnosis' policy (None: the defaults).
+    shown_dir : str or Path, optional
+        The output folder as the user named it, in the printed commands (default ``out_dir``; a command
+        writing into a staging folder passes its final folder).
+    columns, units : dict, optional
+        The log's mapping as given on the command line (:func:`what_next`).
     """
     out = Path(out_dir)
     jpath = out / "diagnosis.json"
@@ -114,6 +141,8 @@ def write_calibrated(params, out_dir, *, run_path: str, params_path: str, run=No
     md = out / "report.md"
     if md.is_file():
         md.write_text(md.read_text(encoding="utf-8").rstrip("\n") + "\n"
-                      + "\n".join(what_next(cal, out, run_path=run_path, params_path=params_path)) + "\n",
+                      + "\n".join(what_next(cal, out if shown_dir is None else shown_dir, run_path=run_path,
+                                             params_path=params_path, columns=columns, units=units,
+                                             duration=run.duration if run is not None else 600.0)) + "\n",
                       encoding="utf-8")
     return cal

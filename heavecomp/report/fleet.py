@@ -10,6 +10,7 @@ from pathlib import Path
 from heavecomp.campaign.fleet import RESULTS, read_json, read_task, run_fleet
 from heavecomp.diagnosis.monitor import GAP_NOTABLE, gap_level
 from heavecomp.effects.base import COMPONENTS
+from heavecomp.io.arrays import fleet_dataset
 from heavecomp.report.figures import _plt, save
 from heavecomp.report.monitor import dump_json, write_segment_diagnoses
 from heavecomp.report.provenance import write_units_csv
@@ -208,6 +209,24 @@ def diagnose_commands(summary, tasks, out, *, worst=WORST, notable=GAP_NOTABLE) 
             words += ["--units", ",".join(f"{k}={v}" for k, v in t.units.items())]
         cmds.append(" ".join(shlex.quote(w) for w in words))
     return cmds
+
+
+def to_xarray(summary, **attrs):
+    """A fleet's results as an ``xarray.Dataset`` over ``log`` x ``segment`` (x ``component``) and
+    ``log`` x ``change`` (:func:`heavecomp.io.arrays.fleet_dataset`; units in each variable's ``attrs``).
+
+    Parameters
+    ----------
+    summary : dict or str or os.PathLike
+        :func:`collect`'s dict (what :func:`run_and_report` returns), or a fleet's output folder (read
+        back through ``fleet.json``'s logs).
+    **attrs : str
+        Dataset attributes (e.g. ``source``).
+    """
+    if not isinstance(summary, dict):
+        keys = [e["log"] for e in read_json(Path(summary) / "fleet.json")["logs"]]
+        summary = collect(summary, keys)
+    return fleet_dataset(summary["logs"], attrs)
 
 
 def _write_csv(path: Path, columns: dict, rows) -> None:

@@ -18,6 +18,13 @@ import numpy as np
 from heavecomp.errors import DataError, ParameterError
 from heavecomp.io.series import gaps
 from heavecomp.io.series import read_series, short
+from heavecomp.signals import HEAVE_CUTOFF, flat_zero_phase
+
+#: what a heave file goes through before it drives the plant (metrics.json ``heave.preprocessing``); the diagnosis'
+#: replay differs only in its start (docs/diagnosis.md, "Replay a log under several files")
+PREPROCESSING = (f"gap-filled, made uniform, zero-phase low-passed at {HEAVE_CUTOFF:g} Hz as the diagnosis' replay; "
+                 "the run starts at rest at the operating point with the first filtered sample as the heave "
+                 "reference, where the replay starts from the state it estimates from the log's first seconds")
 
 G = 9.81
 log = logging.getLogger(__name__)
@@ -357,7 +364,9 @@ def _bridge(t, z, src):
 
 
 def from_series(t, z, duration, spacing, src="heave") -> HeaveSamples:
-    """Heave from measured samples: cubic spline through (t, z), first sample as reference.
+    """Heave from measured samples, pre-processed as the diagnosis' replay does: made uniform, zero-phase
+    low-passed at :data:`heavecomp.signals.HEAVE_CUTOFF` and a cubic spline through it, its first filtered
+    sample as reference (:data:`PREPROCESSING`).
 
     Holes of more than 1.5 sampling intervals are first bridged linearly (warning); holes over
     ``max(MAX_HEAVE_GAP, 3 intervals)`` are refused (:func:`_check_series`).
@@ -384,10 +393,16 @@ def from_series(t, z, duration, spacing, src="heave") -> HeaveSamples:
     span = t[-1] - t[0]
     if duration > span + 1e-9:
         raise ParameterError(f"duration {duration:g} s exceeds the heave record's span {span:g} s ({src})")
-    cs = CubicSpline(t - t[0], z - z[0])
+    # the diagnosis' replay pre-processing (heavecomp.diagnosis.data.heave_filtered): uniform, zero-phase low-pass
+    # at HEAVE_CUTOFF (the waves pass unchanged, a measured heave's noise does not drive the plant)
+    dt = float(np.median(np.diff(t)))
+    tu = np.arange(t[0], t[-1] + 1e-9 * dt, dt)
+    zf = flat_zero_phase(np.interp(tu, t, z), 1.0 / dt, HEAVE_CUTOFF)
+    cs = CubicSpline(tu - t[0], zf - zf[0])
     tg = np.arange(int(math.ceil(duration / spacing)) + 1) * spacing
     tg = np.minimum(tg, span)
-    return HeaveSamples(spacing, cs(tg), cs(tg, 1), cs(tg, 2), {"kind": "file", "source": src, "span": span})
+    return HeaveSamples(spacing, cs(tg), cs(tg, 1), cs(tg, 2), {"kind": "file", "source": src, "span": span,
+                                                                 "preprocessing": PREPROCESSING})
 
 
 def make_heave(heave, duration, spacing, base_dir=None, measurement=None) -> HeaveSamples:
