@@ -155,6 +155,13 @@ def test_resume_recomputes_a_log_whose_result_is_torn_or_swapped(tmp_path):
     rows = {r["log"]: r for r in summary["fleet"]}
     assert rows["log2"]["status"] == "done" and rows["log2"]["segments [-]"] != ""
     assert json.loads(mon2.read_text())["segments"]
+    # the labelled arrays carry each log's gap over the whole log, per component
+    pytest.importorskip("xarray")
+    from heavecomp.report.fleet import to_xarray
+
+    ds = to_xarray(summary)
+    g = ds["log_gap_to_noise"].sel(log="log2").values
+    assert ds["log_gap_to_noise"].attrs["units"] == "noise sigma" and np.isfinite(g).all() and (g >= 1.0).all()
 
 
 @pytest.mark.slow
