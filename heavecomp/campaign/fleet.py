@@ -475,14 +475,60 @@ def finished(out_dir, tasks, settings: Settings) -> set:
     """
     done = set()
     for t in tasks:
-        info = read_task(Path(out_dir) / RESULTS / t.key)
-        if info and info.get("status") == "done" and info.get("fingerprint") == fingerprint(t, settings):
+        folder = Path(out_dir) / RESULTS / t.key
+        info = read_task(folder)
+        if (info and info.get("status") == "done" and info.get("fingerprint") == fingerprint(t, settings)
+                and intact(folder, info)):
             done.add(t.key)
     return done
 
 
+def _digest(path: Path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+def intact(folder, info) -> bool:
+    """Whether a finished log's result folder holds what its ``task.json`` says it wrote: every file it lists
+    (``files``: name -> sha256) with those bytes, and a readable ``monitor.json`` (a result of an earlier
+    version lists none).  A file torn by a crash or a full disk, or replaced by another log's, is not: the
+    log is computed again (``fleet --resume`` took a torn ``monitor.json`` over and reported the log done,
+    with no data).
+
+    Parameters
+    ----------
+    folder : str or os.PathLike
+        ``OUT/logs/<key>``.
+    info : dict
+        Its ``task.json``.
+    """
+    folder = Path(folder)
+    try:
+        if any(_digest(folder / name) != h for name, h in (info.get("files") or {}).items()):
+            return False
+    except OSError:
+        return False
+    mon = read_json(folder / "monitor.json")
+    return isinstance(mon, dict) and "segments" in mon and "changes" in mon
+
+
+def _durable(folder: Path) -> None:
+    """Every file under ``folder`` and the folders themselves flushed to the disk (fsync), so a rename that
+    follows publishes whole files after a power loss too."""
+    for p in sorted(folder.rglob("*")) + [folder]:
+        _fsync_dir(p)
+
+
 def _write_json(path: Path, d) -> None:
     path.write_text(json.dumps(d, indent=2) + "\n", encoding="utf-8")
+
+
+def _fsync_dir(path: Path) -> None:
+    """fsync one file or folder (a folder: its entries, e.g. a rename in it)."""
+    fd = os.open(path, os.O_RDONLY)
+    try:
+        os.fsync(fd)
+    finally:
+        os.close(fd)
 
 
 def _place(out: Path, key: str, result: dict, fp: str, run_id: str, write) -> None:
@@ -494,13 +540,16 @@ def _place(out: Path, key: str, result: dict, fp: str, run_id: str, write) -> No
     work.mkdir(parents=True)
     if result["status"] == "done":
         write(work, result)
+    files = {str(p.relative_to(work)): _digest(p) for p in sorted(work.rglob("*")) if p.is_file()}
     _write_json(work / TASK, {"key": key, "status": result["status"], "reason": result["reason"], "fingerprint": fp,
                               "fleet_run": run_id, "wall_s": round(result["wall_s"], 3),
-                              "cpu_s": round(result["cpu_s"], 3)})
+                              "cpu_s": round(result["cpu_s"], 3), "files": files})
+    _durable(work)
     final = results / key
     if final.exists():
         shutil.rmtree(final)
     os.rename(work, final)
+    _fsync_dir(results)  # the rename itself
 
 
 def run_fleet(tasks, out_dir, settings: Settings, write, *, workers: int | None = None, scheduler: str | None = None,

@@ -67,7 +67,6 @@ def run(args) -> int:
 
     from heavecomp.diagnosis.data import load_run
     from heavecomp.diagnosis.estimator import GapDiagnoser, check_memory
-    from heavecomp.report.diagnosis import write_report
     from heavecomp.errors import InputError
     from heavecomp.io.series import check_spec, parse_mapping
     from heavecomp.effects.spec import load  # the file with its [[effects]] checked
@@ -108,25 +107,58 @@ def run(args) -> int:
 
     d = GapDiagnoser(params, cands, split=args.split, settle=args.settle, n_jobs=args.jobs, progress=progress)
     d.fit(run_)
-    write_report(d, args.out, title=f"Sim-to-real gap diagnosis — {run_.source}")
-    _record_measurement(Path(args.out) / "diagnosis.json", run_.measurement, span.to_json())
-    from heavecomp.report.calibrated import write_calibrated  # calibrated.toml, its json block, "What next"
     from heavecomp.commands._output import final
 
-    from heavecomp.params.measurement import used
-
-    # calibrated.toml records the mapping the log was read with: its re-diagnosis needs no flags
-    cal = write_calibrated(used(params, columns, units), args.out, run_path=args.run, params_path=args.params, run=run_,
-                           policy=d.verdict_policy(), shown_dir=final(args), columns=columns, units=units)
-    from heavecomp.report.provenance import finish
-
-    finish(args.out, params=params, json_files=("diagnosis.json",), heave_used=False, measured_run=str(Path(args.run).resolve()))
+    cal = write_outputs(d, args.out, params=params, run=run_, run_path=args.run, params_path=args.params, span=span,
+                        columns=columns, units=units, shown_dir=final(args))
     v = d.verdict_
     extra = f", second effect {v['second_effect']['effect']}" if v.get("second_effect") else ""
     print(f"verdict: {v['effect']} (confidence {v['confidence']}), held-out shrink {v['shrink']:.2f} "
           f"on {v.get('shrink_channel', 'wob')}{extra} -> {Path(final(args)) / 'diagnosis.json'}, calibrated model "
           f"({len(cal.changes)} change{'s' if len(cal.changes) != 1 else ''}) -> {Path(final(args)) / 'calibrated.toml'}")
     return 0
+
+
+def write_outputs(d, out, *, params, run, run_path, params_path, span=None, columns=None, units=None,
+                  shown_dir=None):
+    """What ``heavecomp diagnose`` writes into its folder ``out`` for a fitted diagnosis ``d``:
+    ``diagnosis.json`` with how the log was read and the span analysed, ``report.md`` and its figures,
+    ``calibrated.toml`` with its "What next", and the provenance stamp and ``report.html``
+    (:func:`heavecomp.report.provenance.finish`).  ``heavecomp monitor --diagnose`` writes each diagnosed
+    segment with it.  Returns the :class:`heavecomp.report.calibrated.Calibrated`.
+
+    Parameters
+    ----------
+    d : heavecomp.diagnosis.GapDiagnoser
+        Fitted on ``run``.
+    out : str or Path
+        The folder (created).
+    params : CMCParams
+        The nominal parameters it was diagnosed against.
+    run : MeasuredRun
+        The log (or its span) as the diagnosis read it.
+    run_path, params_path : str
+        The log and the parameter file as the user named them.
+    span : heavecomp.diagnosis.span.Span, optional
+        The stretch of the log analysed.
+    columns, units : dict, optional
+        The mapping the log was read with (``--columns``/``--units``): ``calibrated.toml`` records it, so its
+        re-diagnosis needs no flags.
+    shown_dir : str, optional
+        The folder as the user named it (the printed commands name it; default ``out``).
+    """
+    from heavecomp.params.measurement import used
+    from heavecomp.report.calibrated import write_calibrated  # calibrated.toml, its json block, "What next"
+    from heavecomp.report.diagnosis import write_report
+    from heavecomp.report.provenance import finish
+
+    write_report(d, out, title=f"Sim-to-real gap diagnosis — {run.source}")
+    _record_measurement(Path(out) / "diagnosis.json", run.measurement, span.to_json() if span is not None else None)
+    cal = write_calibrated(used(params, columns, units), out, run_path=run_path, params_path=params_path, run=run,
+                           policy=d.verdict_policy(), shown_dir=str(shown_dir or out), columns=columns, units=units)
+    finish(out, params=params, json_files=("diagnosis.json",), heave_used=False,
+           measured_run=str(Path(run_path).resolve()))
+    return cal
 
 
 def _record_measurement(path: Path, measurement: dict, span: dict | None = None) -> None:

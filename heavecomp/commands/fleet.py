@@ -98,7 +98,8 @@ def run(args) -> int:
     if args.resume and old.is_dir() and not work.exists():  # resume from a complete earlier result
         shutil.copytree(old, work)
     bar = Progress(f"fleet of {len(tasks)} logs")
-    info, summary = run_and_report(tasks, args.out, settings, source=str(args.logs), workers=args.workers,
+    info, summary = run_and_report(tasks, args.out, settings, source=str(args.logs), final_out=final(args),
+                                   workers=args.workers,
                                    scheduler=args.scheduler,
                                    progress=lambda done, total: bar(done / total if total else 1.0))
     keep = {t.key for t in tasks}
@@ -118,4 +119,11 @@ def run(args) -> int:
           f"({info.executor}, {info.workers} workers) -> {Path(final(args)) / 'fleet.csv'}")
     for r in failed[:5]:
         print(f"  failed: {r['log']}: {r['reason']}")
+    ranked = [r for r in summary["fleet"] if r.get("gap rank [-]") not in ("", "-", None)]
+    if ranked:
+        top = min(ranked, key=lambda r: r["gap rank [-]"])
+        print(f"farthest from the model: {top['log']}, gap/noise {top['gap level [-]']:.2f} in {top['gap component']} "
+              f"(ranking: {Path(final(args)) / 'report.md'})")
+    for c in summary.get("what_next", []):
+        print(f"  {c}")
     return 0

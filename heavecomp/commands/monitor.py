@@ -44,14 +44,14 @@ def run(args) -> int:
     import time
     from pathlib import Path
 
+    from heavecomp.commands._output import final
     from heavecomp.diagnosis import monitor as M
     from heavecomp.diagnosis.data import load_run
     from heavecomp.errors import InputError
     from heavecomp.io.series import check_spec, parse_mapping
     from heavecomp.effects.spec import load  # the file with its [[effects]] checked
-    from heavecomp.report.monitor import write_report, write_segment_diagnoses
+    from heavecomp.report.monitor import diagnosed_lines, write_report
     from heavecomp.report.provenance import finish
-    from heavecomp.commands._output import final
 
     columns, units = check_spec(parse_mapping(args.columns, "--columns"), parse_mapping(args.units, "--units"),
                                 "cli")
@@ -76,9 +76,26 @@ def run(args) -> int:
             print(f"[{time.perf_counter() - t0:6.1f} s {100 * frac:3.0f} %] {msg}", file=sys.stderr, flush=True)
 
     res = M.monitor(run_, params, block=block, progress=progress)
-    diagnoses = M.diagnose_segments(res, run_, params, n_jobs=args.jobs, progress=progress) if args.diagnose else {}
-    write_report(res, args.out, source=run_.source, extra={"measurement": run_.measurement} if run_.measurement else None)
-    write_segment_diagnoses(diagnoses, args.out)
+    spans = {}
+
+    def write_segment(i, d, sub, ab):
+        # what `heavecomp diagnose LOG --span A:B` writes: diagnosis.json, report, figures, calibrated.toml
+        from heavecomp.commands.diagnose import write_outputs
+        from heavecomp.diagnosis import span as SP
+
+        spans[i] = ab
+        write_outputs(d, Path(args.out) / f"segment_{i}", params=params, run=sub, run_path=args.run,
+                      params_path=args.params, span=SP.choose(run_.duration, ab, min_duration=M.DIAGNOSE_MIN),
+                      columns=columns, units=units, shown_dir=str(Path(final(args)) / f"segment_{i}"))
+        print(f"segment {i} ({ab[0]:.0f}-{ab[1]:.0f} s): {d.verdict_['effect']} (confidence "
+              f"{d.verdict_.get('confidence')}) -> {Path(final(args)) / f'segment_{i}'}", file=sys.stderr, flush=True)
+
+    diagnoses = (M.diagnose_segments(res, run_, params, n_jobs=args.jobs, progress=progress, each=write_segment)
+                 if args.diagnose else {})
+    for i, (a, b) in spans.items():  # where the segment's full diagnosis is
+        res.segments[i]["verdict"]["folder"] = f"segment_{i}"
+    write_report(res, args.out, source=run_.source, extra={"measurement": run_.measurement} if run_.measurement else None,
+                 diagnosed=diagnosed_lines(spans, args.run, args.params, final(args)))
     if args.format:  # from monitor.json as written (the segments' verdicts included)
         import json
 
@@ -89,6 +106,8 @@ def run(args) -> int:
     finish(args.out, params=params, json_files=("monitor.json",), heave_used=False, measured_run=str(Path(args.run).resolve()))
     for e, chans in res.skipped.get("equations", {}).items():
         print(f"left out the {e} residual: the log has no {', '.join(chans)} channel", file=sys.stderr)
+    for note in res.notes:
+        print(f"note: {note}", file=sys.stderr)
     eff = [c for c in res.changes if c["kind"] == "effect"]
     ops = [c for c in res.changes if c["kind"] == "operating"]
     print(f"{len(eff)} effect change(s), {len(ops)} operating change(s), {len(res.segments)} segment(s)"

@@ -241,6 +241,9 @@ class ComponentResiduals:
     signals: dict
     mask: np.ndarray
     floor: dict = dataclasses.field(default_factory=dict)
+    #: {component: {equation: array}}: the floor's own parts (the nominal replay's split), sample by sample,
+    #: for a caller that sums them over its own blocks (the monitor)
+    floor_parts: dict = dataclasses.field(default_factory=dict)
     inputs: dict = dataclasses.field(default_factory=dict)
     #: the equations the log's channels cannot compute (:func:`unobservable`): their residuals are NaN
     missing: tuple = ()
@@ -269,11 +272,7 @@ class ComponentResiduals:
         the noise's expected 1 for the equations' own rests and minus :attr:`floor` (what the same
         computation makes of the nominal model's own replay: filter and stick-event artefacts),
         clipped at 0 [-]."""
-        out = {}
-        for c, zs in self.z(mask).items():
-            out[c] = sum(max(z - (1.0 if OWN[eq] == c else 0.0) - self.floor.get(c, {}).get(eq, 0.0), 0.0)
-                         for eq, z in zs.items())
-        return out
+        return gap_of(self.z(mask), self.floor)
 
     def shares(self, mask=None) -> dict:
         """``where.components``: shares of the gap by component, summing to 1, over the components whose
@@ -433,7 +432,27 @@ def residuals(run, params, *, heave_reference=None, noise=None, mask=None, cutof
         ref = dict(ch, **{k: fill_gaps(t, np.asarray(floor_channels[k], float)) for k in ("stroke", "pressure", "wob")})
         nf = _split(t, ref, params, heave_reference, cutoff, None, m, seed, noise_of=out.noise, missing=missing)
         out.floor = nf.z()
+        out.floor_parts = nf.parts
     return out
+
+
+def gap_of(z, floor=None) -> dict:
+    """Per component: the gap of :meth:`ComponentResiduals.gap` from the z-values ``z`` ({component:
+    {equation: mean square of its part / noise variance}}) and the nominal replay's ``floor`` (the same,
+    of the replay): the sum over its equations of z minus the noise's expected 1 for an equation's own
+    rest minus the floor, each clipped at 0 [-].  The one computation of a gap: the diagnosis over its
+    run, the monitor over each segment's blocks.
+
+    Parameters
+    ----------
+    z : {component: {equation: float}}
+        The run's z-values.
+    floor : {component: {equation: float}}, optional
+        The nominal replay's z-values (none: no floor subtracted).
+    """
+    floor = floor or {}
+    return {c: sum(max(v - (1.0 if OWN[eq] == c else 0.0) - floor.get(c, {}).get(eq, 0.0), 0.0)
+                   for eq, v in zs.items()) for c, zs in z.items()}
 
 
 def unobservable(lost) -> tuple:

@@ -82,12 +82,14 @@ import warnings
 import numpy as np
 
 from heavecomp.diagnosis import components as CR
-from heavecomp.diagnosis.data import MeasuredRun, noise_floor
+from heavecomp.diagnosis import replay as R
+from heavecomp.diagnosis.data import HEAVE_CUTOFF, MeasuredRun, heave_samples, lowpass_zero_phase, noise_floor
 from heavecomp.diagnosis.estimator import GapDiagnoser
+from heavecomp.diagnosis.start import string_balance_heave
 from heavecomp.diagnosis.structure import equation_channels
 from heavecomp.effects.base import COMPONENTS
 from heavecomp.io.arrays import monitor_dataset
-from heavecomp.errors import DataError
+from heavecomp.errors import DataError, InputError
 
 log = logging.getLogger(__name__)
 
@@ -117,6 +119,12 @@ JUMP, JUMP_BLOCKS = 6.0, 2
 #: events come in wave groups over several blocks)
 THRESHOLD_EQ = 12.0
 JUMP_EQ = math.inf  #: the Shewhart rule's deviation for the equations' mean squares: none (the same reason) [block sigmas]
+#: the same on a log too short for the long reference (:func:`learning_window`): the clipped sum needs
+#: THRESHOLD_EQ / (CLIP - DRIFT) = 4 blocks after the reference, which a 130 s log may not hold after a change
+#: (a 30 kN WOB step 26 s before its end moved the balances' mean squares by 13 and 43 sigmas and was missed).
+#: The fourth method's tuning set (131 h): a rule at 8-10 sigmas on the mean squares gave 1 more false alarm
+#: or none [block sigmas]
+JUMP_EQ_SHORT = 10.0
 #: the standardising scale of a monitored series is at least the one that puts this quantile of its |first
 #: differences| / sqrt 2 where a normal series has it (:func:`null_sigma`): a heavy-tailed series (stick-slip
 #: bursts, a sea that changes) is not scaled by its quiet bulk alone [-]
@@ -131,6 +139,12 @@ BLANK = 2  #: blocks on each side of an operating change left out of the compone
 #: block at the noise level, z a mean of about 2 x CUTOFF x BLOCK independent squares, is ~sqrt(2/20)/2
 SIGMA_MIN = 0.15
 REFERENCE = 30  #: blocks before an onset the naming compares with [-]
+#: a chain of at least this many effect alarms on one series, in one direction, each starting within DRIFT_LINK
+#: blocks of the previous alarm, is one drift (:func:`merge_drifts`): a gas leak of the tuning set (350004-like,
+#: 1.5e-6 /s) raised 11 alarms in 50 min, 170-210 s apart (RELEARN blocks, then the sum's climb); two alarms
+#: can be a step and its relearning [-]
+DRIFT_ALARMS = 3
+DRIFT_LINK = RELEARN + 6  #: blocks from one alarm to the next one's onset within a drift [-]
 #: features of the equations' own split (components.SPLIT) left out of the block coefficients: within
 #: one block the time ``t`` is the constant again
 NOT_PER_BLOCK = ("t",)
@@ -167,7 +181,22 @@ BAND_EQUATION = "top_mass"
 THRESHOLD_BAND, JUMP_BAND = 10.0, math.inf
 RIDGE = 1e-6  #: relative ridge of a block's normalised normal equations (features of unit scale) [-]
 OP_CHANNELS = ("heave", "stroke", "pressure", "wob")
+#: a log whose gap level (its largest component gap/noise over the whole log) reaches this is worth a diagnosis
+#: (the fleet's "What next"): logs of the nominal plant itself read 1.00-1.24 from 5 to 50 Hz, 10 min and 2 h
+#: (benchmarks/monitor/gap_levels.py); a seal friction 30 % high throughout 2.76 [-]
+GAP_NOTABLE = 1.5
 MIN_DURATION = 120.0  #: shortest log monitored [s]: a reference stretch of LEARN blocks and as many to compare
+#: fewest blocks a log must hold to be monitored (MIN_DURATION at the default BLOCK): the upper bound of a
+#: block (:func:`block_bounds`) [-]
+MIN_BLOCKS = 12
+#: a log of fewer than 2 LEARN blocks learns its reference over this share of its blocks (the rest is
+#: compared with it), and says so (:func:`learning_window`): with the 300 s reference of a long log a 130 s log
+#: was never compared with anything and a 30 kN WOB step in it passed without a word [-]
+SHORT_LEARN_SHARE = 0.5
+#: a block holds at least this share of the log's mean wave period (:func:`block_bounds`): a wave-driven
+#: residual's square swings at twice the wave frequency, so half a period averages it; shorter blocks read
+#: the wave phase as changes (0.1 s blocks: 79 "effect" changes on a clean 10 min log) [-]
+BLOCK_MIN_PERIODS = 0.5
 
 
 @dataclasses.dataclass
@@ -201,6 +230,16 @@ class MonitorResult:
     sensors: list
     duration: float
     skipped: dict = dataclasses.field(default_factory=dict)
+    #: blocks the reference was learnt from (:func:`learning_window`) [-]
+    learn: int = LEARN
+    #: what the reader should know of how the log was monitored (a shortened reference, ...)
+    notes: list = dataclasses.field(default_factory=list)
+    #: {component: gap/noise over the whole log} (:func:`segment_gap` over every block) [-]
+    gap: dict = dataclasses.field(default_factory=dict)
+
+    def gap_level(self) -> dict:
+        """The log's gap level: its largest component gap/noise over the whole log (:func:`gap_level`)."""
+        return gap_level(self.gap)
 
     def to_xarray(self, **attrs):
         """The result as an ``xarray.Dataset`` over ``segment`` (x ``component``) and ``change``
@@ -215,6 +254,11 @@ class MonitorResult:
 
     def to_json(self) -> dict:
         extra = {"skipped": self.skipped} if self.skipped else {}
+        if self.notes:
+            extra["notes"] = list(self.notes)
+        if self.gap:
+            extra["gap_to_noise"] = dict(self.gap)
+            extra["gap_level"] = self.gap_level()
         return {**extra, "schema": SCHEMA, "changes": self.changes, "segments": self.segments,
                 "sensors": list(self.sensors), "block_s": self.block, "duration_s": self.duration,
                 "noise": self.noise,
@@ -224,7 +268,7 @@ class MonitorResult:
                            "detector": "two-sided clipped CUSUM with a Shewhart rule", "drift_sigmas": DRIFT,
                            "threshold_sigmas": THRESHOLD, "threshold_equation_sigmas": THRESHOLD_EQ,
                            "jump_sigmas": JUMP, "jump_equation_sigmas": JUMP_EQ, "jump_blocks": JUMP_BLOCKS,
-                           "threshold_op_sigmas": THRESHOLD_OP, "learn_blocks": LEARN, "chunk_s": CHUNK}}
+                           "threshold_op_sigmas": THRESHOLD_OP, "learn_blocks": self.learn, "chunk_s": CHUNK}}
 
 
 # ---------------------------------------------------------------------------- helpers
@@ -455,6 +499,10 @@ class BlockSums:
     band_sum: dict = dataclasses.field(default_factory=dict)
     band_count: dict = dataclasses.field(default_factory=dict)
     band_edges: object = None
+    #: {(component, equation): per block sum of squares of the nominal replay's part} (the floor
+    #: :func:`segment_gap` subtracts, as the diagnosis does: what the equations make of the nominal model's own
+    #: replay, filters and stick events, :func:`nominal_replay`) [equation unit squared]
+    floor: dict = dataclasses.field(default_factory=dict)
 
     def band_means(self, e) -> np.ndarray:
         """Block mean of equation ``e``'s residual times sign(v) in each stroke band (blocks x bands)
@@ -606,10 +654,101 @@ def _add_chunk(sums, cr, blocks, loc, feats, xs) -> None:
             if part is not None:
                 sums.parts.setdefault((c, e), np.zeros(sums.eq[e].size))[blocks] = \
                     np.add.reduceat(np.where(ok, part * part, 0.0), at)
+            fpart = cr.floor_parts.get(c, {}).get(e)
+            if fpart is not None:
+                sums.floor.setdefault((c, e), np.zeros(sums.eq[e].size))[blocks] = \
+                    np.add.reduceat(np.where(ok & np.isfinite(fpart), fpart * fpart, 0.0), at)
+
+
+#: the nominal replay's floor (:func:`nominal_replay`) is replayed on an operating segment's first chunk and every
+#: FLOOR_EVERY-th after it; the chunks between take the last replayed chunk's floor per sample (it is set by the
+#: sea state, which the 30-min reference follows too).  Every chunk: 2 h at 10 Hz monitored in 7.4 s, 24 h ~90 s
+#: against the benchmark's 60 s; every third: ~1/3 of the replays' cost, the same gap/noise at 5 and 10 Hz [-]
+FLOOR_EVERY = 3
+#: above this rate every chunk is replayed: the floor's share of the noise grows with the rate (the noise is
+#: filtered to the same band, the filters' smear of stick events is not), and so does the error of taking another
+#: chunk's: 2 h no-effect logs read friction 1.26 (25 Hz) and 1.44 (50 Hz) with every third, 1.09 and 1.15 with
+#: every chunk; the replay's cost does not grow with the rate (its own step), the monitor's other passes do [Hz]
+FLOOR_RATE = 15.0
+
+
+def nominal_replay(sub, params, heave_reference) -> dict:
+    """The nominal model's replay of one chunk ``sub`` as the diagnosis replays a log
+    (:func:`heavecomp.diagnosis.replay.build`: its heave pre-processing, its start-state estimate from the
+    chunk's first seconds, the file's own plant effects), its plant driven by the measured heave about
+    ``heave_reference`` [m], the reference the chunk's equation residuals use (a replay about another
+    reference would read the difference as a string deflection).  Returns {stroke, pressure, wob: array}
+    at the chunk's samples [SI]: the floor of the chunk's component residuals (``floor_channels`` of
+    :func:`heavecomp.diagnosis.components.residuals`).  The replay satisfies the model's equations
+    exactly, whatever its start, so what its equation residuals show is the filters' smear of its stick
+    events and the heave pre-processing: what a log of the nominal model shows too, in a share of the
+    noise that grows with the rate (the noise is filtered to the same band, the artefacts are not).
+
+    Parameters
+    ----------
+    sub : MeasuredRun
+        The chunk (any clock; the columns the log has).
+    params : CMCParams
+        The segment's nominal parameters.
+    heave_reference : float [m]
+        The heave of the segment's operating point.
+    """
+    r0 = MeasuredRun(sub.t - sub.t[0], dict(sub.columns), source=sub.source)
+    rp = R.build(r0, params)
+    rp = dataclasses.replace(rp, hs=heave_samples(r0, rp.h, rp.n_steps, reference=heave_reference, spline=rp.spline))
+    nom = rp.simulate([])
+    return {k: np.asarray(nom[k], float) for k in ("stroke", "pressure", "wob")}
+
+
+def segment_point(params, w_segment, w_first):
+    """The nominal parameters of an operating segment: the file's own operating point for the first
+    (as the diagnosis takes it), a later one's WOB set-point moved by its block-median WOB's step from
+    the first segment's.  The mean WOB of a compensated string is not its set-point (the seal friction
+    holds it off by ~0.4 kN on paper A under JONSWAP), so taking a segment's median WOB as its set-point
+    moves the gas law's charge pressure and the string's static deflection by that offset: it read as a
+    gap of 4-8 noise sigmas in the gas law and the lower-mass balance of a nominal log.
+
+    Parameters
+    ----------
+    params : CMCParams
+        The file's parameters.
+    w_segment, w_first : float [N]
+        The block-median WOB of the segment and of the first segment (NaN: no WOB channel).
+    """
+    if not (math.isfinite(w_segment) and math.isfinite(w_first)) or w_segment == w_first:
+        return params
+    w0 = params.operating_point.wob_setpoint + (w_segment - w_first)
+    return params.replace(operating_point={"wob_setpoint": w0}) if w0 > 0 else params
+
+
+def segment_heave_reference(op, a, b, params) -> float:
+    """The heave reference of an operating segment (its reference stretch, blocks a..b) [m]: the median over
+    those blocks of the
+    heave the quasi-static string balance implies (:func:`heavecomp.diagnosis.start.string_balance_heave`,
+    the diagnosis' own start estimate of it) from the block means of heave, stroke and WOB (a missing
+    stroke: 0; a missing WOB: the set-point).  The segment's median heave is not it: the string is stiff
+    (2 MN/m on paper A), so a 1 mm difference reads as 2 kN of string tension, a gap of several noise
+    sigmas in the lower-mass balance of a nominal log at 5 Hz.
+
+    Parameters
+    ----------
+    op : dict
+        Block means per channel [SI].
+    a, b : int
+        First and past-the-last block of the segment.
+    params : CMCParams
+        The segment's nominal parameters (:func:`segment_point`).
+    """
+    z = op["heave"][a:b]
+    s = np.nan_to_num(op["stroke"][a:b], nan=0.0)
+    w = op["wob"][a:b]
+    w = np.where(np.isfinite(w), w, params.operating_point.wob_setpoint)
+    zr = string_balance_heave(z, s, w, params)
+    return float(np.nanmedian(zr)) if np.isfinite(zr).any() else 0.0
 
 
 def component_blocks(run, params, edges, op_bounds, op, noise, *, block=BLOCK, chunk=CHUNK, pad=PAD,
-                     progress=None, equations=None) -> BlockSums:
+                     progress=None, equations=None, learn=LEARN) -> BlockSums:
     """Block sums of the equation residuals and their component parts (pass 2), chunk by chunk, each
     operating segment with its own operating point.
 
@@ -635,6 +774,9 @@ def component_blocks(run, params, edges, op_bounds, op, noise, *, block=BLOCK, c
     equations : sequence of str, optional
         The equations to follow (default: every one); a channel the log lacks is given a constant
         stand-in (:func:`_stand_in`) that only the equations left out read.
+    learn : int
+        Blocks of a segment's reference stretch: its heave reference is read over them
+        (:func:`segment_heave_reference`), so a later change of the WOB's reading does not move it.
     """
     nb = edges.size - 1
     t = run.t
@@ -643,14 +785,20 @@ def component_blocks(run, params, edges, op_bounds, op, noise, *, block=BLOCK, c
     per = max(1, int(round(chunk / block)))
     done = 0
     feats = coefficient_features()
+    every = 1 if (t.size - 1) / max(t[-1] - t[0], 1e-300) > FLOOR_RATE else FLOOR_EVERY
+
+    def median_wob(a, b):
+        return float(np.nanmedian(op["wob"][a:b])) if np.isfinite(op["wob"][a:b]).any() else math.nan
+
+    w_first = median_wob(seg_edges[0], seg_edges[1])
     for s0, s1 in zip(seg_edges[:-1], seg_edges[1:]):
         if s1 <= s0:
             continue
-        w0 = float(np.nanmedian(op["wob"][s0:s1])) if np.isfinite(op["wob"][s0:s1]).any() else math.nan
-        prm = params if not (w0 > 0) else params.replace(operating_point={"wob_setpoint": w0})
-        zref = float(np.nanmedian(op["heave"][s0:s1]))
+        prm = segment_point(params, median_wob(s0, s1), w_first)
+        zref = segment_heave_reference(op, s0, min(s1, s0 + learn), prm)
         xs = float(np.nanmedian(op["stroke"][s0:s1])) if np.isfinite(op["stroke"][s0:s1]).any() else 0.0
-        for a, b in _chunks(s0, s1, per):
+        floor_ms = None  # the segment's last replayed floor: mean square per analysed sample {(c, e): value}
+        for n_chunk, (a, b) in enumerate(_chunks(s0, s1, per)):
             i0, i1 = edges[a], edges[b]
             j0 = int(np.searchsorted(t, t[i0] - pad))
             j1 = int(np.searchsorted(t, t[i1 - 1] + pad, side="right"))
@@ -658,7 +806,11 @@ def component_blocks(run, params, edges, op_bounds, op, noise, *, block=BLOCK, c
                 continue
             sub = MeasuredRun(t[j0:j1], {k: run[k][j0:j1] if k in run.columns else _stand_in(k, params, j1 - j0)
                                          for k in OP_CHANNELS}, source=run.source)
-            cr = CR.residuals(sub, prm, heave_reference=zref, noise=noise)
+            own = MeasuredRun(t[j0:j1], {k: run[k][j0:j1] for k in OP_CHANNELS if k in run.columns},
+                              source=run.source)
+            replay = floor_ms is None or n_chunk % every == 0
+            cr = CR.residuals(sub, prm, heave_reference=zref, noise=noise,
+                              floor_channels=nominal_replay(own, prm, zref) if replay else None)
             if equations is not None:
                 cr.equations = {e: r for e, r in cr.equations.items() if e in equations}
             if sums is None:
@@ -666,6 +818,12 @@ def component_blocks(run, params, edges, op_bounds, op, noise, *, block=BLOCK, c
             if STROKE_BANDS > 1 and BAND_EQUATION in cr.equations and BAND_EQUATION not in sums.band_sum:
                 _open_bands(sums, cr, nb, xs)
             _add_chunk(sums, cr, slice(a, b), edges[a:b + 1] - j0, feats, xs)
+            if replay:
+                floor_ms = {k: float(v[a:b].sum()) / max(float(sums.count[k[1]][a:b].sum()), 1.0)
+                            for k, v in sums.floor.items()}
+            else:  # between replays: the last replayed chunk's floor per sample, over this chunk's samples
+                for k, ms in floor_ms.items():
+                    sums.floor[k][a:b] = ms * sums.count[k[1]][a:b]
             done += b - a
             if progress:
                 progress(done / max(nb, 1), f"component residuals to {t[i1 - 1]:.0f} s")
@@ -802,7 +960,7 @@ def _attribute_change(sums, names, comps, eqs, u, j, onset, alarm, start):
     return _name(sums, eqs[j], onset, alarm, start), moved
 
 
-def component_changes(sums, block_t, block, op_bounds, *, threshold=THRESHOLD, learn=LEARN):
+def component_changes(sums, block_t, block, op_bounds, *, threshold=THRESHOLD, learn=LEARN, jump_eq=JUMP_EQ):
     """CUSUM changes of the equation statistics and block coefficients (pass 3), named by
     :func:`_attribute_change`, restarting at every operating boundary and after every alarm.
 
@@ -818,10 +976,13 @@ def component_changes(sums, block_t, block, op_bounds, *, threshold=THRESHOLD, l
         CUSUM threshold.
     learn : int
         Blocks learnt at a stretch's start.
+    jump_eq : float [sigmas]
+        The Shewhart rule's deviation on the equations' mean squares (:data:`JUMP_EQ`; a short log:
+        :data:`JUMP_EQ_SHORT`).
     """
     names, comps, eqs, u = columns(sums)
     band = [":band" in n for n in names]
-    jumps = np.array([JUMP_EQ if c is None else JUMP_BAND if b else JUMP for c, b in zip(comps, band)])
+    jumps = np.array([jump_eq if c is None else JUMP_BAND if b else JUMP for c, b in zip(comps, band)])
     thresholds = np.array([THRESHOLD_EQ if c is None else THRESHOLD_BAND if b else threshold
                            for c, b in zip(comps, band)])
     out = []
@@ -830,16 +991,95 @@ def component_changes(sums, block_t, block, op_bounds, *, threshold=THRESHOLD, l
     start = 0
     while start < nb:
         stop = next((r for r in restarts if r > start), nb)
-        hit = cusum(u[:stop], learn=learn if start in restarts else RELEARN, start=start,
+        hit = cusum(u[:stop], learn=learn if start in restarts else min(RELEARN, learn), start=start,
                     jump=jumps, threshold=thresholds)
         if hit is None:
             start = stop
             continue
         b, j, onset, size = hit
         comp, moved = _attribute_change(sums, names, comps, eqs, u, j, onset, b, start)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            sign = np.nanmean(u[onset:b + 1, j]) - np.nanmean(u[max(start, onset - REFERENCE):onset, j])
         out.append({"t": float(block_t[b] + block), "component": comp, "size_to_noise": size, "kind": "effect",
-                    "onset": float(block_t[onset]), "equations": sorted(moved), "column": names[j]})
+                    "onset": float(block_t[onset]), "equations": sorted(moved), "column": names[j],
+                    "direction": 1 if not sign < 0 else -1})
         start = b + 1
+    return merge_drifts(out, u, names, block_t, block)
+
+
+def merge_drifts(changes, u, names, block_t, block) -> list:
+    """Effect alarms that follow one drift, as one change.  A slowly growing effect (a gas leak) is alarmed,
+    the CUSUM restarts, relearns for :data:`RELEARN` blocks and alarms again, on the same series in the same
+    direction, as long as the drift goes on: a chain of :data:`DRIFT_ALARMS` or more such alarms, each
+    starting within :data:`DRIFT_LINK` blocks of the previous alarm, is one change (``kind`` ``effect``, at
+    the first alarm and onset) with ``drift`` true, ``until`` [s] (the last alarm), ``alarms`` (how many it
+    merges), ``rate`` [noise sigmas per hour] (the least-squares slope of the standardised series from the
+    onset to the last alarm; the sign of its direction) and ``rate_unit``; the component is the one most of
+    its alarms named.
+
+    Parameters
+    ----------
+    changes : list of dict
+        The effect alarms in time order (:func:`component_changes`).
+    u : array (blocks, series)
+        The standardised series (:func:`columns`).
+    names : list of str
+        Their names.
+    block_t : array [s]
+    block : float [s]
+    """
+    out, i = [], 0
+    while i < len(changes):
+        k = i + 1
+        while (k < len(changes) and changes[k]["column"] == changes[i]["column"]
+               and changes[k]["direction"] == changes[i]["direction"]
+               and changes[k]["onset"] - changes[k - 1]["t"] <= DRIFT_LINK * block):
+            k += 1
+        chain = changes[i:k]
+        if len(chain) < DRIFT_ALARMS:
+            out.extend(chain)
+            i = k
+            continue
+        first, last = chain[0], chain[-1]
+        j = names.index(first["column"])
+        a, b = int(np.searchsorted(block_t, first["onset"])), int(np.searchsorted(block_t, last["t"] - block)) + 1
+        y, x = u[a:b, j], (block_t[a:b] + 0.5 * block) / 3600.0
+        ok = np.isfinite(y)
+        rate = float(np.polyfit(x[ok], y[ok], 1)[0]) if ok.sum() >= 3 else math.nan
+        comps = [c["component"] for c in chain]
+        merged = dict(first, component=max(set(comps), key=lambda c: (comps.count(c), -comps.index(c))),
+                      equations=sorted({e for c in chain for e in c["equations"]}), drift=True, until=last["t"],
+                      alarms=len(chain), rate=rate, rate_unit="noise sigma/h")
+        out.append(merged)
+        i = k
+    return out
+
+
+def one_per_misreading(op_changes, effects) -> list:
+    """The operating changes and the effect changes, a WOB that moved alone counted once: the operating
+    point's detector names it ``sensors`` (the load balance does not carry it) and the component
+    residuals alarm on it too (both balances read the WOB).  An effect alarm of the same component whose
+    onset is within :data:`OP_SLACK` of such a change's is the same change: the earlier detection is kept,
+    with the other's keys it lacks (``wob_step``, ``pressure_step``, ``equations``).
+
+    Parameters
+    ----------
+    op_changes : list of dict
+        :func:`operating_changes`' changes.
+    effects : list of dict
+        The component residuals' effect changes.
+    """
+    out = [dict(e) for e in effects]
+    for o in op_changes:
+        twin = next((e for e in out if o["kind"] == "effect" and e["component"] == o["component"]
+                     and abs(e["onset"] - o["onset"]) <= OP_SLACK), None)
+        if twin is None:
+            out.append(o)
+            continue
+        first, other = (twin, o) if twin["t"] <= o["t"] else (dict(o), twin)
+        merged = {**{k: v for k, v in other.items() if k not in first}, **first}
+        out[out.index(twin)] = merged
     return out
 
 
@@ -859,17 +1099,68 @@ def absorbed(effect, op_changes) -> bool:
                and effect["onset"] <= o["t"] for o in op_changes)
 
 
-def _segment_gap(sums, a, b) -> dict:
-    """gap_to_noise per component over blocks a..b: sqrt(1 + gap), the gap as ComponentResiduals.gap
-    computes it (its parts' mean squares over their equations' noise variances, less the noise's
-    expected 1 for an equation's own rest), without a replay floor."""
-    gap = dict.fromkeys(COMPONENTS, 0.0)
+def segment_gap(sums, a, b) -> dict:
+    """gap_to_noise per component over blocks a..b: sqrt(1 + gap), the gap computed as the diagnosis
+    computes it (:func:`heavecomp.diagnosis.components.gap_of`: its parts' mean squares over their
+    equations' noise variances, less the noise's expected 1 for an equation's own rest and less the
+    nominal replay's floor, :attr:`BlockSums.floor`, over the same blocks).
+
+    Parameters
+    ----------
+    sums : BlockSums
+    a, b : int
+        First and past-the-last block.
+    """
+    z = {c: {} for c in COMPONENTS}
+    floor = {c: {} for c in COMPONENTS}
     for (c, e), sq in sums.parts.items():
+        k = sums.count[e][a:b] > 0
         n = float(sums.count[e][a:b].sum())
         if n > 0:
-            z = float(sq[a:b][sums.count[e][a:b] > 0].sum()) / n / sums.noise[e] ** 2
-            gap[c] += max(z - (1.0 if CR.OWN[e] == c else 0.0), 0.0)
-    return {c: math.sqrt(1.0 + g) for c, g in gap.items()}
+            z[c][e] = float(sq[a:b][k].sum()) / n / sums.noise[e] ** 2
+            if (c, e) in sums.floor:
+                floor[c][e] = float(sums.floor[(c, e)][a:b][k].sum()) / n / sums.noise[e] ** 2
+    return {c: math.sqrt(1.0 + g) for c, g in CR.gap_of(z, floor).items()}
+
+
+def block_gap(sums) -> dict:
+    """{component: array over blocks}: each block's gap/noise, computed as :func:`segment_gap` computes a
+    segment's (the nominal replay's floor subtracted), NaN where a block analysed nothing: the timeline's
+    rows.
+
+    Parameters
+    ----------
+    sums : BlockSums
+    """
+    nb = next(iter(sums.count.values())).size
+    gap = {c: np.zeros(nb) for c in COMPONENTS}
+    seen = np.zeros(nb, bool)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        for (c, e), sq in sums.parts.items():
+            n = sums.count[e]
+            ok = n > 0
+            seen |= ok
+            z = np.where(ok, sq / np.maximum(n, 1), 0.0) / sums.noise[e] ** 2
+            f = np.where(ok, sums.floor[(c, e)] / np.maximum(n, 1), 0.0) / sums.noise[e] ** 2 \
+                if (c, e) in sums.floor else 0.0
+            gap[c] += np.maximum(z - (1.0 if CR.OWN[e] == c else 0.0) - f, 0.0)
+    return {c: np.where(seen, np.sqrt(1.0 + g), np.nan) for c, g in gap.items()}
+
+
+def gap_level(gap) -> dict:
+    """``{"gap_to_noise": largest component gap/noise, "component": its component}`` of a log's (or a
+    segment's) ``gap_to_noise`` (None values when there is none): how far the log is from the model, the
+    fleet's ranking key.
+
+    Parameters
+    ----------
+    gap : {component: float}
+        gap/noise per component [-].
+    """
+    if not gap:
+        return {"gap_to_noise": None, "component": None}
+    c = max(gap, key=lambda k: gap[k])
+    return {"gap_to_noise": float(gap[c]), "component": c}
 
 
 def segments(changes, block_t, block, op, sums, duration) -> list:
@@ -898,8 +1189,91 @@ def segments(changes, block_t, block, op, sums, duration) -> list:
         opp = {k: (float(np.nanmedian(op[c][sl])) if np.isfinite(op[c][sl]).any() else None)
                for k, c in (("wob_setpoint", "wob"), ("static_stroke", "stroke"), ("static_pressure", "pressure"))}
         out.append({"start": float(s), "end": float(e), "operating_point": opp,
-                    "gap_to_noise": _segment_gap(sums, a, b)})
+                    "gap_to_noise": segment_gap(sums, a, b)})
     return out
+
+
+def learning_window(n_blocks, learn=LEARN) -> tuple:
+    """(blocks the reference is learnt from, note or None) for a log of ``n_blocks`` blocks: ``learn`` when
+    the log holds twice as many; else :data:`SHORT_LEARN_SHARE` of its blocks (at least 2), with a note
+    saying so (the rest is compared with a shorter reference: alarms are less certain).
+
+    Parameters
+    ----------
+    n_blocks : int
+        Blocks in the log.
+    learn : int
+        The reference's blocks of a long log.
+    """
+    if n_blocks >= 2 * learn:
+        return learn, None
+    k = max(2, int(SHORT_LEARN_SHARE * n_blocks))
+    return k, (f"the log holds {n_blocks} blocks, fewer than the {2 * learn} a reference of {learn} blocks needs: "
+               f"the reference is learnt over its first {k} blocks and the rest compared with it (a short "
+               "reference: an alarm is less certain, a slow change may be missed)")
+
+
+def mean_wave_period(run, span=CHUNK) -> float:
+    """The log's mean wave period [s]: 2 pi sqrt(m0 / m2) of its low-passed heave over its first ``span``
+    seconds (the spectral moments from the heave's and its velocity's variances); NaN when the heave
+    hardly moves (below 3 x its noise: no wave to average over).
+
+    Parameters
+    ----------
+    run : MeasuredRun
+    span : float [s]
+    """
+    k = run.t <= run.t[0] + span
+    z = run["heave"][k]
+    ok = np.isfinite(z)
+    if ok.sum() < 20:
+        return math.nan
+    zf, dz, _ = lowpass_zero_phase(run.t[k][ok], z[ok], HEAVE_CUTOFF)
+    m0, m2 = float(np.var(zf)), float(np.var(dz))
+    if not (m2 > 0) or math.sqrt(m0) < 3.0 * noise_floor(z[ok]):
+        return math.nan
+    return 2.0 * math.pi * math.sqrt(m0 / m2)
+
+
+def block_bounds(run) -> tuple:
+    """(shortest, longest) statistic block for ``run`` [s], from physics: a block holds
+    :data:`BLOCK_MIN_PERIODS` of the log's mean wave period (:func:`mean_wave_period`) and
+    :data:`MIN_BLOCK_SAMPLES` samples at its rate; the log holds :data:`MIN_BLOCKS` blocks, and a block
+    is at most one :data:`CHUNK`.
+
+    Parameters
+    ----------
+    run : MeasuredRun
+    """
+    rate = (run.t.size - 1) / max(run.duration, 1e-300)
+    lo = MIN_BLOCK_SAMPLES / rate
+    tw = mean_wave_period(run)
+    if math.isfinite(tw):
+        lo = max(lo, BLOCK_MIN_PERIODS * tw)
+    return lo, min(CHUNK, run.duration / MIN_BLOCKS)
+
+
+def check_block(run, block) -> float:
+    """``block`` [s] checked against :func:`block_bounds` (before any work); returns it.
+
+    Parameters
+    ----------
+    run : MeasuredRun
+    block : float [s]
+
+    Raises
+    ------
+    heavecomp.errors.InputError
+        One line naming ``--block``, the bounds and why.
+    """
+    lo, hi = block_bounds(run)
+    if not (math.isfinite(block) and lo <= block <= hi):
+        tw = mean_wave_period(run)
+        wave = f"half the mean wave period {tw:.3g} s, " if math.isfinite(tw) else ""
+        raise InputError(f"block {block:g} s is outside {lo:.3g}..{hi:.3g} s for {run.source}: a block holds at "
+                         f"least {wave}{MIN_BLOCK_SAMPLES} samples, the log at least {MIN_BLOCKS} blocks "
+                         f"(it spans {run.duration:.4g} s), a block at most {CHUNK:g} s", option="block")
+    return block
 
 
 def monitor(run, params, *, block=BLOCK, chunk=CHUNK, threshold=THRESHOLD, threshold_op=THRESHOLD_OP,
@@ -945,9 +1319,14 @@ def monitor(run, params, *, block=BLOCK, chunk=CHUNK, threshold=THRESHOLD, thres
     elif "pressure" not in sensors:
         skipped["operating_point"] = ("no pressure channel: a WOB step is reported as an operating change, "
                                       "unchecked by the load balance (a WOB misreading reads the same)")
+    check_block(run, block)
     t = run.t
     edges = _block_edges(t, block)
     block_t = t[edges[:-1]]
+    learn, note = learning_window(edges.size - 1, learn)
+    notes = [note] if note else []
+    if note:
+        log.warning("%s: %s", run.source, note)
     nan = np.full(edges.size - 1, np.nan)
     op = {k: _block_means(run[k], edges) if k in sensors else nan.copy() for k in OP_CHANNELS}
     if noise is None:
@@ -960,13 +1339,15 @@ def monitor(run, params, *, block=BLOCK, chunk=CHUNK, threshold=THRESHOLD, thres
     else:
         op_changes, op_bounds = [], []
     sums = component_blocks(run, params, edges, op_bounds, op, noise, block=block, chunk=chunk, progress=progress,
-                            equations=use)
-    eff = [e for e in component_changes(sums, block_t, block, op_bounds, threshold=threshold, learn=learn)
+                            equations=use, learn=learn)
+    eff = [e for e in component_changes(sums, block_t, block, op_bounds, threshold=threshold, learn=learn,
+                                        jump_eq=JUMP_EQ_SHORT if note else JUMP_EQ)
            if not absorbed(e, op_changes)]
-    changes = sorted(op_changes + eff, key=lambda c: c["t"])
+    changes = sorted(one_per_misreading(op_changes, eff), key=lambda c: c["t"])
     segs = segments(changes, block_t, block, op, sums, run.duration)
     return MonitorResult(block_t, block, sums.stats(), op, sums, changes, segs,
-                         {k: float(v) for k, v in noise.items() if k in sensors}, sensors, run.duration, skipped)
+                         {k: float(v) for k, v in noise.items() if k in sensors}, sensors, run.duration, skipped,
+                         learn, notes, segment_gap(sums, 0, block_t.size))
 
 
 # ---------------------------------------------------------------------------- --diagnose: one verdict per segment
@@ -1005,7 +1386,8 @@ def segment_run(run, start, end) -> MeasuredRun:
                        source=f"{run.source} [{start:.0f}-{end:.0f} s]", measurement=dict(run.measurement))
 
 
-def diagnose_segments(result, run, params, *, candidates=None, n_jobs=1, span=DIAGNOSE_SPAN, progress=None) -> dict:
+def diagnose_segments(result, run, params, *, candidates=None, n_jobs=1, span=DIAGNOSE_SPAN, progress=None,
+                      each=None) -> dict:
     """Diagnose every segment of ``result`` (:func:`monitor`) that carries a gap (:func:`carries_gap`) with
     :class:`heavecomp.diagnosis.estimator.GapDiagnoser` on that segment (at most its first ``span`` s).
 
@@ -1028,6 +1410,10 @@ def diagnose_segments(result, run, params, *, candidates=None, n_jobs=1, span=DI
     span : float [s]
         Longest part of a segment diagnosed.
     progress : callable (fraction, message), optional
+        Called as each segment starts and as its diagnosis goes (the candidates' fits, named by segment).
+    each : callable (index, GapDiagnoser, MeasuredRun, (start, end)), optional
+        Called with each fitted diagnosis, the segment's run and its span [s, log time], as it is done
+        (``heavecomp monitor --diagnose`` writes the segment's folder with it, as ``diagnose --span`` does).
 
     Returns
     -------
@@ -1045,11 +1431,18 @@ def diagnose_segments(result, run, params, *, candidates=None, n_jobs=1, span=DI
             continue
         if progress:
             progress(n / len(todo), f"diagnosing segment {i} ({a:.0f}-{b:.0f} s)")
-        d = GapDiagnoser(params, candidates, n_jobs=n_jobs)
-        d.fit(segment_run(run, a, b))
+        inner = None
+        if progress:
+            def inner(frac, msg, n=n, i=i):
+                progress((n + frac) / len(todo), f"segment {i}: {msg}")
+        d = GapDiagnoser(params, candidates, n_jobs=n_jobs, progress=inner)
+        sub = segment_run(run, a, b)
+        d.fit(sub)
         v = d.verdict_
         seg["verdict"] = {"effect": v["effect"], "confidence": v.get("confidence"), "component": v.get("component"),
                           "shrink": v.get("shrink"), "span": [float(a), float(b)]}
         out[i] = d.to_json()
+        if each is not None:
+            each(i, d, sub, (float(a), float(b)))
         log.info("segment %d (%.0f-%.0f s): %s (%s)", i, a, b, v["effect"], v.get("confidence"))
     return out

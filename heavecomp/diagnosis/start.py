@@ -119,6 +119,25 @@ def _wob_slope(tw, W, at):
     return _poly_at_zero(tw[m] - at, W[m], 1)[1]
 
 
+def string_balance_heave(z, s, W, params):
+    """The heave reference the quasi-static string balance implies at each sample [m]:
+    k_ds (z - z_ref + s - y_b) = W_0 - W with y_b = delta_0 - W / k_F, solved for z_ref (the lower mass is
+    quasi-static below its eigenfrequency; its inertia averages out over a window of waves).  Read by the
+    start estimate over its window and by the monitor over a segment's block means.
+
+    Parameters
+    ----------
+    z, s, W : float or array
+        Heave [m], stroke [m] and WOB [N] (a missing stroke: 0; a missing WOB: W_0).
+    params : CMCParams
+        The parameters (string and formation stiffness, the WOB set-point W_0).
+    """
+    kds, kF = params.drill_string.stiffness, params.formation.stiffness
+    W0 = params.operating_point.wob_setpoint
+    yb = W0 / kF - W / kF
+    return z + s - yb - (W0 - W) / kds
+
+
 def estimate(run, params, heave_filtered, *, window=WINDOW, stuck_speed=STUCK_SPEED, noise=None) -> InitialState:
     """Estimate the initial state of a measured run (see the module docstring).
 
@@ -167,12 +186,11 @@ def estimate(run, params, heave_filtered, *, window=WINDOW, stuck_speed=STUCK_SP
     Wz, sz = col["wob"][wz], col["stroke"][wz]
     z = heave_filtered(t[wz])
     ok = np.isfinite(Wz) & np.isfinite(sz)
-    yb = delta0 - Wz / kF
     # the lower mass' inertia over the window, mean(m_b a_b) = m_b (v_b(end) - v_b(start)) / T, with
     # v_b = -dW/dt / k_F from straight lines at both ends (it oscillates at its own mode after stick events)
     inertia = (ds.lower_mass * (_wob_slope(tz, Wz, tz[-1]) - _wob_slope(tz, Wz, tz[0])) / (-kF)
                / max(tz[-1] - tz[0], 1e-9))
-    zref = float(np.mean((z + sz - yb - (W0 - Wz) / kds)[ok]) - inertia / kds)
+    zref = float(np.mean(string_balance_heave(z, sz, Wz, params)[ok]) - inertia / kds)
     se_z = math.hypot(noise["wob"] * (1.0 / kds + 1.0 / kF), noise["stroke"]) / math.sqrt(max(int(ok.sum()), 1))
     # lower mass from the measured WOB at t = 0 (a straight line over LOWER_WINDOW: shorter than half a
     # period of the lower-mass mode, which stick events excite), W = k_F (delta_0 - y_b) - c_F v_b

@@ -153,9 +153,12 @@ def monitor_dataset(mon: dict, attrs: dict | None = None):
             for k, v in seg.items()}
     data.update({f"change_{k}": (("change",), np.asarray(v, dtype=float if k not in ("component", "kind") else str))
                  for k, v in ch.items()})
+    data["log_gap_to_noise"] = (("component",), np.asarray(
+        [float((mon.get("gap_to_noise") or {}).get(c, np.nan)) for c in comps]))  # over the whole log
     ds = xr.Dataset(data, coords={"segment": np.arange(len(seg["start"])), "component": np.asarray(comps, dtype=str),
                                   "change": np.arange(len(ch["t"]))})
-    _units(ds, {**SEGMENT_UNITS, **{f"change_{k}": u for k, u in CHANGE_UNITS.items()}})
+    _units(ds, {**SEGMENT_UNITS, **{f"change_{k}": u for k, u in CHANGE_UNITS.items()},
+                "log_gap_to_noise": "noise sigma"})
     ds.attrs.update({"title": "heavecomp monitor", "block_s": float(mon.get("block_s", np.nan)),
                      "duration_s": float(mon.get("duration_s", np.nan)), "sensors": " ".join(mon.get("sensors") or []),
                      **(attrs or {})})
@@ -201,11 +204,15 @@ def fleet_dataset(logs: list, attrs: dict | None = None):
     data["status"] = (("log",), np.asarray([str(e.get("status", "")) for e in logs], dtype=str))
     data["reason"] = (("log",), np.asarray([str(e.get("reason", "")) for e in logs], dtype=str))
     data["duration"] = (("log",), np.asarray([float((m or {}).get("duration_s", np.nan)) for m in mons]))
+    # how far each log is from the model over the whole log (the fleet's ranking key: its largest)
+    data["log_gap_to_noise"] = (("log", "component"), np.asarray(
+        [[float(((m or {}).get("gap_to_noise") or {}).get(c, np.nan)) for c in comps] for m in mons]).reshape(
+            len(mons), len(comps)))
     ds = xr.Dataset(data, coords={"log": np.asarray([str(e["log"]) for e in logs], dtype=str),
                                   "segment": np.arange(ns), "component": np.asarray(comps, dtype=str),
                                   "change": np.arange(nc)})
     _units(ds, {**SEGMENT_UNITS, **{f"change_{k}": u for k, u in CHANGE_UNITS.items()}, "duration": "s",
-                "status": "", "reason": ""})
+                "status": "", "reason": "", "log_gap_to_noise": "noise sigma"})
     ds.attrs.update({"title": "heavecomp fleet", **(attrs or {})})
     return ds
 

@@ -8,6 +8,7 @@ import csv
 from pathlib import Path
 
 from heavecomp.campaign.fleet import RESULTS, read_json, read_task, run_fleet
+from heavecomp.diagnosis.monitor import GAP_NOTABLE, gap_level
 from heavecomp.effects.base import COMPONENTS
 from heavecomp.io.arrays import fleet_dataset
 from heavecomp.report.figures import _plt, save
@@ -20,14 +21,21 @@ FLEET_COLUMNS = {"log": "-", "status": "-", "reason": "-", "duration [h]": "h", 
                  "segments [-]": "-", "effect changes [-]": "-", "operating changes [-]": "-",
                  "changes (t [s] component size [noise sigma])": "-",
                  "operating changes (t [s] WOB step [kN])": "-",
-                 "verdicts (segment: effect, confidence, group)": "-"}
+                 "verdicts (segment: effect, confidence, group)": "-",
+                 # how far each log is from the model (issue 31): the monitor's gap/noise over the whole log, per
+                 # component, its largest (the gap level) and the log's rank by it (1: the farthest)
+                 "gap level [-]": "-", "gap component": "-", "gap rank [-]": "-", "notes": "-",
+                 **{f"{c} gap/noise [-]": "-" for c in COMPONENTS}}
 #: ``changes.csv``: one row per change
 CHANGE_COLUMNS = {"log": "-", "kind": "-", "t [s]": "s", "onset [s]": "s", "component": "-",
-                  "size [noise sigma]": "-", "equations": "-", "WOB step [kN]": "kN", "pressure step [MPa]": "MPa"}
+                  "size [noise sigma]": "-", "equations": "-", "WOB step [kN]": "kN", "pressure step [MPa]": "MPa",
+                  "drift until [s]": "s", "drift rate [noise sigma/h]": "1/h"}
 #: ``segments.csv``: one row per segment
 SEGMENT_COLUMNS = {"log": "-", "segment": "-", "start [s]": "s", "end [s]": "s", "WOB set-point [kN]": "kN",
                    "static stroke [m]": "m", "static pressure [MPa]": "MPa", "verdict": "-", "confidence": "-",
-                   "verdict component": "-", "group": "-", "shrink [-]": "-", "diagnosed span [s]": "s"}
+                   "verdict component": "-", "group": "-", "shrink [-]": "-", "diagnosed span [s]": "s",
+                   **{f"{c} gap/noise [-]": "-" for c in COMPONENTS}}
+WORST = 3  #: the fleet's report ends in the diagnose commands of at most this many logs, the farthest first
 COLORS = dict(zip(COMPONENTS, ("tab:red", "tab:blue", "tab:green", "tab:brown", "tab:purple", "tab:olive")))
 
 
@@ -95,7 +103,7 @@ def collect(out_dir, keys) -> dict:
                              "verdict component": v.get("component") or "-", "group": grp,
                              "shrink [-]": "-" if v.get("shrink") is None else round(v["shrink"], 3),
                              "diagnosed span [s]": "-" if not v.get("span") else
-                             f"{v['span'][0]:.0f}-{v['span'][1]:.0f}"})
+                             f"{v['span'][0]:.0f}-{v['span'][1]:.0f}", **gap_cells(s.get("gap_to_noise"))})
             if v:
                 verdicts.append(f"{i}: {v['effect']}" + ("" if v["effect"] == "not_diagnosed" else
                                                          f", {v.get('confidence')}, {grp}"))
@@ -105,17 +113,102 @@ def collect(out_dir, keys) -> dict:
                             "equations": " ".join(c.get("equations") or []),
                             "WOB step [kN]": "" if c.get("wob_step") is None else round(c["wob_step"] * 1e-3, 2),
                             "pressure step [MPa]": "" if c.get("pressure_step") is None else
-                            round(c["pressure_step"] * 1e-6, 4)})
+                            round(c["pressure_step"] * 1e-6, 4),
+                            "drift until [s]": round(c["until"], 1) if c.get("drift") else "",
+                            "drift rate [noise sigma/h]": round(c["rate"], 2) if c.get("drift") else ""})
         row.update({"duration [h]": round(mon["duration_s"] / 3600.0, 3), "sensors": " ".join(mon["sensors"]),
                     "segments [-]": len(mon["segments"]), "effect changes [-]": len(eff),
                     "operating changes [-]": len(ops),
                     "changes (t [s] component size [noise sigma])": "; ".join(
-                        f"{c['t']:.0f} {c['component']} {c['size_to_noise']:.1f}" for c in eff),
+                        f"{c['t']:.0f} {c['component']} {c['size_to_noise']:.1f}"
+                        + (f" drift to {c['until']:.0f} s" if c.get("drift") else "") for c in eff),
                     "operating changes (t [s] WOB step [kN])": "; ".join(
                         f"{c['t']:.0f} {(c.get('wob_step') or 0.0) * 1e-3:+.1f}" for c in ops),
                     "verdicts (segment: effect, confidence, group)": "; ".join(verdicts)})
+        row.update(log_gap(mon), notes="; ".join(mon.get("notes") or []))
         fleet.append(row)
+    rank_by_gap(fleet)
     return {"logs": logs, "fleet": fleet, "changes": changes, "segments": segments}
+
+
+def gap_cells(gap) -> dict:
+    """``{"<component> gap/noise [-]": value}`` of a ``gap_to_noise`` dict (a result without one: empty).
+
+    Parameters
+    ----------
+    gap : {component: float} or None
+    """
+    return {f"{c} gap/noise [-]": round(float(gap[c]), 3) for c in COMPONENTS if c in (gap or {})}
+
+
+def log_gap(mon) -> dict:
+    """A log's gap cells of ``fleet.csv``: per component its gap/noise over the whole log, the largest
+    (``gap level [-]``) and its component (:func:`heavecomp.diagnosis.monitor.gap_level`).  A ``monitor.json``
+    written before the monitor reported the whole log's gap: the longest segment's.
+
+    Parameters
+    ----------
+    mon : dict
+        The log's ``monitor.json`` content.
+    """
+    gap = mon.get("gap_to_noise")
+    if gap is None and mon.get("segments"):
+        gap = max(mon["segments"], key=lambda s: s["end"] - s["start"]).get("gap_to_noise")
+    if not gap:
+        return {}
+    lvl = gap_level(gap)
+    return {"gap level [-]": round(lvl["gap_to_noise"], 3), "gap component": lvl["component"], **gap_cells(gap)}
+
+
+def rank_by_gap(rows) -> list:
+    """Rank the logs of ``fleet.csv`` by their gap level, the farthest from the model first (``gap rank [-]``
+    1); a log without one (failed) has none.  Returns the ranked rows, farthest first.
+
+    Parameters
+    ----------
+    rows : list of dict
+        ``fleet.csv`` rows (:func:`collect`); their ``gap rank [-]`` is set.
+    """
+    ranked = sorted((r for r in rows if r.get("gap level [-]") not in ("", None)), key=lambda r: -r["gap level [-]"])
+    for i, r in enumerate(ranked, 1):
+        r["gap rank [-]"] = i
+    return ranked
+
+
+def diagnose_commands(summary, tasks, out, *, worst=WORST, notable=GAP_NOTABLE) -> list:
+    """The ``heavecomp diagnose`` command lines of the logs farthest from the model: the first ``worst`` of
+    the ranking whose gap level reaches ``notable`` (each with its parameter file, column mapping and units,
+    and an output folder beside the fleet's ``out``); none when every log is near the model.
+
+    Parameters
+    ----------
+    summary : dict
+        :func:`collect`'s answer.
+    tasks : list of heavecomp.campaign.fleet.LogTask
+        The fleet's logs (their paths, parameter files, columns and units).
+    out : str or os.PathLike
+        The fleet's output folder as the user named it.
+    worst : int
+        Most commands.
+    notable : float [-]
+        Smallest gap level worth a diagnosis.
+    """
+    import shlex
+
+    by_key = {t.key: t for t in tasks}
+    out = Path(out)
+    cmds = []
+    for r in rank_by_gap([dict(r) for r in summary["fleet"]]):
+        if len(cmds) >= worst or r["gap level [-]"] < notable or r["log"] not in by_key:
+            continue
+        t = by_key[r["log"]]
+        words = ["heavecomp", "diagnose", t.path, "--params", t.params, "--out", str(out.parent / f"{out.name}-{t.key}")]
+        if t.columns:
+            words += ["--columns", ",".join(f"{k}={v}" for k, v in t.columns.items())]
+        if t.units:
+            words += ["--units", ",".join(f"{k}={v}" for k, v in t.units.items())]
+        cmds.append(" ".join(shlex.quote(w) for w in words))
+    return cmds
 
 
 def to_xarray(summary, **attrs):
@@ -169,6 +262,11 @@ def timeline_figure(summary, *, title=""):
             ax.text(0.0, y, f"  {lg['status']}: {lg['reason'][:90]}", va="center", fontsize=7, color="0.4")
             continue
         ax.plot([0, mon["duration_s"] / 3600.0], [y, y], color="0.8", lw=6, solid_capstyle="butt")
+        row = next((r for r in summary["fleet"] if r["log"] == lg["log"]), {})
+        if row.get("gap level [-]") not in (None, "", "-"):  # how far the log is from the model, at its end
+            ax.annotate(f" gap/noise {row['gap level [-]']:.2f} ({row['gap component']}), rank {row['gap rank [-]']}",
+                        (mon["duration_s"] / 3600.0, y), va="center", fontsize=7,
+                        color="tab:red" if row["gap level [-]"] >= GAP_NOTABLE else "0.3")
         for c in mon["changes"]:
             th = c["t"] / 3600.0
             if c["kind"] == "effect":
@@ -189,12 +287,41 @@ def timeline_figure(summary, *, title=""):
         ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.0, 1.0))
     ax.grid(axis="x", alpha=0.3)
     ax.set_title(title or "Changes per log (dots: effect changes by component, at detection; ticks: operating "
-                 "changes)", fontsize=10)
+                 "changes); each log's gap level at its end", fontsize=10)
     fig.tight_layout()
     return fig
 
 
-def report_markdown(summary, run_info, *, source="", figure="timeline.png") -> str:
+def ranking_markdown(summary, commands=()) -> list:
+    """The report's lines on how far each log is from the model: the logs ranked by their gap level, with
+    each component's gap/noise, then the ``heavecomp diagnose`` commands of the farthest (``commands``,
+    :func:`diagnose_commands`).
+
+    Parameters
+    ----------
+    summary : dict
+        :func:`collect`'s answer.
+    commands : sequence of str
+        The command lines to end with.
+    """
+    ranked = rank_by_gap([dict(r) for r in summary["fleet"]])
+    if not ranked:
+        return []
+    cols = ["gap rank [-]", "log", "gap level [-]", "gap component"] + [f"{c} gap/noise [-]" for c in COMPONENTS]
+    lines = ["## How far each log is from the model", "",
+             "Each log's gap over its noise per model component over the whole log (sqrt(1 + gap), the gap as "
+             "`heavecomp diagnose` measures it: the nominal replay's floor subtracted; 1.00: at the noise), ranked by "
+             f"its largest, the gap level. At {GAP_NOTABLE:g} or more a log is worth a diagnosis.", "",
+             md_table(cols, [[r.get(c, "-") for c in cols] for r in ranked]), "", "## What next", ""]
+    if commands:
+        lines += ["Diagnose the logs farthest from the model (each command carries the log's parameter file, "
+                  "columns and units):", "", "```", *commands, "```"]
+    else:
+        lines += [f"Every log is within {GAP_NOTABLE:g}x its noise of the model: nothing to diagnose."]
+    return lines
+
+
+def report_markdown(summary, run_info, *, source="", figure="timeline.png", commands=()) -> str:
     """The fleet's ``report.md``: counts, the strips, the table per log, and the diagnosed segments.
 
     Parameters
@@ -207,6 +334,8 @@ def report_markdown(summary, run_info, *, source="", figure="timeline.png") -> s
         The folder or pattern of the logs, for the title.
     figure : str
         File name of the figure, relative to the report.
+    commands : sequence of str
+        The diagnose commands the report ends in (:func:`diagnose_commands`).
     """
     logs = summary["logs"]
     n_failed = sum(lg["status"] != "done" for lg in logs)
@@ -217,7 +346,7 @@ def report_markdown(summary, run_info, *, source="", figure="timeline.png") -> s
              f"({run_info['executor']}, {run_info['workers']} workers). Each log's own result: "
              f"`{RESULTS}/<log>/monitor.json` (and `segment_<i>/diagnosis.json` when diagnosed).", "",
              f"![changes per log]({figure})", "", "## Per log", ""]
-    keep = [k for k in FLEET_COLUMNS if k not in ("reason", "sensors")]
+    keep = [k for k in FLEET_COLUMNS if k not in ("reason", "sensors", "notes") and "gap/noise" not in k]
     lines.append(md_table(keep, [[r[k] if r[k] != "" else "-" for k in keep] for r in summary["fleet"]]))
     bad = [r for r in summary["fleet"] if r["status"] != "done"]
     if bad:
@@ -232,10 +361,13 @@ def report_markdown(summary, run_info, *, source="", figure="timeline.png") -> s
               "carries (docs/monitoring.md). `group`: the candidates the log's sensor set cannot tell apart from "
               "the verdict (docs/diagnosis.md). Tables: `fleet.csv` (one row per log), `changes.csv`, "
               "`segments.csv` (units in the headers and in `<table>.units.csv`)."]
+    rank = ranking_markdown(summary, commands)
+    if rank:
+        lines += [""] + rank
     return "\n".join(lines) + "\n"
 
 
-def write_report(out_dir, summary, run_info, *, source="") -> Path:
+def write_report(out_dir, summary, run_info, *, source="", commands=()) -> Path:
     """``fleet.csv``, ``changes.csv``, ``segments.csv`` (+ ``.units.csv``), ``fleet.json``, ``timeline.png``
     and ``report.md`` in ``out_dir`` (the HTML comes with the provenance stamp).
 
@@ -249,6 +381,8 @@ def write_report(out_dir, summary, run_info, *, source="") -> Path:
         How it ran (:func:`report_markdown`).
     source : str
         The folder or pattern of the logs.
+    commands : sequence of str
+        The diagnose commands the report ends in (:func:`diagnose_commands`).
 
     Returns
     -------
@@ -260,18 +394,21 @@ def write_report(out_dir, summary, run_info, *, source="") -> Path:
     _write_csv(out / "changes.csv", CHANGE_COLUMNS, summary["changes"])
     _write_csv(out / "segments.csv", SEGMENT_COLUMNS, summary["segments"])
     doc = {"schema": 1, "source": source, "run": run_info,
+           "what_next": list(commands),
            "logs": [{"log": lg["log"], "status": lg["status"], "reason": lg["reason"],
                      "duration_s": lg["monitor"]["duration_s"] if lg["monitor"] else None,
+                     "gap_to_noise": (lg["monitor"] or {}).get("gap_to_noise"),
+                     "gap_level": (lg["monitor"] or {}).get("gap_level"),
                      "changes": lg["monitor"]["changes"] if lg["monitor"] else [],
                      "segments": lg["monitor"]["segments"] if lg["monitor"] else []} for lg in summary["logs"]]}
     dump_json(doc, out / "fleet.json")
     save(timeline_figure(summary), out / "timeline.png")
     p = out / "report.md"
-    p.write_text(report_markdown(summary, run_info, source=source), encoding="utf-8")
+    p.write_text(report_markdown(summary, run_info, source=source, commands=commands), encoding="utf-8")
     return p
 
 
-def run_and_report(tasks, out_dir, settings, *, source="", **kw):
+def run_and_report(tasks, out_dir, settings, *, source="", final_out=None, **kw):
     """:func:`heavecomp.campaign.fleet.run_fleet` (each log's result by :func:`write_log`), then the summary
     and the report.  Returns ``(FleetRun, summary)``.
 
@@ -283,6 +420,9 @@ def run_and_report(tasks, out_dir, settings, *, source="", **kw):
     settings : heavecomp.campaign.fleet.Settings
     source : str
         The folder or pattern of the logs, for the report.
+    final_out : str or os.PathLike, optional
+        The output folder as the user named it, for the printed commands (default ``out_dir``; the command
+        line runs into a staging folder).
     **kw : dict
         Passed to :func:`heavecomp.campaign.fleet.run_fleet` (``workers``, ``scheduler``, ``client``,
         ``progress``, ``limit``).
@@ -291,5 +431,6 @@ def run_and_report(tasks, out_dir, settings, *, source="", **kw):
     summary = collect(out_dir, info.keys)
     run_info = {"executor": info.executor, "workers": info.workers, "logs_computed": info.n_computed,
                 "logs_resumed": info.n_skipped, "logs_failed": info.n_failed, "wall_time_s": round(info.wall_time, 2)}
-    write_report(out_dir, summary, run_info, source=source)
+    summary["what_next"] = diagnose_commands(summary, tasks, final_out or out_dir)
+    write_report(out_dir, summary, run_info, source=source, commands=summary["what_next"])
     return info, summary

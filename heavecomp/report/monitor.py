@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from heavecomp.diagnosis.components import UNITS
+from heavecomp.diagnosis.monitor import block_gap
 from heavecomp.effects.base import COMPONENTS
 from heavecomp.report.figures import _plt, save
 from heavecomp.report.scenario import _clean as clean
@@ -15,8 +16,9 @@ from heavecomp.report.scenario import md_table
 
 
 def timeline_figure(res, *, title=""):
-    """One row per component: the block statistic as rms over noise (sqrt of the block's mean square
-    of the component's parts over the noise variance) against time, on a log scale; the block-mean
+    """One row per component: each block's gap/noise (:func:`heavecomp.diagnosis.monitor.block_gap`: as the
+    segments' and the diagnosis' gap, the nominal replay's floor subtracted; 1: at the noise, dotted)
+    against time, on a log scale; the block-mean
     WOB on top; effect changes as solid red lines, operating changes dashed.
 
     Parameters
@@ -33,9 +35,12 @@ def timeline_figure(res, *, title=""):
     tb = (res.t_blocks + 0.5 * res.block) * scale
     axes[0].plot(tb, res.op["wob"] * 1e-3, color="k", lw=0.8)
     axes[0].set_ylabel("WOB\nblock mean [kN]")
+    gaps = block_gap(res.sums) if getattr(res, "sums", None) is not None else \
+        {c: np.sqrt(np.maximum(res.stats[c], 1e-6)) for c in COMPONENTS}
     for ax, c in zip(axes[1:], COMPONENTS):
-        ax.semilogy(tb, np.sqrt(np.maximum(res.stats[c], 1e-6)), lw=0.7)
-        ax.set_ylabel(f"{c}\nrms/noise [-]", fontsize=8)
+        ax.semilogy(tb, gaps[c], lw=0.7)
+        ax.axhline(1.0, color="0.6", lw=0.6, ls=":")
+        ax.set_ylabel(f"{c}\ngap/noise [-]", fontsize=8)
     for ch in res.changes:
         op = ch["kind"] == "operating"
         for ax in axes:
@@ -45,7 +50,8 @@ def timeline_figure(res, *, title=""):
             ax.annotate(f"{ch['size_to_noise']:.1f} σ", (ch["t"] * scale, 1), xycoords=("data", "axes fraction"),
                         va="top", fontsize=7, color="tab:red")
     axes[-1].set_xlabel(f"time [{unit}]")
-    axes[0].set_title(title or "Component residuals over time (red: effect change, orange dashed: operating change)",
+    axes[0].set_title(title or "Gap over noise per component and block (red: effect change, orange dashed: "
+                      "operating change)",
                       fontsize=10)
     fig.tight_layout()
     return fig
@@ -107,7 +113,7 @@ def write_segment_diagnoses(diagnoses, out) -> list:
     return paths
 
 
-def report_markdown(res, source="", figure="timeline.png") -> str:
+def report_markdown(res, source="", figure="timeline.png", diagnosed=()) -> str:
     """The monitor's ``report.md``: the changes, the segments (with their verdicts) and the method.
 
     Parameters
@@ -117,6 +123,9 @@ def report_markdown(res, source="", figure="timeline.png") -> str:
         Name of the log, for the title.
     figure : str
         File name of the timeline figure, relative to the report.
+    diagnosed : sequence of str
+        Lines on the diagnosed segments' folders and the ``diagnose --span`` command of each (the command's
+        :func:`diagnosed_lines`).
     """
     lines = [f"# Monitor — {source}" if source else "# Monitor", "",
              f"{res.duration / 3600:.2f} h of log, sensors {', '.join(res.sensors)}; statistic blocks of "
@@ -131,11 +140,18 @@ def report_markdown(res, source="", figure="timeline.png") -> str:
               "docs/monitoring.md, isolability per sensor set).", ""]
     if sk.get("operating_point"):
         lines += [f"**Operating point:** {sk['operating_point']}.", ""]
+    for note in getattr(res, "notes", None) or []:
+        lines += [f"**Note:** {note}.", ""]
+    gap = getattr(res, "gap", None)
+    if gap:
+        c = max(gap, key=lambda k: gap[k])
+        lines += [f"Gap over the whole log: largest in `{c}`, {gap[c]:.2f}x the noise (1.00: at the noise; "
+                  "measured as `heavecomp diagnose` measures it, the nominal replay's floor subtracted).", ""]
     lines += ["## Changes", ""]
     if res.changes:
         lines.append(md_table(["detected t [s]", "onset [s]", "component", "size [noise σ]", "kind"],
                               [[f"{c['t']:.0f}", f"{c['onset']:.0f}", c["component"], f"{c['size_to_noise']:.1f}",
-                                c["kind"]] for c in res.changes]))
+                                _kind(c)] for c in res.changes]))
     else:
         lines.append("No change: every component's residual stayed at its level over the whole log.")
     lines += ["", "`size`: the mean shift of the component's standardised block statistic between onset and "
@@ -157,7 +173,44 @@ def report_markdown(res, source="", figure="timeline.png") -> str:
               + ", ".join(f"{c} {UNITS[c]}" for c in COMPONENTS) + ".", "",
               "Method: component residuals (equation error) in windows, a two-sided CUSUM per component on the "
               "log of its block statistic (docs/monitoring.md)."]
+    if diagnosed:
+        lines += ["", "## Diagnosed segments", "", *diagnosed]
     return "\n".join(lines) + "\n"
+
+
+def diagnosed_lines(spans, log, params, out) -> list:
+    """The report's lines on each diagnosed segment: its folder (what ``heavecomp diagnose --span`` writes:
+    ``diagnosis.json``, ``report.md``/``.html``, the figures, ``calibrated.toml``) and the command that
+    diagnoses that span again.
+
+    Parameters
+    ----------
+    spans : {int: (float, float)}
+        Segment index -> the span diagnosed [s, log time].
+    log, params : str
+        The log and the parameter file as the user named them.
+    out : str or Path
+        The monitor's output folder as the user named it.
+    """
+    import shlex
+
+    lines = []
+    for i, (a, b) in sorted(spans.items()):
+        folder = Path(out) / f"segment_{i}"
+        cmd = " ".join(shlex.quote(w) for w in ("heavecomp", "diagnose", str(log), "--params", str(params),
+                                                 "--span", f"{a:.0f}:{b:.0f}", "--out", str(folder)))
+        lines += [f"- segment {i}, {a:.0f}-{b:.0f} s: [`{folder.name}/report.md`]({folder.name}/report.md), "
+                  f"`{folder.name}/calibrated.toml`; the same diagnosis: `{cmd}`"]
+    return lines
+
+
+def _kind(change) -> str:
+    """A change's kind as the report shows it: a drift (:func:`heavecomp.diagnosis.monitor.merge_drifts`)
+    with its end and rate."""
+    if change.get("drift"):
+        return (f"{change['kind']}: drift to {change['until']:.0f} s ({change['alarms']} alarms), "
+                f"{change['rate']:+.1f} {change['rate_unit']}")
+    return change["kind"]
 
 
 def _verdict(segment) -> str:
@@ -169,7 +222,7 @@ def _verdict(segment) -> str:
     return f"{v['effect']} ({v.get('confidence')}; {v.get('component') or '-'})"
 
 
-def write_report(res, out, *, source="", extra=None) -> Path:
+def write_report(res, out, *, source="", extra=None, diagnosed=()) -> Path:
     """``monitor.json``, ``timeline.png`` and ``report.md`` in ``out`` (the HTML comes with the provenance
     stamp, :func:`heavecomp.report.provenance.finish`).
 
@@ -182,11 +235,13 @@ def write_report(res, out, *, source="", extra=None) -> Path:
         Name of the log, for the title.
     extra : dict, optional
         Keys added to ``monitor.json``.
+    diagnosed : sequence of str
+        The report's lines on the diagnosed segments (:func:`diagnosed_lines`).
     """
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     write_json(res, out / "monitor.json", extra)
     save(timeline_figure(res), out / "timeline.png")
     p = out / "report.md"
-    p.write_text(report_markdown(res, source), encoding="utf-8")
+    p.write_text(report_markdown(res, source, diagnosed=diagnosed), encoding="utf-8")
     return p
