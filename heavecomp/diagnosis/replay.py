@@ -98,7 +98,13 @@ class Ledger:
 
 
 def sorted_config(config) -> tuple:
-    """A configuration ``[(effect name, values), ...]`` as a hashable, order-free-within-values tuple."""
+    """A configuration ``[(effect name, values), ...]`` as a hashable, order-free-within-values tuple.
+
+    Parameters
+    ----------
+    config : list of (str, dict)
+        The effects replayed, each by name with its parameter values.
+    """
     return tuple((n, tuple(sorted((k, float(v) if isinstance(v, (int, float, np.floating)) else v)
                                   for k, v in dict(v).items()))) for n, v in config)
 
