@@ -234,9 +234,10 @@ def _sea(rng) -> tuple[dict, dict]:
             {"hs": hs2, "tp": tp2, "seed": int(rng.integers(0, 2**31))})
 
 
-def _run(plant: Plant, effects: list[Effect], sea: dict, duration: float) -> dict:
-    """Noise-free channels at the logger's rate, as the sensors read them (before noise)."""
-    heave = Heave(sea["hs"], sea["tp"], seed=sea["seed"])
+def _run(plant: Plant, effects: list[Effect], sea, duration: float) -> dict:
+    """Noise-free channels at the logger's rate, as the sensors read them (before noise); ``sea`` is
+    a sea-state dict or a heave (the plant's input). ``true_heave``: the heave the plant saw."""
+    heave = Heave(sea["hs"], sea["tp"], seed=sea["seed"]) if isinstance(sea, dict) else sea
     for e in effects:
         if e.plant is not None:
             plant = e.plant(plant)
@@ -249,7 +250,7 @@ def _run(plant: Plant, effects: list[Effect], sea: dict, duration: float) -> dic
         if e.reading is not None:
             ch = e.reading(t, ch)
     step = int(round(SIM_RATE / RATE))
-    return {"t": t[::step], **{k: v[::step] for k, v in ch.items()}}
+    return {"t": t[::step], **{k: v[::step] for k, v in ch.items()}, "true_heave": r["heave"][::step]}
 
 
 def _log(clean: dict, effects: list[Effect], rng, noise_scale: float) -> dict:
@@ -277,26 +278,15 @@ def _gap(size: dict) -> float:
     return float(sum(v * v for v in size.values()))
 
 
-def make_case(seed: int, cls: str, out: str | Path, *, noise_scale: float = 1.0,
-              duration: float = DURATION) -> dict:
-    """Generate one case of class ``cls`` into folder ``out``; return its truth (also ``truth.json``).
-
-    Files: ``log.csv`` (the measured-run contract: t, heave, stroke, pressure, wob; SI, 10 Hz),
-    ``nominal.toml`` (the paper-A set with JONSWAP heave of the log's sea), ``truth_channels.csv``
-    (noise-free, as the sensors read them), ``log_sea2.csv`` and ``truth_channels_sea2.csv`` (the
-    same truth plant and sensors in another sea), ``truth.json``.
-    """
-    if cls not in CLASSES:
-        raise ValueError(f"class: unknown {cls!r}; known: {', '.join(CLASSES)}")
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
+def _draw_case(seed: int, cls: str):
+    """(rng, sea, sea2, nominal parameters, nominal plant, effects) of a case: the same for the same
+    (seed, class), so :func:`truth_replay` rebuilds the truth :func:`make_case` logged."""
     rng = np.random.default_rng([seed, CLASSES.index(cls)])
     sea1, sea2 = _sea(rng)
     params = paper_a().replace(heave={"kind": "jonswap", "hs": round(sea1["hs"], 3), "tp": round(sea1["tp"], 3),
                                       "gamma": 3.3, "seed": sea1["seed"], "amplitude": None, "period": None,
                                       "ramp": None})
     nominal = Plant.from_params(params)
-
     if cls == "none":
         effects = []
     elif cls == "two_effects":
@@ -305,6 +295,36 @@ def make_case(seed: int, cls: str, out: str | Path, *, noise_scale: float = 1.0,
         effects = [_draw(a, rng, nominal), _draw(b, rng, nominal)]
     else:
         effects = [_draw(cls, rng, nominal)]
+    return rng, sea1, sea2, params, nominal, effects
+
+
+def truth_replay(seed: int, cls: str, t: np.ndarray, heave: np.ndarray) -> dict | None:
+    """The case's true model (plant and sensors, no noise) driven by the heave samples (t, heave):
+    a replay of the truth, as a user replays a model on a log's heave. None for a truth whose heave
+    channel is filtered (``mru_filter``): the logged heave is not the heave its plant saw."""
+    if cls not in CLASSES:
+        raise ValueError(f"class: unknown {cls!r}")
+    _, _, _, _, nominal, effects = _draw_case(seed, cls)
+    if any("heave_channel" in e.extra for e in effects):
+        return None  # the true model reads its heave through the MRU: the logged heave is not its input
+    return _run(nominal, effects, SampledHeave(t, heave), float(t[-1] - t[0]))
+
+
+def make_case(seed: int, cls: str, out: str | Path, *, noise_scale: float = 1.0,
+              duration: float = DURATION) -> dict:
+    """Generate one case of class ``cls`` into folder ``out``; return its truth (also ``truth.json``).
+
+    Files: ``log.csv`` (the measured-run contract: t, heave, stroke, pressure, wob; SI, 10 Hz),
+    ``nominal.toml`` (the paper-A set with JONSWAP heave of the log's sea), ``truth_channels.csv``
+    (noise-free, as the sensors read them), ``log_sea2.csv`` and ``truth_channels_sea2.csv`` (the
+    same truth plant and sensors in another sea), ``truth.json``. :func:`truth_replay` runs the same
+    truth under another heave.
+    """
+    if cls not in CLASSES:
+        raise ValueError(f"class: unknown {cls!r}; known: {', '.join(CLASSES)}")
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    rng, sea1, sea2, params, nominal, effects = _draw_case(seed, cls)
 
     clean = _run(nominal, effects, sea1, duration)
     nom_clean = _run(nominal, [], sea1, duration)
@@ -335,10 +355,9 @@ def make_case(seed: int, cls: str, out: str | Path, *, noise_scale: float = 1.0,
     log = _log(clean, effects, rng, noise_scale)
     clean2 = _run(nominal, effects, sea2, duration)
     log2 = _log(clean2, effects, rng, noise_scale)
-    write_csv(out / "log.csv", log)
-    write_csv(out / "truth_channels.csv", clean)
-    write_csv(out / "log_sea2.csv", log2)
-    write_csv(out / "truth_channels_sea2.csv", clean2)
+    for name, cols in (("log", log), ("truth_channels", clean), ("log_sea2", log2), ("truth_channels_sea2", clean2)):
+        write_csv(out / f"{name}.csv", cols)
+
     (out / "nominal.toml").write_text(dumps(params, header=f"independent truth, class {cls}, seed {seed}: the "
                                                            "nominal the user believes"))
     (out / "truth.json").write_text(json.dumps(truth, indent=2, default=float))
