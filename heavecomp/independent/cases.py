@@ -264,6 +264,20 @@ def _log(clean: dict, effects: list[Effect], rng, noise_scale: float) -> dict:
 
 
 def write_csv(path: Path, cols: dict) -> Path:
+    """A measured-run CSV (header ``t,heave,stroke,pressure,wob``, SI units).
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The file.
+    cols : dict
+        t and the four channels [SI].
+
+    Returns
+    -------
+    pathlib.Path
+        path.
+    """
     names = ["t", *CHANNELS]
     np.savetxt(path, np.column_stack([cols[k] for k in names]), delimiter=",", header=",".join(names),
                comments="", fmt="%.9g")
@@ -301,7 +315,24 @@ def _draw_case(seed: int, cls: str):
 def truth_replay(seed: int, cls: str, t: np.ndarray, heave: np.ndarray) -> dict | None:
     """The case's true model (plant and sensors, no noise) driven by the heave samples (t, heave):
     a replay of the truth, as a user replays a model on a log's heave. None for a truth whose heave
-    channel is filtered (``mru_filter``): the logged heave is not the heave its plant saw."""
+    channel is filtered (``mru_filter``): the logged heave is not the heave its plant saw.
+
+    Parameters
+    ----------
+    seed : int
+        The case's seed.
+    cls : str
+        Its class.
+    t : ndarray [s]
+        Heave sample times.
+    heave : ndarray [m]
+        The heave the plant sees.
+
+    Returns
+    -------
+    dict or None
+        Noise-free channels at 10 Hz [SI].
+    """
     if cls not in CLASSES:
         raise ValueError(f"class: unknown {cls!r}")
     _, _, _, _, nominal, effects = _draw_case(seed, cls)
@@ -319,6 +350,24 @@ def make_case(seed: int, cls: str, out: str | Path, *, noise_scale: float = 1.0,
     (noise-free, as the sensors read them), ``log_sea2.csv`` and ``truth_channels_sea2.csv`` (the
     same truth plant and sensors in another sea), ``truth.json``. :func:`truth_replay` runs the same
     truth under another heave.
+
+    Parameters
+    ----------
+    seed : int
+        Case seed (with the class, it fixes every draw).
+    cls : str
+        One of ``CLASSES``.
+    out : str or pathlib.Path
+        Folder to write.
+    noise_scale : float [-]
+        Multiplies ``NOISE``.
+    duration : float [s]
+        Length of each log.
+
+    Returns
+    -------
+    dict
+        The truth (as in ``truth.json``).
     """
     if cls not in CLASSES:
         raise ValueError(f"class: unknown {cls!r}; known: {', '.join(CLASSES)}")

@@ -24,6 +24,24 @@ def stribeck_level(v: float, p: float, f_s: float, f_c: float, v_s: float, c_p: 
 
     Ottestad, Nilsen & Hansen, ICCAS 2012, eq. 4 (the sign and the viscous part left out): the
     steady sliding friction is g(v, p) sign(v) + C_v v.
+
+    Parameters
+    ----------
+    v : float [m/s]
+        Sliding velocity.
+    p : float [Pa]
+        Pressure across the seal.
+    f_s, f_c : float [N]
+        Static and Coulomb levels.
+    v_s : float [m/s]
+        Stribeck velocity.
+    c_p : float [N/Pa]
+        Pressure coefficient.
+
+    Returns
+    -------
+    float [N]
+        g(v, p) > 0.
     """
     return f_c + (f_s - f_c) * math.exp(-abs(v) / v_s) + c_p * abs(p)
 
@@ -174,7 +192,24 @@ class ThermalGas:
 
 
 def polytropic_p_abs(p_abs0: float, v0: float, v_gas: float, n: float) -> float:
-    """cmc-reference.md: p + p_atm = (p_0 + p_atm) (V_0 / V)^n [Pa, absolute]."""
+    """cmc-reference.md: p + p_atm = (p_0 + p_atm) (V_0 / V)^n [Pa, absolute].
+
+    Parameters
+    ----------
+    p_abs0 : float [Pa]
+        Absolute pressure at V_0.
+    v0 : float [m^3]
+        Gas volume at the operating point.
+    v_gas : float [m^3]
+        Gas volume now.
+    n : float [-]
+        Polytropic index.
+
+    Returns
+    -------
+    float [Pa]
+        Absolute gas pressure.
+    """
     return p_abs0 * (v0 / v_gas) ** n
 
 
@@ -234,7 +269,26 @@ def hardening(t: float, k0: float, factor: float, t_start: float, duration: floa
     """Formation stiffness that moves from k0 to factor*k0 between t_start and t_start + duration,
     a smooth (cosine) step: the bit drills into a harder layer (Detournay & Defourny, "A phenomenological
     model for the drilling action of drag bits", Int. J. Rock Mech. 29, 1992: the contact response
-    scales with the rock's strength)."""
+    scales with the rock's strength).
+
+    Parameters
+    ----------
+    t : float [s]
+        Time.
+    k0 : float [N/m]
+        Stiffness before.
+    factor : float [-]
+        Stiffness after / before.
+    t_start : float [s]
+        Start of the change.
+    duration : float [s]
+        How long the change takes.
+
+    Returns
+    -------
+    float [N/m]
+        k_F(t).
+    """
     if t <= t_start:
         return k0
     if t >= t_start + duration:
@@ -254,6 +308,22 @@ def mru_highpass(t: np.ndarray, z: np.ndarray, corner_period: float, damping: fl
     Kongsberg Seatex MRU and similar units output heave through such a filter (the heave filter's
     'period' setting, typically 50-200 s); Godhaven, "Adaptive tuning of heave filter in motion
     sensor", OCEANS 1998. Gain at the corner: 1 / (2 zeta) (0.707 for the Butterworth zeta).
+
+    Parameters
+    ----------
+    t : ndarray [s]
+        Sample times.
+    z : ndarray [m]
+        True heave.
+    corner_period : float [s]
+        2 pi / w_c.
+    damping : float [-]
+        zeta (default Butterworth).
+
+    Returns
+    -------
+    ndarray [m]
+        The heave the MRU reports.
     """
     from scipy import signal
 
@@ -265,12 +335,38 @@ def mru_highpass(t: np.ndarray, z: np.ndarray, corner_period: float, damping: fl
 
 def quantise(y: np.ndarray, step: float) -> np.ndarray:
     """Mid-tread quantiser: round to the nearest multiple of ``step`` (error within +-step/2;
-    Widrow & Kollár, "Quantization Noise", CUP 2008, ch. 4)."""
+    Widrow & Kollár, "Quantization Noise", CUP 2008, ch. 4).
+
+    Parameters
+    ----------
+    y : ndarray
+        Signal.
+    step : float
+        Quantum, in y's unit.
+
+    Returns
+    -------
+    ndarray
+        Quantised signal.
+    """
     return step * np.round(y / step)
 
 
 def adc16(y: np.ndarray, lo: float, hi: float) -> np.ndarray:
-    """A 16-bit logger over [lo, hi]: 65535 steps, values outside clip."""
+    """A 16-bit logger over [lo, hi]: 65535 steps, values outside clip.
+
+    Parameters
+    ----------
+    y : ndarray
+        Signal.
+    lo, hi : float
+        The logger's range, in y's unit.
+
+    Returns
+    -------
+    ndarray
+        The logged values.
+    """
     step = (hi - lo) / 65535.0
     return lo + quantise(np.clip(y, lo, hi) - lo, step)
 
@@ -278,17 +374,64 @@ def adc16(y: np.ndarray, lo: float, hi: float) -> np.ndarray:
 def mains_hum(t: np.ndarray, amplitude: float, frequency: float, phase: float) -> np.ndarray:
     """Mains pickup sampled at the logger's times: a sine at ``frequency`` (50 or 60 Hz, off by the
     grid's drift) evaluated at t, so that a logger without anti-alias filter aliases it to
-    |f - k f_s| (IEC 61000-4-30 grid tolerance: +-1 %)."""
+    |f - k f_s| (IEC 61000-4-30 grid tolerance: +-1 %).
+
+    Parameters
+    ----------
+    t : ndarray [s]
+        Sample times.
+    amplitude : float
+        Hum amplitude, in the channel's unit.
+    frequency : float [Hz]
+        Mains frequency.
+    phase : float [rad]
+        Phase at t = 0.
+
+    Returns
+    -------
+    ndarray
+        The hum at t.
+    """
     return amplitude * np.sin(2.0 * math.pi * frequency * t + phase)
 
 
 def delayed(t: np.ndarray, y: np.ndarray, delay: float) -> np.ndarray:
-    """The channel read ``delay`` s late: y(t - delay), cubic interpolation, the first values held."""
+    """The channel read ``delay`` s late: y(t - delay), cubic interpolation, the first values held.
+
+    Parameters
+    ----------
+    t : ndarray [s]
+        Sample times.
+    y : ndarray
+        Channel.
+    delay : float [s]
+        Lag (> 0: late).
+
+    Returns
+    -------
+    ndarray
+        y(t - delay).
+    """
     from scipy.interpolate import CubicSpline
 
     return CubicSpline(t, y)(np.maximum(t - delay, t[0]))
 
 
 def gain_offset(y: np.ndarray, gain: float = 1.0, offset: float = 0.0) -> np.ndarray:
-    """A miscalibrated sensor: reading = gain * y + offset (a gauge read as absolute: offset p_atm)."""
+    """A miscalibrated sensor: reading = gain * y + offset (a gauge read as absolute: offset p_atm).
+
+    Parameters
+    ----------
+    y : ndarray
+        True value.
+    gain : float [-]
+        Factor.
+    offset : float
+        Offset, in y's unit.
+
+    Returns
+    -------
+    ndarray
+        The reading.
+    """
     return gain * y + offset

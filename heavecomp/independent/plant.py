@@ -39,6 +39,21 @@ class Heave:
 
     JONSWAP: Hasselmann et al., Dtsch. Hydrogr. Z. A8(12), 1973; the normalisation of
     DNV-RP-C205 (2010) section 3.5.5: S(w) = A_g 5/16 Hs^2 wp^4 w^-5 exp(-5/4 (w/wp)^-4) gamma^r.
+
+    Parameters
+    ----------
+    hs : float [m]
+        Significant height of the platform heave.
+    tp : float [s]
+        Peak period.
+    gamma : float [-]
+        Peak enhancement.
+    seed : int
+        Phase seed.
+    ramp : float or None [s]
+        Fade-in (default 2 tp).
+    n : int
+        Number of sines.
     """
 
     def __init__(self, hs: float, tp: float, gamma: float = 3.3, seed: int = 0, ramp: float | None = None,
@@ -118,7 +133,15 @@ class Heave:
 
 class SampledHeave(Heave):
     """Heave given as samples (a logged heave): a cubic spline through them, tabulated like
-    :class:`Heave` (its third derivative is piecewise constant)."""
+    :class:`Heave` (its third derivative is piecewise constant).
+
+    Parameters
+    ----------
+    t : ndarray [s]
+        Sample times.
+    z : ndarray [m]
+        Heave samples.
+    """
 
     def __init__(self, t: np.ndarray, z: np.ndarray):
         from scipy.interpolate import CubicSpline
@@ -259,7 +282,26 @@ def _critical_damping(seal: LuGre, mass: float, zeta: float) -> float:
 def simulate(plant: Plant, heave: Heave, duration: float, rate: float = 50.0,
              rtol: float = 1e-8) -> dict:
     """Integrate ``plant`` under ``heave`` from rest at the operating point; outputs sampled at
-    ``rate`` Hz: t, heave, stroke, pressure, wob (and friction, stroke_velocity, p_gas)."""
+    ``rate`` Hz: t, heave, stroke, pressure, wob (and friction, stroke_velocity, p_gas).
+
+    Parameters
+    ----------
+    plant : Plant
+        The true plant.
+    heave : Heave
+        Its input.
+    duration : float [s]
+        Length of the run.
+    rate : float [Hz]
+        Output sample rate.
+    rtol : float [-]
+        LSODA's relative tolerance.
+
+    Returns
+    -------
+    dict
+        Arrays by name [SI], and ``nfev``.
+    """
     from scipy.integrate import solve_ivp
 
     t = np.arange(0.0, duration + 0.5 / rate, 1.0 / rate)
