@@ -23,7 +23,8 @@ answer against the truth:
   (``--transfer replay|simulate``).
 
 Writes ``DIR/report.md`` and ``DIR/scores.json`` (one row per case) and keeps every case in
-``DIR/cases/<class>_<seed>/`` (a finished case is not run again: the set resumes).
+``DIR/cases/<class>_<seed>/`` (a finished case is not run again: the set resumes; ``--rescore`` scores
+finished cases again from their kept logs and diagnoses).
 """
 
 from __future__ import annotations
@@ -118,8 +119,10 @@ def _read_through(e: dict, t: np.ndarray, y: np.ndarray) -> np.ndarray:
     name = e["name"]
     if name == "sensor_gain":
         return e.get("factor", 1.0) * y
-    if name == "sensor_offset":
-        return y + e.get("offset", 0.0) + e.get("drift", 0.0) * (t - t[0])
+    if name == "sensor_offset":  # the offset's key is not in the contract: the one number besides drift
+        off = e.get("offset", next((x for k, x in e.items() if k not in ("name", "channel", "drift")
+                                    and isinstance(x, (int, float))), 0.0))
+        return y + off + e.get("drift", 0.0) * (t - t[0])
     if name in ("sensor_delay", "sensor_lag"):
         tau = e.get("time_constant", 0.0)
         if tau > 0:
@@ -225,22 +228,32 @@ def _verdict_score(truth: dict, v: dict) -> dict:
             "separate_by": v.get("separate_by") or [], "distinguishable": v.get("distinguishable")}
 
 
-def run_case(out: Path, cls: str, seed: int, transfer: str) -> dict:
+def run_case(out: Path, cls: str, seed: int, transfer: str, rescore: bool = False) -> dict:
+    """Generate, diagnose and score one case (what exists is reused: a finished case's score unless
+    ``rescore``, its logs and its diagnosis always)."""
     case = out / "cases" / f"{cls}_{seed}"
-    done = case / "score.json"
-    if done.exists():
+    done, timing = case / "score.json", case / "timings.json"
+    if done.exists() and not rescore:
         return json.loads(done.read_text())
     t0 = time.time()
-    truth = make_case(seed, cls, case)
-    t_gen = time.time() - t0
-    r = _cli("diagnose", case / "log.csv", "--params", case / "nominal.toml", "--out", case / "diag", "--quiet")
-    t_diag = time.time() - t0 - t_gen
+    secs = json.loads(timing.read_text()) if timing.exists() else {}
+    if not (case / "truth.json").exists():
+        make_case(seed, cls, case)
+        secs["generate"] = time.time() - t0
+    truth = json.loads((case / "truth.json").read_text())
+    t1 = time.time()
+    if not (case / "diag" / "diagnosis.json").exists():
+        r = _cli("diagnose", case / "log.csv", "--params", case / "nominal.toml", "--out", case / "diag", "--quiet")
+        secs["diagnose"] = time.time() - t1
+        if r.returncode != 0:
+            secs["diagnose_error"] = (r.stderr.strip().splitlines() or ["?"])[-1]
+    timing.write_text(json.dumps(secs, indent=1))
     row = {"class": cls, "seed": seed, "in_library": truth["in_library"], "truth_component": truth["component"],
            "truth_verdicts": truth["verdicts"], "dominant": truth.get("dominant"),
-           "size_to_noise": truth["size_to_noise"], "seconds_generate": t_gen, "seconds_diagnose": t_diag}
-    if r.returncode != 0:
-        row.update(error=(r.stderr.strip().splitlines() or ["?"])[-1])
-        case.mkdir(parents=True, exist_ok=True)
+           "size_to_noise": truth["size_to_noise"], "seconds_generate": secs.get("generate"),
+           "seconds_diagnose": secs.get("diagnose")}
+    if "diagnose_error" in secs:
+        row.update(error=secs["diagnose_error"])
         done.write_text(json.dumps(row, indent=1))
         return row
     d = json.loads((case / "diag" / "diagnosis.json").read_text())
@@ -252,7 +265,11 @@ def run_case(out: Path, cls: str, seed: int, transfer: str) -> dict:
     window = tuple(x + start for x in d["split"]["validate"])
     best = next((c for c in d.get("candidates", []) if c.get("effect") == v.get("effect")), None)
     g_nom = d["gap"]["channels"][ch].get("rms_validate", best["rms_before"] if best else float("nan"))
-    g_cal = best["rms_after"] if best and v.get("effect") not in NAMED_NOT else g_nom
+    # the calibrated model's held-out shrink (a second effect's joint one), else the verdict's
+    shrink_cal = (d.get("calibrated") or {}).get("expected_shrink")
+    if shrink_cal is None or (v.get("effect") not in NAMED_NOT and not shrink_cal):
+        shrink_cal = v.get("shrink") if v.get("effect") not in NAMED_NOT else 0.0
+    g_cal = g_nom * (1.0 - float(shrink_cal or 0.0))
     log = _csv(case / "log.csv")
     mask = (log["t"] >= window[0]) & (log["t"] <= window[1])
     g_true_clean = _rms(log[ch], _csv(case / "truth_channels.csv")[ch], mask)
@@ -265,7 +282,7 @@ def run_case(out: Path, cls: str, seed: int, transfer: str) -> dict:
     # transfer: the second log, another sea
     cal = case / "diag" / "calibrated.toml"
     if row["right"] and cal.exists() and v.get("effect") not in NAMED_NOT:
-        t1 = time.time()
+        t2 = time.time()
         tomls = {"nominal": case / "nominal.toml", "calibrated": cal}
         tr = (transfer_replay if transfer == "replay" else transfer_simulate)(case, tomls, ch, window)
         log2 = _csv(case / "log_sea2.csv")
@@ -275,8 +292,8 @@ def run_case(out: Path, cls: str, seed: int, transfer: str) -> dict:
         row.update(transfer_method=tr["method"], transfer_notes=tr["notes"], gap2_nominal=rms.get("nominal"),
                    gap2_calibrated=rms.get("calibrated"), gap2_true=g2_true,
                    transfer=_ratio(rms.get("nominal", float("nan")), rms.get("calibrated", float("nan")), g2_true),
-                   seconds_transfer=time.time() - t1)
-    row["seconds_total"] = time.time() - t0
+                   seconds_transfer=time.time() - t2)
+    row["seconds_total"] = (secs.get("generate") or 0.0) + (secs.get("diagnose") or 0.0) + row.get("seconds_transfer", 0.0)
     done.write_text(json.dumps(row, indent=1, default=float))
     return row
 
@@ -315,8 +332,8 @@ def summarise(rows: list[dict]) -> dict:
         "transfer_median": tr[0], "transfer_min": tr[1], "transfer_n": tr[2],
         "transfer_under_0.6": sum(1 for r in right if r.get("transfer") is not None and r["transfer"] < 0.6),
         "errors": [(r["class"], r["seed"], r["error"]) for r in rows if "error" in r],
-        "seconds_per_case_median": statistics.median([r.get("seconds_total", r["seconds_generate"]) for r in rows])
-        if rows else None,
+        "seconds_per_case_median": statistics.median(secs) if (secs := [r["seconds_total"] for r in rows
+                                                                          if r.get("seconds_total")]) else None,
     }
 
 
@@ -324,7 +341,9 @@ def write_report(out: Path, rows: list[dict], args, transfer: str) -> None:
     s = summarise(rows)
     lines = [
         f"Generated by `python scenarios/independent_truth.py --seed-base {args.seed_base} --n-per-class "
-        f"{args.n_per_class} --out {args.out}` (heavecomp.independent, clean room; issue 30 items 5-6). "
+        f"{args.n_per_class} --out {args.out}"
+        + (f" --classes {args.classes}" if set(args.classes.split(",")) != set(CLASSES) else "")
+        + "` (heavecomp.independent, clean room; issue 30 items 5-6). "
         f"Transfer by `{transfer}`. {len(rows)} cases.",
         "",
         "## Against the goals (issue 30)",
@@ -396,6 +415,7 @@ def _extra(p) -> None:
     p.add_argument("--n-per-class", type=int, default=None, help="cases per class (default 1 with --quick, else 5)")
     p.add_argument("--jobs", type=int, default=1, help="parallel cases (default 1)")
     p.add_argument("--classes", default=",".join(CLASSES), help="comma-separated subset of the classes")
+    p.add_argument("--rescore", action="store_true", help="score finished cases again (their logs and diagnoses kept)")
     p.add_argument("--transfer", choices=("auto", "replay", "simulate"), default="auto",
                    help="how the second log is replayed (auto: heavecomp replay when the tree has it)")
 
@@ -416,7 +436,7 @@ def main(argv=None) -> int:
     todo = [(c, args.seed_base + k) for k in range(args.n_per_class) for c in classes]
     rows = []
     with ProcessPoolExecutor(max_workers=args.jobs) as ex:
-        futs = {ex.submit(run_case, args.out, c, s, transfer): (c, s) for c, s in todo}
+        futs = {ex.submit(run_case, args.out, c, s, transfer, args.rescore): (c, s) for c, s in todo}
         for f in as_completed(futs):
             c, s = futs[f]
             try:
