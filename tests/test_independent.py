@@ -268,3 +268,43 @@ def test_every_class_has_a_distribution_and_a_component():
     assert set(DISTRIBUTIONS) >= set(CLASSES)
     assert set(COMPONENT) == set(SINGLE) | set(OUT_OF_LIBRARY)
     assert set(COMPONENT.values()) == COMPONENTS
+
+
+# ---- the scorer ----------------------------------------------------------------------------------
+
+def _scenario():
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("scenario_independent_truth", ROOT / "scenarios" / "independent_truth.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+@pytest.mark.parametrize("verdict, right, group, wrong, comp", [
+    ({"effect": "flow_loss", "confidence": "high", "component": "flow_line"}, True, False, False, True),
+    ({"effect": "gas_heat_transfer", "confidence": "medium", "component": "gas_spring",
+      "group": ["gas_heat_transfer", "flow_loss"]}, True, True, False, False),
+    ({"effect": "gas_heat_transfer", "confidence": "low", "component": "gas_spring",
+      "group": ["gas_heat_transfer", "flow_loss", "gas_leak", "string_damping"]}, False, False, False, False),
+    ({"effect": "gas_heat_transfer", "confidence": "medium", "component": "gas_spring"}, False, False, True, False),
+    ({"effect": "inconclusive", "confidence": "low", "component": "flow_line"}, False, False, False, True),
+])
+def test_the_scorer_counts_names_groups_and_confident_wrong(verdict, right, group, wrong, comp):
+    truth = {"class": "line_dynamics", "verdicts": ["flow_loss"], "components": ["flow_line"], "component": "flow_line"}
+    s = _scenario()._verdict_score(truth, verdict)
+    assert (s["right"], s["right_group"], s["confident_wrong"], s["right_component"]) == (right, group, wrong, comp)
+
+
+def test_the_scorer_on_a_no_effect_log():
+    sc = _scenario()._verdict_score
+    truth = {"class": "none", "verdicts": ["none"], "component": None}
+    assert sc(truth, {"effect": "none", "confidence": "high"})["right"]
+    assert sc(truth, {"effect": "flow_loss", "confidence": "medium"})["confident_wrong"]
+    assert not sc(truth, {"effect": "inconclusive", "confidence": "medium"})["confident_wrong"]
+
+
+def test_shrink_ratio():
+    r = _scenario()._ratio
+    assert r(10.0, 4.0, 2.0) == pytest.approx(0.75)
+    assert r(2.0, 1.0, 2.0) is None  # no gap to close: undefined, not infinite
