@@ -189,20 +189,13 @@ def transfer_replay(case: Path, tomls: dict, channel: str, window: tuple) -> dic
     rep = json.loads((work / "replay.json").read_text())
     out = {}
     for (name, src), m in zip(tomls.items(), rep["models"]):
-        g = m.get("gap_to_noise_validate", {}).get(channel)
-        rms_v = m.get("rms_validate", {}).get(channel) if isinstance(m.get("rms_validate"), dict) else None
-        noise = (rep.get("noise", {}) or {}).get(channel) if isinstance(rep.get("noise"), dict) else None
-        if rms_v is not None:
-            out[name] = float(rms_v)
-        elif g is not None:
-            out[name] = float(g) * float(noise if noise else NOISE[channel])
-        else:
-            out[name] = float("nan")
-    floor = (rep.get("noise_floor") or {}).get(channel) if isinstance(rep.get("noise_floor"), dict) else None
-    if floor is not None:
+        rms_v = (m.get("rms_validate") or {}).get(channel)
+        out[name] = float(rms_v) if rms_v is not None else float("nan")
+    floor = (rep["models"][0].get("noise_floor") or {}).get(channel) if rep.get("models") else None
+    if floor is not None:  # the true model's gap: the replay's noise floor (heave-noise draws included)
         out["true"] = float(floor)
     return {"rms": out, "notes": [] if floor is not None else ["true model: the noise-free truth (replay.json has no "
-                                                              "noise floor)"], "method": "replay",
+                                                              "noise_floor)"], "method": "replay",
             "split": rep.get("split")}
 
 
