@@ -289,6 +289,8 @@ def _scenario():
       "group": ["gas_heat_transfer", "flow_loss", "gas_leak", "string_damping"]}, False, False, False, False),
     ({"effect": "gas_heat_transfer", "confidence": "medium", "component": "gas_spring"}, False, False, True, False),
     ({"effect": "inconclusive", "confidence": "low", "component": "flow_line"}, False, False, False, True),
+    ({"effect": "sensor_offset", "confidence": "medium", "component": "sensors",
+      "group": ["sensor_offset:pressure", "flow_loss"]}, True, True, False, False),
 ])
 def test_the_scorer_counts_names_groups_and_confident_wrong(verdict, right, group, wrong, comp):
     truth = {"class": "line_dynamics", "verdicts": ["flow_loss"], "components": ["flow_line"], "component": "flow_line"}
