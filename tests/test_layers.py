@@ -41,6 +41,7 @@ LAYER_OF = {
     "heavecomp.benchmark": "analysis",        # the withheld-effect benchmark: checks diagnosis, beside it
     "heavecomp.estimator": "analysis",        # base of the gap diagnosers
     "heavecomp.benchmark": "analysis",        # generated truth: withheld effects, corrupted logs
+    "heavecomp.independent": "analysis",      # the clean-room truth generator (issue 30 item 5), beside benchmark
     "heavecomp.report": "report",
     # the wings (paper B's pneumatic cylinder, paper A's rotating-piston rig) keep the same order
     "heavecomp.pneumatic.friction": "physics",
