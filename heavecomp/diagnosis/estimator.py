@@ -40,6 +40,7 @@ import time
 import numpy as np
 
 from heavecomp.diagnosis import components as CR
+from heavecomp.diagnosis import distinguish as D
 from heavecomp.diagnosis import fitting as F
 from heavecomp.diagnosis import joint as J
 from heavecomp.diagnosis import replay as R
@@ -326,6 +327,8 @@ class GapDiagnoser(GapEstimator):
             for n in names:
                 finish(n, fit_and_replay(n))
         fits = [F.score(ctx, n, *results[n]) for n in names]
+        # the replays on the heave-noise draws, kept for the distinguishability test (channels only)
+        self.perturbed_ = {n: [{c: p[c] for c in CH} for p in results[n][2]] for n in names}
         return sorted(fits, key=lambda r: -r.score)
 
     def _fit_one(self, ctx, name, start=None, fixed=()) -> F.Fit:
@@ -353,11 +356,21 @@ class GapDiagnoser(GapEstimator):
             return self.components_.stationarity(component, mask=mask, drift_sigmas=P.drift_sigmas,
                                                  drift_share=P.drift_share)
 
+        # can the log tell the leading explanations apart (schema 4)? only a named verdict reads it
+        distinct = None
+        if not a.is_none and fits[0].explained >= P.min_explained and len(fits) > 1:
+            distinct = D.distinguish(ctx, fits, getattr(self, "perturbed_", {}), P)
         evidence = V.Evidence(shares, self.prescreen_, second, self.discovered_, stationarity,
-                              tuple(self.where_.get("not_observable", ())))
+                              tuple(self.where_.get("not_observable", ())), distinct)
         verdict = V.decide(fits, self.gap_["channels"], self.noise_floor_, self.input_envelope_, P, evidence)
         self.warnings_ += list(verdict.warnings)
         out = verdict.to_json()
+        if len(out.get("group", ())) > 1:  # what would tell the group apart, computed (Box-Hill)
+            self.separate_ = D.separate_by(ctx, fits, out["group"], P)
+            out["separate_by"] = [r["description"] for r in self.separate_]
+            out["separate_by_experiments"] = self.separate_
+        elif distinct is not None:
+            out["separate_by"] = []
         # a named law that is not the plant's: the open search's form of its component, when it fits better
         form = S.named_form(self.components_, out.get("effect", ""), ctx.fitmask, ctx.valmask) \
             if P.named_form else None
@@ -416,6 +429,23 @@ class GapDiagnoser(GapEstimator):
         named = v.get("effect")
         if named in ("none", "inconclusive", "discovered", None):
             return None
+        if "distinguishable" in v:  # tested on the log itself (schema 4): the explanations it cannot tell apart
+            return list(v.get("group") or [named])
+        return self.structural_group(iso)
+
+    def structural_group(self, iso=None):
+        """The shape-level isolability group of a named verdict (schema 3's ``verdict.group``; the effect
+        alone when it is isolable), or None for ``none``, ``inconclusive`` and ``discovered``.
+
+        Parameters
+        ----------
+        iso : dict, optional
+            :meth:`isolability`'s answer (computed when not given).
+        """
+        v = self.verdict_
+        named = v.get("effect")
+        if named in ("none", "inconclusive", "discovered", None):
+            return None
         channel = (v.get("parameters") or {}).get("channel")
         group = ST.group_of(f"{named}:{channel}" if channel else named, self.isolability() if iso is None else iso)
         return group if group else [named]
@@ -430,7 +460,8 @@ class GapDiagnoser(GapEstimator):
         group = self.verdict_group(iso)
         if group is not None:
             v["group"] = group
-        return {"schema": 3,
+            v["structural_group"] = self.structural_group(iso)
+        return {"schema": 4,
                 "sensors": list(self.sensors_),
                 "isolability": iso,
                 "verdict": v,
