@@ -34,7 +34,8 @@ configurations) are simulated from rest under experiments a rig can run -- anoth
 calmer and a rougher sea (JONSWAP at the log's peak period), a longer log -- and, for a channel the log
 lacks, on this log's heave.  Each experiment's divergence is 1/2 sum_t sum_c (A_c - B_c)^2 / sigma_c^2 at
 one sample a second, the expected log-likelihood ratio between the two if one is right; experiments are
-ranked by it against the same sea as the log's (``ratio``), and the best ones are written in words.
+ranked by it against this log's own (the members' replays of it, ``ratio``), and those that beat it
+are written in words; a log that does not start at rest adds the experiment of a log that does.
 """
 
 from __future__ import annotations
@@ -183,16 +184,16 @@ def pair_test(ctx, a, b, pred_a, pred_b, pert_a, pert_b, alpha, block) -> Pair:
     return Pair(a, b, float(stat), thr, bool(same and abs(stat) > thr), nb, float(z0), zd)
 
 
+def null_stats(ctx, perturbed, block) -> list:
+    """[(t, blocks)] of every pair of heave-noise draws of each model in ``perturbed`` (a list of the model's
+    replays on the draws), tested as if they were two explanations: equal by construction."""
+    return [_stat(ctx, x, y, block) for preds in perturbed for x, y in itertools.combinations(preds, 2)]
+
+
 def null_pairs(ctx, perturbed, alpha, block) -> tuple:
-    """(pairs, apart): every pair of heave-noise draws of each model in ``perturbed`` (a list of the
-    model's replays on the draws), tested as if they were two explanations."""
-    n = apart = 0
-    for preds in perturbed:
-        for x, y in itertools.combinations(preds, 2):
-            z, nb = _stat(ctx, x, y, block)
-            n += 1
-            apart += abs(z) > threshold(alpha, nb)
-    return n, apart
+    """(pairs, apart): :func:`null_stats` against the test's threshold at ``alpha``."""
+    st = null_stats(ctx, perturbed, block)
+    return len(st), sum(abs(z) > threshold(alpha, nb) for z, nb in st)
 
 
 def distinguish(ctx, fits, perturbed, policy, nominal_pert=None) -> Distinguishability:
@@ -217,9 +218,12 @@ def distinguish(ctx, fits, perturbed, policy, nominal_pert=None) -> Distinguisha
     """
     P = policy
     block = block_length(ctx.run, P)
-    lead = [f for f in fits[:P.distinguish_leading]]
+    lead = list(fits[:P.distinguish_leading])
     lead += [f for f in fits[P.distinguish_leading:] if f.effect == "parameter_mismatch"]
-    lead = [f for f in lead if f.pred is not None and math.isfinite(f.explained) and f.effect in perturbed]
+    # an explanation explains: a candidate under min_explained is no named verdict's rival (a short held-out
+    # part has few blocks, and the test alone would keep it in the group)
+    lead = [f for f in lead if f.pred is not None and math.isfinite(f.explained) and f.effect in perturbed
+            and (f is fits[0] or f.explained >= P.min_explained)]
     best = fits[0]
     seen = set()
     while True:  # the best is the one no other leading candidate beats on the held-out log
@@ -305,10 +309,10 @@ def divergence(preds, sigma, t, mask=None) -> float:
     return out if math.isfinite(out) else 0.0
 
 
-def separate_by(ctx, fits, group, policy, top=3) -> list:
+def separate_by(ctx, fits, group, policy, top=3, pairs=()) -> list:
     """What would tell the ``group``'s members apart, ranked by Box-Hill divergence (see the module
-    docstring): [{experiment, description, divergence, ratio}] (ratio: against a log of the same
-    length in the log's own sea), best first, the ``top`` that beat that log.  Empty for a group of one.
+    docstring): [{experiment, description, divergence, ratio}] (ratio: against this log, the members'
+    replays of it), best first, the ``top`` that beat it.  Empty for a group of one.
 
     Parameters
     ----------
@@ -320,6 +324,10 @@ def separate_by(ctx, fits, group, policy, top=3) -> list:
         The group's members (effect names), best first.
     policy : heavecomp.diagnosis.policy.VerdictPolicy
         The experiments' sizes (``separate_*``, ``added_channel_noise``).
+    top : int
+        Experiments returned.
+    pairs : sequence of Pair
+        The block tests of the group (the longer log's length the test would need).
     """
     if len(group) < 2:
         return []
@@ -338,9 +346,12 @@ def separate_by(ctx, fits, group, policy, top=3) -> list:
         settle = rp.run.t >= min(30.0, 0.1 * rp.run.t[-1])
         return {"experiment": label, "description": text, "divergence": divergence(preds, sigma, rp.run.t, settle)}
 
-    base = run("same_sea", f"another {T:.0f} s log in a sea like this one (H_s {hs0:.1f} m, T_p {tp:.1f} s)")
-    d0 = max(base["divergence"], 1e-12)
+    # the reference: this very log (the members' replays of it), against which every experiment is ranked
+    d0 = max(divergence([ctx.simulate(conf[m]) for m in members], sigma, ctx.run.t, ctx.allmask), 1e-12)
     rows = []
+    if not ctx.replay.initial.at_rest:
+        rows.append(run("from_rest", f"a {T:.0f} s log that starts from rest at the operating point, in a sea like "
+                        f"this one (H_s {hs0:.1f} m, T_p {tp:.1f} s; this log starts mid-operation)"))
     for s in P.separate_sea:
         rows.append(run("calmer_sea" if s < 1 else "rougher_sea",
                         f"a {'calmer' if s < 1 else 'rougher'} sea (H_s {s * hs0:.1f} m instead of {hs0:.1f} m; "
@@ -352,8 +363,16 @@ def separate_by(ctx, fits, group, policy, top=3) -> list:
                         f"({100 * step:+.0f} %, from {w0 / 1e3:.0f} kN), {T:.0f} s logged at the new set-point "
                         "(the gas pressure, the friction's load and the string's stretch move)", setpoint=step))
     longer = min(P.separate_longer * T, 3600.0)
+    need = ""
+    if pairs:  # the block test's t grows with the square root of the held-out length at a fixed difference
+        p = max((p for p in pairs if p.b in members and p.a in members), key=lambda p: abs(p.statistic), default=None)
+        held = float(ctx.split["validate"][1] - ctx.split["validate"][0])
+        if p is not None and abs(p.statistic) > 0 and math.isfinite(p.threshold):
+            t_need = held * (p.threshold / abs(p.statistic)) ** 2
+            need = (f"; at the present difference the block test would tell `{p.a}` from `{p.b}` on about "
+                    f"{t_need / 60:.0f} min of held-out log")
     rows.append(run("longer_log", f"a {longer / 60:.0f} min log in the same sea ({longer / T:.1f} x this one: "
-                    "a drift or a slow change shows over it)", duration=longer))
+                    f"a drift or a slow change shows over it{need})", duration=longer))
     noise = dict(P.added_channel_noise)
     missing = [c for c in CH if c not in ctx.channels and c in noise]
     for c in missing:  # a channel added, on this very log (its replays predict every channel)
@@ -366,7 +385,6 @@ def separate_by(ctx, fits, group, policy, top=3) -> list:
                      "divergence": d})
     for r in rows:
         r["ratio"] = r["divergence"] / d0
-        r["description"] = (f"{r['description']}: drives {names} {r['ratio']:.1f} x further apart than a log like "
-                            "this one")
+        r["description"] = (f"{r['description']}: drives {names} {r['ratio']:.1f} x further apart than this log")
     rows.sort(key=lambda r: -r["divergence"])
     return [r for r in rows if r["ratio"] > 1.0][:top]

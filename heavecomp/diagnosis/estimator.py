@@ -358,7 +358,7 @@ class GapDiagnoser(GapEstimator):
 
         # can the log tell the leading explanations apart (schema 4)? only a named verdict reads it
         distinct = None
-        if not a.is_none and fits[0].explained >= P.min_explained and len(fits) > 1:
+        if not a.is_none and len(fits) > 1 and max(f.explained for f in fits[:P.distinguish_leading]) >= P.min_explained:
             distinct = D.distinguish(ctx, fits, getattr(self, "perturbed_", {}), P)
         evidence = V.Evidence(shares, self.prescreen_, second, self.discovered_, stationarity,
                               tuple(self.where_.get("not_observable", ())), distinct)
@@ -366,7 +366,7 @@ class GapDiagnoser(GapEstimator):
         self.warnings_ += list(verdict.warnings)
         out = verdict.to_json()
         if len(out.get("group", ())) > 1:  # what would tell the group apart, computed (Box-Hill)
-            self.separate_ = D.separate_by(ctx, fits, out["group"], P)
+            self.separate_ = D.separate_by(ctx, fits, out["group"], P, pairs=distinct.pairs if distinct else ())
             out["separate_by"] = [r["description"] for r in self.separate_]
             out["separate_by_experiments"] = self.separate_
         elif distinct is not None:

@@ -185,7 +185,7 @@ def decide(fits, gap, floors, envelope, policy, evidence: Evidence) -> Verdict:
     """
     a = assess(fits, gap, floors, envelope, policy)
     group, by_score = (), fits[0]
-    if not a.is_none and fits[0].explained >= policy.min_explained:
+    if not a.is_none:  # the group the log cannot split, and its lead (which may explain more than the best score)
         group, fits, a = _grouped(fits, gap, floors, envelope, policy, evidence.distinct, a)
     best = fits[0]
     v = {"effect": best.effect, "confidence": "low", "parameters": best.parameters,
@@ -230,8 +230,12 @@ def _grouped(fits, gap, floors, envelope, P, distinct, a):
     inside = [byname[m] for m in distinct.group if m in byname]
     if len(inside) == 1 and inside[0] is fits[0]:
         return tuple(distinct.group), fits, a
-    lead = next((f for f in inside if f.effect == "parameter_mismatch" and f.explained >= P.min_explained),
-                inside[0])
+    pm = next((f for f in inside if f.effect == "parameter_mismatch"), None)
+    others = [f for f in inside if f is not pm]
+    if pm is not None and (not others or pm.explained >= max(f.explained for f in others)):
+        lead = pm  # explains as much as any new mechanism the log cannot tell it from: the simpler model
+    else:
+        lead = others[0]  # the best of the mechanisms (a refit that explains less does not lead)
     order = [lead] + [f for f in inside if f is not lead]
     rest = [lead] + [f for f in fits if f.effect not in distinct.group]
     ag = dataclasses.replace(assess(rest, gap, floors, envelope, P), is_none=False)
