@@ -170,6 +170,9 @@ def judge(row) -> dict:
            "component_right": v["component"] is not None and v["component"] == row["truth"]["component"]}
     if cat in ("named", "two_effects"):
         out["right"] = v["verdict"] == lab and v["shrink"] >= SHRINK_REAL
+        # issue 30: the right group (at most three members) where the log cannot tell them apart
+        group = v.get("group") or []
+        out["group_right"] = out["right"] or (lab in group and len(group) <= 3 and v["shrink"] >= SHRINK_REAL)
     elif cat == "none":
         out["right"] = v["verdict"] == "none"
         out["confident_wrong"] = v["verdict"] != "none" and confident
@@ -233,7 +236,10 @@ def summarize(rows) -> dict:
         calibration[c] = {"n": len(rs), "right": sum(r["judged"]["right"] for r in rs),
                           "share_right": _share(sum(r["judged"]["right"] for r in rs), len(rs))}
     fa = [r["full"] for r in ok if "null_pairs" in r["full"]]
+    gr = [r for c in ("named", "two_effects") for r in by[c]]
     distinguish = {"groups": sum(1 for f in fa if len(f.get("group") or []) > 1),
+                   "named_or_group_right": sum(r["judged"].get("group_right", False) for r in gr),
+                   "named_right": sum(r["judged"]["right"] for r in gr), "named_runs": len(gr),
                    "groups_of": len(fa),
                    "null_pairs": sum(f["null_pairs"] for f in fa), "null_apart": sum(f["null_apart"] for f in fa),
                    "null_pairs_by_category": {c: [sum(r["full"].get(k, 0) for r in by[c]) for k in
@@ -292,7 +298,9 @@ def write(out: Path, which, rows, summary, settings, digest, frozen_note, quick)
                      for r in rows if "full" in r])
     dz = summary.get("distinguish") or {}
     dist = (f"{dz.get('groups', 0)} of {dz.get('groups_of', 0)} verdicts are groups (the log could not tell the "
-            f"leading explanations apart). The block test's false alarms, measured on pairs equal by construction "
+            f"leading explanations apart). Named and two-effect runs: {dz.get('named_right', 0)} of "
+            f"{dz.get('named_runs', 0)} named right, {dz.get('named_or_group_right', 0)} named right or in the right "
+            "group (at most three members). The block test's false alarms, measured on pairs equal by construction "
             f"(every fitted candidate and the nominal model, each replayed on two heave-noise draws): "
             f"{dz.get('null_apart', 0)} of {dz.get('null_pairs', 0)} called apart at the stated 1 % ("
             + ", ".join(f"{c}: {a} of {n}" for c, (n, a) in (dz.get("null_pairs_by_category") or {}).items() if n)

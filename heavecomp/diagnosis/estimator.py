@@ -451,7 +451,8 @@ class GapDiagnoser(GapEstimator):
         return group if group else [named]
 
     def to_json(self) -> dict:
-        """The ``diagnosis.json`` content (contract schema 3: schema 1's keys, plus ``verdict.component``,
+        """The ``diagnosis.json`` content (contract schema 4: ``verdict.group`` tested on the log,
+        ``verdict.structural_group``, ``verdict.distinguishable``, ``verdict.separate_by``; schema 3: schema 1's keys, plus ``verdict.component``,
         ``verdict.discovered``, ``gap.where.components``, ``initial_state``, ``warnings`` (schema 2),
         ``sensors``, ``isolability`` and ``verdict.group`` (schema 3; the ``calibrated`` block is added by
         the command that writes ``calibrated.toml``); extras: ``prescreen``)."""
