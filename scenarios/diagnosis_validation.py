@@ -304,7 +304,10 @@ def write(out: Path, which, rows, summary, settings, digest, frozen_note, quick)
             f"(every fitted candidate and the nominal model, each replayed on two heave-noise draws): "
             f"{dz.get('null_apart', 0)} of {dz.get('null_pairs', 0)} called apart at the stated 1 % ("
             + ", ".join(f"{c}: {a} of {n}" for c, (n, a) in (dz.get("null_pairs_by_category") or {}).items() if n)
-            + ").")
+            + "); runs with any: " + (", ".join(f"{r['seed']} {r['label']} ({r['full']['null_apart']} of "
+                                                f"{r['full']['null_pairs']})" for r in rows
+                                                if "full" in r and r["full"].get("null_apart")) or "none")
+            + ". The verdict's rule (the replay and the median of the draws both apart) is stricter than one pair.")
     missing = sum(1 for r in rows if "full" in r and r["full"]["component"] is None and r["full"]["verdict"] != "none")
     s = summary
     write_report(out, f"Diagnosis validation: the {which} set", [
