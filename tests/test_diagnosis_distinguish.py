@@ -128,6 +128,13 @@ def test_a_verdict_the_equation_error_table_does_not_support_is_at_most_low():
     assert any("equation-error gap" in w and "lowered from high to low" in w for w in got.warnings)
     got = decide(fits, GAP, ONES, ONES, VerdictPolicy(), Evidence(_shares(flow_line=0.85, friction=0.05)))
     assert got.body["confidence"] == "high" and not got.warnings
+    # a stroke read with an offset lands in the gas law's own part (structure), not in a sensors part: a table
+    # with the gap in the gas spring does not disagree with it (tuning seed 20012)
+    off = CandidateFit("sensor_offset", {"channel": "stroke", "offset": -0.03}, {},
+                       {c: {"rms_before": 1.0, "rms_after": 0.5, "shrink": 0.5} for c in CH}, 0.95, 0.95, 0.95, 1,
+                       0.92, 0.0, {"channel": "stroke", "offset": -0.03})
+    got = decide([off, _fit("gas_leak", 0.2)], GAP, ONES, ONES, VerdictPolicy(), Evidence(_shares(gas_spring=1.0)))
+    assert got.body["confidence"] == "high" and got.body["component_table"]["largest"] == "gas_spring"
 
 
 # ------------------------------------------------------------------ the planted case

@@ -31,6 +31,8 @@ from typing import Callable
 from heavecomp.diagnosis.joint import SecondSearch
 from heavecomp.diagnosis.replay import CH
 from heavecomp.diagnosis.screen import candidate_component
+from heavecomp.diagnosis.structure import entries
+from heavecomp.errors import InputError
 from heavecomp.effects.base import COMPONENTS
 from heavecomp.effects.candidates import get
 
@@ -422,7 +424,7 @@ def _table_check(v, shares, largest, P, not_observable=(), warnings=None) -> Non
                             "verdict_share": float(shares.get(comp, 0.0)), "reason": reason}
     # the confidence never outruns the evidence (issue 30 item 2): a named verdict the equation-error table
     # does not support is at most low, and says why
-    if named and comp not in not_observable and v["confidence"] != "low":
+    if named and comp not in not_observable and largest not in _lands_in(v) and v["confidence"] != "low":
         was = v["confidence"]
         v["confidence"] = "low"
         if warnings is not None:
@@ -430,6 +432,20 @@ def _table_check(v, shares, largest, P, not_observable=(), warnings=None) -> Non
                             f"{100 * shares.get(comp, 0.0):.0f} % of the equation-error gap, "
                             f"{largest.replace('_', ' ')} {100 * shares[largest]:.0f} % ({reason}) -- confidence "
                             f"lowered from {was} to low")
+
+
+def _lands_in(v) -> set:
+    """The components of the equation residuals the verdict's effect enters by structure
+    (:func:`heavecomp.diagnosis.structure.entries`): a stroke misread by an offset lands in the gas law's,
+    the lower- and top-mass balances' own laws, never in a ``sensors`` part of its own, so a table that puts
+    the gap in the gas spring does not disagree with it."""
+    name = v["effect"]
+    channel = (v.get("parameters") or {}).get("channel")
+    try:
+        parts = entries(f"{name}:{channel}" if channel else name)
+    except (KeyError, InputError):
+        return set()
+    return {p.split("/", 1)[1] for p in parts if not p.startswith("replay/")}
 
 
 def _refit_disagrees(moved, shares, largest, P) -> bool:
