@@ -98,12 +98,31 @@ def _diagnose(tr, kind, workdir: Path, n_jobs: int) -> dict:
     v = d.verdict_
     ch = v.get("shrink_channel", "wob")
     true = tr.true_shrink(d.split)
-    return {"kind": kind, "verdict": v["effect"], "confidence": v["confidence"], "component": v.get("component"),
+    return {**_distinguish_record(d), "kind": kind, "verdict": v["effect"], "confidence": v["confidence"],
+            "component": v.get("component"),
             "discovered": (v.get("discovered") or {}).get("term"), "shrink": float(v["shrink"]),
             "shrink_channel": ch, "true_shrink": None if true is None else true[ch],
             "explained": v.get("explained"), "gap_to_noise_diagnosed": v.get("gap_to_noise"),
             "second_effect": (v.get("second_effect") or {}).get("effect"), "diagnosis_wall_time": d.wall_time_,
             "duration": float(tr.t[-1] - tr.t[0])}
+
+
+def _distinguish_record(d) -> dict:
+    """The verdict's group and block tests (schema 4), and the block test's false alarms on this run: every
+    pair of heave-noise draws of the nominal model and of every fitted candidate, equal by construction
+    (docs/diagnosis.md, "Can the log tell them apart")."""
+    from heavecomp.diagnosis import distinguish as DS
+
+    ctx, P, v = d.context_, d.verdict_policy(), d.verdict_
+    block = DS.block_length(ctx.run, P)
+    nominal = [{c: p[c] for c in ctx.channels} for p in (ctx.simulate([], hs=hs) for hs in ctx.hs_pert)]
+    stats = DS.null_stats(ctx, [nominal] + list(getattr(d, "perturbed_", {}).values()), block)
+    dist = v.get("distinguishable") or {}
+    return {"group": v.get("group"), "separate_by": v.get("separate_by"),
+            "pairs": [{k: p[k] for k in ("a", "b", "statistic", "threshold", "apart")} for p in dist.get("pairs", [])],
+            "null_pairs": len(stats), "null_apart": int(sum(abs(z) > DS.threshold(P.distinguish_alpha, nb)
+                                                            for z, nb in stats)),
+            "null_t": [float(z) for z, _ in stats], "null_blocks": [int(nb) for _, nb in stats]}
 
 
 def run_case(case, workdir, n_jobs=1) -> dict:
@@ -151,6 +170,9 @@ def judge(row) -> dict:
            "component_right": v["component"] is not None and v["component"] == row["truth"]["component"]}
     if cat in ("named", "two_effects"):
         out["right"] = v["verdict"] == lab and v["shrink"] >= SHRINK_REAL
+        # issue 30: the right group (at most three members) where the log cannot tell them apart
+        group = v.get("group") or []
+        out["group_right"] = out["right"] or (lab in group and len(group) <= 3 and v["shrink"] >= SHRINK_REAL)
     elif cat == "none":
         out["right"] = v["verdict"] == "none"
         out["confident_wrong"] = v["verdict"] != "none" and confident
@@ -213,8 +235,17 @@ def summarize(rows) -> dict:
         rs = [r for r in ok if r["full"]["confidence"] == c]
         calibration[c] = {"n": len(rs), "right": sum(r["judged"]["right"] for r in rs),
                           "share_right": _share(sum(r["judged"]["right"] for r in rs), len(rs))}
+    fa = [r["full"] for r in ok if "null_pairs" in r["full"]]
+    gr = [r for c in ("named", "two_effects") for r in by[c]]
+    distinguish = {"groups": sum(1 for f in fa if len(f.get("group") or []) > 1),
+                   "named_or_group_right": sum(r["judged"].get("group_right", False) for r in gr),
+                   "named_right": sum(r["judged"]["right"] for r in gr), "named_runs": len(gr),
+                   "groups_of": len(fa),
+                   "null_pairs": sum(f["null_pairs"] for f in fa), "null_apart": sum(f["null_apart"] for f in fa),
+                   "null_pairs_by_category": {c: [sum(r["full"].get(k, 0) for r in by[c]) for k in
+                                                  ("null_pairs", "null_apart")] for c in CATEGORIES}}
     return {"n_cases": len(rows), "n_generated": len(ok), "not_generated": [r["label"] for r in rows if "error" in r],
-            "goals": goals, "confusion": confusion, "calibration": calibration,
+            "goals": goals, "confusion": confusion, "calibration": calibration, "distinguish": distinguish,
             "median_shrink_right": med, "median_true_shrink_right": med_true,
             "per_category": {c: {"n": len(by[c]), "right": sum(r["judged"]["right"] for r in by[c])} for c in CATEGORIES}}
 
@@ -255,15 +286,28 @@ def write(out: Path, which, rows, summary, settings, digest, frozen_note, quick)
                    [[c, d["n"], d["right"], _fmt(d["share_right"], pct=True)] for c, d in summary["calibration"].items()])
     runs = md_table(["category", "true effect", "component", "seed", "sea", "params", "rate [Hz]", "log [s]",
                      "noise [x]", "planted gap [x floor]", "verdict", "confidence", "verdict component", "shrink [-]",
-                     "true model shrink [-]", "right", "cut 60 s verdict"],
+                     "true model shrink [-]", "right", "cut 60 s verdict", "group (schema 4)"],
                     [[r["category"], r["label"] + (f" ({r['case']['variant']})" if r["case"]["variant"] else ""),
                       r["truth"]["component"] or "-", r["seed"], r["case"]["sea"], r["case"]["params"],
                       f"{r['case']['rate']:g}", f"{r['full']['duration']:.0f}", f"{r['case']['noise']:g}",
                       " / ".join(f"{g:.1f}" for g in r["truth"]["gap_to_noise"].values()) or "-",
                       r["full"]["verdict"], r["full"]["confidence"], r["full"]["component"] or "missing",
                       _fmt(r["full"]["shrink"]), _fmt(r["full"]["true_shrink"]), _fmt(r["judged"]["right"]),
-                      r["cut"]["verdict"] if "cut" in r else ""]
+                      r["cut"]["verdict"] if "cut" in r else "",
+                      ", ".join(r["full"].get("group") or []) if len(r["full"].get("group") or []) > 1 else ""]
                      for r in rows if "full" in r])
+    dz = summary.get("distinguish") or {}
+    dist = (f"{dz.get('groups', 0)} of {dz.get('groups_of', 0)} verdicts are groups (the log could not tell the "
+            f"leading explanations apart). Named and two-effect runs: {dz.get('named_right', 0)} of "
+            f"{dz.get('named_runs', 0)} named right, {dz.get('named_or_group_right', 0)} named right or in the right "
+            "group (at most three members). The block test's false alarms, measured on pairs equal by construction "
+            f"(every fitted candidate and the nominal model, each replayed on two heave-noise draws): "
+            f"{dz.get('null_apart', 0)} of {dz.get('null_pairs', 0)} called apart at the stated 1 % ("
+            + ", ".join(f"{c}: {a} of {n}" for c, (n, a) in (dz.get("null_pairs_by_category") or {}).items() if n)
+            + "); runs with any: " + (", ".join(f"{r['seed']} {r['label']} ({r['full']['null_apart']} of "
+                                                f"{r['full']['null_pairs']})" for r in rows
+                                                if "full" in r and r["full"].get("null_apart")) or "none")
+            + ". The verdict's rule (the replay and the median of the draws both apart) is stricter than one pair.")
     missing = sum(1 for r in rows if "full" in r and r["full"]["component"] is None and r["full"]["verdict"] != "none")
     s = summary
     write_report(out, f"Diagnosis validation: the {which} set", [
@@ -284,6 +328,7 @@ def write(out: Path, which, rows, summary, settings, digest, frozen_note, quick)
         "replayed from the logged heave, 1 - rms(measured - true replay) / rms(measured - nominal replay) on the "
         "held-out part).",
         "## Calibration of the confidence", cal,
+        "## Can the log tell them apart (schema 4)", dist,
         "## Confusion matrix (rows: true effect; columns: verdict)", confusion,
         "## Runs", "planted gap: the effect's own rms gap over the noise floor on its largest channel; shrink on the "
         "verdict's shrink channel.", runs])

@@ -78,7 +78,9 @@ def test_diagnose_a_log_without_pressure(tmp_path):
     assert not any("pressure" in m for g in j["isolability"]["groups"] for m in g)
     v = j["verdict"]
     if v["effect"] not in ("none", "inconclusive", "discovered"):
-        assert v["group"] in j["isolability"]["groups"] or v["group"] == [v["effect"]]
+        sg = v["structural_group"]  # schema 3's group (structure); verdict.group is tested on the log (schema 4)
+        assert sg in j["isolability"]["groups"] or sg == [v["effect"]]
+        assert v["group"][0] == v["effect"] and len(v["group"]) <= 3
     md = (tmp_path / "report.md").read_text()
     if len(v.get("group") or []) > 1:  # the headline names the group, not one member of it
         assert md.split("\n")[2].startswith("**Verdict: one of ")

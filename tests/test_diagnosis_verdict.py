@@ -57,13 +57,17 @@ def test_cli_diagnose_contract_json(tmp_path):
                 str(tmp_path / "out"), "--candidates", "sensor_delay,flow_loss,string_damping")
     assert r.returncode == 0, r.stderr[-2000:]
     d = json.loads((tmp_path / "out" / "diagnosis.json").read_text())
-    assert d["schema"] == 3
+    assert d["schema"] == 4
     v = d["verdict"]
     # schema 3: the sensor set and what it can tell apart; a named verdict carries its group
     assert d["sensors"] == ["heave", "stroke", "pressure", "wob"]
     assert set(d["isolability"]) >= {"detectable", "groups"}
     if v["effect"] not in ("none", "inconclusive", "discovered"):
-        assert any(set(v["group"]) == set(g) for g in d["isolability"]["groups"]) or v["group"] == [v["effect"]]
+        sg = v["structural_group"]
+        assert any(set(sg) == set(g) for g in d["isolability"]["groups"]) or sg == [v["effect"]]
+        # schema 4: the group this log cannot split, led by the verdict, with its test and what would split it
+        assert v["group"][0] == v["effect"] and len(v["group"]) <= 3
+        assert v["distinguishable"]["false_alarm_rate"] == 0.01 and isinstance(v["separate_by"], list)
     # schema 2: where the gap lives by model component, the start state, warnings
     comps = d["gap"]["where"]["components"]
     assert set(comps) == {"friction", "gas_spring", "flow_line", "string_formation", "sensors", "heave_input"}
@@ -103,7 +107,7 @@ def test_diagnosis_example_scenario_quick(tmp_path):
     assert sd["channels"]["wob"]["rms_after"] < sd["channels"]["wob"]["rms_before"]
     assert m["verdict"]["effect"] == "string_damping"
     d = json.loads((tmp_path / "diagnosis.json").read_text())
-    assert d["schema"] == 3 and (tmp_path / "overlay.png").is_file()
+    assert d["schema"] == 4 and (tmp_path / "overlay.png").is_file()
     assert d["verdict"]["component"] == "string_formation" and "components" in d["gap"]["where"]
     # a re-run leaves git clean: the fit wall times are in the untracked timings.json only
     assert "wall" not in json.dumps({k: v for k, v in d.items() if k != "units"})

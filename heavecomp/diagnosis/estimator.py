@@ -40,6 +40,7 @@ import time
 import numpy as np
 
 from heavecomp.diagnosis import components as CR
+from heavecomp.diagnosis import distinguish as D
 from heavecomp.diagnosis import fitting as F
 from heavecomp.diagnosis import joint as J
 from heavecomp.diagnosis import replay as R
@@ -327,6 +328,8 @@ class GapDiagnoser(GapEstimator):
                 finish(n, fit_and_replay(n))
         pert = self._contention(ctx, names, results)
         fits = [F.score(ctx, n, *results[n], pert.get(n)) for n in names]
+        # the replays on the heave-noise draws, kept for the distinguishability test (channels only)
+        self.perturbed_ = {n: [{c: p[c] for c in CH} for p in pert[n]] for n in pert}
         return sorted(fits, key=lambda r: -r.score)
 
     def _contention(self, ctx, names, results) -> dict:
@@ -334,9 +337,11 @@ class GapDiagnoser(GapEstimator):
 
         A candidate's score is the smaller of its replay's explained share and the draws' median, less its
         penalty, so its replay alone bounds it from above (:func:`~heavecomp.diagnosis.fitting.upper_score`).
-        The verdict reads the best, the runner-up, the ``second`` best-ranked joint partners (no two
-        output candidates) and the best of each component holding ``second_share`` of the equation-error
-        gap (:func:`heavecomp.diagnosis.joint.partners`).  Candidates are drawn for in the order of their
+        The verdict reads the best ``distinguish_leading`` (at least the best and the runner-up; the
+        distinguishability test compares them on their draws), the refit of the nominal's own parameters
+        (drawn for first, wherever it ranks), the ``second`` best-ranked joint partners (no two output
+        candidates) and the best of each component holding ``second_share`` of the equation-error gap
+        (:func:`heavecomp.diagnosis.joint.partners`).  Candidates are drawn for in the order of their
         bound until every one not drawn for has a bound below the score of each candidate those reads
         would take: the rest cannot be among them, so the ranking the verdict reads is the one all draws
         would give.  Those not drawn for are scored on their replay (``explained_perturbed`` None)."""
@@ -344,6 +349,17 @@ class GapDiagnoser(GapEstimator):
         upper = {n: F.upper_score(ctx, n, *results[n]) for n in names}
         order = sorted(names, key=lambda n: -upper[n])
         final, pert = {}, {}
+        # the verdict's distinguishability test (schema 4) reads the leading candidates' draws, and the
+        # refit of the nominal's own parameters' wherever it ranks: they are drawn for as the verdict's reads
+        lead = max(2, P.distinguish_leading)
+
+        def draw(n):
+            cfg = [(n, results[n][0].values)]
+            pert[n] = ctx.map(lambda hs, cfg=cfg: ctx.simulate(cfg, hs=hs), ctx.hs_pert)
+            final[n] = F.score(ctx, n, *results[n], pert[n]).score
+
+        if "parameter_mismatch" in results:
+            draw("parameter_mismatch")
         shares = self.where_["components"]
         comps = {c for c, x in shares.items() if x >= P.second_share}
 
@@ -356,8 +372,8 @@ class GapDiagnoser(GapEstimator):
                 return False
             best_output = get(ranked[0]).kind == "output"
             allowed = [n for n in ranked[1:] if not (best_output and get(n).kind == "output")]
-            read = ranked[:2] + allowed[:self.second]
-            if len(ranked) < 2 or len(allowed) < self.second:
+            read = ranked[:lead] + allowed[:self.second]
+            if len(ranked) < lead or len(allowed) < self.second:
                 return False
             if min(final[n] for n in read) <= upper[nxt]:
                 return False
@@ -369,12 +385,11 @@ class GapDiagnoser(GapEstimator):
                     return False
             return True
 
+        order = [n for n in order if n not in pert]
         for i, n in enumerate(order):
             if all(settled(m) for m in order[i:]):
                 break
-            cfg = [(n, results[n][0].values)]
-            pert[n] = ctx.map(lambda hs, cfg=cfg: ctx.simulate(cfg, hs=hs), ctx.hs_pert)
-            final[n] = F.score(ctx, n, *results[n], pert[n]).score
+            draw(n)
         return pert
 
     def _fit_one(self, ctx, name, start=None, fixed=()) -> F.Fit:
@@ -403,11 +418,21 @@ class GapDiagnoser(GapEstimator):
             return self.components_.stationarity(component, mask=mask, drift_sigmas=P.drift_sigmas,
                                                  drift_share=P.drift_share)
 
+        # can the log tell the leading explanations apart (schema 4)? only a named verdict reads it
+        distinct = None
+        if not a.is_none and len(fits) > 1 and max(f.explained for f in fits[:P.distinguish_leading]) >= P.min_explained:
+            distinct = D.distinguish(ctx, fits, getattr(self, "perturbed_", {}), P)
         evidence = V.Evidence(shares, self.prescreen_, second, self.discovered_, stationarity,
-                              tuple(self.where_.get("not_observable", ())))
+                              tuple(self.where_.get("not_observable", ())), distinct)
         verdict = V.decide(fits, self.gap_["channels"], self.noise_floor_, self.input_envelope_, P, evidence)
         self.warnings_ += list(verdict.warnings)
         out = verdict.to_json()
+        if len(out.get("group", ())) > 1:  # what would tell the group apart, computed (Box-Hill)
+            self.separate_ = D.separate_by(ctx, fits, out["group"], P, pairs=distinct.pairs if distinct else ())
+            out["separate_by"] = [r["description"] for r in self.separate_]
+            out["separate_by_experiments"] = self.separate_
+        elif distinct is not None:
+            out["separate_by"] = []
         # a named law that is not the plant's: the open search's form of its component, when it fits better
         form = S.named_form(self.components_, out.get("effect", ""), ctx.fitmask, ctx.valmask) \
             if P.named_form else None
@@ -466,12 +491,30 @@ class GapDiagnoser(GapEstimator):
         named = v.get("effect")
         if named in ("none", "inconclusive", "discovered", None):
             return None
+        if "distinguishable" in v:  # tested on the log itself (schema 4): the explanations it cannot tell apart
+            return list(v.get("group") or [named])
+        return self.structural_group(iso)
+
+    def structural_group(self, iso=None):
+        """The shape-level isolability group of a named verdict (schema 3's ``verdict.group``; the effect
+        alone when it is isolable), or None for ``none``, ``inconclusive`` and ``discovered``.
+
+        Parameters
+        ----------
+        iso : dict, optional
+            :meth:`isolability`'s answer (computed when not given).
+        """
+        v = self.verdict_
+        named = v.get("effect")
+        if named in ("none", "inconclusive", "discovered", None):
+            return None
         channel = (v.get("parameters") or {}).get("channel")
         group = ST.group_of(f"{named}:{channel}" if channel else named, self.isolability() if iso is None else iso)
         return group if group else [named]
 
     def to_json(self) -> dict:
-        """The ``diagnosis.json`` content (contract schema 3: schema 1's keys, plus ``verdict.component``,
+        """The ``diagnosis.json`` content (contract schema 4: ``verdict.group`` tested on the log,
+        ``verdict.structural_group``, ``verdict.distinguishable``, ``verdict.separate_by``; schema 3: schema 1's keys, plus ``verdict.component``,
         ``verdict.discovered``, ``gap.where.components``, ``initial_state``, ``warnings`` (schema 2),
         ``sensors``, ``isolability`` and ``verdict.group`` (schema 3; the ``calibrated`` block is added by
         the command that writes ``calibrated.toml``); extras: ``prescreen``)."""
@@ -480,7 +523,8 @@ class GapDiagnoser(GapEstimator):
         group = self.verdict_group(iso)
         if group is not None:
             v["group"] = group
-        return {"schema": 3,
+            v["structural_group"] = self.structural_group(iso)
+        return {"schema": 4,
                 "sensors": list(self.sensors_),
                 "isolability": iso,
                 "verdict": v,

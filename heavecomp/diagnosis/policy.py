@@ -189,6 +189,33 @@ class VerdictPolicy:
     with confidence high and a 38 kN WOB noise floor (true 0.4 kN), while the same run at 5 and 10 Hz reads
     ``string_damping``, high (reproducers 2026-12, D1): paper A's floor is 4.4 Hz."""
 
+    # ---------------------------------------------------------------- practical distinguishability (schema 4)
+    distinguish_alpha: float = 0.01
+    """Two-sided false-alarm rate of the block test that two explanations fit the held-out log
+    differently (:mod:`heavecomp.diagnosis.distinguish`): guards against naming one of two explanations
+    the log cannot tell apart.  A priori (1 %); measured on every log by pairs that are equal by
+    construction (one model replayed on two heave-noise draws), and on the tuning set
+    (docs/diagnosis.md, "Can the log tell them apart")."""
+    distinguish_block_periods: float = 1.0
+    """Block length of that test in periods of the wave band's lowest frequency (the longest wave
+    period): one block holds a whole wave, so the stick events of one wave (whose replay errors are
+    correlated) fall in one block.  The issue's minimum (a wave period), a priori."""
+    distinguish_leading: int = 4
+    """Leading candidates (best score first, the best included) tested against the best, plus the refit
+    of the nominal's own parameters (``parameter_mismatch``) wherever it ranks."""
+    group_max: int = 3
+    """Most members a verdict's group holds (best first): a group of more is no answer (issue 30)."""
+    separate_setpoint: float = 0.2
+    """Relative WOB set-point change of the set-point experiment of ``separate_by`` (a driller's
+    ordinary step, a priori)."""
+    separate_sea: tuple = (0.5, 1.5)
+    """H_s factors of the calmer and the rougher sea experiments of ``separate_by``."""
+    separate_longer: float = 4.0
+    """Length factor of the longer-log experiment of ``separate_by`` (at most an hour is simulated)."""
+    added_channel_noise: tuple = (("stroke", 2e-3), ("pressure", 2e3), ("wob", 400.0))
+    """Noise [SI] assumed for a channel the log lacks, in the channel-added experiment of
+    ``separate_by``: the benchmark's sensor noise (2 mm, 2 kPa, 400 N; docs/diagnosis.md)."""
+
     def to_json(self) -> dict:
         """Every field by name (JSON-ready): what the tuning report hashes."""
         return dataclasses.asdict(self)

@@ -31,6 +31,8 @@ from typing import Callable
 from heavecomp.diagnosis.joint import SecondSearch
 from heavecomp.diagnosis.replay import CH
 from heavecomp.diagnosis.screen import candidate_component
+from heavecomp.diagnosis.structure import entries
+from heavecomp.errors import InputError
 from heavecomp.effects.base import COMPONENTS
 from heavecomp.effects.candidates import get
 
@@ -51,6 +53,9 @@ class Evidence:
     discovered: dict | None = None
     stationarity: Callable = lambda component: None
     not_observable: tuple = ()
+    #: the practical distinguishability of the leading candidates on this log
+    #: (:class:`heavecomp.diagnosis.distinguish.Distinguishability`; None: not tested)
+    distinct: object = None
 
 
 @dataclasses.dataclass(frozen=True)
@@ -181,6 +186,9 @@ def decide(fits, gap, floors, envelope, policy, evidence: Evidence) -> Verdict:
         search and stationarity.
     """
     a = assess(fits, gap, floors, envelope, policy)
+    group, by_score = (), fits[0]
+    if not a.is_none:  # the group the log cannot split, and its lead (which may explain more than the best score)
+        group, fits, a = _grouped(fits, gap, floors, envelope, policy, evidence.distinct, a)
     best = fits[0]
     v = {"effect": best.effect, "confidence": "low", "parameters": best.parameters,
          "shrink": best.channels[a.channel]["shrink"], "shrink_channel": a.channel, "uncertainty": best.uncertainty,
@@ -192,10 +200,74 @@ def decide(fits, gap, floors, envelope, policy, evidence: Evidence) -> Verdict:
         v = _short_of_min(v, fits, a, policy, evidence)
     else:
         v = _named(v, fits, a, policy, evidence)
+    if evidence.distinct is not None and v["effect"] not in ("inconclusive", "discovered"):
+        v["distinguishable"] = evidence.distinct.to_json()
+        if len(group) > 1:
+            v["group"] = list(group)
+            v["group_note"] = _group_note(group, fits, evidence.distinct)
+        if fits[0] is not by_score:
+            _test_lead(v, fits, a, policy, evidence.distinct, by_score)
+            p = next((p for p in evidence.distinct.pairs if {p.a, p.b} == {fits[0].effect, by_score.effect}), None)
+            v["lead_note"] = (f"`{fits[0].effect}` leads although `{by_score.effect}` scored higher (parsimony "
+                              f"penalty): " + (f"the held-out block test prefers it (t = {p.statistic:+.2f}, "
+                                               f"threshold {p.threshold:.2f})" if p and p.apart else
+                                               "the log cannot tell them apart and it adds no mechanism"))
     warnings = []
     _at_bound(v, fits, warnings)
     _component(v, fits, policy, evidence, warnings)
     return Verdict(v, tuple(warnings))
+
+
+def _grouped(fits, gap, floors, envelope, P, distinct, a):
+    """The verdict's group (schema 4): the best and the leading candidates the log cannot tell from it
+    (:mod:`heavecomp.diagnosis.distinguish`).  A group of two or more is named by its lead with the
+    group's confidence: the runner-up the group's margin is measured to is the best candidate outside
+    it.  The lead is the best fit, except that a refit of the nominal's own parameters
+    (``parameter_mismatch``) in the group leads it when it explains ``min_explained``: the log does not
+    need the new mechanism (issue 30 item 3: the nominal structure with other values is the simpler
+    model).  Returns (group, fits reordered: lead then those outside the group, the assessment)."""
+    if distinct is None or not distinct.group:
+        return (), fits, a
+    byname = {f.effect: f for f in fits}
+    inside = [byname[m] for m in distinct.group if m in byname]
+    if len(inside) == 1 and inside[0] is fits[0]:
+        return tuple(distinct.group), fits, a
+    pm = next((f for f in inside if f.effect == "parameter_mismatch"), None)
+    others = [f for f in inside if f is not pm]
+    if pm is not None and (not others or pm.explained >= max(f.explained for f in others)):
+        lead = pm  # explains as much as any new mechanism the log cannot tell it from: the simpler model
+    else:
+        lead = others[0]  # the best of the mechanisms (a refit that explains less does not lead)
+    order = [lead] + [f for f in inside if f is not lead]
+    rest = [lead] + [f for f in fits if f.effect not in distinct.group]
+    ag = dataclasses.replace(assess(rest, gap, floors, envelope, P), is_none=False)
+    return tuple(f.effect for f in order), rest, ag
+
+
+def _test_lead(v, fits, a, P, distinct, by_score) -> None:
+    """A lead the held-out block test prefers over the best by score: its score margin (negative: the
+    penalty) is not the evidence, the test is.  When the test sets it apart from every leading candidate,
+    it is medium (never high: the test's preference, not a margin of ``high_margin``) if it explains
+    ``medium_explained`` outside the stick-event-noise tail."""
+    if len(v.get("group") or [v["effect"]]) > 1 or any(not p.apart for p in distinct.pairs):
+        return
+    if fits[0].explained >= P.medium_explained and a.input_ratio > P.none_tail and v["confidence"] == "low":
+        v["confidence"] = "medium"
+        v["note"] = (f"the held-out block test sets `{fits[0].effect}` apart from every leading candidate, "
+                     f"`{by_score.effect}` included: confidence medium")
+
+
+def _group_note(group, fits, distinct) -> str:
+    """Why the verdict is a group, in words."""
+    others = ", ".join(f"`{m}`" for m in group[1:])
+    stats = {p.b: p for p in distinct.pairs}
+    st = "; ".join(f"{m}: t = {stats[m].statistic:+.2f} (threshold {stats[m].threshold:.2f})"
+                   for m in group if m in stats)
+    lead = group[0]
+    why = (" (the refit of the nominal's own parameters explains as much: no new mechanism is needed)"
+           if lead == "parameter_mismatch" else "")
+    return (f"this log cannot tell `{lead}` from {others}{why}; held-out block test at a "
+            f"{100 * distinct.alpha:g} % false-alarm rate: {st}; the confidence is the group's")
 
 
 def _none(v, a, P) -> dict:
@@ -302,7 +374,7 @@ def _component(v, fits, P, evidence, warnings) -> None:
     if eff == "parameter_mismatch":
         _refit_check(v, shares, largest, P, warnings)
         _stationarity(v, evidence, warnings)
-    _table_check(v, shares, largest, P, evidence.not_observable)
+    _table_check(v, shares, largest, P, evidence.not_observable, warnings)
     if best.explained >= P.min_explained or evidence.discovered is None:
         return
     found = evidence.discovered
@@ -316,7 +388,7 @@ def _component(v, fits, P, evidence, warnings) -> None:
                       f"held-out {found['component']} residual by {100 * found['shrink']:.0f} %")
 
 
-def _table_check(v, shares, largest, P, not_observable=()) -> None:
+def _table_check(v, shares, largest, P, not_observable=(), warnings=None) -> None:
     """One verdict, one component (issue 23 item 4): ``verdict.component`` is the component of the effect
     the held-out replay fit named (that fit is what was scored), while the component table
     (``where.components``) splits the equation residuals by their terms.  The two can disagree by the
@@ -350,6 +422,30 @@ def _table_check(v, shares, largest, P, not_observable=()) -> None:
                   f"{largest.replace('_', ' ')}")
     v["component_table"] = {"largest": largest, "share": float(shares[largest]),
                             "verdict_share": float(shares.get(comp, 0.0)), "reason": reason}
+    # the confidence never outruns the evidence (issue 30 item 2): a named verdict the equation-error table
+    # does not support is at most low, and says why
+    if named and comp not in not_observable and largest not in _lands_in(v) and v["confidence"] != "low":
+        was = v["confidence"]
+        v["confidence"] = "low"
+        if warnings is not None:
+            warnings.append(f"verdict {v['effect']}: its component {comp.replace('_', ' ')} holds "
+                            f"{100 * shares.get(comp, 0.0):.0f} % of the equation-error gap, "
+                            f"{largest.replace('_', ' ')} {100 * shares[largest]:.0f} % ({reason}) -- confidence "
+                            f"lowered from {was} to low")
+
+
+def _lands_in(v) -> set:
+    """The components of the equation residuals the verdict's effect enters by structure
+    (:func:`heavecomp.diagnosis.structure.entries`): a stroke misread by an offset lands in the gas law's,
+    the lower- and top-mass balances' own laws, never in a ``sensors`` part of its own, so a table that puts
+    the gap in the gas spring does not disagree with it."""
+    name = v["effect"]
+    channel = (v.get("parameters") or {}).get("channel")
+    try:
+        parts = entries(f"{name}:{channel}" if channel else name)
+    except (KeyError, InputError):
+        return set()
+    return {p.split("/", 1)[1] for p in parts if not p.startswith("replay/")}
 
 
 def _refit_disagrees(moved, shares, largest, P) -> bool:

@@ -349,13 +349,16 @@ def write_report(diag, out_dir, *, title="Sim-to-real gap diagnosis") -> dict:
     pc = diag.where_.get("channel", "wob")
     pu, ps = CH_UNITS[pc]
     group = diag.verdict_group()
-    named = (f"**Verdict: one of {', '.join(f'`{m}`' for m in group)}** (this sensor set cannot tell them apart; "
-             f"`{v['effect']}` fitted best)" if group and len(group) > 1 else f"**Verdict: `{v['effect']}`**")
+    tested = "distinguishable" in v
+    named = (f"**Verdict: one of {', '.join(f'`{m}`' for m in group)}** "
+             f"({'this log' if tested else 'this sensor set'} cannot tell them apart; `{v['effect']}` "
+             f"{'leads' if tested else 'fitted best'})" if group and len(group) > 1 else f"**Verdict: `{v['effect']}`**")
     lines = [f"# {title}", "",
-             f"{named} (confidence {v['confidence']}); held-out shrink of the "
-             f"{v.get('shrink_channel', 'wob')} residual {v['shrink']:.2f}."]
+             f"{named} (confidence {v['confidence']}{', the group' + chr(39) + 's' if group and len(group) > 1 else ''}); "
+             f"held-out shrink of the {v.get('shrink_channel', 'wob')} residual {v['shrink']:.2f}."]
     if v.get("note"):
         lines.append(f"\n{v['note']}.")
+    lines += _distinguish_lines(v)
     if v.get("parameters"):
         unc = v.get("uncertainty", {})
         lines.append("\nFitted parameters: " + ", ".join(
@@ -430,9 +433,36 @@ def _isolability_lines(diag) -> list:
                   *[f"- {', '.join(f'`{m}`' for m in g)}" for g in groups]]
     v = diag.verdict_
     group = diag.verdict_group(iso)
+    group = diag.structural_group(iso)
     if group is not None and len(group) > 1:
         lines += ["", f"The verdict `{v['effect']}` lies in the group {', '.join(f'`{m}`' for m in group)}: "
-                  "it fitted best among effects this sensor set cannot tell apart by structure."]
+                  "effects this sensor set cannot tell apart by structure (whether this log tells them apart "
+                  "is the verdict's block test above)."]
+    return lines
+
+
+def _distinguish_lines(v) -> list:
+    """The verdict's practical distinguishability (schema 4): why it is a group, the block test's pairs
+    and what would separate the group."""
+    d = v.get("distinguishable")
+    if not d:
+        return []
+    lines = []
+    for key in ("group_note", "lead_note"):
+        if v.get(key):
+            lines.append(f"\n{v[key]}.")
+    fam = d.get("false_alarm_measured", {})
+    lines += ["", f"Can this log tell the leading explanations apart? Held-out block test (Vuong, blocks of "
+              f"{d['block_s']:.1f} s, false-alarm rate {100 * d['false_alarm_rate']:g} % stated; "
+              f"{fam.get('apart', 0)} of {fam.get('null_pairs', 0)} pairs equal by construction called apart on "
+              "this log):", "",
+              md_table(["a", "b", "t statistic [-]", "threshold [-]", "blocks", "told apart"],
+                       [[f"`{p['a']}`", f"`{p['b']}`", f"{p['statistic']:+.2f}", f"{p['threshold']:.2f}",
+                         str(p.get("blocks", "")), "yes" if p["apart"] else "**no**"] for p in d["pairs"]])]
+    if v.get("separate_by"):
+        lines += ["", "What would tell them apart (the members simulated under each experiment, ranked by how far "
+                  "apart it drives their predictions against the noise, Box-Hill):", "",
+                  *[f"- {s}" for s in v["separate_by"]]]
     return lines
 
 
