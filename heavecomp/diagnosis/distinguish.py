@@ -123,7 +123,15 @@ def block_length(run, policy) -> float:
 
 def losses(ctx, pred) -> np.ndarray:
     """Per-sample held-out loss 1/2 sum_c (pred_c - y_c)^2 / sigma_c^2 (sigma: the noise floor) on the
-    held-out samples of ``ctx`` (NaN where no channel is finite)."""
+    held-out samples of ``ctx`` (NaN where no channel is finite).
+
+    Parameters
+    ----------
+    ctx : heavecomp.diagnosis.replay.ReplayContext
+        The prepared run (its held-out mask, measured channels and noise floor).
+    pred : dict
+        A replay, {channel: array} [SI].
+    """
     m = ctx.valmask
     tot = np.zeros(int(m.sum()))
     seen = np.zeros(tot.size, bool)
@@ -141,7 +149,17 @@ def losses(ctx, pred) -> np.ndarray:
 
 def block_t(d, t, block) -> tuple:
     """Student's t of the block sums of ``d`` (samples at times ``t``, NaN left out; blocks of ``block``
-    s, a block with under half its samples dropped) and the number of blocks."""
+    s, a block with under half its samples dropped) and the number of blocks.
+
+    Parameters
+    ----------
+    d : numpy.ndarray
+        Per-sample loss differences (NaN: left out).
+    t : numpy.ndarray
+        Their times [s].
+    block : float
+        Block length [s].
+    """
     ok = np.isfinite(d)
     if ok.sum() < 4:
         return 0.0, 0
@@ -161,7 +179,15 @@ def block_t(d, t, block) -> tuple:
 
 
 def threshold(alpha, blocks) -> float:
-    """Two-sided critical value t(1 - alpha/2, blocks - 1) (infinite below two blocks)."""
+    """Two-sided critical value t(1 - alpha/2, blocks - 1) (infinite below two blocks).
+
+    Parameters
+    ----------
+    alpha : float
+        Two-sided false-alarm rate.
+    blocks : int
+        Number of blocks the statistic was formed from.
+    """
     from scipy.stats import t as student
 
     return float(student.ppf(1.0 - 0.5 * alpha, blocks - 1)) if blocks >= 2 else math.inf
@@ -174,7 +200,23 @@ def _stat(ctx, pa, pb, block):
 
 def pair_test(ctx, a, b, pred_a, pred_b, pert_a, pert_b, alpha, block) -> Pair:
     """The test of ``a`` against ``b`` from their replays (``pred_*``) and their replays on the same
-    heave-noise draws (``pert_*``); see the module docstring."""
+    heave-noise draws (``pert_*``); see the module docstring.
+
+    Parameters
+    ----------
+    ctx : heavecomp.diagnosis.replay.ReplayContext
+        The prepared run (its held-out mask, measured channels and noise floor).
+    a, b : str
+        The two explanations' names.
+    pred_a, pred_b : dict
+        Their replays on the logged heave ({channel: array} [SI]).
+    pert_a, pert_b : list of dict
+        Their replays on the same heave-noise draws.
+    alpha : float
+        Two-sided false-alarm rate.
+    block : float
+        Block length [s].
+    """
     z0, nb = _stat(ctx, pred_a, pred_b, block)
     zs = [_stat(ctx, x, y, block)[0] for x, y in zip(pert_a, pert_b)]
     zd = float(np.median(zs)) if zs else z0
@@ -186,12 +228,34 @@ def pair_test(ctx, a, b, pred_a, pred_b, pert_a, pert_b, alpha, block) -> Pair:
 
 def null_stats(ctx, perturbed, block) -> list:
     """[(t, blocks)] of every pair of heave-noise draws of each model in ``perturbed`` (a list of the model's
-    replays on the draws), tested as if they were two explanations: equal by construction."""
+    replays on the draws), tested as if they were two explanations: equal by construction.
+
+    Parameters
+    ----------
+    ctx : heavecomp.diagnosis.replay.ReplayContext
+        The prepared run (its held-out mask, measured channels and noise floor).
+    perturbed : list of list of dict
+        Per model, its replays on the heave-noise draws.
+    block : float
+        Block length [s].
+    """
     return [_stat(ctx, x, y, block) for preds in perturbed for x, y in itertools.combinations(preds, 2)]
 
 
 def null_pairs(ctx, perturbed, alpha, block) -> tuple:
-    """(pairs, apart): :func:`null_stats` against the test's threshold at ``alpha``."""
+    """(pairs, apart): :func:`null_stats` against the test's threshold at ``alpha``.
+
+    Parameters
+    ----------
+    ctx : heavecomp.diagnosis.replay.ReplayContext
+        The prepared run (its held-out mask, measured channels and noise floor).
+    perturbed : list of list of dict
+        Per model, its replays on the heave-noise draws.
+    alpha : float
+        Two-sided false-alarm rate.
+    block : float
+        Block length [s].
+    """
     st = null_stats(ctx, perturbed, block)
     return len(st), sum(abs(z) > threshold(alpha, nb) for z, nb in st)
 
@@ -269,7 +333,21 @@ class _RestStarts(dict):
 def experiment_replay(ctx, *, hs_scale=1.0, duration=None, setpoint=0.0, seed=7):
     """A :class:`~heavecomp.diagnosis.replay.Replay` of an experiment: a JONSWAP sea at the log's peak
     period and ``hs_scale`` x its H_s, ``duration`` [s] (default the log's), the nominal WOB set-point
-    moved by the share ``setpoint``, from rest, sampled as the log."""
+    moved by the share ``setpoint``, from rest, sampled as the log.
+
+    Parameters
+    ----------
+    ctx : heavecomp.diagnosis.replay.ReplayContext
+        The prepared run (its held-out mask, measured channels and noise floor).
+    hs_scale : float
+        Factor on the log's significant wave height.
+    duration : float, optional
+        Length of the experiment [s]; default the log's.
+    setpoint : float
+        Relative change of the WOB set-point.
+    seed : int
+        Seed of the JONSWAP sea.
+    """
     rp = ctx.replay
     run = rp.run
     hs0, tp = _sea(run)
@@ -293,7 +371,19 @@ def experiment_replay(ctx, *, hs_scale=1.0, duration=None, setpoint=0.0, seed=7)
 
 def divergence(preds, sigma, t, mask=None) -> float:
     """Box-Hill divergence of the members' predictions ``preds`` (dicts of channels): the smallest over
-    the pairs of 1/2 sum_c mean_t (A_c - B_c)^2 / sigma_c^2 times the duration [s] (one sample a second)."""
+    the pairs of 1/2 sum_c mean_t (A_c - B_c)^2 / sigma_c^2 times the duration [s] (one sample a second).
+
+    Parameters
+    ----------
+    preds : list of dict
+        The members' predictions, {channel: array} [SI].
+    sigma : dict
+        Noise per channel [SI].
+    t : numpy.ndarray
+        Sample times [s].
+    mask : numpy.ndarray, optional
+        Samples to compare (default all).
+    """
     out = math.inf
     T = float(t[-1] - t[0]) if t.size > 1 else 0.0
     for a, b in itertools.combinations(preds, 2):
