@@ -5,10 +5,13 @@ Every replay of a diagnosis goes through its one prepared :class:`heavecomp.diag
 which records a digest of its inputs (configuration, replayed span, heave samples) in its ledger.
 """
 
+import dataclasses
+
 import pytest
 
 from heavecomp.benchmark import benchmark_case, generate
 from heavecomp.diagnosis.estimator import GapDiagnoser
+from heavecomp.diagnosis.policy import VerdictPolicy
 from heavecomp.effects.candidates import MISMATCH_KEYS
 
 
@@ -77,15 +80,18 @@ def test_draws_only_in_contention_give_the_ranking_all_draws_give(diagnosed, mon
     every candidate drawn for."""
     tr, d0 = diagnosed
     run = tr.to_run()
-    d = GapDiagnoser(d0.nominal, candidates=d0.candidates, n_jobs=2, second=1).fit(run)
+    # the distinguishability test's rivals are read too (the best distinguish_leading): with four candidates
+    # and the default four every one is drawn for, so the rule is checked where it can leave some out
+    policy = dataclasses.replace(VerdictPolicy(), distinguish_leading=2)
+    d = GapDiagnoser(d0.nominal, candidates=d0.candidates, n_jobs=2, second=1, policy=policy).fit(run)
     drawn = {r["effect"] for r in d.candidates_ if r.get("explained_perturbed_heave") is not None}
 
     def every(self, ctx, names, results):
         return {n: [ctx.simulate([(n, results[n][0].values)], hs=hs) for hs in ctx.hs_pert] for n in names}
 
     monkeypatch.setattr(GapDiagnoser, "_contention", every)
-    full = GapDiagnoser(d.nominal, candidates=d.candidates, n_jobs=2, second=1).fit(run)
+    full = GapDiagnoser(d.nominal, candidates=d.candidates, n_jobs=2, second=1, policy=policy).fit(run)
     assert drawn < {f.effect for f in full.fits_}  # some were left out ...
-    read = 2 + d.second
+    read = policy.distinguish_leading + d.second
     assert [(f.effect, f.score) for f in d.fits_[:read]] == [(f.effect, f.score) for f in full.fits_[:read]]
     assert d.verdict_ == full.verdict_  # ... and the verdict is the same, to the last digit

@@ -300,8 +300,8 @@ def distinguish(ctx, fits, perturbed, policy, nominal_pert=None) -> Distinguisha
         winner = min(beaten, key=lambda p: p.statistic).b
         best = next(f for f in lead if f.effect == winner)
     together = [best.effect] + [p.b for p in sorted(pairs, key=lambda p: abs(p.statistic)) if not p.apart]
-    if nominal_pert is None:
-        nominal_pert = [ctx.simulate([], hs=hs) for hs in ctx.hs_pert]
+    if nominal_pert is None:  # the nominal's draws the preparation replayed (not twice)
+        nominal_pert = list(ctx.nominal_pert) or [ctx.simulate([], hs=hs) for hs in ctx.hs_pert]
     n, k = null_pairs(ctx, [nominal_pert, perturbed.get(best.effect, [])], P.distinguish_alpha, block)
     return Distinguishability(pairs, tuple(together[:P.group_max]), P.distinguish_alpha, n, k, block,
                               tuple(together[P.group_max:]))

@@ -444,6 +444,9 @@ class ReplayContext:
     n_jobs: int = 1
     #: the output channels the run has (:func:`present`): every loss, floor and share is on these only
     channels: tuple = CH
+    #: the nominal's replays on :attr:`hs_pert` (the distinguishability test's pairs equal by construction
+    #: read them: kept, not replayed again)
+    nominal_pert: tuple = ()
 
     @property
     def run(self):
@@ -619,7 +622,7 @@ def prepare(run, nominal, *, split=0.67, settle=None, stuck_speed=S.STUCK_SPEED,
     return ReplayContext(rp, sp, y, fitmask, valmask, allmask, noise, fl["heave_noise"], fl["replay_floor"], floor,
                          envelope, weights, nom, mse(y, nom, valmask, chans), fl["hs_pert"],
                          [mse(y, a, valmask, chans) for a in fl["pert_preds"]], policy, max(1, int(decimate)),
-                         max(1, int(n_jobs)), chans)
+                         max(1, int(n_jobs)), chans, tuple(fl["pert_preds"]))
 
 
 def _replay_floor(rp, nom, mask, val, input_draws, n_jobs, policy, chans=CH) -> dict:
