@@ -39,6 +39,10 @@ time base          dominant heave period outside ``WAVE_PERIOD`` (3-25 s); the W
 clock skew         heave -> stroke / pressure cross-correlation lag over               warning, cap low
                    ``MAX_SKEW_S`` (the largest sensor lag the diagnosis models), with
                    the correlation at lag 0 clearly weaker (``ZERO_LAG_SHARE``)
+quantised          over ``QUANT_ZERO_SHARE`` of consecutive samples repeat exactly     warning; its
+                   and ``QUANT_GRID_SHARE`` of the samples lie on one grid of step q   noise floor
+                   (:func:`quantum`): the reading's error is q^2/12, which the         includes q^2/12
+                   difference estimate of the noise cannot see (it reads ~0)          (no cap)
 =================  ==================================================================  ===============
 """
 
@@ -84,6 +88,18 @@ MIN_CORRELATION = 0.5  #: a lag is read only from a cross-correlation peak at le
 #: ... and only when the correlation at lag 0 is weaker than this share of the peak's [-]: a regular heave
 #: correlates (with the opposite sign) as well half a period away, a skewed clock's channel does not at 0
 ZERO_LAG_SHARE = 0.8
+# ---- quantisation
+#: a channel whose consecutive samples repeat exactly this often is read on a grid coarse against its noise:
+#: with white noise of sigma >= 1.4 q on a grid of step q the share is under 0.2 (two samples' difference
+#: has sigma 2 sigma >= 2.8 q, and it rounds to 0 with probability about q / (2.8 q sqrt(2 pi)) = 0.14), and
+#: there q^2/12 adds 4 % to the noise's variance at most; above it the difference estimate of the noise
+#: (:func:`heavecomp.diagnosis.data.noise_floor`) reads the grid, not the noise (a pressure on a 0.25 bar grid
+#: with 2 kPa of noise read 51 Pa, issue 30)
+QUANT_ZERO_SHARE = 0.2
+#: ... and this share of its samples lies on one grid (within ``QUANT_TOL`` of a step): a frozen stretch
+#: repeats too, but the rest of a live, unquantised channel is off every grid [-]
+QUANT_GRID_SHARE = 0.99
+QUANT_TOL = 0.01  #: how far from a grid line [steps] a quantised sample may lie (the text of a CSV, float rounding) [-]
 CHANNELS = ("heave", "stroke", "pressure", "wob")
 
 
@@ -203,6 +219,35 @@ def spikes(y, last=True):
         bool(torn and idx[-1] == y.size - 1)
 
 
+def quantum(y) -> float:
+    """The step q of a channel read on a grid that is coarse against its noise, 0.0 when it is not (module
+    table: over ``QUANT_ZERO_SHARE`` of consecutive samples repeat exactly and ``QUANT_GRID_SHARE`` of the
+    samples lie on the grid through the first sample with step q, q the smallest change between samples).
+
+    The reading's error is then uniform over one step (variance q^2/12 when the signal or its noise crosses
+    grid lines at random), which a noise estimate from differences of samples cannot see: most differences
+    are exactly 0.  A finer grid (a 16-bit logger, a CSV's last digit) returns 0.0: the noise dithers it and
+    the difference estimate already holds its share.
+
+    Parameters
+    ----------
+    y : array_like [unit of the channel]
+        One channel's samples; NaN where missing (left out).
+    """
+    y = np.asarray(y, dtype=float)
+    y = y[np.isfinite(y)]
+    if y.size < 10:
+        return 0.0
+    d = np.abs(np.diff(y))
+    if np.mean(d == 0.0) < QUANT_ZERO_SHARE or not np.any(d > 0.0):
+        return 0.0
+    nz = d[d > 0.0]
+    step = float(np.median(nz[nz <= 1.5 * nz.min()]))  # the smallest change, robust to float rounding
+    r = (y - y[0]) / step
+    on = np.abs(r - np.round(r)) <= QUANT_TOL
+    return step if np.mean(on) >= QUANT_GRID_SHARE else 0.0
+
+
 def frozen_runs(y, min_len):
     """(start, stop) index pairs of stretches where ``y`` repeats one value exactly for >= ``min_len`` samples.
 
@@ -296,7 +341,8 @@ def assess(run, params=None, *, rows=None) -> Quality:
     cols = {c: np.array(run[c], dtype=float) for c in CHANNELS if c in run.columns}  # the channels the log has
     t, cols = _torn_and_spikes(q, t, cols, line)
     T_wave = mean_period(t, cols["heave"])
-    _frozen(q, t, cols, T_wave, line, src)
+    steps = _quantised(q, cols)
+    _frozen(q, t, {c: y for c, y in cols.items() if c not in steps}, T_wave, line, src)
     _magnitudes(q, cols, params, src)
     _time_base(q, t, cols.get("wob"), T_wave, params)
     _clock_skew(q, t, cols)
@@ -381,6 +427,31 @@ def _frozen(q: Quality, t, cols: dict, T_wave: float, line, src: str) -> None:
             cols[c][a:b] = np.nan
         _issue(q, "frozen", c, f"frozen: {what} (a live channel changes within {FROZEN_PERIODS:g} wave periods): "
                                "excluded, confidence low")
+
+
+def _quantised(q: Quality, cols: dict) -> dict:
+    """Channels read on a coarse grid (:func:`quantum`): a warning naming the step and the noise floor the
+    diagnosis uses (:func:`heavecomp.diagnosis.data.noise_floor` includes q^2/12); no cap (the floor is
+    corrected, nothing is excluded).  Returns ``{channel: step}``: a quantised channel repeats values while
+    its signal moves less than a step, which is no frozen sensor (it is left out of that check).
+
+    Parameters
+    ----------
+    q : Quality
+        The findings so far, extended in place.
+    cols : dict
+        Channel -> samples [SI].
+    """
+    steps = {}
+    for c, y in cols.items():
+        step = quantum(y)
+        if step > 0.0:
+            steps[c] = step
+            q.issues.append({"kind": "quantised", "column": c, "step": step,
+                             "message": f"column '{c}': read on a grid of {step:.4g} (SI): a reading error of "
+                                        f"{step / math.sqrt(12.0):.4g} rms (step/sqrt(12)) is part of its noise floor",
+                             "cap": None})
+    return steps
 
 
 def _magnitudes(q: Quality, cols: dict, params, src: str) -> None:
