@@ -257,3 +257,19 @@ def test_a_fine_grid_is_no_artefact():
     run = _checked(t, cols)
     assert Q.quantum(cols["pressure"]) == 0.0 and not _issue(run, "quantised")
     assert noise_floor(cols["pressure"]) == pytest.approx(noise_floor(p), rel=0.05)
+
+
+def test_a_hum_in_one_channel_joins_its_noise_floor():
+    """Mains hum aliased to 0.02 Hz on the pressure alone (3 kPa, under the wave band): a line no other channel
+    has is a reading artefact; its rms is part of the pressure's floor (the replay's output noise), no cap;
+    the clean log has no such line."""
+    from heavecomp.diagnosis.replay import output_noise
+
+    assert not _issue(_checked(T0, C0), "hum")
+    t, cols, _ = K.quantised(T0, C0, "pressure", 1.0, hum=3e3, hum_frequency=0.02)
+    run = _checked(t, cols)
+    (h,) = _issue(run, "hum")
+    assert h["column"] == "pressure" and h["frequency"] == pytest.approx(0.02, abs=2 / 300.0)
+    assert h["amplitude"] == pytest.approx(3e3, rel=0.1) and run.quality.confidence_cap is None
+    clean = output_noise(_checked(T0, C0))["pressure"]
+    assert output_noise(run)["pressure"] == pytest.approx(math.hypot(clean, 3e3 / math.sqrt(2)), rel=0.1)

@@ -43,6 +43,11 @@ quantised          over ``QUANT_ZERO_SHARE`` of consecutive samples repeat exact
                    and ``QUANT_GRID_SHARE`` of the samples lie on one grid of step q   noise floor
                    (:func:`quantum`): the reading's error is q^2/12, which the         includes q^2/12
                    difference estimate of the noise cannot see (it reads ~0)          (no cap)
+hum                a spectral line below the wave band (>= 3 cycles in the log, under  warning; its rms
+                   1/3 of the heave's mean frequency) standing ``HUM_PROMINENCE`` x   is part of the
+                   above its neighbours' median in one output channel and in no other  channel's noise
+                   channel (:func:`hum_line`): mains hum aliased by the logger, no     floor (no cap)
+                   plant response (the plant answers a heave line in every channel)
 =================  ==================================================================  ===============
 """
 
@@ -100,6 +105,16 @@ QUANT_ZERO_SHARE = 0.2
 #: repeats too, but the rest of a live, unquantised channel is off every grid [-]
 QUANT_GRID_SHARE = 0.99
 QUANT_TOL = 0.01  #: how far from a grid line [steps] a quantised sample may lie (the text of a CSV, float rounding) [-]
+# ---- hum: a line in one channel's spectrum that no other channel shares
+#: a periodogram bin of a broadband signal exceeds the median of its neighbours by a factor x with
+#: probability 2^-x (chi-square with 2 degrees of freedom): 30 x is a false line once in 1e9 bins; a
+#: sinusoid of amplitude A over a log of T s stands (A^2 T / 4) / (the background's density) above it
+HUM_PROMINENCE = 30.0
+#: ... and the other channels show no line within a bin of it (a plant response to a line in the heave
+#: would be in every channel): at most this many times their neighbours' median [-]
+HUM_OTHER = 10.0
+HUM_CYCLES = 3.0  #: a hum is read only at frequencies with this many cycles in the log [-]
+HUM_WAVE = 1.0 / 3.0  #: ... and below this share of the heave's mean frequency 1/T_m01 (under the wave band) [-]
 CHANNELS = ("heave", "stroke", "pressure", "wob")
 
 
@@ -122,6 +137,9 @@ class Quality:
     issues: list = dataclasses.field(default_factory=list)
     exclude: dict = dataclasses.field(default_factory=dict)
     drop_last: bool = False
+    #: channel -> rms [SI] of a reading artefact that is part of the channel's noise floor and that the
+    #: difference estimate of the noise cannot see (a hum: a slow line)
+    reading_noise: dict = dataclasses.field(default_factory=dict)
 
     @property
     def warnings(self) -> list:
@@ -135,7 +153,8 @@ class Quality:
 
     def to_json(self) -> dict:
         return {"confidence_cap": self.confidence_cap,
-                "issues": [{k: v for k, v in i.items()} for i in self.issues]}
+                "issues": [{k: v for k, v in i.items()} for i in self.issues],
+                "reading_noise": dict(self.reading_noise)}
 
 
 def _issue(q, kind, column, message, cap="low"):
@@ -346,6 +365,7 @@ def assess(run, params=None, *, rows=None) -> Quality:
     _magnitudes(q, cols, params, src)
     _time_base(q, t, cols.get("wob"), T_wave, params)
     _clock_skew(q, t, cols)
+    _hum(q, t, cols, T_wave)
     q.exclude = {c: np.array(sorted(s), dtype=int) for c, s in q.exclude.items() if s}
     return q
 
@@ -560,6 +580,91 @@ def _clock_skew(q: Quality, t, cols: dict) -> None:
         shown = ", ".join(f"{c} {g:+.2f} s" for c, g in lags.items())
         _issue(q, "clock_skew", col, f"clock skew? offset from the heave by {shown} (cross-correlation peak), more "
                                      f"than any sensor lag ({MAX_SKEW_S:g} s): confidence low")
+
+
+def _periodogram(t, y):
+    """(frequencies [Hz], Hann-windowed periodogram [unit^2/Hz]) of ``y`` at ``t`` less its linear trend."""
+    tu, yu = _uniform(t, y)
+    yu = yu - np.polyval(np.polyfit(tu - tu[0], yu, 1), tu - tu[0])
+    fs = 1.0 / (tu[1] - tu[0])
+    w = np.hanning(yu.size)
+    P = np.abs(np.fft.rfft(yu * w)) ** 2 / (fs * np.sum(w * w))
+    return np.fft.rfftfreq(yu.size, 1.0 / fs), P
+
+
+def _prominence(P, k, near=2, far=15):
+    """Periodogram bin ``k`` over the median of the bins ``near`` + 1 to ``far`` away on either side [-]."""
+    idx = np.r_[np.arange(k - far, k - near), np.arange(k + near + 1, k + far + 1)]
+    idx = idx[(idx >= 1) & (idx < P.size)]
+    bg = float(np.median(P[idx])) if idx.size else 0.0
+    return float(P[k] / bg) if bg > 0 else 0.0
+
+
+def hum_line(t, cols: dict, T_wave: float) -> dict:
+    """Lines below the wave band that one output channel has and no other channel shares (module table):
+    ``{channel: (frequency [Hz], amplitude [SI], prominence [-])}``.
+
+    Parameters
+    ----------
+    t : numpy.ndarray [s]
+        Time of each sample.
+    cols : dict
+        Channel -> samples [SI] (the heave and the outputs the log has; NaN where missing).
+    T_wave : float [s]
+        The heave's mean period (:func:`mean_period`).
+    """
+    T = float(t[-1] - t[0])
+    if not (T > 0 and math.isfinite(T_wave) and T_wave > 0):
+        return {}
+    spectra = {c: _periodogram(t, y) for c, y in cols.items() if np.isfinite(y).sum() > 64}
+    out = {}
+    for c in ("stroke", "pressure", "wob"):
+        if c not in spectra:
+            continue
+        f, P = spectra[c]
+        band = np.flatnonzero((f >= HUM_CYCLES / T) & (f <= HUM_WAVE / T_wave))
+        if band.size == 0:
+            continue
+        prom = np.array([_prominence(P, int(k)) for k in band])
+        i = int(np.argmax(prom))
+        k = int(band[i])
+        if prom[i] < HUM_PROMINENCE:
+            continue
+        others = [max(_prominence(spectra[o][1], j) for j in (k - 1, k, k + 1) if 1 <= j < spectra[o][1].size)
+                  for o in spectra if o != c and spectra[o][1].size == P.size]
+        if others and max(others) > HUM_OTHER:
+            continue
+        tu, yu = _uniform(t, cols[c])
+        X = np.column_stack([np.sin(2 * np.pi * f[k] * tu), np.cos(2 * np.pi * f[k] * tu), np.ones_like(tu),
+                             tu - tu[0]])
+        coef = np.linalg.lstsq(X, yu, rcond=None)[0]
+        out[c] = (float(f[k]), float(math.hypot(coef[0], coef[1])), float(prom[i]))
+    return out
+
+
+def _hum(q: Quality, t, cols: dict, T_wave: float) -> None:
+    """A hum (:func:`hum_line`): a warning naming the channel, its frequency and amplitude; its rms joins the
+    channel's noise floor (``q.reading_noise``; the replay's output noise), no cap.
+
+    Parameters
+    ----------
+    q : Quality
+        The findings so far, extended in place.
+    t : numpy.ndarray
+        Times [s].
+    cols : dict
+        Channel -> samples [SI].
+    T_wave : float
+        The heave's mean period [s].
+    """
+    for c, (f, amp, prom) in hum_line(t, cols, T_wave).items():
+        rms = amp / math.sqrt(2.0)
+        q.reading_noise[c] = float(math.hypot(q.reading_noise.get(c, 0.0), rms))
+        q.issues.append({"kind": "hum", "column": c, "frequency": f, "amplitude": amp,
+                         "message": f"column '{c}': a line at {f:.3g} Hz ({amp:.4g} SI amplitude, {prom:.0f} x its "
+                                    "neighbours) that no other channel has: a reading artefact (mains hum aliased by "
+                                    f"the logger?); its rms {rms:.4g} is part of the channel's noise floor",
+                         "cap": None})
 
 
 def cleaned(run, q: Quality):
