@@ -2,6 +2,7 @@
 and their verdicts: does the diagnosis name the right component on each?
 
     python scripts/third_set_logs.py make DIR       # writes DIR/<class>.csv, .toml, .truth.json
+    python scripts/third_set_logs.py drawn DIR      # the two plant classes at their drawn (held-back) sizes
     python scripts/third_set_logs.py diagnose DIR OUT.json
 
 ``diagnose`` imports only ``load_run``, ``GapDiagnoser`` and ``load``, so the same logs can be diagnosed by
@@ -12,7 +13,7 @@ The classes, each at about 5 x the noise floor (its largest channel's own gap, `
 - ``friction_memory``: a LuGre bristle friction, relaxation length 3-6 cm (truth ``friction_memory``);
 - ``mru_heave``: the heave through an MRU's 2nd-order high-pass (corner ~100 s) plus a drift of ~2 cm
   (truth ``heave_reference``, variant ``mru_drift``);
-- ``hardening_formation``: the formation's stiffness doubled over 5 s half-way (``long_log``, ``hardening``);
+- ``hardening_formation``: the formation's stiffness doubled over 5 s half-way (``long_log``, ``hardening``, 150 s into the 300 s log);
 - ``quantised_pressure``: a run without any plant effect whose pressure is read on a 0.25 bar grid with
   0.1 bar of mains hum aliased to 0.02 Hz (``corruption.quantised``).
 """
@@ -38,23 +39,40 @@ def make(out: Path) -> None:
 
     out.mkdir(parents=True, exist_ok=True)
     runs = {
-        "friction_memory": lambda: generate(Case("friction_memory", 300001, "named", duration=600.0, size=SIZE)),
-        "mru_heave": lambda: generate(Case("heave_reference", 300002, "named", duration=600.0, variant="mru_drift",
+        "friction_memory": lambda: generate(Case("friction_memory", 300001, "named", duration=300.0, size=SIZE)),
+        "mru_heave": lambda: generate(Case("heave_reference", 300002, "named", duration=300.0, variant="mru_drift",
                                            size=SIZE)),
-        "hardening_formation": lambda: long_log([(300.0, "hardening")], seed=300003, duration=600.0, rate=50.0,
+        "hardening_formation": lambda: long_log([(150.0, "hardening")], seed=300003, duration=300.0, rate=50.0,
                                                 size=5.0),
     }
     for name, fn in runs.items():
+        print("making", name, flush=True)
         tr = fn()
         tr.to_csv(out / f"{name}.csv")
         write_params(out, tr.nominal, f"{name}.toml")
         (out / f"{name}.truth.json").write_text(json.dumps(tr.truth, indent=1, default=str))
-    tr = generate(Case("none", 300004, "none", duration=600.0))
+    tr = generate(Case("none", 300004, "none", duration=300.0))
     t, cols, desc = corruption.quantised(tr.t, tr.columns, "pressure", 25e3, hum=10e3, hum_frequency=0.02)
     q = TestRun(t=t, columns=cols, nominal=tr.nominal, truth={**tr.truth, "reading": desc})
     q.to_csv(out / "quantised_pressure.csv")
     write_params(out, tr.nominal, "quantised_pressure.toml")
     (out / "quantised_pressure.truth.json").write_text(json.dumps(q.truth, indent=1, default=str))
+
+
+def drawn(out: Path) -> None:
+    """The friction memory and the MRU heave at the sizes their draws give (the whole friction in a 3-6 cm
+    bristle; a high-pass corner of 0.008-0.012 Hz with a 2 cm drift), not sized to 5 x the noise."""
+    from heavecomp.benchmark import Case, generate
+    from heavecomp.report.provenance import write_params
+
+    out.mkdir(parents=True, exist_ok=True)
+    for name, case in (("friction_memory", Case("friction_memory", 300011, "named", duration=300.0)),
+                       ("mru_heave", Case("heave_reference", 300012, "named", duration=300.0, variant="mru_drift"))):
+        print("making", name, flush=True)
+        tr = generate(case)
+        tr.to_csv(out / f"{name}.csv")
+        write_params(out, tr.nominal, f"{name}.toml")
+        (out / f"{name}.truth.json").write_text(json.dumps(tr.truth, indent=1, default=str))
 
 
 def diagnose(folder: Path, out: Path) -> None:
@@ -63,6 +81,8 @@ def diagnose(folder: Path, out: Path) -> None:
 
     rows = {}
     for name, component in EXPECT.items():
+        if not (folder / f"{name}.csv").exists():
+            continue
         t0 = time.perf_counter()
         nominal = load(folder / f"{name}.toml")
         run = load_run(folder / f"{name}.csv", nominal)
@@ -84,7 +104,9 @@ def diagnose(folder: Path, out: Path) -> None:
 if __name__ == "__main__":
     if len(sys.argv) >= 3 and sys.argv[1] == "make":
         make(Path(sys.argv[2]))
+    elif len(sys.argv) >= 3 and sys.argv[1] == "drawn":
+        drawn(Path(sys.argv[2]))
     elif len(sys.argv) >= 4 and sys.argv[1] == "diagnose":
         diagnose(Path(sys.argv[2]), Path(sys.argv[3]))
     else:
-        sys.exit("usage: third_set_logs.py make DIR | diagnose DIR OUT.json")
+        sys.exit("usage: third_set_logs.py make DIR | drawn DIR | diagnose DIR OUT.json")

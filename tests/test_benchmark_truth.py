@@ -23,7 +23,7 @@ TRUTH_DIR = ROOT / "heavecomp" / "benchmark" / "truth"
 NOMINAL = parameter_sets()["paper_a"]
 #: laws whose size is a time constant: a zero size is the singular limit T -> 0 (a division by zero),
 #: not a runnable law
-SINGULAR_AT_ZERO = {"friction_lag", "sensor_delay", "friction_memory"}  # friction_memory: a length L_c -> 0
+SINGULAR_AT_ZERO = {"friction_lag", "sensor_delay"}
 #: (law, variant) whose size knob leaves a filter in place at zero size: a misreading channel keeps
 #: its 5 Hz sensor bandwidth (about 2 x the WOB floor on its own), an MRU keeps its high-pass; their
 #: zero size is not the nominal run, only a smaller gap than the drawn size
