@@ -82,10 +82,10 @@ def test_a_sensor_effect_corrects_the_reading_and_leaves_the_plant():
     (e,) = spec.reading_effects(p)
     assert (e.name, e.channel, e.values["factor"]) == ("sensor_gain", "wob", 1.08)
     assert cal.changes[0]["role"] == "reading"
-    # heave_reference fitted without a logged angle: the lever arm is written at its null value
+    # heave_reference fitted without a logged angle: the lever arm (and a high-pass not fitted) at its null value
     cal = calibrate(NOM, _diag("heave_reference", {"scale": 0.9, "delay": -0.2}))
     (e,) = spec.reading_effects(_round_trip(cal))
-    assert e.values == {"scale": 0.9, "delay": -0.2, "lever_arm": 0.0}
+    assert e.values == {"scale": 0.9, "delay": -0.2, "lever_arm": 0.0, "highpass": 0.0}
 
 
 def test_a_discovered_friction_term_is_carried_as_discovered_term():
