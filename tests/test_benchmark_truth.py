@@ -27,7 +27,8 @@ SINGULAR_AT_ZERO = {"friction_lag", "sensor_delay"}
 #: (law, variant) whose size knob leaves a filter in place at zero size: a misreading channel keeps
 #: its 5 Hz sensor bandwidth (about 2 x the WOB floor on its own), an MRU keeps its high-pass; their
 #: zero size is not the nominal run, only a smaller gap than the drawn size
-FILTER_AT_ZERO = {("sensor_gain", v) for v in (None, "wob", "stroke", "pressure")} | {("heave_reference", "mru")}
+FILTER_AT_ZERO = {("sensor_gain", v) for v in (None, "wob", "stroke", "pressure")} | {("heave_reference", "mru"),
+                                                                                     ("heave_reference", "mru_drift")}
 
 
 def _draws(name, n=12):

@@ -36,9 +36,10 @@ def test_none_and_inconclusive_write_the_nominal_and_say_why():
 
 def test_a_plant_effect_becomes_an_effects_entry_with_the_fitted_values():
     cal = calibrate(NOM, _diag("string_damping", {"damping": 4.7e4}))
-    assert cal.params.effects == (("string_damping", {"damping": 4.7e4}),)
+    # a verdict without the exponent (fitted last, optional in a file) is the linear dashpot: written out as n = 1
+    assert cal.params.effects == (("string_damping", {"damping": 4.7e4, "exponent": 1.0}),)
     assert cal.changes == [{"kind": "effect", "name": "string_damping", "role": "plant",
-                            "parameters": {"damping": 4.7e4}}]
+                            "parameters": {"damping": 4.7e4, "exponent": 1.0}}]
     assert cal.expected_shrink == 0.6
     p = _round_trip(cal)
     assert [e.name for e in spec.plant_effects(p)] == ["string_damping"]
@@ -58,7 +59,7 @@ def test_a_gas_effect_whose_null_needs_the_plant_becomes_an_effects_entry():
 def test_a_file_effect_refitted_is_replaced_not_doubled():
     nom = NOM.replace(effects=[("string_damping", {"damping": 1e4})])
     cal = calibrate(nom, _diag("string_damping", {"damping": 4.7e4}))
-    assert cal.params.effects == (("string_damping", {"damping": 4.7e4}),)
+    assert cal.params.effects == (("string_damping", {"damping": 4.7e4, "exponent": 1.0}),)
 
 
 def test_parameter_mismatch_writes_the_refitted_values_with_the_fit_clip():
@@ -81,10 +82,10 @@ def test_a_sensor_effect_corrects_the_reading_and_leaves_the_plant():
     (e,) = spec.reading_effects(p)
     assert (e.name, e.channel, e.values["factor"]) == ("sensor_gain", "wob", 1.08)
     assert cal.changes[0]["role"] == "reading"
-    # heave_reference fitted without a logged angle: the lever arm is written at its null value
+    # heave_reference fitted without a logged angle: the lever arm (and a high-pass not fitted) at its null value
     cal = calibrate(NOM, _diag("heave_reference", {"scale": 0.9, "delay": -0.2}))
     (e,) = spec.reading_effects(_round_trip(cal))
-    assert e.values == {"scale": 0.9, "delay": -0.2, "lever_arm": 0.0}
+    assert e.values == {"scale": 0.9, "delay": -0.2, "lever_arm": 0.0, "highpass": 0.0}
 
 
 def test_a_discovered_friction_term_is_carried_as_discovered_term():

@@ -227,3 +227,49 @@ def test_diagnose_cli_on_the_spike_reproducer_is_low_with_a_warning(tmp_path):
     d = json.loads((tmp_path / "d" / "diagnosis.json").read_text())
     assert d["verdict"]["confidence"] == "low"
     assert any("column 'wob'" in w and "spike" in w for w in d["warnings"])
+
+
+# ---- a reading on a coarse grid (issue 30: a pressure on a 0.25 bar grid with hum read as a gas effect) --
+def test_coarse_grid_is_part_of_the_noise_floor_and_reported():
+    """A pressure read on a 0.25 bar grid with hum aliased to 0.02 Hz: most differences of the reading are
+    exactly 0, so the difference estimate alone read the noise as ~50 Pa; the floor must hold the reading's
+    own error, step / sqrt(12) = 7.2 kPa, the warning names the column, and nothing is capped or frozen."""
+    from heavecomp.diagnosis.data import noise_floor
+
+    step = 25e3
+    t, cols, _ = K.quantised(T0, C0, "pressure", step, hum=10e3, hum_frequency=0.02)
+    run = _checked(t, cols)
+    assert noise_floor(run["pressure"]) >= 0.95 * step / math.sqrt(12.0)
+    (iq,) = _issue(run, "quantised")
+    assert iq["column"] == "pressure" and iq["step"] == pytest.approx(step) and "pressure" in iq["message"]
+    assert not _issue(run, "frozen") and run.quality.confidence_cap is None
+    assert noise_floor(run["wob"]) == noise_floor(C0["wob"])  # the other channels as they were
+
+
+def test_a_fine_grid_is_no_artefact():
+    """A 16-bit reading of the pressure (its range over 65536 steps) is dithered by its own noise: no
+    warning, and the noise floor is the difference estimate's."""
+    from heavecomp.diagnosis.data import noise_floor
+
+    p = C0["pressure"]
+    step = float(np.ptp(p)) / 65536
+    t, cols, _ = K.quantised(T0, C0, "pressure", step)
+    run = _checked(t, cols)
+    assert Q.quantum(cols["pressure"]) == 0.0 and not _issue(run, "quantised")
+    assert noise_floor(cols["pressure"]) == pytest.approx(noise_floor(p), rel=0.05)
+
+
+def test_a_hum_in_one_channel_joins_its_noise_floor():
+    """Mains hum aliased to 0.02 Hz on the pressure alone (3 kPa, under the wave band): a line no other channel
+    has is a reading artefact; its rms is part of the pressure's floor (the replay's output noise), no cap;
+    the clean log has no such line."""
+    from heavecomp.diagnosis.replay import output_noise
+
+    assert not _issue(_checked(T0, C0), "hum")
+    t, cols, _ = K.quantised(T0, C0, "pressure", 1.0, hum=3e3, hum_frequency=0.02)
+    run = _checked(t, cols)
+    (h,) = _issue(run, "hum")
+    assert h["column"] == "pressure" and h["frequency"] == pytest.approx(0.02, abs=2 / 300.0)
+    assert h["amplitude"] == pytest.approx(3e3, rel=0.1) and run.quality.confidence_cap is None
+    clean = output_noise(_checked(T0, C0))["pressure"]
+    assert output_noise(run)["pressure"] == pytest.approx(math.hypot(clean, 3e3 / math.sqrt(2)), rel=0.1)

@@ -14,7 +14,9 @@ from heavecomp.errors import ParameterError
 CONTRACT = ("friction_lag", "dwell_stiction", "pressure_friction", "gas_heat_transfer", "flow_loss",
             "string_damping", "sensor_delay", "parameter_mismatch",
             # schema 2 (diagnosis-contract.md)
-            "asymmetric_friction", "position_friction", "gas_leak", "sensor_gain", "sensor_offset", "heave_reference")
+            "asymmetric_friction", "position_friction", "gas_leak", "sensor_gain", "sensor_offset", "heave_reference",
+            # schema 4: the distance form of the frictional memory (issue 30 item 4)
+            "friction_memory")
 
 
 def test_contract_names_exactly():

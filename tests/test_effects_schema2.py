@@ -166,7 +166,8 @@ def test_heave_reference_scales_and_delays_what_the_plant_sees():
 @pytest.mark.parametrize("name, values", [("sensor_gain", {"channel": "stroke", "factor": 1.0}),
                                           ("sensor_offset", {"channel": "wob", "offset": 0.0, "drift": 0.0}),
                                           ("sensor_delay", {"channel": "pressure", "delay": 0.0}),
-                                          ("heave_reference", {"scale": 1.0, "delay": 0.0, "lever_arm": 0.0})])
+                                          ("heave_reference", {"scale": 1.0, "delay": 0.0, "lever_arm": 0.0,
+                                                               "highpass": 0.0})])
 def test_channel_and_heave_effects_at_null_reproduce_the_nominal_run_bit_for_bit(nominal, name, values):
     cls = effect_class(name)
     assert values == {**values, **cls.null(None)}
@@ -243,7 +244,7 @@ class _Drifts(Effect):
 
 
 def test_a_composition_has_as_many_state_slots_as_its_effects():
-    """The library's three state effects plus one with two states: five effect states (the
+    """The library's four state effects plus one with two states: six effect states (the
     stepper's state was once limited to three), laid out after the plant's four."""
     from heavecomp.effects.compose import composition
     from heavecomp.effects.model import casadi_model
@@ -251,15 +252,15 @@ def test_a_composition_has_as_many_state_slots_as_its_effects():
 
     classes = tuple(c for c in library().values() if c.kind == "plant" and c.states) + (_Drifts,)
     comp = composition(classes)
-    assert comp.n_states == 5 and comp.slots["_drifts"] == (7, 8)
+    assert comp.n_states == 6 and comp.slots["_drifts"] == (8, 9)
     plant = cmc.plant_vectors(paper_a())
     EP = comp.ep([_Drifts(rate=0.5)])
     X0 = comp.initial_state(plant.FP, plant.PP, EP)
-    assert X0.shape == (10,) and X0[8] == 1.0
+    assert X0.shape == (11,) and X0[9] == 1.0
     fn = comp.functions
-    X = tuple(X0[:9])
+    X = tuple(X0[:10])
     k = fn["state_dot"](0.1, 0.2, 0.3, 0.4, 0.0, 0.1, 2e6, X, plant.PP, plant.FP, EP)
-    assert k == (0.1, 0.2, 0.3, 0.4, 0.0, 0.0, 0.0, 0.5, 1.0)
+    assert k == (0.1, 0.2, 0.3, 0.4, 0.0, 0.0, 0.0, 0.0, 0.5, 1.0)
     f = casadi_model(paper_a("none"), effects=[_Drifts(rate=0.5)])
     xd = np.asarray(f(np.r_[0.0, 0.1, 0.0, 0.0, 0.0, 1.0], np.zeros(4))[0]).ravel()
     assert xd.size == 6 and xd[4] == 0.5 and xd[5] == 1.0

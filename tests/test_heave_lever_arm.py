@@ -47,8 +47,8 @@ def test_no_angle_fits_two_parameters_and_a_lever_arm_needs_one():
     t, z, zm, th = _lever_heave(dur=30.0)
     with_angle = heave_samples(MeasuredRun(t, {"heave": zm, "pitch": th}), 0.01, 2000)
     without = heave_samples(MeasuredRun(t, {"heave": zm}), 0.01, 2000)
-    assert HeaveReference.for_input(with_angle).n_params() == 3
-    assert HeaveReference.for_input(without).n_params() == 2
+    assert HeaveReference.for_input(with_angle).n_params() == 4  # g, t_d, L and the MRU's high-pass corner
+    assert HeaveReference.for_input(without).n_params() == 3
     with pytest.raises(ParameterError, match="lever_arm"):
         HeaveReference(lever_arm=5.0).transform(without)
 

@@ -80,6 +80,10 @@ class Case:
         A second, weaker truth law (its squared gap 30-60 % of the dominant's).
     pair_cut : float [s]
         > 0: the validation diagnoses the run again with this much cut from the front.
+    size : (float, float) or None
+        Size the (dominant) effect so that its largest channel gap over the noise floor is within this
+        band [-] (e.g. (4.5, 5.5): an effect at 5 x the noise), instead of ``GAP_MIN`` in each half
+        (``near`` takes its own band).
     """
 
     label: str
@@ -95,6 +99,7 @@ class Case:
     near: bool = False
     second: str | None = None
     pair_cut: float = 0.0
+    size: tuple | None = None
 
     def __post_init__(self):
         for key, value, allowed in (("label", self.label, ("none",) + tuple(LAWS)),

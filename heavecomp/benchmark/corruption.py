@@ -230,6 +230,38 @@ def offset(t, cols, channel, value, cls="magnitude"):
                                            "expect": "refuse"}
 
 
+def quantised(t, cols, channel, step, hum=0.0, hum_frequency=0.02, hum_phase=0.0):
+    """``channel`` read on a grid of ``step`` (a coarse logger or display resolution) with a mains hum
+    aliased to ``hum_frequency`` added before the rounding (issue 30's held-back set: a pressure on a
+    0.25 bar grid with hum aliased to 0.02 Hz).  Not a class of :data:`CLASSES` (a reading artefact the
+    diagnosis reads, not a corrupt log): the honest answer is the sensors component, or the artefact
+    reported with the noise floor corrected.
+
+    Parameters
+    ----------
+    t : numpy.ndarray [s]
+        Time of each sample.
+    cols : dict of str to numpy.ndarray
+        The run's columns by contract name, SI units (with their noise); not modified.
+    channel : str
+        Name of the quantised column.
+    step : float [unit of the channel]
+        Grid step of the reading.
+    hum : float [unit of the channel]
+        Amplitude of the aliased hum.
+    hum_frequency : float [Hz]
+        Frequency the hum aliases to.
+    hum_phase : float [rad]
+        Its phase at the first sample.
+    """
+    out = _copy(cols)
+    tt = np.asarray(t, dtype=float)
+    y = out[channel] + hum * np.sin(2.0 * np.pi * hum_frequency * (tt - tt[0]) + hum_phase)
+    out[channel] = np.round(y / step) * step
+    return tt, out, {"class": "quantised", "column": channel, "step": float(step), "hum": float(hum),
+                     "hum_frequency": float(hum_frequency), "expect": "sensors"}
+
+
 def corrupt(kind, t, cols, rng, params):
     """One corruption of class ``kind`` (:data:`CLASSES`) with its size drawn from ``rng``; sizes are
     clearly corrupt, not borderline (the borderline is the quality checks' business).

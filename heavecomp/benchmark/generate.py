@@ -121,7 +121,8 @@ def generate(case: Case) -> TestRun:
         for i, lab in enumerate(labels):
             if target is not None:
                 target = (target[0], float(rng.uniform(*SECOND_SHARE)))
-            got = plant(LAWS[lab], rng, bed, setting, target, near=NEAR_NOISE if case.near and i == 0 else None)
+            band = (NEAR_NOISE if case.near else case.size) if i == 0 else None
+            got = plant(LAWS[lab], rng, bed, setting, target, near=band)
             if got is None:
                 break
             planted.append((lab,) + got)

@@ -35,9 +35,11 @@ from heavecomp.plants.cmc import plant_vectors
 
 BLEND = 20.0  #: s over which two configurations are blended at an effect change (raised cosine)
 BLEND_OP = 60.0  #: s over which a set-point change is blended
+BLEND_HARD = 5.0  #: s over which a hardening formation stiffens (the maintainers' held-back set, issue 30)
 #: change label -> the component whose residual it should move (monitor.json ``component``)
 COMPONENT = {"operating": "operating_point", "formation": "string_formation", "pressure_friction": "friction",
-             "position_friction": "friction", "gas_leak": "gas_spring", "sensor_gain": "sensors"}
+             "position_friction": "friction", "gas_leak": "gas_spring", "sensor_gain": "sensors",
+             "hardening": "string_formation"}
 LABELS = tuple(COMPONENT)
 LEAD = 120.0  #: s simulated before the log starts (cut: the log starts mid-operation, not at rest) [s]
 NEAR = 0.1  #: the planted size is within +- this share of the asked one [-]
@@ -59,9 +61,21 @@ FORMATION = TruthLaw("formation", "string_formation", _formation_draw,
                                                                * (1.0 - d["drop"])}})
 
 
+def _hardening_draw(rng, setting):
+    """A harder formation: its stiffness 80-120 % higher (doubled, issue 30); the size knob is the rise, at
+    most x5."""
+    return Draw({"rise": float(rng.uniform(0.8, 1.2))}, "rise", 4.0)
+
+
+#: a formation that hardens part-way (the bit enters a harder layer): its stiffness raised from its time on
+HARDENING = TruthLaw("hardening", "string_formation", _hardening_draw,
+                     changes=lambda d, nominal: {"formation": {"stiffness": nominal.formation.stiffness
+                                                               * (1.0 + d["rise"])}})
+
+
 def _law(label):
     """The truth law of a change label (the variant of ``sensor_gain``: the WOB channel)."""
-    return FORMATION if label == "formation" else LAWS[label]
+    return {"formation": FORMATION, "hardening": HARDENING}.get(label) or LAWS[label]
 
 
 def long_log(changes, *, seed=0, duration=3600.0, rate=10.0, sea="jonswap", params="paper_a", size=5.0):
@@ -130,7 +144,7 @@ def long_log(changes, *, seed=0, duration=3600.0, rate=10.0, sea="jonswap", para
             cols = _onset(s, nominal, eff, tc)
         else:
             _, cfg = s.sim(parts[:k + 1])  # parameter changes apply on top of each other
-            width = BLEND_OP if label == "operating" else BLEND
+            width = {"operating": BLEND_OP, "hardening": BLEND_HARD}.get(label, BLEND)
             w = 0.5 - 0.5 * np.cos(np.pi * np.clip((t - tc) / width, 0.0, 1.0))  # smooth: no kink in a
             cols = dict(cols)
             for c in s.OUT:

@@ -548,6 +548,9 @@ def noise_floor(y, t=None) -> float:
     Second differences alone (until 2026-11) hold at 50-100 Hz but read the waves as noise at 10 Hz
     (1.8x too high for 2 mm on a 2.5 m sea, 6x for 0.5 mm); from 10 to 100 Hz this estimate is within
     a few % (``tests/test_diagnosis_preprocessing.py``).  A non-uniform ``t`` is resampled first.
+    A channel read on a grid coarse against its noise (:func:`heavecomp.diagnosis.quality.quantum`: most
+    differences are exactly 0, so the estimate reads the grid, not the noise) adds the reading's error,
+    step^2/12, in quadrature.
 
     Parameters
     ----------
@@ -568,4 +571,6 @@ def noise_floor(y, t=None) -> float:
             break
         d = np.diff(y, k)
         best = min(best, float(1.4826 * np.median(np.abs(d - np.median(d))) / math.sqrt(comb(2 * k, k))))
-    return best if math.isfinite(best) else 0.0
+    best = best if math.isfinite(best) else 0.0
+    step = quality.quantum(y)  # a coarse grid: most differences are 0, the reading's error is step^2/12
+    return math.hypot(best, step / math.sqrt(12.0)) if step > 0.0 else best

@@ -39,6 +39,15 @@ time base          dominant heave period outside ``WAVE_PERIOD`` (3-25 s); the W
 clock skew         heave -> stroke / pressure cross-correlation lag over               warning, cap low
                    ``MAX_SKEW_S`` (the largest sensor lag the diagnosis models), with
                    the correlation at lag 0 clearly weaker (``ZERO_LAG_SHARE``)
+quantised          over ``QUANT_ZERO_SHARE`` of consecutive samples repeat exactly     warning; its
+                   and ``QUANT_GRID_SHARE`` of the samples lie on one grid of step q   noise floor
+                   (:func:`quantum`): the reading's error is q^2/12, which the         includes q^2/12
+                   difference estimate of the noise cannot see (it reads ~0)          (no cap)
+hum                a spectral line below the wave band (>= 3 cycles in the log, under  warning; its rms
+                   1/3 of the heave's mean frequency) standing ``HUM_PROMINENCE`` x   is part of the
+                   above its neighbours' median in one output channel and in no other  channel's noise
+                   channel (:func:`hum_line`): mains hum aliased by the logger, no     floor (no cap)
+                   plant response (the plant answers a heave line in every channel)
 =================  ==================================================================  ===============
 """
 
@@ -86,6 +95,28 @@ MIN_CORRELATION = 0.5  #: a lag is read only from a cross-correlation peak at le
 #: ... and only when the correlation at lag 0 is weaker than this share of the peak's [-]: a regular heave
 #: correlates (with the opposite sign) as well half a period away, a skewed clock's channel does not at 0
 ZERO_LAG_SHARE = 0.8
+# ---- quantisation
+#: a channel whose consecutive samples repeat exactly this often is read on a grid coarse against its noise:
+#: with white noise of sigma >= 1.4 q on a grid of step q the share is under 0.2 (two samples' difference
+#: has sigma 2 sigma >= 2.8 q, and it rounds to 0 with probability about q / (2.8 q sqrt(2 pi)) = 0.14), and
+#: there q^2/12 adds 4 % to the noise's variance at most; above it the difference estimate of the noise
+#: (:func:`heavecomp.diagnosis.data.noise_floor`) reads the grid, not the noise (a pressure on a 0.25 bar grid
+#: with 2 kPa of noise read 51 Pa, issue 30)
+QUANT_ZERO_SHARE = 0.2
+#: ... and this share of its samples lies on one grid (within ``QUANT_TOL`` of a step): a frozen stretch
+#: repeats too, but the rest of a live, unquantised channel is off every grid [-]
+QUANT_GRID_SHARE = 0.99
+QUANT_TOL = 0.01  #: how far from a grid line [steps] a quantised sample may lie (the text of a CSV, float rounding) [-]
+# ---- hum: a line in one channel's spectrum that no other channel shares
+#: a periodogram bin of a broadband signal exceeds the median of its neighbours by a factor x with
+#: probability 2^-x (chi-square with 2 degrees of freedom): 30 x is a false line once in 1e9 bins; a
+#: sinusoid of amplitude A over a log of T s stands (A^2 T / 4) / (the background's density) above it
+HUM_PROMINENCE = 30.0
+#: ... and the other channels show no line within a bin of it (a plant response to a line in the heave
+#: would be in every channel): at most this many times their neighbours' median [-]
+HUM_OTHER = 10.0
+HUM_CYCLES = 3.0  #: a hum is read only at frequencies with this many cycles in the log [-]
+HUM_WAVE = 1.0 / 3.0  #: ... and below this share of the heave's mean frequency 1/T_m01 (under the wave band) [-]
 CHANNELS = ("heave", "stroke", "pressure", "wob")
 
 
@@ -108,6 +139,9 @@ class Quality:
     issues: list = dataclasses.field(default_factory=list)
     exclude: dict = dataclasses.field(default_factory=dict)
     drop_last: bool = False
+    #: channel -> rms [SI] of a reading artefact that is part of the channel's noise floor and that the
+    #: difference estimate of the noise cannot see (a hum: a slow line)
+    reading_noise: dict = dataclasses.field(default_factory=dict)
 
     @property
     def warnings(self) -> list:
@@ -121,7 +155,8 @@ class Quality:
 
     def to_json(self) -> dict:
         return {"confidence_cap": self.confidence_cap,
-                "issues": [{k: v for k, v in i.items()} for i in self.issues]}
+                "issues": [{k: v for k, v in i.items()} for i in self.issues],
+                "reading_noise": dict(self.reading_noise)}
 
 
 def _issue(q, kind, column, message, cap="low"):
@@ -203,6 +238,35 @@ def spikes(y, last=True):
     torn = last and off > floor and abs(d2[-2]) <= floor
     return np.asarray(hit[:-1] if hit and hit[-1] == idx[-2] and torn else hit, dtype=int), \
         bool(torn and idx[-1] == y.size - 1)
+
+
+def quantum(y) -> float:
+    """The step q of a channel read on a grid that is coarse against its noise, 0.0 when it is not (module
+    table: over ``QUANT_ZERO_SHARE`` of consecutive samples repeat exactly and ``QUANT_GRID_SHARE`` of the
+    samples lie on the grid through the first sample with step q, q the smallest change between samples).
+
+    The reading's error is then uniform over one step (variance q^2/12 when the signal or its noise crosses
+    grid lines at random), which a noise estimate from differences of samples cannot see: most differences
+    are exactly 0.  A finer grid (a 16-bit logger, a CSV's last digit) returns 0.0: the noise dithers it and
+    the difference estimate already holds its share.
+
+    Parameters
+    ----------
+    y : array_like [unit of the channel]
+        One channel's samples; NaN where missing (left out).
+    """
+    y = np.asarray(y, dtype=float)
+    y = y[np.isfinite(y)]
+    if y.size < 10:
+        return 0.0
+    d = np.abs(np.diff(y))
+    if np.mean(d == 0.0) < QUANT_ZERO_SHARE or not np.any(d > 0.0):
+        return 0.0
+    nz = d[d > 0.0]
+    step = float(np.median(nz[nz <= 1.5 * nz.min()]))  # the smallest change, robust to float rounding
+    r = (y - y[0]) / step
+    on = np.abs(r - np.round(r)) <= QUANT_TOL
+    return step if np.mean(on) >= QUANT_GRID_SHARE else 0.0
 
 
 def frozen_runs(y, min_len):
@@ -299,11 +363,13 @@ def assess(run, params=None, *, rows=None) -> Quality:
     t, cols = _torn_and_spikes(q, t, cols, line)
     _sample_rate(t, params, src)
     T_wave = mean_period(t, cols["heave"])
-    _frozen(q, t, cols, T_wave, line, src)
+    steps = _quantised(q, cols)
+    _frozen(q, t, {c: y for c, y in cols.items() if c not in steps}, T_wave, line, src)
     _magnitudes(q, cols, params, src, wob_from=(getattr(run, "measurement", None) or {}).get("wob_from"))
     if not _still(q, cols["heave"]):
         _time_base(q, t, cols.get("wob"), T_wave, params)
     _clock_skew(q, t, cols)
+    _hum(q, t, cols, T_wave)
     q.exclude = {c: np.array(sorted(s), dtype=int) for c, s in q.exclude.items() if s}
     return q
 
@@ -385,6 +451,31 @@ def _frozen(q: Quality, t, cols: dict, T_wave: float, line, src: str) -> None:
             cols[c][a:b] = np.nan
         _issue(q, "frozen", c, f"frozen: {what} (a live channel changes within {FROZEN_PERIODS:g} wave periods): "
                                "excluded, confidence low")
+
+
+def _quantised(q: Quality, cols: dict) -> dict:
+    """Channels read on a coarse grid (:func:`quantum`): a warning naming the step and the noise floor the
+    diagnosis uses (:func:`heavecomp.diagnosis.data.noise_floor` includes q^2/12); no cap (the floor is
+    corrected, nothing is excluded).  Returns ``{channel: step}``: a quantised channel repeats values while
+    its signal moves less than a step, which is no frozen sensor (it is left out of that check).
+
+    Parameters
+    ----------
+    q : Quality
+        The findings so far, extended in place.
+    cols : dict
+        Channel -> samples [SI].
+    """
+    steps = {}
+    for c, y in cols.items():
+        step = quantum(y)
+        if step > 0.0:
+            steps[c] = step
+            q.issues.append({"kind": "quantised", "column": c, "step": step,
+                             "message": f"column '{c}': read on a grid of {step:.4g} (SI): a reading error of "
+                                        f"{step / math.sqrt(12.0):.4g} rms (step/sqrt(12)) is part of its noise floor",
+                             "cap": None})
+    return steps
 
 
 def _still(q: Quality, z) -> bool:
@@ -560,6 +651,91 @@ def _clock_skew(q: Quality, t, cols: dict) -> None:
         shown = ", ".join(f"{c} {g:+.2f} s" for c, g in lags.items())
         _issue(q, "clock_skew", col, f"clock skew? offset from the heave by {shown} (cross-correlation peak), more "
                                      f"than any sensor lag ({MAX_SKEW_S:g} s): confidence low")
+
+
+def _periodogram(t, y):
+    """(frequencies [Hz], Hann-windowed periodogram [unit^2/Hz]) of ``y`` at ``t`` less its linear trend."""
+    tu, yu = _uniform(t, y)
+    yu = yu - np.polyval(np.polyfit(tu - tu[0], yu, 1), tu - tu[0])
+    fs = 1.0 / (tu[1] - tu[0])
+    w = np.hanning(yu.size)
+    P = np.abs(np.fft.rfft(yu * w)) ** 2 / (fs * np.sum(w * w))
+    return np.fft.rfftfreq(yu.size, 1.0 / fs), P
+
+
+def _prominence(P, k, near=2, far=15):
+    """Periodogram bin ``k`` over the median of the bins ``near`` + 1 to ``far`` away on either side [-]."""
+    idx = np.r_[np.arange(k - far, k - near), np.arange(k + near + 1, k + far + 1)]
+    idx = idx[(idx >= 1) & (idx < P.size)]
+    bg = float(np.median(P[idx])) if idx.size else 0.0
+    return float(P[k] / bg) if bg > 0 else 0.0
+
+
+def hum_line(t, cols: dict, T_wave: float) -> dict:
+    """Lines below the wave band that one output channel has and no other channel shares (module table):
+    ``{channel: (frequency [Hz], amplitude [SI], prominence [-])}``.
+
+    Parameters
+    ----------
+    t : numpy.ndarray [s]
+        Time of each sample.
+    cols : dict
+        Channel -> samples [SI] (the heave and the outputs the log has; NaN where missing).
+    T_wave : float [s]
+        The heave's mean period (:func:`mean_period`).
+    """
+    T = float(t[-1] - t[0])
+    if not (T > 0 and math.isfinite(T_wave) and T_wave > 0):
+        return {}
+    spectra = {c: _periodogram(t, y) for c, y in cols.items() if np.isfinite(y).sum() > 64}
+    out = {}
+    for c in ("stroke", "pressure", "wob"):
+        if c not in spectra:
+            continue
+        f, P = spectra[c]
+        band = np.flatnonzero((f >= HUM_CYCLES / T) & (f <= HUM_WAVE / T_wave))
+        if band.size == 0:
+            continue
+        prom = np.array([_prominence(P, int(k)) for k in band])
+        i = int(np.argmax(prom))
+        k = int(band[i])
+        if prom[i] < HUM_PROMINENCE:
+            continue
+        others = [max(_prominence(spectra[o][1], j) for j in (k - 1, k, k + 1) if 1 <= j < spectra[o][1].size)
+                  for o in spectra if o != c and spectra[o][1].size == P.size]
+        if others and max(others) > HUM_OTHER:
+            continue
+        tu, yu = _uniform(t, cols[c])
+        X = np.column_stack([np.sin(2 * np.pi * f[k] * tu), np.cos(2 * np.pi * f[k] * tu), np.ones_like(tu),
+                             tu - tu[0]])
+        coef = np.linalg.lstsq(X, yu, rcond=None)[0]
+        out[c] = (float(f[k]), float(math.hypot(coef[0], coef[1])), float(prom[i]))
+    return out
+
+
+def _hum(q: Quality, t, cols: dict, T_wave: float) -> None:
+    """A hum (:func:`hum_line`): a warning naming the channel, its frequency and amplitude; its rms joins the
+    channel's noise floor (``q.reading_noise``; the replay's output noise), no cap.
+
+    Parameters
+    ----------
+    q : Quality
+        The findings so far, extended in place.
+    t : numpy.ndarray
+        Times [s].
+    cols : dict
+        Channel -> samples [SI].
+    T_wave : float
+        The heave's mean period [s].
+    """
+    for c, (f, amp, prom) in hum_line(t, cols, T_wave).items():
+        rms = amp / math.sqrt(2.0)
+        q.reading_noise[c] = float(math.hypot(q.reading_noise.get(c, 0.0), rms))
+        q.issues.append({"kind": "hum", "column": c, "frequency": f, "amplitude": amp,
+                         "message": f"column '{c}': a line at {f:.3g} Hz ({amp:.4g} SI amplitude, {prom:.0f} x its "
+                                    "neighbours) that no other channel has: a reading artefact (mains hum aliased by "
+                                    f"the logger?); its rms {rms:.4g} is part of the channel's noise floor",
+                         "cap": None})
 
 
 def cleaned(run, q: Quality):

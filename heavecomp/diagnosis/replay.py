@@ -256,14 +256,18 @@ def present(run) -> tuple:
 
 
 def output_noise(run) -> dict:
-    """Output-noise standard deviation of every channel the run has [SI] (second-difference estimate).
+    """Output-noise standard deviation of every channel the run has [SI] (difference estimate, with a
+    coarse grid's step^2/12, :func:`heavecomp.diagnosis.data.noise_floor`), and the rms of a reading
+    artefact the quality checks found (a hum: ``run.quality.reading_noise``) in quadrature.
 
     Parameters
     ----------
     run : heavecomp.diagnosis.data.MeasuredRun
         The measured run.
     """
-    return {c: noise_floor(run[c], run.t if not run.uniform else None) for c in present(run)}
+    extra = getattr(getattr(run, "quality", None), "reading_noise", None) or {}  # a hum (quality.assess)
+    return {c: math.hypot(noise_floor(run[c], run.t if not run.uniform else None), extra.get(c, 0.0))
+            for c in present(run)}
 
 
 def build(run, nominal, *, stuck_speed=S.STUCK_SPEED, segment=None, reinit=1.5, noise=None) -> Replay:

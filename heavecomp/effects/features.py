@@ -39,7 +39,11 @@ def first_order_lag(t, x, tau: float, y0: float = 0.0) -> np.ndarray:
 
         d = float(np.exp(-dt.mean() / tau))
         return lfilter([0.0, 1.0 - d], [1.0, -d], x, zi=[float(y0)])[0]
-    decay = np.exp(-dt / tau)
+    return _lag_steps(x, np.exp(-dt / tau), y0)
+
+
+def _lag_steps(x, decay, y0):
+    """y[i + 1] = x[i] + (y[i] - x[i]) decay[i] from y[0] = ``y0``: a first-order lag, x held over each step."""
     y = np.empty(x.size)
     yk = float(y0)
     for i in range(x.size):
@@ -129,3 +133,27 @@ def need(sig: dict, *names) -> bool:
         Signal names needed.
     """
     return all(n in sig for n in names)
+
+
+def distance_lag(x, u, length: float, y0: float = 0.0) -> np.ndarray:
+    """y with dy/dx_s = (u - y) / ``length`` over the sliding distance x_s (the path |dx| travelled):
+    a first-order lag in distance, not in time (Dahl's memory), u held over each sample interval.
+
+    Parameters
+    ----------
+    x : array, m
+        Position of the sliding element at each sample.
+    u : array
+        Input at the same samples (e.g. sign(v)).
+    length : float, m
+        Relaxation length.
+    y0 : float
+        State before the first sample.
+
+    Returns
+    -------
+    ndarray
+        ``y[i]`` is the state when ``u[i]`` is sampled (before ``u[i]`` acts), so ``y`` lags ``u``;
+        at rest (no distance travelled) it holds.
+    """
+    return _lag_steps(np.asarray(u, dtype=float), np.exp(-np.abs(np.diff(np.asarray(x, dtype=float))) / length), y0)

@@ -47,9 +47,16 @@ class HeaveReference(HeaveEffect):
         # start stalls short of it (spent seed 560018: 9.2 m fitted of 13.65 m, the cost at the truth a
         # fifth of the fit's); rescanned over its range for a second start
         rugged=("lever_arm",),
+        # an MRU's high-pass refines the gain and delay: fitted last, from their optimum (never worse on the fit part)
+        released_last=("highpass",),
+        # no high-pass (0 Hz) is a physical answer, not a sign of standing in for something else
+        limits=("highpass",),
+        # a file written before the high-pass existed reads none
+        optional=("highpass",),
     )
 
     angle_params = ("lever_arm",)
+
     @dataclass(frozen=True)
     class Params:
         scale: float = q(1.0, "-", bounds=(-1.5, 1.5), symbol="g",
@@ -59,6 +66,9 @@ class HeaveReference(HeaveEffect):
         lever_arm: float = q(0.0, "m", bounds=(-30.0, 30.0), symbol="L",
                              doc="lever arm from the compensator to where the heave is measured, times the "
                                  "logged angle: z_meas = z_crown + L sin(pitch); 0 without an angle column")
+        highpass: float = q(0.0, "Hz", bounds=(0.0, 0.05), symbol="f_c",
+                            doc="corner of the MRU's 2nd-order high-pass (its drift-free double integration) that the "
+                                "measured heave went through; undone above the corner (0: none)")
 
     @classmethod
     def features(cls, sig, shape=None):
@@ -76,11 +86,12 @@ class HeaveReference(HeaveEffect):
         return cols
 
     @staticmethod
-    def seen(t, z, scale, delay, lever_arm=0.0):
+    def seen(t, z, scale, delay, lever_arm=0.0, highpass=0.0):
         """The seen heave (or its derivative) on the uniform grid ``t`` [s] from the measured ``z``
         (linear interpolation; held at the ends), without the lever-arm term (:meth:`transform` adds
-        it from the angle)."""
-        return scale * np.interp(t - delay, t, z)
+        it from the angle), the MRU's high-pass undone (:func:`undo_highpass`) when ``highpass`` > 0."""
+        y = scale * np.interp(t - delay, t, z)
+        return undo_highpass(t, y, highpass) if highpass > 0.0 else y
 
     def transform(self, hs):
         """:meth:`HeaveEffect.transform` less L (sin(theta) - sin(theta_ref)) and its derivatives
@@ -109,6 +120,34 @@ class HeaveReference(HeaveEffect):
         return {f.name: {"scale": 1.0}.get(f.name, 0.0) for f in cls.fields()}
 
 
+def undo_highpass(t, y, corner):
+    """``y`` [m] on the uniform grid ``t`` [s] with a 2nd-order Butterworth high-pass of ``corner`` [Hz] undone
+    where it can be: the inverse 1 / H(f) = 1 + sqrt(2) f_c / (i f) - (f_c / f)^2, faded in as
+    w = f^4 / (f^4 + f_c^4) (G = 1 + w (1/H - 1), bounded by 1.5 x at every frequency), so a slow drift or
+    the record's own low-frequency content is not blown up as (f_c / f)^2.  Its mean and linear trend pass
+    unchanged (the FFT's period is the record).
+
+    Parameters
+    ----------
+    t : numpy.ndarray [s]
+        Uniform grid.
+    y : numpy.ndarray [m]
+        The measured heave (or a derivative) on ``t``.
+    corner : float [Hz]
+        Corner frequency of the high-pass.
+    """
+    y = np.asarray(y, dtype=float)
+    if y.size < 4:
+        return y
+    tt = np.asarray(t, dtype=float) - float(t[0])
+    trend = np.polyval(np.polyfit(tt, y, 1), tt)
+    f = np.fft.rfftfreq(y.size, float(tt[1] - tt[0]))
+    ratio = np.divide(corner, f, out=np.zeros(f.size), where=f > 0)  # f_c / f (0 at f = 0, where G = 1)
+    w = np.where(f > 0, 1.0 / (1.0 + ratio ** 4), 0.0)
+    G = 1.0 + w * (-1j * np.sqrt(2.0) * ratio - ratio ** 2)
+    return np.fft.irfft(np.fft.rfft(y - trend) * G, y.size) + trend
+
+
 class HeaveReferenceNoAngle(HeaveReference):
     """``heave_reference`` on a run without an angle column: the same map with the lever arm fixed at 0
     (two parameters, g and t_d; not registered: :meth:`HeaveReference.for_input` picks it)."""
@@ -119,6 +158,11 @@ class HeaveReferenceNoAngle(HeaveReference):
         "Params", [(f.name, f.type, dataclasses.field(default=f.default, metadata=f.metadata))
                    for f in dataclasses.fields(HeaveReference.Params) if f.name not in HeaveReference.angle_params],
         frozen=True)
+
+    @staticmethod
+    def seen(t, z, scale, delay, highpass=0.0):
+        """:meth:`HeaveReference.seen` without a lever arm (this variant's parameters: g, t_d, f_c)."""
+        return HeaveReference.seen(t, z, scale, delay, 0.0, highpass)
 
     @classmethod
     def for_input(cls, hs):

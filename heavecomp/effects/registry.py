@@ -26,6 +26,7 @@ MODULES = (
     "sensor_gain",
     "sensor_offset",
     "heave_reference",
+    "friction_memory",
 )
 
 _LIBRARY: dict = {}

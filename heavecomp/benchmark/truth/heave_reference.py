@@ -2,7 +2,8 @@
 
 Variant ``lever_arm`` (default): measured at a lever arm L, z_m = z + L sin(theta(t)), theta a
 synthetic pitch logged as column ``pitch`` [rad]; variant ``mru``: a motion reference unit with a
-gain error and a 2nd-order high-pass.  The candidate (fitted, :mod:`heavecomp.effects`) is a
+gain error and a 2nd-order high-pass; variant ``mru_drift``: an MRU's 2nd-order high-pass with its corner
+near 100 s and a slow drift of centimetres (the maintainers' held-back set, issue 30).  The candidate (fitted, :mod:`heavecomp.effects`) is a
 scaled, shifted heave less a lever arm times a pitch.
 """
 
@@ -87,10 +88,30 @@ def heave_mru(t, cols, gain, corner=0.01):
     """
     from scipy.signal import butter, lfilter
 
-    b, a = butter(2, corner, btype="highpass", fs=1.0 / (t[1] - t[0]))
     out = dict(cols)
+    if corner <= 0.0:  # no high-pass (a drift alone)
+        out["heave"] = gain * np.asarray(cols["heave"], dtype=float)
+        return out
+    b, a = butter(2, corner, btype="highpass", fs=1.0 / (t[1] - t[0]))
     out["heave"] = gain * lfilter(b, a, cols["heave"])
     return out
+
+
+def heave_drift(t, amplitude, period, phase):
+    """A slow drift of an MRU's heave [m]: amplitude sin(2 pi t / period + phase).
+
+    Parameters
+    ----------
+    t : numpy.ndarray [s]
+        Sample times.
+    amplitude : float [m]
+        Amplitude of the drift.
+    period : float [s]
+        Its period (minutes: far below the wave band).
+    phase : float [rad]
+        Its phase at t = 0.
+    """
+    return amplitude * np.sin(2.0 * np.pi * np.asarray(t, dtype=float) / period + phase)
 
 
 def misreference(t, cols, **parameters):
@@ -112,15 +133,20 @@ def misreference(t, cols, **parameters):
     dict
         ``cols`` with the misreferenced ``heave`` [m] (and ``pitch`` [rad] for a lever arm).
     """
-    if "lever_arm" in parameters:
-        p = parameters
+    p = parameters
+    if "lever_arm" in p:
         return heave_lever_arm(t, cols, p["lever_arm"],
                                synthetic_pitch(t, p["pitch_rms"], p["pitch_period"], p["pitch_seed"]))
-    return heave_mru(t, cols, 1.0 + parameters["gain_error"], parameters["corner"])
+    out = heave_mru(t, cols, 1.0 + p["gain_error"], p["corner"])
+    if "drift" in p:
+        out["heave"] = out["heave"] + heave_drift(t, p["drift"], p["drift_period"], p["drift_phase"])
+    return out
 
 
 def draw(rng, setting):
     """``mru``: a gain 8-14 % low and a 0.005-0.015 Hz high-pass, size the gain error, at most 50 %;
+    ``mru_drift``: a 0.008-0.012 Hz high-pass and a drift of 1.5-2.5 cm over 10-30 min, size the corner, at
+    most 0.05 Hz (zero: the drift alone);
     else L 5-15 m, pitch rms 0.005-0.01 rad at 8-12 s, size L, at most 120 m.
 
     Parameters
@@ -137,9 +163,15 @@ def draw(rng, setting):
     """
     if setting.variant == "mru":
         return Draw({"gain_error": -rng.uniform(0.08, 0.14), "corner": rng.uniform(0.005, 0.015)}, "gain_error", 0.5)
+    if setting.variant == "mru_drift":  # no gain error: the high-pass near 100 s and a 2 cm drift over minutes
+        # the size knob is the corner: the high-pass's phase lead in the wave band (~ sqrt(2) f_c / f rad)
+        # moves the stroke far more than a 2 cm drift does (18 x the floor against nothing measurable)
+        return Draw({"gain_error": 0.0, "corner": rng.uniform(0.008, 0.012), "drift": rng.uniform(0.015, 0.025),
+                     "drift_period": rng.uniform(600.0, 1800.0), "drift_phase": rng.uniform(0.0, 2 * np.pi)},
+                    "corner", 0.05)
     return Draw({"lever_arm": rng.uniform(5.0, 15.0), "pitch_rms": rng.uniform(0.005, 0.01),
                  "pitch_period": rng.uniform(8.0, 12.0), "pitch_seed": int(rng.integers(2**31))}, "lever_arm", 120.0)
 
 
 LAW = TruthLaw("heave_reference", "heave_input", draw, output=misreference, on_heave=True,
-               variants=("lever_arm", "mru"))
+               variants=("lever_arm", "mru", "mru_drift"))
