@@ -260,3 +260,25 @@ def test_a_reading_with_its_own_dynamics_reaches_both_mpcs_through_its_static_ma
     said = " ".join(r.getMessage() for r in caplog.records)
     assert "sensor_lag" in said and "time_constant=0.5" in said and "delay=0.02" in said, said
     assert lag.values["time_constant"] == 0.5  # the file's effect itself is left as it is
+
+
+def test_the_observer_leaves_out_only_what_no_output_sees():
+    """The disturbance observer's Kalman filter corrects the states the outputs see: for the nominal model
+    and an effect whose state reaches the outputs (friction_lag, through its friction in the model) that is
+    every state; friction_memory's direction state is left out of the linear model's friction, so at rest it
+    only integrates the velocity and no output sees it: its gain row is exactly 0 and the filter of the
+    others is the one designed without it (else (A, C) is not detectable and the Riccati equation fails)."""
+    from heavecomp.controllers.estimation import DisturbanceObserver, seen_states
+
+    nominal = _mpc("linear-mpc", [], horizon=3).model
+    obs = DisturbanceObserver(nominal)
+    n = nominal.Ad.shape[0]
+    assert list(seen_states(obs.A, obs.Cm)) == list(range(n + 1))
+    mem = _mpc("linear-mpc", [library()["friction_memory"]()], horizon=3).model
+    o = DisturbanceObserver(mem)
+    k = seen_states(o.A, o.Cm)
+    hidden = sorted(set(range(o.A.shape[0])) - set(k))
+    assert hidden == [mem.Ad.shape[0] - 1]  # the effect's one state, after the plant's four
+    assert np.all(o.L[hidden] == 0.0) and np.all(np.isfinite(o.L))
+    # the seen part of the filter is the nominal's: the hidden state drives nothing the outputs see
+    assert np.allclose(o.L[k], obs.L, rtol=1e-9, atol=1e-12)

@@ -361,6 +361,33 @@ class ARBlockPredictor:
         return out
 
 
+def seen_states(A, C) -> np.ndarray:
+    """Indices of the states of x+ = A x, y = C x that the outputs see: directly (a nonzero column of
+    ``C``) or through a seen state they drive (a nonzero entry of ``A`` in a seen state's row).  The others
+    never reach an output: they span part of the unobservable subspace.
+
+    Parameters
+    ----------
+    A : (n, n) array
+        State transition.
+    C : (m, n) array
+        Output map.
+
+    Returns
+    -------
+    numpy.ndarray
+        Sorted indices of the seen states.
+    """
+    A, C = np.asarray(A), np.asarray(C)
+    hidden = ~np.any(C != 0, axis=0)
+    while hidden.any():
+        drives = np.any(A[np.ix_(~hidden, hidden)] != 0, axis=0)  # a hidden state driving a seen one is seen
+        if not drives.any():
+            break
+        hidden[np.flatnonzero(hidden)[drives]] = False
+    return np.flatnonzero(~hidden)
+
+
 class DisturbanceObserver:
     """Steady-state Kalman filter for x = [s, v, y_b, v_b] and the force disturbance d.
 
@@ -390,8 +417,15 @@ class DisturbanceObserver:
         R = np.diag([sy[2] ** 2, sy[0] ** 2, sy[1] ** 2])
         Gf = np.vstack([model.Bf, [[0.0]]])
         Q = sigma_f ** 2 * (Gf @ Gf.T) + np.diag([1e-10] * n + [sigma_d ** 2])
-        P = solve_discrete_are(A.T, C.T, Q, R)
-        self.L = P @ C.T @ np.linalg.inv(C @ P @ C.T + R)
+        # the filter corrects the states the outputs see; a state no output sees, directly or through the
+        # states it drives (an effect's memory the linear model leaves out of the friction, e.g.
+        # friction_memory's direction state: at rest an integrator of v), follows the model (gain rows 0):
+        # with it in, (A, C) is not detectable and the Riccati equation has no solution
+        k = seen_states(A, C)
+        P = solve_discrete_are(A[np.ix_(k, k)].T, C[:, k].T, Q[np.ix_(k, k)], R)
+        Ck = C[:, k]
+        self.L = np.zeros((n + 1, C.shape[0]))
+        self.L[k] = P @ Ck.T @ np.linalg.inv(Ck @ P @ Ck.T + R)
         self.A, self.Cm = A, C
         self.n = n
         self.reset()

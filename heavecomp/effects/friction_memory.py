@@ -95,7 +95,7 @@ class FrictionMemory(Effect):
 
     @staticmethod
     def steady(v, FP, PP, relaxation_length, depth):
-        return (float(np.sign(v)),)
+        return (np.sign(v),)
 
     @classmethod
     def null(cls, plant):
