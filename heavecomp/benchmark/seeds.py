@@ -31,6 +31,11 @@ SPENT = (
     (600000, 601000, "sim_to_real_loop: scored (reports/sim_to_real_loop/ of session 10)"),
     (610000, 611000, "calibration validation: fourth scoring run (reports/calibration_validation/report.md)"),
     (620000, 621000, "sim_to_real_loop: scored (reports/sim_to_real_loop/)"),
+    (300000, 300100, "the third held-back set's classes made with the generator (docs/history.md), studied"),
+    (700000, 700100, "replay / simulate / reported shrink on five logs (benchmarks/replay/measure_shrink.py)"),
+    (710000, 710100, "monitor gap levels on no-effect logs (benchmarks/monitor/gap_levels.py)"),
+    (820000, 821000, "independent truth: first scoring run (reports/independent_truth/)"),
+    (9000000, 9000100, "independent truth: smoke runs while it was written"),
 )
 
 
