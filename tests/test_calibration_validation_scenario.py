@@ -38,3 +38,39 @@ def test_the_loop_scenario_refuses_a_spent_seed_for_a_full_run(tmp_path, capsys)
     cv = _scenario()
     assert spent(c.seed for c in cv.cases(seed0=cv.SEED0)) == [] and spent(range(loop.SEED0, loop.SEED0 + 100)) == []
     assert loop.SEED0 > max(c.seed for c in cv.cases(seed0=cv.SEED0))
+
+
+def test_transfer_is_one_for_the_true_model_and_zero_for_the_nominal(tmp_path):
+    """Check (d)'s arithmetic on a 120 s parameter-error case: on the second log (another sea), the true
+    model's own file (the nominal with the planted values) carries the true model's gap closure, the
+    nominal file none; the true model's own gap gives exactly 1, the nominal's exactly 0; an unchanged
+    file (a right none) and a log the true model does not improve give no transfer, never a score."""
+    from heavecomp.benchmark import benchmark_case, generate
+    from heavecomp.report.provenance import write_params
+
+    cv = _scenario()
+    case = benchmark_case("parameter_mismatch", seed=7, duration=120.0)
+    first, other = generate(case, other_sea=True)
+    planted = first.truth["parameters"]["parameter_mismatch"]
+    changes = {}
+    for path, value in planted.items():
+        table, key = path.split(".")
+        changes.setdefault(table, {})[key] = value
+    nom = write_params(tmp_path, first.nominal, "nominal.toml")
+    true = write_params(tmp_path, first.nominal.replace(**changes), "true.toml")
+    ch = max(("wob", "stroke", "pressure"), key=lambda c: first.truth["gap_channels"]["parameter_mismatch"][c])
+    tf = cv.other_sea_gaps(other, nom, true, ch, tmp_path)
+    g = tf["gap_to_noise_validate"]
+    assert tf["sea"] != tf["first_sea"] and not tf["unchanged"]
+    assert g["nominal"] > 2 * g["true"], g  # the planted error shows on the other sea
+    # by the definition's arithmetic
+    assert cv.transfer(g["nominal"], g["true"], g["true"]) == 1.0
+    assert cv.transfer(g["nominal"], g["nominal"], g["true"]) == 0.0
+    assert cv.transfer(g["true"], g["true"], g["nominal"]) is None
+    # the true model's own file, replayed as the diagnosis replays, closes the gap the generator's truth does
+    assert abs(cv.transfer(g["nominal"], g["calibrated"], g["true"]) - 1.0) < 0.01, g
+    # the nominal file replayed as calibrated: the same replay, transfer 0 exactly; flagged unchanged -> none
+    same = cv.other_sea_gaps(other, nom, nom, ch, tmp_path)
+    gs = same["gap_to_noise_validate"]
+    assert cv.transfer(gs["nominal"], gs["calibrated"], gs["true"]) == 0.0
+    assert same["unchanged"] and cv.rescore({"transfer": same})["transfer"]["transfer"] is None
