@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import importlib.util
 
+import pytest
+
 from heavecomp.report.scenario import ROOT
 
 
@@ -74,3 +76,24 @@ def test_transfer_is_one_for_the_true_model_and_zero_for_the_nominal(tmp_path):
     gs = same["gap_to_noise_validate"]
     assert cv.transfer(gs["nominal"], gs["calibrated"], gs["true"]) == 0.0
     assert same["unchanged"] and cv.rescore({"transfer": same})["transfer"]["transfer"] is None
+
+
+def test_the_summary_scores_transfer_median_and_least_against_the_goals():
+    """The two transfer goals read the right verdicts' transfers (an unchanged file's none left out and
+    counted); a metrics.json from before the check reads 'not measured', never FAIL."""
+    cv = _scenario()
+
+    def row(g, unchanged=False):
+        tf = {"gap_to_noise_validate": dict(zip(("nominal", "calibrated", "true"), g)), "unchanged": unchanged}
+        return {"label": "x", "seed": 0, "judged": {"right": True}, "full": {"verdict": "flow_loss"},
+                "checks": cv.rescore({"transfer": tf})}
+
+    rows = [row((10.0, 1.9, 1.0)), row((10.0, 1.0, 1.0)), row((5.0, 3.0, 1.0)), row((3.0, 3.0, 3.0), True)]
+    s = cv.summarize(rows)
+    assert s["transfer"]["n"] == 3 and s["transfer"]["n_right_without"] == 1
+    assert s["transfer"]["median"] == pytest.approx(0.9) and s["transfer"]["min"] == 0.5
+    goals = {g["goal"].split(" (")[0]: g["result"] for g in s["goals"]}
+    assert goals["median transfer to another sea >= 0.85"] == "PASS"
+    assert goals["no transfer to another sea under 0.6"] == "FAIL"
+    old = cv.summarize([dict(r, checks={k: v for k, v in r["checks"].items() if k != "transfer"}) for r in rows])
+    assert old["transfer"]["not_measured"] and {g["result"] for g in old["goals"][-2:]} == {"not measured"}
