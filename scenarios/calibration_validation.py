@@ -20,7 +20,8 @@ diagnosed by the command, ``heavecomp diagnose RUN.csv --params NOMINAL.toml``, 
   exactly as the diagnosis replays (:func:`heavecomp.diagnosis.replay_files`), and the true model's clean
   replay of it (the generator's) is read on the same held-out samples; with the held-out gap/noise of the
   verdict's shrink channel, all three over the nominal replay's noise floor,
-  transfer = (nominal - calibrated) / (nominal - true) (goal: median >= 0.85, none under 0.6).
+  transfer = (nominal - calibrated) / (nominal - true) (goal: median >= 0.85, none under 0.6; a file
+  that changes nothing scores 0, a no-effect truth none).
 
 No threshold of the diagnosis or of these checks is tuned on this set: it is run once.
 """
@@ -155,7 +156,7 @@ def other_sea_gaps(other, nom, cal, channel: str, d: Path) -> dict:
     return {"channel": channel, "noise_floor": floor, "rms_validate": rms,
             "gap_to_noise_validate": {k: v / floor for k, v in rms.items()},
             "sea": other.truth["sea"], "first_sea": other.truth["first_sea"],
-            "unchanged": bool(load(cal) == load(nom))}
+            "unchanged": bool(load(cal) == load(nom)), "truth_none": other.truth["effects"] == ["none"]}
 
 
 def transfer(nominal: float, calibrated: float, true: float):
@@ -173,8 +174,9 @@ def rescore(checks: dict) -> dict:
     tf = checks.get("transfer")
     if tf is not None:
         g = tf["gap_to_noise_validate"]
-        # an unchanged file (a right none) has nothing to carry: no transfer, never a 0
-        tf["transfer"] = None if tf["unchanged"] else transfer(g["nominal"], g["calibrated"], g["true"])
+        # a no-effect truth has nothing to carry (its nominal - true is the noise of two replays): no
+        # transfer, never a 0 or a ratio of noise; a right verdict whose file changes nothing scores its 0
+        tf["transfer"] = None if tf.get("truth_none") else transfer(g["nominal"], g["calibrated"], g["true"])
     rd = checks.get("rediagnosis")
     if rd is None:
         return checks
@@ -300,8 +302,8 @@ def _transfer_cell(tf):
 def _transfer_line(t):
     if not t or t.get("not_measured"):
         return "transfer (check d): not measured (no right verdict of this run was checked on another sea)."
-    return (f"transfer (check d) on {t['n']} right verdicts that change the model: median {_num(t['median'])}, "
-            f"least {_num(t['min'])}; {t['n_right_without']} right verdicts without one (an unchanged file, or a "
+    return (f"transfer (check d) on {t['n']} right verdicts: median {_num(t['median'])}, "
+            f"least {_num(t['min'])}; {t['n_right_without']} right verdicts without one (a no-effect truth, or a "
             "true model that closes no gap on the other sea).")
 
 

@@ -45,8 +45,8 @@ def test_the_loop_scenario_refuses_a_spent_seed_for_a_full_run(tmp_path, capsys)
 def test_transfer_is_one_for_the_true_model_and_zero_for_the_nominal(tmp_path):
     """Check (d)'s arithmetic on a 120 s parameter-error case: on the second log (another sea), the true
     model's own file (the nominal with the planted values) carries the true model's gap closure, the
-    nominal file none; the true model's own gap gives exactly 1, the nominal's exactly 0; an unchanged
-    file (a right none) and a log the true model does not improve give no transfer, never a score."""
+    nominal file none; the true model's own gap gives exactly 1, the nominal's exactly 0 (an unchanged
+    file scores its 0); a no-effect truth and a log the true model does not improve give no transfer."""
     from heavecomp.benchmark import benchmark_case, generate
     from heavecomp.report.provenance import write_params
 
@@ -63,7 +63,7 @@ def test_transfer_is_one_for_the_true_model_and_zero_for_the_nominal(tmp_path):
     ch = max(("wob", "stroke", "pressure"), key=lambda c: first.truth["gap_channels"]["parameter_mismatch"][c])
     tf = cv.other_sea_gaps(other, nom, true, ch, tmp_path)
     g = tf["gap_to_noise_validate"]
-    assert tf["sea"] != tf["first_sea"] and not tf["unchanged"]
+    assert tf["sea"] != tf["first_sea"] and not tf["unchanged"] and not tf["truth_none"]
     assert g["nominal"] > 2 * g["true"], g  # the planted error shows on the other sea
     # by the definition's arithmetic
     assert cv.transfer(g["nominal"], g["true"], g["true"]) == 1.0
@@ -71,20 +71,19 @@ def test_transfer_is_one_for_the_true_model_and_zero_for_the_nominal(tmp_path):
     assert cv.transfer(g["true"], g["true"], g["nominal"]) is None
     # the true model's own file, replayed as the diagnosis replays, closes the gap the generator's truth does
     assert abs(cv.transfer(g["nominal"], g["calibrated"], g["true"]) - 1.0) < 0.01, g
-    # the nominal file replayed as calibrated: the same replay, transfer 0 exactly; flagged unchanged -> none
+    # the nominal file replayed as calibrated: the same replay, transfer 0 exactly
     same = cv.other_sea_gaps(other, nom, nom, ch, tmp_path)
-    gs = same["gap_to_noise_validate"]
-    assert cv.transfer(gs["nominal"], gs["calibrated"], gs["true"]) == 0.0
-    assert same["unchanged"] and cv.rescore({"transfer": same})["transfer"]["transfer"] is None
+    assert same["unchanged"] and cv.rescore({"transfer": same})["transfer"]["transfer"] == 0.0
+    assert cv.rescore({"transfer": dict(same, truth_none=True)})["transfer"]["transfer"] is None
 
 
 def test_the_summary_scores_transfer_median_and_least_against_the_goals():
-    """The two transfer goals read the right verdicts' transfers (an unchanged file's none left out and
+    """The two transfer goals read the right verdicts' transfers (a no-effect truth's left out and
     counted); a metrics.json from before the check reads 'not measured', never FAIL."""
     cv = _scenario()
 
-    def row(g, unchanged=False):
-        tf = {"gap_to_noise_validate": dict(zip(("nominal", "calibrated", "true"), g)), "unchanged": unchanged}
+    def row(g, none=False):
+        tf = {"gap_to_noise_validate": dict(zip(("nominal", "calibrated", "true"), g)), "truth_none": none}
         return {"label": "x", "seed": 0, "judged": {"right": True}, "full": {"verdict": "flow_loss"},
                 "checks": cv.rescore({"transfer": tf})}
 
