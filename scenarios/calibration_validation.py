@@ -13,7 +13,15 @@ diagnosed by the command, ``heavecomp diagnose RUN.csv --params NOMINAL.toml``, 
 - (b) replaying the log with it reproduces the held-out shrink the diagnosis reported within 10 %
   (:func:`heavecomp.diagnosis.calibrate.replay_shrink`);
 - (c) ``heavecomp diagnose RUN.csv --params calibrated.toml`` reads ``none`` (goal: >= 80 % of the runs),
-  or a held-out gap on the verdict's shrink channel smaller by at least the reported shrink.
+  or a held-out gap on the verdict's shrink channel smaller by at least the reported shrink;
+- (d) transfer (issue 30 item 6): a second log of the same truth plant in another sea of the same kind
+  (:func:`heavecomp.benchmark.generate.other_sea_run`: the same planted laws and parameters, another
+  H_s/T_p and phases, its own sensor noise) is replayed under the nominal and under ``calibrated.toml``
+  exactly as the diagnosis replays (:func:`heavecomp.diagnosis.replay_files`), and the true model's clean
+  replay of it (the generator's) is read on the same held-out samples; with the held-out gap/noise of the
+  verdict's shrink channel, all three over the nominal replay's noise floor,
+  transfer = (nominal - calibrated) / (nominal - true) (goal: median >= 0.85, none under 0.6; a file
+  that changes nothing scores 0, a no-effect truth none).
 
 No threshold of the diagnosis or of these checks is tuned on this set: it is run once.
 """
@@ -29,9 +37,12 @@ import tempfile
 import time
 from pathlib import Path
 
+import numpy as np
+
 from heavecomp.benchmark import generate, parameter_sets, validation_cases
 from heavecomp.benchmark.seeds import spent as spent_ranges
 from heavecomp.cli import main as cli
+from heavecomp.diagnosis import replay_files
 from heavecomp.diagnosis.calibrate import replay_shrink
 from heavecomp.effects.spec import load
 from heavecomp.report.provenance import write_params
@@ -53,6 +64,9 @@ NONE_GOAL = 0.8
 #: relative rounding allowed when the re-diagnosed gap is compared with (1 - reported shrink) x the first
 #: gap: both come from the same replay, so an exact agreement must not fail by one float rounding [-]
 ROUNDING = 1e-9
+#: the carry-over goals of issue 30 item 6: the median transfer of the right verdicts, and the least [-]
+TRANSFER_MEDIAN_GOAL = 0.85
+TRANSFER_MIN_GOAL = 0.6
 
 
 def cases(quick: bool = False, seed0: int = SEED0) -> list:
@@ -74,7 +88,7 @@ def run_case(case, workdir, jobs: int = 1) -> dict:
     t0 = time.perf_counter()
     row = {"case": dataclasses.asdict(case), "label": case.label, "category": case.category, "seed": case.seed}
     try:
-        tr = generate(case)
+        tr, other = generate(case, other_sea=True)
     except RuntimeError as exc:  # a sea that cannot carry the effect: reported, never hidden
         row["error"] = str(exc)
         return row
@@ -92,7 +106,7 @@ def run_case(case, workdir, jobs: int = 1) -> dict:
         row["calibrated"] = {k: diag["calibrated"].get(k) for k in ("changes", "expected_shrink", "note")
                              if k in diag["calibrated"]}
         if row["judged"]["right"]:
-            row["checks"] = _checks(d, csv, nom, diag)
+            row["checks"] = _checks(d, csv, nom, diag, other)
     except Exception as exc:  # noqa: BLE001 - one crashing run is reported, the set goes on
         log.exception("%s (seed %s) failed", case.label, case.seed)
         row["error"] = f"failed: {exc!r}"
@@ -100,7 +114,7 @@ def run_case(case, workdir, jobs: int = 1) -> dict:
     return row
 
 
-def _checks(d: Path, csv: Path, nom: Path, diag: dict) -> dict:
+def _checks(d: Path, csv: Path, nom: Path, diag: dict, other=None) -> dict:
     cal = d / "diag" / "calibrated.toml"
     out = {"params_ok": cal.is_file() and cli(["params", str(cal), "-o", str(d / "checked.toml")]) == 0}
     if not out["params_ok"]:
@@ -119,7 +133,37 @@ def _checks(d: Path, csv: Path, nom: Path, diag: dict) -> dict:
     out["rediagnosis"] = {"verdict": again["verdict"]["effect"], "confidence": again["verdict"]["confidence"],
                           "channel": ch, "rms_before": before, "rms_after": after,
                           "gap_shrink": 1.0 - after / before if before > 0 else 0.0, "reported_shrink": shrink}
+    if other is not None:
+        out["transfer"] = other_sea_gaps(other, nom, cal, ch, d)
     return rescore(out)
+
+
+def other_sea_gaps(other, nom, cal, channel: str, d: Path) -> dict:
+    """Held-out gap/noise of ``channel`` on the second log ``other`` (a
+    :class:`heavecomp.benchmark.TestRun` of the same truth plant in another sea) under the nominal file
+    ``nom`` and the calibrated file ``cal`` (replayed as the diagnosis replays, :func:`replay_files`), and of
+    the true model (the generator's clean truth replay of it, on the same span's held-out samples), all
+    three over the nominal replay's noise floor; the second log and its sea are recorded beside them."""
+    csv = other.to_csv(d / "other_sea.csv")
+    cmp = replay_files(csv, [nom, cal], names=["nominal", "calibrated"])
+    if channel not in cmp.channels:
+        raise RuntimeError(f"the second log has no {channel} channel")
+    sp, val = cmp.span, cmp.split["validate"][0]
+    floor = cmp.models[0].noise_floor[channel]
+    rms = {"nominal": cmp.models[0].rms_validate[channel], "calibrated": cmp.models[1].rms_validate[channel],
+           "true": other.replay_rms("truth", channel, sp["start_s"], sp["end_s"], val),
+           "nominal_generator": other.replay_rms("nominal", channel, sp["start_s"], sp["end_s"], val)}
+    return {"channel": channel, "noise_floor": floor, "rms_validate": rms,
+            "gap_to_noise_validate": {k: v / floor for k, v in rms.items()},
+            "sea": other.truth["sea"], "first_sea": other.truth["first_sea"],
+            "unchanged": bool(load(cal) == load(nom)), "truth_none": other.truth["effects"] == ["none"]}
+
+
+def transfer(nominal: float, calibrated: float, true: float):
+    """(nominal - calibrated) / (nominal - true) of three held-out gaps (same channel, samples and noise
+    floor) [-]: 1 when the calibrated file closes the gap as the true model does, 0 when it does not move
+    it; None when the true model does not close any gap on this log (nominal <= true: nothing to carry)."""
+    return (nominal - calibrated) / (nominal - true) if nominal > true else None
 
 
 def rescore(checks: dict) -> dict:
@@ -127,6 +171,12 @@ def rescore(checks: dict) -> dict:
     reported shrink, to :data:`ROUNDING`) and ``rediagnosis_within_replay_tolerance`` (the gap's
     shrink at least 1 - :data:`REPLAY_AGREEMENT` of the reported: reported beside, never a goal) of
     one run's checks, from its stored re-diagnosis numbers."""
+    tf = checks.get("transfer")
+    if tf is not None:
+        g = tf["gap_to_noise_validate"]
+        # a no-effect truth has nothing to carry (its nominal - true is the noise of two replays): no
+        # transfer, never a 0 or a ratio of noise; a right verdict whose file changes nothing scores its 0
+        tf["transfer"] = None if tf.get("truth_none") else transfer(g["nominal"], g["calibrated"], g["true"])
     rd = checks.get("rediagnosis")
     if rd is None:
         return checks
@@ -157,6 +207,12 @@ def summarize(rows) -> dict:
         out[key] = {"all_right": [count(right, key), len(right), _share(count(right, key), len(right))],
                     "changed": [count(named, key), len(named), _share(count(named, key), len(named))]}
     share = out["rediagnosis_none"]["all_right"][2]
+    tfs = [r["checks"]["transfer"]["transfer"] for r in right
+           if r["checks"].get("transfer", {}).get("transfer") is not None]
+    # a metrics.json from before the check (re-scored): the goal was not measured, not failed
+    measured = None if any("transfer" in r["checks"] for r in right) else "not measured"
+    out["transfer"] = {"not_measured": measured is not None, "n": len(tfs), "n_right_without": len(right) - len(tfs),
+                       "median": float(np.median(tfs)) if tfs else None, "min": min(tfs) if tfs else None}
     out["goals"] = [
         {"goal": "every right verdict's calibrated.toml passes heavecomp params", "measured": out["params_ok"]["all_right"][2],
          "result": "PASS" if right and count(right, "params_ok") == len(right) else "FAIL"},
@@ -167,6 +223,14 @@ def summarize(rows) -> dict:
         {"goal": "re-diagnosis: none, or a gap smaller by at least the reported shrink",
          "measured": out["rediagnosis_ok"]["all_right"][2],
          "result": "PASS" if right and count(right, "rediagnosis_ok") == len(right) else "FAIL"},
+        {"goal": f"median transfer to another sea >= {TRANSFER_MEDIAN_GOAL:g} (issue 30)",
+         "measured": out["transfer"]["median"], "number": True,
+         "result": measured if measured else "PASS" if tfs and out["transfer"]["median"] >= TRANSFER_MEDIAN_GOAL
+         else "FAIL"},
+        {"goal": f"no transfer to another sea under {TRANSFER_MIN_GOAL:g} (issue 30)",
+         "measured": out["transfer"]["min"], "number": True,
+         "result": measured if measured else "PASS" if tfs and out["transfer"]["min"] >= TRANSFER_MIN_GOAL
+         else "FAIL"},
     ]
     return out
 
@@ -175,12 +239,17 @@ def _pct(x):
     return "-" if x is None else f"{100 * x:.0f} %"
 
 
+def _num(x):
+    return "-" if x is None else f"{x:.2f}"
+
+
 def write(out: Path, rows, summary, quick: bool, seed0: int = SEED0) -> None:
     write_metrics(out, {"seed0": seed0, "quick": quick, "replay_agreement": REPLAY_AGREEMENT, "none_goal": NONE_GOAL,
                         "summary": summary, "runs": rows})
     s = summary
-    goals = md_table(["goal (issue 22)", "measured", "result"], [[g["goal"], _pct(g["measured"]), g["result"]]
-                                                                for g in s["goals"]])
+    goals = md_table(["goal (issue 22)", "measured", "result"], [
+        [g["goal"], _num(g["measured"]) if g.get("number") else _pct(g["measured"]), g["result"]]
+        for g in s["goals"]])
     counts = md_table(["check", "right verdicts", "of which the model changed"],
                       [[k, f"{s[k]['all_right'][0]} / {s[k]['all_right'][1]}", f"{s[k]['changed'][0]} / {s[k]['changed'][1]}"]
                        for k in ("params_ok", "replay_ok", "rediagnosis_none", "rediagnosis_ok",
@@ -195,11 +264,13 @@ def write(out: Path, rows, summary, quick: bool, seed0: int = SEED0) -> None:
                 "-" if not rep else f"{rep['shrink']:.2f}",
                 "-" if not rep else f"{rep['agreement']:.3f}", {True: "yes", False: "**no**"}.get(c.get("params_ok"), "-"),
                 rd.get("verdict", "-"), "-" if not rd else f"{rd['gap_shrink']:.2f}",
-                {True: "yes", False: "**no**"}.get(c.get("rediagnosis_ok"), "-")]
+                {True: "yes", False: "**no**"}.get(c.get("rediagnosis_ok"), "-"), _transfer_cell(c.get("transfer"))]
 
     table = md_table(["category", "true effect", "seed", "verdict", "confidence", "right", "verdict shrink",
                       "reported shrink (calibrated)", "replay shrink", "|replay - reported| / reported", "params", "re-diagnosis",
-                      "gap shrink by calibrating", "re-diagnosis ok"], [line(r) for r in rows if "judged" in r])
+                      "gap shrink by calibrating", "re-diagnosis ok",
+                      "transfer (gap/noise nominal, calibrated, true on the other sea)"],
+                     [line(r) for r in rows if "judged" in r])
     write_report(out, "Calibration validation: calibrated.toml on the scoring set with fresh seeds", [
         __doc__.split("\n\n", 1)[1].strip(),
         f"{s['n_diagnosed']} of {s['n_cases']} cases diagnosed, {s['n_right']} right verdicts ({s['n_right_changed']} "
@@ -211,7 +282,7 @@ def write(out: Path, rows, summary, quick: bool, seed0: int = SEED0) -> None:
         + (" Re-judged (--rescore) from the checks the run stored: no run repeated."
            if s.get("rescored") else "")
         + (f" Diagnosis settings: {s['frozen']}." if s.get("frozen") else ""),
-        "## Goals", goals, "## Checks", counts,
+        "## Goals", goals, "## Checks", counts, _transfer_line(s.get("transfer")),
         "rediagnosis_within_replay_tolerance: none, or a gap shrink at least 90 % of the reported one (the replay "
         "check's 10 % tolerance); added after the set was run, beside the goal, never instead of it.",
         "## Runs", "verdict shrink: the verdict's held-out shrink; reported shrink (calibrated): the one "
@@ -219,6 +290,21 @@ def write(out: Path, rows, summary, quick: bool, seed0: int = SEED0) -> None:
         "drift's start state, :func:`heavecomp.diagnosis.calibrate.start_state`, the calibrated model's held-out "
         "shrink), which the replay check compares with. gap shrink by calibrating: 1 - (held-out rms gap of the re-diagnosis against calibrated.toml) / "
         "(the first diagnosis'), on the verdict's shrink channel.", table])
+
+
+def _transfer_cell(tf):
+    if not tf:
+        return "-"
+    g = tf["gap_to_noise_validate"]
+    return f"{_num(tf.get('transfer'))} ({g['nominal']:.2f}, {g['calibrated']:.2f}, {g['true']:.2f})"
+
+
+def _transfer_line(t):
+    if not t or t.get("not_measured"):
+        return "transfer (check d): not measured (no right verdict of this run was checked on another sea)."
+    return (f"transfer (check d) on {t['n']} right verdicts: median {_num(t['median'])}, "
+            f"least {_num(t['min'])}; {t['n_right_without']} right verdicts without one (a no-effect truth, or a "
+            "true model that closes no gap on the other sea).")
 
 
 def main(argv=None) -> int:

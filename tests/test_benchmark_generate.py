@@ -110,3 +110,24 @@ def test_a_case_makes_the_same_run_and_a_corrupted_log_continues_its_stream():
     assert {c for c in ca.columns if np.isnan(ca.columns[c]).any()} == {"heave", "wob", "pressure"}
     assert not any(np.isnan(a.columns[c]).any() for c in a.columns)
     assert ca.truth["corrupted"] == ["jitter", "dropouts"]
+
+
+def test_the_other_sea_log_has_the_same_planted_plant_in_another_sea():
+    """generate(case, other_sea=True): the first log is generate(case)'s bit for bit; the second carries the
+    same planted laws and parameters, in another sea of the same kind (another H_s, T_p and phases), with
+    its own sensor noise, and its own truth replay that explains its log where the nominal's does not."""
+    case = benchmark_case("flow_loss", seed=5, duration=DUR)
+    alone = generate(case)
+    first, other = generate(case, other_sea=True)
+    assert all(np.array_equal(alone.columns[c], first.columns[c]) for c in alone.columns) and alone.truth == first.truth
+    assert other.truth["parameters"] == first.truth["parameters"] and other.truth["effects"] == ["flow_loss"]
+    sa, sb = first.truth["sea"], other.truth["sea"]
+    assert sb["kind"] == sa["kind"] and other.truth["first_sea"] == sa
+    assert sb["hs"] != sa["hs"] and sb["tp"] != sa["tp"] and sb["phase_seed"] != sa["phase_seed"]
+    assert np.array_equal(other.t, first.t) and not np.allclose(other.columns["heave"], first.columns["heave"])
+    # the truth replay explains the second log down to its own noise floor; the nominal's does not
+    k = other.t >= 30.0
+    gap = {m: {c: np.sqrt(np.mean((other.columns[c][k] - other.replays[m][c][k]) ** 2)) / other.truth["noise_floor"][c]
+               for c in OUT} for m in ("truth", "nominal")}
+    assert max(gap["truth"].values()) < 1.5 and max(gap["nominal"].values()) > 2.0, gap
+    assert other.truth["noise_floor"] != first.truth["noise_floor"]

@@ -22,13 +22,13 @@ arrays into a corrupted log of one of the classes the input checks must catch
 from heavecomp.benchmark.case import (benchmark_case, benchmark_cases, Case, CASES, NEW_EFFECTS, parameter_sets,
                                       PARAMETER_SETS, TUNING_SETTINGS, TWO_EFFECTS, validation_cases)
 from heavecomp.benchmark.corrupt import corrupt
-from heavecomp.benchmark.generate import generate, PITCH_NOISE, TestRun
+from heavecomp.benchmark.generate import generate, other_sea_run, PITCH_NOISE, TestRun
 from heavecomp.benchmark.sea import make_sea, SEAS, VesselRAO
 from heavecomp.benchmark.sizing import GAP_MIN, NEAR_NOISE, SECOND_SHARE
 from heavecomp.benchmark.testbed import NOISE
 from heavecomp.benchmark.truth import COMPONENT, LAWS, OUT_OF_LIBRARY
 
-__all__ = ["Case", "generate", "TestRun", "corrupt", "benchmark_case", "benchmark_cases", "validation_cases",
+__all__ = ["Case", "generate", "other_sea_run", "TestRun", "corrupt", "benchmark_case", "benchmark_cases", "validation_cases",
            "parameter_sets", "make_sea", "VesselRAO", "LAWS", "COMPONENT", "OUT_OF_LIBRARY", "CASES", "TWO_EFFECTS",
            "NEW_EFFECTS", "PARAMETER_SETS", "TUNING_SETTINGS", "SEAS", "NOISE", "PITCH_NOISE", "GAP_MIN",
            "NEAR_NOISE", "SECOND_SHARE"]

@@ -65,6 +65,17 @@ class TestRun:
         return TestRun(self.t[k] - self.t[k][0], {c: y[k] for c, y in self.columns.items()}, self.nominal, truth, rep,
                        self.rng)
 
+    def replay_rms(self, model, channel, start, end, validate):
+        """Held-out rms of the measured ``channel`` minus the clean replay ``model`` (``nominal`` or
+        ``truth``) [SI], on the samples a replay of the log's span (``start``, ``end``) [s] holds out:
+        from ``validate`` [s] on the span's clock (:func:`heavecomp.diagnosis.replay_files`' ``span``
+        and ``split``)."""
+        t = self.t - self.t[0]
+        k = (t >= start - 1e-9) & (t <= end + 1e-9)
+        k &= t - t[k][0] >= validate
+        r = self.columns[channel][k] - self.replays[model][channel][k]
+        return float(np.sqrt(np.mean(r ** 2)))
+
     def true_shrink(self, split=0.67):
         """Held-out shrink the true model reaches, per channel: 1 - rms(measured - true replay) /
         rms(measured - nominal replay) on the part after ``split`` of the run (the diagnosis' held-out
@@ -80,7 +91,7 @@ class TestRun:
         return out
 
 
-def generate(case: Case) -> TestRun:
+def generate(case: Case, other_sea: bool = False):
     """The run of ``case``, its truth laws planted at a detectable strength.
 
     Each law is drawn (its own file in :mod:`heavecomp.benchmark.truth`) and sized on the drawn sea
@@ -96,9 +107,12 @@ def generate(case: Case) -> TestRun:
     ----------
     case : Case
 
+    other_sea : bool
+        Also make the same truth plant's log in another sea (:func:`other_sea_run`).
+
     Returns
     -------
-    TestRun
+    TestRun, or (TestRun, TestRun) with ``other_sea``
         ``truth`` holds the label, the planted laws (``effects``, dominant first), their component,
         whether it is a contract name (``named``, ``out_of_library``), the case, the parameter set,
         seed, seas drawn, the sea, the noise floor per channel, the planted parameters, each law's
@@ -133,18 +147,7 @@ def generate(case: Case) -> TestRun:
         # the text is the one the scoring report records
         raise RuntimeError(f"no sea of {case.max_draws} carries {case.label} ({case.variant})")
     parts = [p for _, _, p, _ in planted]
-    t, clean = bed.sim(parts)
-    cols = dict(clean)
-    cols["heave"] = clean["heave"] + bed.heave_noise
-    for c in bed.OUT:
-        cols[c] = clean[c] + rng.normal(0.0, bed.noise[c], t.size)
-    if "pitch" in cols:
-        cols["pitch"] = clean["pitch"] + rng.normal(0.0, PITCH_NOISE, t.size)
-    # replays from the logged heave: the nominal model, and the true model (plant and sensor laws known,
-    # driven by the heave the compensator saw plus the same heave noise)
-    replays = {"nominal": bed.sim([], hs=bed.heave_samples(cols["heave"]))[1],
-               "truth": bed.sim([p for p in parts if not p.on_heave],
-                                hs=bed.heave_samples(bed.base["heave"] + bed.heave_noise))[1]}
+    t, cols, replays = _log(bed, parts, rng)
     lab = case.label
     truth = {"label": lab, "effects": list(labels) or ["none"], "component": COMPONENT.get(lab),
              "named": lab != "none" and LAWS[lab].named, "out_of_library": lab != "none" and not LAWS[lab].named,
@@ -157,4 +160,57 @@ def generate(case: Case) -> TestRun:
     if len(planted) > 1:
         truth["second_share"] = truth["gap_alone"][labels[1]] / truth["gap_alone"][labels[0]]
     tr = TestRun(t=t, columns=cols, nominal=nominal, truth=truth, replays=replays, rng=rng)
+    tr = tr.cropped(case.start) if case.start > 0 else tr
+    return (tr, other_sea_run(case, parts, truth)) if other_sea else tr
+
+
+def _log(bed, parts, rng):
+    """The logged channels of the truth model with ``parts`` on ``bed`` (sensor noise drawn from ``rng``) and
+    the clean replays from the logged heave: the nominal model, and the true model (plant and sensor laws
+    known, driven by the heave the compensator saw plus the same heave noise)."""
+    t, clean = bed.sim(parts)
+    cols = dict(clean)
+    cols["heave"] = clean["heave"] + bed.heave_noise
+    for c in bed.OUT:
+        cols[c] = clean[c] + rng.normal(0.0, bed.noise[c], t.size)
+    if "pitch" in cols:
+        cols["pitch"] = clean["pitch"] + rng.normal(0.0, PITCH_NOISE, t.size)
+    replays = {"nominal": bed.sim([], hs=bed.heave_samples(cols["heave"]))[1],
+               "truth": bed.sim([p for p in parts if not p.on_heave],
+                                hs=bed.heave_samples(bed.base["heave"] + bed.heave_noise))[1]}
+    return t, cols, replays
+
+
+#: the stream key of the second sea of a case: ``default_rng([case.seed, OTHER_SEA_STREAM])`` never
+#: meets the case's own stream ``default_rng(case.seed)`` (a different seed sequence entropy)
+OTHER_SEA_STREAM = 1
+
+
+def other_sea_run(case: Case, parts, truth: dict) -> TestRun:
+    """The same truth plant's log in another sea: the planted ``parts`` of ``case`` as drawn (laws and
+    parameters unchanged, not re-sized), on a new :class:`Testbed` whose sea of the same kind is drawn
+    from its own stream (``default_rng([case.seed, OTHER_SEA_STREAM])``: another H_s, T_p and phases),
+    with its own heave and sensor noise and its own nominal and truth replays; cut at ``case.start`` as
+    the first.  The test of a calibrated model on a log it was not fitted on (issue 30 item 6).
+
+    Parameters
+    ----------
+    case : Case
+    parts : list of heavecomp.benchmark.truth.Part
+        The laws planted in the case's first log.
+    truth : dict
+        The first log's ``truth``; the second's is a copy with its own ``sea``, ``noise_floor`` and
+        ``stick``, and ``other_sea: True``.
+
+    Returns
+    -------
+    TestRun
+    """
+    rng = np.random.default_rng([case.seed, OTHER_SEA_STREAM])
+    nominal = parameter_sets()[case.params]
+    bed = Testbed(nominal, rng, case.duration + case.start, case.rate, case.sea, case.noise)
+    t, cols, replays = _log(bed, parts, rng)
+    tr = TestRun(t=t, columns=cols, nominal=nominal,
+                 truth=dict(truth, sea=bed.info, noise_floor=bed.floor, stick=bed.stick, other_sea=True,
+                            first_sea=truth["sea"]), replays=replays, rng=rng)
     return tr.cropped(case.start) if case.start > 0 else tr
