@@ -197,8 +197,22 @@ def test_a_stepper_divergence_names_the_files_effects():
     from heavecomp.simulate.core import SimulationError
 
     p = paper_a().replace(effects=[("string_damping", {"damping": 2e6})])
-    with pytest.raises(SimulationError, match="with the effects string_damping"):
+    with pytest.raises(SimulationError, match=r"with effects\[0\] \(string_damping\)"):
         simulate(p, 10.0, dt=0.05)
+
+
+@pytest.mark.slow  # compiles a stepper with a string_term (about 60 s of CPU once)
+def test_a_divergence_at_the_default_step_names_the_entry_and_not_the_step():
+    """A huge ``string_term`` diverges at the plant's own stable step: the message named the type only and
+    advised ``--dt`` (F5); it names ``effects[1] (string_term)`` and gives no step advice."""
+    from heavecomp.simulate import simulate
+    from heavecomp.simulate.core import SimulationError
+
+    p = paper_a().replace(effects=[("sensor_gain", {"channel": "wob", "factor": 1.1}),
+                                   ("string_term", {"rel_cubed": 1e12, "v_abs_v": 1e12})])
+    with pytest.raises(SimulationError, match=r"effects\[1\] \(string_term\)") as e:
+        simulate(p, 60.0)
+    assert "dt" not in str(e.value) and e.value.option != "dt", str(e.value)
 
 
 # ---------------------------------------------------------------- D1: the sample-rate floor from the rig's modes
