@@ -308,6 +308,22 @@ def test_a_hook_load_in_tonnes_is_named_as_the_hook_load(tmp_path):
     assert "hook_load=t" in r.stderr and "column 'wob'" not in r.stderr
 
 
+def test_a_hook_load_in_n_declared_in_tonnes_is_named_as_the_hook_load(tmp_path):
+    """``--units hook_load=t`` on a hook load in N: the WOB it gives (-1.4e10 N) was blamed on a ``wob`` column the
+    log lacks by the generic unit check (F4); the line names the hook load and the string weight."""
+    from heavecomp.simulate import simulate
+
+    res = simulate(paper_a(), 120.0, rate=10.0)
+    f = tmp_path / "hook.csv"
+    rows = [f"{t:.2f},{z:.6g},{s:.6g},{p:.6g},{1.5e6 - w:.6g}" for t, z, s, p, w in
+            zip(res["t"], res["heave"], res["stroke"], res["pressure"], res["wob"])]
+    f.write_text("t,heave,stroke,pressure,hook_load\n" + "\n".join(rows) + "\n")
+    params = _file(tmp_path, "[measurement]\nstring_weight = 1.5e6\n")
+    r = run("diagnose", f, "--params", params, "--out", tmp_path / "d", "--units", "hook_load=t")
+    assert r.returncode == 2 and "column 'hook_load'" in r.stderr and "string_weight" in r.stderr, r.stderr
+    assert "column 'wob'" not in r.stderr and "hook_load=N" in r.stderr, r.stderr
+
+
 def test_a_log_without_heave_motion_says_so_not_a_wrong_time_base(tmp_path):
     """A calm-sea log's heave noise has a "period" of 2 s: it was read as a time base at the wrong scale (D8)."""
     from heavecomp.diagnosis.data import load_run
