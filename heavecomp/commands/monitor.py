@@ -85,7 +85,7 @@ def run(args) -> int:
 
         spans[i] = ab
         write_outputs(d, Path(args.out) / f"segment_{i}", params=params, run=sub, run_path=args.run,
-                      params_path=args.params, span=SP.choose(run_.duration, ab, min_duration=M.DIAGNOSE_MIN),
+                      params_path=args.params, span=SP.segment(run_.duration, *ab, i, min_duration=M.DIAGNOSE_MIN),
                       columns=columns, units=units, shown_dir=str(Path(final(args)) / f"segment_{i}"))
         print(f"segment {i} ({ab[0]:.0f}-{ab[1]:.0f} s): {d.verdict_['effect']} (confidence "
               f"{d.verdict_.get('confidence')}) -> {Path(final(args)) / f'segment_{i}'}", file=sys.stderr, flush=True)
