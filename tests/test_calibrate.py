@@ -162,6 +162,15 @@ def test_what_next_of_a_segment_acts_on_the_segment():
     assert any("--heave-file log.csv" in x for x in lines) and not any("--span" in x for x in lines)
 
 
+def test_the_monitors_diagnose_line_names_the_segments_exact_span_and_the_logs_mapping():
+    """monitor's "the same diagnosis" line rounded the span to whole seconds and dropped --columns/--units (F1)."""
+    from heavecomp.report.monitor import diagnosed_lines
+
+    line = diagnosed_lines({1: (1200.5, 1800.25)}, "log.csv", "rig.toml", "mon", columns={"wob": "WOB kN"},
+                           units={"wob": "kN"})[0]
+    assert "--span 1200.5:1800.25" in line and "--columns 'wob=WOB kN' --units wob=kN" in line, line
+
+
 def test_what_next_commands_carry_the_logs_mapping_quoted():
     """issue 31: a command that reads the log with the file the diagnosis ran against carries --columns/--units
     (the re-diagnosis reads calibrated.toml's [measurement]); paths with spaces are quoted."""

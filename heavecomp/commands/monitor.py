@@ -95,7 +95,8 @@ def run(args) -> int:
     for i, (a, b) in spans.items():  # where the segment's full diagnosis is
         res.segments[i]["verdict"]["folder"] = f"segment_{i}"
     write_report(res, args.out, source=run_.source, extra={"measurement": run_.measurement} if run_.measurement else None,
-                 diagnosed=diagnosed_lines(spans, args.run, args.params, final(args)))
+                 diagnosed=diagnosed_lines(spans, args.run, args.params, final(args), columns=columns,
+                                           units=units))
     if args.format:  # from monitor.json as written (the segments' verdicts included)
         import json
 

@@ -9,7 +9,7 @@ from pathlib import Path
 
 from heavecomp.diagnosis.calibrate import FILE, Calibrated, write
 from heavecomp.effects.spec import field_units
-from heavecomp.report.commands import command
+from heavecomp.report.commands import command, span_text
 from heavecomp.report.provenance import strip_declared
 
 
@@ -53,7 +53,7 @@ def what_next(cal: Calibrated, out_dir, *, run_path: str = "LOG", params_path: s
     out = Path(out_dir)
     f = (out / FILE).as_posix()
     dur = f"{max(1.0, math.floor(duration)):g}"
-    part = () if span is None or span.whole else ("--span", f"{span.start:.10g}:{span.end:.10g}")
+    part = () if span is None or span.whole else ("--span", span_text(span.start, span.end))
     lines = ["", "## What next", ""]
     if not cal.changes:
         lines.append(f"Nothing to change in `{params_path}`: {cal.why[0] if cal.why else 'no change'}. "
