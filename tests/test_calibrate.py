@@ -141,6 +141,36 @@ def test_what_next_names_the_change_the_file_and_the_commands():
     assert sum(line.startswith("heavecomp ") for line in text.splitlines()) == 2
 
 
+def test_what_next_of_a_segment_acts_on_the_segment():
+    """A diagnosed segment of ``monitor --diagnose`` (or a ``diagnose --span``): the replay and the re-diagnosis
+    lacked ``--span`` and ``simulate --heave-file`` drove the log from 0 (F1); every printed command that reads the
+    log acts on the span, the one that cannot is left out, and the span's rule says the monitor chose it."""
+    from heavecomp.diagnosis import span as SP
+    from heavecomp.report.calibrated import what_next
+
+    sp = SP.segment(3600.0, 1200.0, 1800.0, 1)
+    assert sp.rule == "monitor" and "monitor's segment 1" in sp.reason and "asked for" not in sp.reason
+    par = {"compensator.gas_stiffness": 0.6 * NOM.compensator.gas_stiffness}
+    for cal in (calibrate(NOM, _diag("parameter_mismatch", par)), calibrate(NOM, _diag("none"))):
+        lines = [x for x in what_next(cal, "out", run_path="log.csv", params_path="rig.toml", duration=600.0,
+                                      span=sp) if x.startswith("heavecomp ")]
+        reads = [x for x in lines if "log.csv" in x]
+        assert all("--span 1200:1800" in x for x in reads), reads
+        assert not any("--heave-file" in x or x.startswith("heavecomp monitor") for x in lines), lines
+    lines = what_next(calibrate(NOM, _diag("parameter_mismatch", par)), "out", run_path="log.csv",
+                      span=SP.choose(600.0, None))
+    assert any("--heave-file log.csv" in x for x in lines) and not any("--span" in x for x in lines)
+
+
+def test_the_monitors_diagnose_line_names_the_segments_exact_span_and_the_logs_mapping():
+    """monitor's "the same diagnosis" line rounded the span to whole seconds and dropped --columns/--units (F1)."""
+    from heavecomp.report.monitor import diagnosed_lines
+
+    line = diagnosed_lines({1: (1200.5, 1800.25)}, "log.csv", "rig.toml", "mon", columns={"wob": "WOB kN"},
+                           units={"wob": "kN"})[0]
+    assert "--span 1200.5:1800.25" in line and "--columns 'wob=WOB kN' --units wob=kN" in line, line
+
+
 def test_what_next_commands_carry_the_logs_mapping_quoted():
     """issue 31: a command that reads the log with the file the diagnosis ran against carries --columns/--units
     (the re-diagnosis reads calibrated.toml's [measurement]); paths with spaces are quoted."""

@@ -197,8 +197,22 @@ def test_a_stepper_divergence_names_the_files_effects():
     from heavecomp.simulate.core import SimulationError
 
     p = paper_a().replace(effects=[("string_damping", {"damping": 2e6})])
-    with pytest.raises(SimulationError, match="with the effects string_damping"):
+    with pytest.raises(SimulationError, match=r"with effects\[0\] \(string_damping\)"):
         simulate(p, 10.0, dt=0.05)
+
+
+@pytest.mark.slow  # compiles a stepper with a string_term (about 60 s of CPU once)
+def test_a_divergence_at_the_default_step_names_the_entry_and_not_the_step():
+    """A huge ``string_term`` diverges at the plant's own stable step: the message named the type only and
+    advised ``--dt`` (F5); it names ``effects[1] (string_term)`` and gives no step advice."""
+    from heavecomp.simulate import simulate
+    from heavecomp.simulate.core import SimulationError
+
+    p = paper_a().replace(effects=[("sensor_gain", {"channel": "wob", "factor": 1.1}),
+                                   ("string_term", {"rel_cubed": 1e12, "v_abs_v": 1e12})])
+    with pytest.raises(SimulationError, match=r"effects\[1\] \(string_term\)") as e:
+        simulate(p, 60.0)
+    assert "dt" not in str(e.value) and e.value.option != "dt", str(e.value)
 
 
 # ---------------------------------------------------------------- D1: the sample-rate floor from the rig's modes
@@ -292,6 +306,22 @@ def test_a_hook_load_in_tonnes_is_named_as_the_hook_load(tmp_path):
     r = run("diagnose", f, "--params", params, "--out", tmp_path / "d")
     assert r.returncode == 2 and "column 'hook_load'" in r.stderr and "measurement.string_weight" in r.stderr
     assert "hook_load=t" in r.stderr and "column 'wob'" not in r.stderr
+
+
+def test_a_hook_load_in_n_declared_in_tonnes_is_named_as_the_hook_load(tmp_path):
+    """``--units hook_load=t`` on a hook load in N: the WOB it gives (-1.4e10 N) was blamed on a ``wob`` column the
+    log lacks by the generic unit check (F4); the line names the hook load and the string weight."""
+    from heavecomp.simulate import simulate
+
+    res = simulate(paper_a(), 120.0, rate=10.0)
+    f = tmp_path / "hook.csv"
+    rows = [f"{t:.2f},{z:.6g},{s:.6g},{p:.6g},{1.5e6 - w:.6g}" for t, z, s, p, w in
+            zip(res["t"], res["heave"], res["stroke"], res["pressure"], res["wob"])]
+    f.write_text("t,heave,stroke,pressure,hook_load\n" + "\n".join(rows) + "\n")
+    params = _file(tmp_path, "[measurement]\nstring_weight = 1.5e6\n")
+    r = run("diagnose", f, "--params", params, "--out", tmp_path / "d", "--units", "hook_load=t")
+    assert r.returncode == 2 and "column 'hook_load'" in r.stderr and "string_weight" in r.stderr, r.stderr
+    assert "column 'wob'" not in r.stderr and "hook_load=N" in r.stderr, r.stderr
 
 
 def test_a_log_without_heave_motion_says_so_not_a_wrong_time_base(tmp_path):

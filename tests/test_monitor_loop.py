@@ -188,6 +188,12 @@ def test_monitor_diagnose_writes_each_segment_as_diagnose_span_does_with_progres
     assert json.loads((seg / "diagnosis.json").read_text())["span"]["start_s"] == pytest.approx(
         mon["segments"][done[0]]["start"])
     assert f"segment {done[0]}:" in cap.err and "--span" in (out / "report.md").read_text()
+    # F1: the segment's commands act on the segment, and its span says the monitor chose it
+    sp = json.loads((seg / "diagnosis.json").read_text())["span"]
+    assert sp["rule"] == "monitor" and "asked for" not in sp["reason"], sp
+    cmds = [x for x in (seg / "report.md").read_text().splitlines() if x.startswith("heavecomp ")]
+    reads = [x for x in cmds if str(log) in x]
+    assert reads and all("--span" in x for x in reads) and not any("--heave-file" in x for x in cmds), cmds
 
 
 @pytest.mark.slow

@@ -88,6 +88,15 @@ def test_diagnose_what_next_commands_run_verbatim(user):
     assert "columns = {" in (home / "diagA" / "calibrated.toml").read_text()
 
 
+def test_diagnose_span_what_next_commands_run_verbatim_on_the_span(user):
+    """A diagnosed span (as each ``monitor --diagnose`` segment is): every command that reads the log carries it."""
+    home, env = user
+    cmds = check(f"heavecomp diagnose logs/rig.csv --params nominal.toml --span 20:150 --out diagS {FLAGS} --quiet",
+                 home, env, expect_commands=True)
+    reads = [c for c in cmds if "logs/rig.csv" in c]
+    assert reads and all("--span 20:150" in c for c in reads) and not any("--heave-file" in c for c in cmds), cmds
+
+
 def test_monitor_printed_commands_run_verbatim(user):
     home, env = user
     check(f"heavecomp monitor logs/rig.csv --params nominal.toml --out mon {FLAGS}", home, env)

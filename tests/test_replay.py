@@ -144,3 +144,26 @@ def test_against_log_reads_the_simulation_through_the_files_sensors(nominal_log)
     read = against_log(run.t, true, log, gain)["rms_validate"]["wob"]
     plain = against_log(run.t, true, log, p)["rms_validate"]["wob"]
     assert read < 1.0 < 0.05 * plain, (read, plain)
+
+
+def test_simulate_shorter_than_its_heave_file_holds_out_the_end_of_what_it_simulated(nominal_log, tmp_path, capsys):
+    """``simulate --heave-file LOG --duration D`` with D shorter than the log: the held-out part is the last third
+    of the simulated span, as the diagnosis splits its span (before: split from the log's length, past the
+    simulation's end, so ``held-out nan kN`` and ``rms_validate`` all None)."""
+    from heavecomp.diagnosis.compare import against_log
+    from heavecomp.diagnosis.data import load_run
+    from heavecomp.effects.spec import load
+
+    log, nom = nominal_log
+    p = load(nom)
+    run = load_run(log, p)
+    keep = run.t <= 80.0
+    got = against_log(run.t[keep], {c: run[c][keep] for c in ("heave", "wob", "stroke", "pressure")}, log, p)
+    assert got["split"]["validate"] == [pytest.approx(0.67 * 80.0, abs=0.1), pytest.approx(80.0, abs=0.1)]
+    assert all(math.isfinite(v) for v in got["rms_validate"].values()), got["rms_validate"]
+    out = tmp_path / "s"
+    assert main(["simulate", str(nom), "--heave-file", str(log), "--duration", "80", "--out", str(out)]) == 0
+    line = capsys.readouterr().out
+    assert "nan" not in line.lower() and "held-out" in line, line
+    sim = json.loads((out / "metrics.json").read_text())
+    assert all(math.isfinite(v) for v in sim["against_log"]["rms_validate"].values())

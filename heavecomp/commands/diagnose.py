@@ -155,7 +155,8 @@ def write_outputs(d, out, *, params, run, run_path, params_path, span=None, colu
     write_report(d, out, title=f"Sim-to-real gap diagnosis — {run.source}")
     _record_measurement(Path(out) / "diagnosis.json", run.measurement, span.to_json() if span is not None else None)
     cal = write_calibrated(used(params, columns, units), out, run_path=run_path, params_path=params_path, run=run,
-                           policy=d.verdict_policy(), shown_dir=str(shown_dir or out), columns=columns, units=units)
+                           policy=d.verdict_policy(), shown_dir=str(shown_dir or out), columns=columns, units=units,
+                           span=span)
     finish(out, params=params, json_files=("diagnosis.json",), heave_used=False,
            measured_run=str(Path(run_path).resolve()))
     return cal

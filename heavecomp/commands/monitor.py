@@ -85,7 +85,7 @@ def run(args) -> int:
 
         spans[i] = ab
         write_outputs(d, Path(args.out) / f"segment_{i}", params=params, run=sub, run_path=args.run,
-                      params_path=args.params, span=SP.choose(run_.duration, ab, min_duration=M.DIAGNOSE_MIN),
+                      params_path=args.params, span=SP.segment(run_.duration, *ab, i, min_duration=M.DIAGNOSE_MIN),
                       columns=columns, units=units, shown_dir=str(Path(final(args)) / f"segment_{i}"))
         print(f"segment {i} ({ab[0]:.0f}-{ab[1]:.0f} s): {d.verdict_['effect']} (confidence "
               f"{d.verdict_.get('confidence')}) -> {Path(final(args)) / f'segment_{i}'}", file=sys.stderr, flush=True)
@@ -95,7 +95,8 @@ def run(args) -> int:
     for i, (a, b) in spans.items():  # where the segment's full diagnosis is
         res.segments[i]["verdict"]["folder"] = f"segment_{i}"
     write_report(res, args.out, source=run_.source, extra={"measurement": run_.measurement} if run_.measurement else None,
-                 diagnosed=diagnosed_lines(spans, args.run, args.params, final(args)))
+                 diagnosed=diagnosed_lines(spans, args.run, args.params, final(args), columns=columns,
+                                           units=units))
     if args.format:  # from monitor.json as written (the segments' verdicts included)
         import json
 

@@ -142,6 +142,7 @@ def _against_log(res, params, metrics_path) -> str:
     output channels (:func:`heavecomp.diagnosis.compare.against_log`), added to ``metrics.json``; returns the
     summary's words."""
     import json
+    import math
 
     heave = params.heave
     if heave is None or heave.kind != "file":
@@ -159,8 +160,11 @@ def _against_log(res, params, metrics_path) -> str:
         d["against_log"] = got
         c = got["channel"]
         unit, sc = CH_UNITS[c]
-        words = (f"; {c} error against the log {got['rms'][c] * sc:.3g} {unit}, held-out "
-                 f"{got['rms_validate'][c] * sc:.3g} {unit} (after {got['split']['validate'][0]:.0f} s)")
+        words = "".join(f"{label} {v * sc:.3g} {unit}" for label, v in (
+            (f"; {c} error against the log", got["rms"][c]),
+            (", held-out", got["rms_validate"][c])) if math.isfinite(v))  # no sample compared: no number
+        if math.isfinite(got["rms_validate"][c]):
+            words += f" (after {got['split']['validate'][0]:.0f} s)"
     metrics_path.write_text(json.dumps(d, indent=2) + "\n", encoding="utf-8")
     return words
 

@@ -211,7 +211,8 @@ def _window(window, end: float):
 def against_log(t, channels: dict, log, params, *, split=0.67, settle=None) -> dict | None:
     """A simulation driven by a measured log's heave (``[heave] kind = "file"``) compared with the log's own
     output channels: per channel the rms of simulation minus log after the settling window and on the
-    diagnosis' held-out part (the last ``1 - split`` of the log) [SI].  The log is read as recorded (its
+    diagnosis' held-out part (the last ``1 - split`` of the simulated span of the log, as the diagnosis splits
+    its span) [SI].  The log is read as recorded (its
     ``[measurement]`` mapping, no reading effect undone) and the simulation as the rig's sensors read it under
     the file (its ``[[effects]]`` readings applied: ``simulate`` records the plant's true channels), as
     :func:`replay_files` compares.  None when the heave file holds none of wob, stroke, pressure.
@@ -239,6 +240,9 @@ def against_log(t, channels: dict, log, params, *, split=0.67, settle=None) -> d
     chans = R.present(raw)
     if not chans:
         return None
+    end = min(float(t[-1]), raw.duration)  # the simulated span: a shorter simulation is split on its own length
+    if end < raw.duration:
+        raw = SP.cut(raw, SP.Span(0.0, end, raw.duration, "simulated", f"the simulated 0-{end:g} s"))
     sp = R.split_of(raw, split, settle)
     tl = raw.t - raw.t[0]
     inside = tl <= t[-1] + 1e-9

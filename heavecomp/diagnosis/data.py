@@ -190,7 +190,8 @@ def _checked_run(s, params, string_weight) -> MeasuredRun:
     fixes = reading_effects(params) if params is not None else []
     if fixes:  # [[effects]] sensor effects: the log is read as the rig truly moved (docs/contracts/parameter-file.md)
         data, notes = correct(fixes, t, data)
-    run = check_run(t, data, params=params, source=s.source, rows=s.rows)
+    run = check_run(t, data, params=params, source=s.source, rows=s.rows,
+                    wob_from=(s.measurement or {}).get("wob_from"))
     run.warnings[:0] = s.warnings
     run.measurement = dict(s.measurement or {}, corrections=notes) if fixes else s.measurement
     return quality.checked(run, params, rows=s.rows)  # corruption: refused, or warned about with a confidence cap
@@ -233,7 +234,7 @@ def wob_from_hook_load(data: dict, series, string_weight) -> None:
     m["conversions"] = list(m.get("conversions", [])) + [f"wob: string weight {w:.6g} N - hook_load"]
 
 
-def check_run(t, columns: dict, *, params=None, source="<array>", rows=None) -> MeasuredRun:
+def check_run(t, columns: dict, *, params=None, source="<array>", rows=None, wob_from=None) -> MeasuredRun:
     """Check arrays against the contract (see the module docstring); returns a :class:`MeasuredRun`.
 
     ``rows`` (optional) gives the file line of each sample, for messages (default: header on
@@ -252,6 +253,8 @@ def check_run(t, columns: dict, *, params=None, source="<array>", rows=None) -> 
         Name of the data's origin, for messages.
     rows : sequence of int, optional
         File line of each sample, for messages; None: header on line 1, one sample per line.
+    wob_from : dict or None
+        How the WOB was derived from a hook load (:func:`check_units`).
     """
 
     t = np.asarray(t, dtype=float)
@@ -283,7 +286,7 @@ def check_run(t, columns: dict, *, params=None, source="<array>", rows=None) -> 
                         "actual times, spectra a uniform resampling")
     run = MeasuredRun(t=t - t[0], columns=columns, source=source, warnings=warnings)
     if params is not None:
-        check_units(run, params)
+        check_units(run, params, wob_from=wob_from)
     return run
 
 
@@ -367,7 +370,7 @@ def _check_mean(run, src, column, unit, symbol, nominal, band, other_units, hint
                         f"{nominal:.4g} {unit} ({hint})")
 
 
-def check_units(run: MeasuredRun, params) -> None:
+def check_units(run: MeasuredRun, params, *, wob_from=None) -> None:
     """Compare channel magnitudes with the nominal operating point; DataError naming the likely unit.
 
     Pressure: the mean gauge pressure should be near p_0 (cmc-reference.md); a mean near
@@ -380,6 +383,9 @@ def check_units(run: MeasuredRun, params) -> None:
         The measured run.
     params : heavecomp.params.CMCParams
         Nominal parameters (p_0 [Pa], the WOB set-point W_0 [N]).
+    wob_from : dict or None
+        How the WOB was derived from the hook load (``measurement.wob_from``, :func:`wob_from_hook_load`): a bad
+        mean is then the hook load's or the string weight's, and the message names them.
     """
     src = run.source
     p0 = params.p0
@@ -394,9 +400,15 @@ def check_units(run: MeasuredRun, params) -> None:
                     ((1e-5, "bar"), (1e-3, "kPa"), (1e-6, "MPa"), (1.45038e-4, "psi")),
                     "wrong unit, absolute pressure of another rig, or wrong parameter file?")
     if "wob" in have:
-        _check_mean(run, src, "wob", "N", "W_0", W0, (0.05, 20.0),
-                    ((1e-3, "kN"), (1.0 / 9810.0, "tonnes"), (1.0 / 4448.22, "kip")),
-                    "wrong unit or wrong parameter file?")
+        try:
+            _check_mean(run, src, "wob", "N", "W_0", W0, (0.05, 20.0),
+                        ((1e-3, "kN"), (1.0 / 9810.0, "tonnes"), (1.0 / 4448.22, "kip")),
+                        "wrong unit or wrong parameter file?")
+        except DataError:
+            if not wob_from:
+                raise
+            raise quality.hook_load_error(src, float(np.nanmedian(run["wob"])), wob_from, W0,
+                                          "far from the set-point") from None
     if "stroke" not in have:
         return
     sz = float(np.nanstd(run["heave"]))

@@ -499,15 +499,43 @@ def _still(q: Quality, z) -> bool:
     return True
 
 
+def hook_load_error(src: str, wm: float, wob_from: dict, W0: float, how: str) -> DataError:
+    """The one line for a WOB derived from the hook load (``wob_from``: WOB = string weight - hook load) whose
+    mean ``wm`` [N] is ``how`` (against the set-point ``W0`` [N]): it names the hook load and the string weight,
+    not a 'wob' column the log lacks, and the hook load's likely unit (:func:`_hook_load_unit`).
+
+    Parameters
+    ----------
+    src : str
+        The log's name.
+    wm : float [N]
+        The derived WOB's mean.
+    wob_from : dict
+        The conversion (``string_weight_N``).
+    W0 : float [N]
+        The WOB set-point.
+    how : str
+        How the mean is wrong (e.g. ``"not positive"``).
+    """
+    return DataError(f"{src}: column 'hook_load': the WOB it gives (measurement.string_weight "
+                     f"{wob_from.get('string_weight_N', math.nan):.4g} N - hook_load) has mean {wm:.4g} N, {how} "
+                     f"(nominal W_0 = {W0:.4g} N): the hook load in another unit, or measurement.string_weight "
+                     f"wrong{_hook_load_unit(wm, wob_from)}", option="units")
+
+
 def _hook_load_unit(wm: float, wob_from: dict) -> str:
     """``; it looks like t`` when the hook load, read in another force unit, would give a WOB near the
-    string weight less the set-point (empty otherwise)."""
+    string weight less the set-point; ``; it looks like N`` when it reads a force unit's factor times the string
+    weight (a column in N declared in that unit); empty otherwise."""
     sw = float(wob_from.get("string_weight_N", math.nan))
     hl = sw - wm  # the hook load as read [N]
     for unit in ("kn", "t", "kip", "klbf", "lbf"):
         kind, factor, _ = UNITS[unit]
         if kind == "force" and hl > 0 and abs(hl * factor / sw - 1.0) < 0.5:
             return f"; it looks like {unit if unit != 'kn' else 'kN'}: declare its unit, hook_load={unit if unit != 'kn' else 'kN'}"
+        if kind == "force" and hl > 0 and abs(hl / (factor * sw) - 1.0) < 0.5:
+            return (f"; it reads {hl / sw:.4g} x the string weight, as a column in N declared in "
+                    f"{unit if unit != 'kn' else 'kN'} would: declare its unit, hook_load=N")
     return ""
 
 
@@ -550,11 +578,8 @@ def _magnitudes(q: Quality, cols: dict, params, src: str, wob_from: dict | None 
     wm = float(np.nanmean(w))
     mbg = ds.lower_mass * G
     if (wm >= mbg or wm <= 0) and wob_from:  # the WOB is the string weight less the hook load: name those
-        raise DataError(f"{src}: column 'hook_load': the WOB it gives (measurement.string_weight "
-                        f"{wob_from.get('string_weight_N', math.nan):.4g} N - hook_load) has mean {wm:.4g} N, "
-                        + (f"above the lower mass's weight m_b g = {mbg:.4g} N" if wm > 0 else "not positive")
-                        + f" (nominal W_0 = {W0:.4g} N): the hook load in another unit, or measurement.string_weight "
-                        f"wrong{_hook_load_unit(wm, wob_from)}", option="units")
+        raise hook_load_error(src, wm, wob_from, W0, f"above the lower mass's weight m_b g = {mbg:.4g} N"
+                              if wm > 0 else "not positive")
     if wm >= mbg or wm <= 0:
         raise DataError(f"{src}: column 'wob': mean {wm:.4g} N is "
                         + (f"above the lower mass's weight m_b g = {mbg:.4g} N (the drill string would push; "

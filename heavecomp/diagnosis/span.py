@@ -37,7 +37,8 @@ DEFAULT_SPAN = 600.0
 @dataclasses.dataclass(frozen=True)
 class Span:
     """The analysed stretch: ``start`` and ``end`` [s from the log's first sample], the log's length
-    ``log_duration`` [s], ``rule`` (``"whole"``, ``"user"``, ``"last"``) and a one-line ``reason``."""
+    ``log_duration`` [s], ``rule`` (``"whole"``, ``"user"``, ``"last"``,
+    ``"monitor"``: a segment ``heavecomp monitor --diagnose`` chose) and a one-line ``reason``."""
 
     start: float
     end: float
@@ -116,6 +117,26 @@ def choose(duration: float, span=None, *, min_duration: float = 60.0) -> Span:
                 f"the log is {_length(duration)} long: the diagnosis analyses its last {DEFAULT_SPAN:g} s "
                 f"({a:g}-{duration:.6g} s; the longest run it is validated on, and the plant as it is now), "
                 f"not the whole log; name another span, or monitor the whole log (heavecomp monitor)")
+
+
+def segment(duration: float, start: float, end: float, index: int, *, min_duration: float = 60.0) -> Span:
+    """The span of segment ``index`` that ``heavecomp monitor --diagnose`` chose (``start``-``end`` [s] of a
+    log of ``duration`` [s]): checked as a user's span (:func:`choose`), its rule ``"monitor"``.
+
+    Parameters
+    ----------
+    duration : float [s]
+        The log's length.
+    start, end : float [s]
+        The segment's diagnosed stretch, from the log's first sample.
+    index : int
+        The monitor's segment number.
+    min_duration : float [s]
+        Shortest span diagnosed.
+    """
+    sp = choose(duration, (start, end), min_duration=min_duration)
+    return dataclasses.replace(sp, rule="monitor", reason=f"the monitor's segment {index}, {sp.start:g}-{sp.end:g} s "
+                                                        f"of a {_length(duration)} log")
 
 
 def _length(seconds: float) -> str:

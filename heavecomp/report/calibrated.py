@@ -9,7 +9,7 @@ from pathlib import Path
 
 from heavecomp.diagnosis.calibrate import FILE, Calibrated, write
 from heavecomp.effects.spec import field_units
-from heavecomp.report.commands import command
+from heavecomp.report.commands import command, span_text
 from heavecomp.report.provenance import strip_declared
 
 
@@ -25,7 +25,7 @@ def _value(name: str, key: str, value) -> str:
 
 
 def what_next(cal: Calibrated, out_dir, *, run_path: str = "LOG", params_path: str = "NOMINAL.toml",
-              columns=None, units=None, duration: float = 600.0) -> list[str]:
+              columns=None, units=None, duration: float = 600.0, span=None) -> list[str]:
     """Markdown lines of the "What next" section: what to change (the parameter, the effect, or
     nothing), the calibrated file, and the exact commands that use it -- each one runs as printed from the
     folder the diagnosis was run in (the final output folder, the log's ``--columns``/``--units``).
@@ -45,10 +45,15 @@ def what_next(cal: Calibrated, out_dir, *, run_path: str = "LOG", params_path: s
         ``params_path``; ``calibrated.toml`` records it in its ``[measurement]`` table).
     duration : float [s]
         The diagnosed span's length: the simulations run as long as the log.
+    span : heavecomp.diagnosis.span.Span, optional
+        The stretch of the log diagnosed; not the whole log, the commands that read the log act on it
+        (``--span START:END``), and ``simulate --heave-file`` (which drives the log from its start) and
+        ``monitor`` (the whole log) are left out.
     """
     out = Path(out_dir)
     f = (out / FILE).as_posix()
     dur = f"{max(1.0, math.floor(duration)):g}"
+    part = () if span is None or span.whole else ("--span", span_text(span.start, span.end))
     lines = ["", "## What next", ""]
     if not cal.changes:
         lines.append(f"Nothing to change in `{params_path}`: {cal.why[0] if cal.why else 'no change'}. "
@@ -74,12 +79,12 @@ def what_next(cal: Calibrated, out_dir, *, run_path: str = "LOG", params_path: s
             lines.append(f"- Add the effect **`{c['name']}`** to the model: "
                          + ", ".join(_value(c["name"], k, v) for k, v in c["parameters"].items()) + ".")
     if not cal.changes:  # the file stays: what is left to do with it is to use it
-        lines += ["", f"Commands that use it (the controller on the rig as this file describes it; the log "
-                      f"followed for a change):", "", "```",
+        lines += ["", "Commands that use it (the controller on the rig as this file describes it"
+                      + ("" if part else "; the log followed for a change") + "):", "", "```",
                   command("heavecomp", "simulate", params_path, "--duration", dur, "--controller", "linear-mpc",
                           "--out", (out / "mpc").as_posix()),
-                  command("heavecomp", "monitor", run_path, "--params", params_path, "--out",
-                          (out / "monitor").as_posix(), columns=columns, units=units),
+                  *(() if part else (command("heavecomp", "monitor", run_path, "--params", params_path, "--out",
+                                             (out / "monitor").as_posix(), columns=columns, units=units),)),
                   "```"]
         return lines
     lines += ["", f"`{f}` is `{params_path}` with these changes (expected held-out shrink of the gap "
@@ -87,25 +92,28 @@ def what_next(cal: Calibrated, out_dir, *, run_path: str = "LOG", params_path: s
                   "(`[measurement]`), and every command reads it:"]
     lines += ["", "```",
               command("heavecomp", "params", f, "-q"),
-              command("heavecomp", "replay", run_path, "--params", params_path, "--params", f, "--out",
+              command("heavecomp", "replay", run_path, "--params", params_path, "--params", f, *part, "--out",
                       (out / "replay").as_posix(), columns=columns, units=units),
-              command("heavecomp", "simulate", f, "--heave-file", run_path, "--duration", dur, "--out",
-                      (out / "calibrated_sim").as_posix()),
+              *(() if part else (command("heavecomp", "simulate", f, "--heave-file", run_path, "--duration", dur,
+                                         "--out", (out / "calibrated_sim").as_posix()),)),
               command("heavecomp", "analyse", f, "--out", (out / "calibrated_analysis").as_posix()),
               command("heavecomp", "simulate", f, "--duration", dur, "--controller", "linear-mpc",
                       "--out", (out / "calibrated_mpc").as_posix()),
-              command("heavecomp", "diagnose", run_path, "--params", f, "--out", (out / "rediagnosis").as_posix()),
+              command("heavecomp", "diagnose", run_path, "--params", f, *part, "--out",
+                      (out / "rediagnosis").as_posix()),
               "```",
               "", "The replay shows the log under both files (the calibrated one should shrink the held-out gap by "
                   "the expected shrink; on a log from another day or sea state it is the test of the calibration); "
-                  "the simulation drives the calibrated file with the log's own heave and reports its WOB error "
-                  "against the log; the last command re-diagnoses: it should read `none`, or a gap smaller by at "
+                  + ("the simulation drives the calibrated file with the log's own heave and reports its WOB error "
+                     "against the log; " if not part else
+                     f"the replay and the re-diagnosis act on the diagnosed span {part[1]} s, as the diagnosis did; ")
+                  + "the last command re-diagnoses: it should read `none`, or a gap smaller by at "
                   "least the expected shrink."]
     return lines
 
 
 def write_calibrated(params, out_dir, *, run_path: str, params_path: str, run=None, policy=None, shown_dir=None,
-                     columns=None, units=None) -> Calibrated:
+                     columns=None, units=None, span=None) -> Calibrated:
     """Write ``out_dir/calibrated.toml`` from ``out_dir/diagnosis.json``, add the ``calibrated`` block to
     ``diagnosis.json`` and the "What next" section to ``report.md``; returns the :class:`Calibrated`.
 
@@ -129,6 +137,8 @@ def write_calibrated(params, out_dir, *, run_path: str, params_path: str, run=No
         writing into a staging folder passes its final folder).
     columns, units : dict, optional
         The log's mapping as given on the command line (:func:`what_next`).
+    span : heavecomp.diagnosis.span.Span, optional
+        The stretch of the log diagnosed (:func:`what_next`).
     """
     out = Path(out_dir)
     jpath = out / "diagnosis.json"
@@ -143,6 +153,7 @@ def write_calibrated(params, out_dir, *, run_path: str, params_path: str, run=No
         md.write_text(md.read_text(encoding="utf-8").rstrip("\n") + "\n"
                       + "\n".join(what_next(cal, out if shown_dir is None else shown_dir, run_path=run_path,
                                              params_path=params_path, columns=columns, units=units,
-                                             duration=run.duration if run is not None else 600.0)) + "\n",
+                                             duration=run.duration if run is not None else 600.0, span=span))
+                      + "\n",
                       encoding="utf-8")
     return cal

@@ -36,4 +36,16 @@ def command(*words, columns=None, units=None) -> str:
     return shlex.join(argv)
 
 
-__all__ = ["command", "mapping_text"]
+def span_text(start: float, end: float) -> str:
+    """``--span``'s value for the stretch ``start``-``end`` [s from the log's first sample], exact enough that the
+    command acts on the same samples (``1200.25:1800``; :func:`heavecomp.diagnosis.span.parse` reads it).
+
+    Parameters
+    ----------
+    start, end : float [s]
+        The stretch.
+    """
+    return f"{start:.10g}:{end:.10g}"
+
+
+__all__ = ["command", "mapping_text", "span_text"]

@@ -10,6 +10,7 @@ import numpy as np
 from heavecomp.diagnosis.components import UNITS
 from heavecomp.diagnosis.monitor import block_gap
 from heavecomp.effects.base import COMPONENTS
+from heavecomp.report.commands import command, span_text
 from heavecomp.report.figures import _plt, save
 from heavecomp.report.scenario import _clean as clean
 from heavecomp.report.scenario import md_table
@@ -178,7 +179,7 @@ def report_markdown(res, source="", figure="timeline.png", diagnosed=()) -> str:
     return "\n".join(lines) + "\n"
 
 
-def diagnosed_lines(spans, log, params, out) -> list:
+def diagnosed_lines(spans, log, params, out, *, columns=None, units=None) -> list:
     """The report's lines on each diagnosed segment: its folder (what ``heavecomp diagnose --span`` writes:
     ``diagnosis.json``, ``report.md``/``.html``, the figures, ``calibrated.toml``) and the command that
     diagnoses that span again.
@@ -191,14 +192,14 @@ def diagnosed_lines(spans, log, params, out) -> list:
         The log and the parameter file as the user named them.
     out : str or Path
         The monitor's output folder as the user named it.
+    columns, units : dict, optional
+        The log's mapping as given on the command line (the command reads the log with ``params``).
     """
-    import shlex
-
     lines = []
     for i, (a, b) in sorted(spans.items()):
         folder = Path(out) / f"segment_{i}"
-        cmd = " ".join(shlex.quote(w) for w in ("heavecomp", "diagnose", str(log), "--params", str(params),
-                                                 "--span", f"{a:.0f}:{b:.0f}", "--out", str(folder)))
+        cmd = command("heavecomp", "diagnose", str(log), "--params", str(params), "--span", span_text(a, b),
+                      "--out", str(folder), columns=columns, units=units)
         lines += [f"- segment {i}, {a:.0f}-{b:.0f} s: [`{folder.name}/report.md`]({folder.name}/report.md), "
                   f"`{folder.name}/calibrated.toml`; the same diagnosis: `{cmd}`"]
     return lines

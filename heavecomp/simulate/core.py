@@ -276,8 +276,10 @@ def simulate(params, duration: float, *, dt: float | None = None, rate: float = 
     measured = hs
     for e in heave_fx:  # the heave the plant sees is not the measured one
         hs = e.transform(hs)
+    own_step = h <= default_dt(params, rate) * (1 + 1e-9)  # stable for the plant without its effects
     result = run_kernel(plant_vectors(params), hs, h, n_steps, out_every, u_active=u_active, progress=progress,
-                        effects=plant_fx)
+                        effects=plant_fx, labels=effect_labels(params if effects is None else effects, plant_fx),
+                        step_advice=not own_step)
     data, stats, wall = result
     if heave_fx:  # the recorded heave is the measured one (interpolated as the stepper does)
         data[:, CHANNELS.index("heave")] = [heave_at(ti, measured.spacing, measured.z, measured.dz, measured.ddz)[0]
@@ -292,7 +294,31 @@ def simulate(params, duration: float, *, dt: float | None = None, rate: float = 
                             wall_time=wall, stats_start=stats_start)
 
 
-def run_kernel(plant, hs, h, n_steps, out_every, *, u_active=0.0, progress=None, chunk_steps=200_000, effects=()):
+def effect_labels(given, effects) -> list:
+    """``effects[i] (name)`` for each instance of ``effects``, ``i`` its place in ``given`` (the file's
+    ``[[effects]]``: a CMCParams, or the sequence of effects passed), so a message points at the entry to fix.
+
+    Parameters
+    ----------
+    given : CMCParams or sequence
+        Where the effects came from: a parameter set (its ``effects`` specs) or the effects passed.
+    effects : sequence of Effect
+        The instances (a subset of ``given``'s, in its order).
+    """
+    entries = list(getattr(given, "effects", given) or ())
+    names = [e[0] if isinstance(e, tuple) else (e if isinstance(e, str) else getattr(e, "name", str(e)))
+             for e in entries]
+    out, i = [], 0
+    for e in effects:
+        name = getattr(e, "name", str(e))
+        j = next((k for k in range(i, len(names)) if names[k] == name), None)
+        out.append(f"effects[{j}] ({name})" if j is not None else name)
+        i = i if j is None else j + 1
+    return out
+
+
+def run_kernel(plant, hs, h, n_steps, out_every, *, u_active=0.0, progress=None, chunk_steps=200_000, effects=(),
+               labels=None, step_advice=True):
     """Run the compiled stepper from rest (stuck) at the operating point.
 
     Returns ``(data, stats, wall)``: the output rows (columns :data:`CHANNELS`), the stepper's
@@ -318,6 +344,11 @@ def run_kernel(plant, hs, h, n_steps, out_every, *, u_active=0.0, progress=None,
         Steps per call of the compiled stepper (between progress calls).
     effects : sequence of Effect
         Effect instances at the plant's hooks (:func:`heavecomp.simulate.stepper.plant_stepper`).
+    labels : sequence of str, optional
+        How a divergence names each effect (:func:`effect_labels`; default their names).
+    step_advice : bool
+        A divergence with effects also advises a smaller step (False: the step is the plant's own stable
+        default, so the effects are the cause).
     """
     n_out = n_steps // out_every + 1
     out = np.empty((n_out, NCH))
@@ -343,10 +374,14 @@ def run_kernel(plant, hs, h, n_steps, out_every, *, u_active=0.0, progress=None,
                                   f"{spike[0]:.3g} m/s^2 at t = {spike[1]:g} s, beyond the {HEAVE_ACCEL_MAX:g} m/s^2 "
                                   f"a rig floor can reach: check the heave input for a spike or a gap there")
         if effects:  # the terms the file adds are the likeliest cause: name them, not only the step
-            names = ", ".join(dict.fromkeys(getattr(e, "name", str(e)) for e in effects))
-            raise SimulationError(f"the stepper diverged near t = {t_div:g} s (non-finite state) with the effects "
-                                  f"{names} at the plant's hooks: check their sizes ([[effects]]), or reduce the step "
-                                  f"dt (now {h:g} s)", option="dt")
+            names = ", ".join(labels or dict.fromkeys(getattr(e, "name", str(e)) for e in effects))
+            one = len(effects) == 1
+            raise SimulationError(f"the stepper diverged near t = {t_div:g} s (non-finite state) with "
+                                  f"{names} at the plant's hooks: check {'its size' if one else 'their sizes'} "
+                                  f"([[effects]])" + (f", or reduce the step dt (now {h:g} s)" if step_advice else
+                                                      f" (the step {h:g} s is stable for the plant without "
+                                                      f"{'it' if one else 'them'})"),
+                                  option="dt" if step_advice else "effects")
         raise SimulationError(f"the stepper diverged near t = {t_div:g} s (non-finite state); "
                               f"reduce the step dt (now {h:g} s) or check the parameters", option="dt")
     spike = heave_accel_outlier(hs, data[-1, 0] if len(data) else 0.0)
