@@ -5,9 +5,6 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-#: shortest run diagnosed [s]: a third held out must still hold a few 5-20 s wave periods
-MIN_DURATION = 60.0
-
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     """Add the arguments of ``heavecomp diagnose`` to its parser.
@@ -91,10 +88,8 @@ def run(args) -> int:
 
     check_read_memory(estimate_rows(args.run), source=short(args.run))  # the whole-log pass, before reading
     run_ = load_run(args.run, params, columns=columns, units=units)  # read in chunks, checked whole
-    if run_.duration < MIN_DURATION:
-        raise InputError(f"{run_.source}: column 't': the run spans {run_.duration:.3g} s; diagnose needs at least "
-                         f"{MIN_DURATION:g} s (a fitted and a held-out part of several wave periods each)")
-    span = SP.choose(run_.duration, wanted, min_duration=MIN_DURATION)
+    SP.check_length(run_, "diagnose", "run")
+    span = SP.choose(run_.duration, wanted)
     run_ = SP.cut(run_, span)  # the whole log's arrays are dropped here
     check_memory(run_, params, args.jobs)  # the whole diagnosis' memory (fit checks it too): refused in one line
     if not span.whole:  # never silent, --quiet or not

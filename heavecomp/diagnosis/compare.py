@@ -38,8 +38,6 @@ from heavecomp.errors import InputError
 
 #: SI units of the compared channels (replay.json ``units``)
 UNITS = {"wob": "N", "stroke": "m", "pressure": "Pa"}
-#: shortest log replayed [s]: the diagnosis' own (a fitted and a held-out part of several wave periods)
-MIN_DURATION = 60.0
 
 
 @dataclasses.dataclass
@@ -117,10 +115,8 @@ def _read(log, params, name, columns, units, span):
         run = load_run(log, params, columns=columns, units=units)
     except InputError as exc:
         raise type(exc)(f"reading the log with {name}: {exc}") from None
-    if run.duration < MIN_DURATION:
-        raise InputError(f"{run.source}: column 't': the log spans {run.duration:.3g} s; replay needs at least "
-                         f"{MIN_DURATION:g} s (a fitted and a held-out part of several wave periods each)")
-    sp = SP.choose(run.duration, span, min_duration=MIN_DURATION)
+    SP.check_length(run, "replay", "log")
+    sp = SP.choose(run.duration, span)
     return SP.cut(run, sp), sp
 
 

@@ -87,7 +87,28 @@ def parse(text) -> tuple:
     return tuple(out)
 
 
-def choose(duration: float, span=None, *, min_duration: float = 60.0) -> Span:
+
+#: shortest log (or span) diagnosed or replayed [s]: a third held out must still hold a few 5-20 s wave periods
+MIN_DURATION = 60.0
+
+
+def check_length(run, command: str = "diagnose", noun: str = "run") -> None:
+    """Refuse a log shorter than :data:`MIN_DURATION`, in one line naming its time column.
+
+    Parameters
+    ----------
+    run : heavecomp.diagnosis.data.MeasuredRun
+        The log as read.
+    command : str
+        The command named in the message (``diagnose``, ``replay``).
+    noun : str
+        What the message calls the log (``run``, ``log``).
+    """
+    if run.duration < MIN_DURATION:
+        raise InputError(f"{run.source}: column 't': the {noun} spans {run.duration:.3g} s; {command} needs at least "
+                         f"{MIN_DURATION:g} s (a fitted and a held-out part of several wave periods each)")
+
+def choose(duration: float, span=None, *, min_duration: float = MIN_DURATION) -> Span:
     """The span of a log of ``duration`` [s] the diagnosis analyses (the rule in the module docstring).
 
     Parameters
@@ -119,7 +140,7 @@ def choose(duration: float, span=None, *, min_duration: float = 60.0) -> Span:
                 f"not the whole log; name another span, or monitor the whole log (heavecomp monitor)")
 
 
-def segment(duration: float, start: float, end: float, index: int, *, min_duration: float = 60.0) -> Span:
+def segment(duration: float, start: float, end: float, index: int, *, min_duration: float = MIN_DURATION) -> Span:
     """The span of segment ``index`` that ``heavecomp monitor --diagnose`` chose (``start``-``end`` [s] of a
     log of ``duration`` [s]): checked as a user's span (:func:`choose`), its rule ``"monitor"``.
 
