@@ -47,6 +47,7 @@ import numpy as np
 
 from heavecomp.diagnosis import GapDiagnoser, load_run, quality
 from heavecomp.diagnosis.data import check_run
+from heavecomp.effects.candidates import family_of, same_family
 from heavecomp.errors import InputError
 from heavecomp.benchmark import Case, corruption, generate, NEAR_NOISE, parameter_sets, validation_cases
 from heavecomp.params import load
@@ -99,7 +100,7 @@ def _diagnose(tr, kind, workdir: Path, n_jobs: int) -> dict:
     ch = v.get("shrink_channel", "wob")
     true = tr.true_shrink(d.split)
     return {**_distinguish_record(d), "kind": kind, "verdict": v["effect"], "confidence": v["confidence"],
-            "component": v.get("component"),
+            "component": v.get("component"), "law": v.get("law"), "member": v.get("member"),
             "discovered": (v.get("discovered") or {}).get("term"), "shrink": float(v["shrink"]),
             "shrink_channel": ch, "true_shrink": None if true is None else true[ch],
             "explained": v.get("explained"), "gap_to_noise_diagnosed": v.get("gap_to_noise"),
@@ -153,7 +154,8 @@ def run_case(case, workdir, n_jobs=1) -> dict:
 def judge(row) -> dict:
     """How the verdict counts (diagnosis-contract.md, "How it will be checked"):
 
-    - named and two-effect runs: right when the verdict is the (dominant) withheld effect and its
+    - named and two-effect runs: right when the verdict is the (dominant) withheld effect's class (its
+      contract family: a ``friction_lag`` verdict of either law for a frictional-memory truth) and its
       held-out shrink is real (>= :data:`SHRINK_REAL`);
     - no-effect runs: right when the verdict is ``none``;
     - out-of-library runs: a named effect with medium or high confidence is a failure; right when
@@ -166,13 +168,16 @@ def judge(row) -> dict:
     lab, cat = row["label"], row["category"]
     named = v["verdict"] not in NOT_NAMED
     confident = v["confidence"] in ("medium", "high")
-    out = {"confident_wrong": bool(named and confident and v["verdict"] != lab),
+    # the contract's class: a verdict of a family (friction_lag, either law) is right for a truth of that class
+    hit = same_family(v["verdict"], lab)
+    out = {"confident_wrong": bool(named and confident and not hit),
            "component_right": v["component"] is not None and v["component"] == row["truth"]["component"]}
     if cat in ("named", "two_effects"):
-        out["right"] = v["verdict"] == lab and v["shrink"] >= SHRINK_REAL
+        out["right"] = hit and v["shrink"] >= SHRINK_REAL
         # issue 30: the right group (at most three members) where the log cannot tell them apart
         group = v.get("group") or []
-        out["group_right"] = out["right"] or (lab in group and len(group) <= 3 and v["shrink"] >= SHRINK_REAL)
+        out["group_right"] = out["right"] or (family_of(lab) in {family_of(g) for g in group} and len(group) <= 3
+                                              and v["shrink"] >= SHRINK_REAL)
     elif cat == "none":
         out["right"] = v["verdict"] == "none"
         out["confident_wrong"] = v["verdict"] != "none" and confident
@@ -180,7 +185,7 @@ def judge(row) -> dict:
         out["confident_wrong"] = bool(named and confident)
         out["right"] = out["component_right"] and not out["confident_wrong"]
     else:  # near_noise
-        out["right"] = v["verdict"] == lab or (v["verdict"] in ("none", "inconclusive") and not confident)
+        out["right"] = hit or (v["verdict"] in ("none", "inconclusive") and not confident)
     if "cut" in row:
         out["unchanged_when_cut"] = row["cut"]["verdict"] == v["verdict"]
     return out

@@ -256,7 +256,8 @@ def run_case(out: Path, cls: str, seed: int, transfer: str, rescore: bool = Fals
     noise = (d.get("noise", {}).get("output", {}) or {}).get(ch) or NOISE[ch]
     start = d.get("span", {}).get("start_s", 0.0)
     window = tuple(x + start for x in d["split"]["validate"])
-    best = next((c for c in d.get("candidates", []) if c.get("effect") == v.get("effect")), None)
+    # the candidates table names the effect fitted: a family's law (friction_lag, law distance) by its member
+    best = next((c for c in d.get("candidates", []) if c.get("effect") == (v.get("member") or v.get("effect"))), None)
     g_nom = d["gap"]["channels"][ch].get("rms_validate", best["rms_before"] if best else float("nan"))
     # the calibrated model's held-out shrink (a second effect's joint one), else the verdict's
     shrink_cal = (d.get("calibrated") or {}).get("expected_shrink")

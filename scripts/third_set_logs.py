@@ -89,7 +89,8 @@ def diagnose(folder: Path, out: Path) -> None:
         d = GapDiagnoser(nominal, n_jobs=1).fit(run)
         v = d.verdict_
         q = getattr(run, "quality", None)
-        rows[name] = {"expected_component": component, "effect": v["effect"], "confidence": v["confidence"],
+        rows[name] = {"expected_component": component, "effect": v["effect"], "law": v.get("law"),
+                      "member": v.get("member"), "confidence": v["confidence"],
                       "component": v.get("component"), "right_component": v.get("component") == component,
                       "parameters": v.get("parameters"), "explained": v.get("explained"), "shrink": v.get("shrink"),
                       "shrink_channel": v.get("shrink_channel"), "gap_to_noise": v.get("gap_to_noise"),

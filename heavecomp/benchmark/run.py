@@ -9,6 +9,7 @@ import numpy as np
 from heavecomp.benchmark.case import benchmark_cases, CASES
 from heavecomp.benchmark.generate import generate
 from heavecomp.diagnosis import GapDiagnoser
+from heavecomp.effects.candidates import same_family
 
 
 def run_benchmark(quick=False, duration=None, progress=None, n_jobs=2, max_nfev=None, seed0=1000):
@@ -55,7 +56,11 @@ def run_benchmark(quick=False, duration=None, progress=None, n_jobs=2, max_nfev=
                "second_tried": [s["effect"] for s in d.second_tried_],
                "best_partner": max(d.second_tried_, key=lambda s: s["added_explained"])["effect"] if d.second_tried_ else None,
                "stuck_share": tr.truth["stick"]["stuck_share"], "sea": tr.truth["sea"]}
-        row["correct"] = row["verdict"] == row["truth"]
+        row["law"] = v.get("law")  # a family's law (friction_lag: time or distance) and the effect fitted
+        row["member"] = v.get("member")
+        # right when the verdict names the truth's contract class (a friction_lag verdict of either law for a
+        # frictional-memory truth: diagnosis-contract.md's effect table, issue 30 item 4)
+        row["correct"] = same_family(row["verdict"], row["truth"])
         rows.append(row)
         if progress:
             progress((i + 1) / len(cases), f"{'+'.join(effects)} -> {v['effect']} ({v['confidence']}), "
@@ -78,7 +83,7 @@ def summarize(rows):
     truths = [lab for lab in CASES if any(r["truth"] == lab for r in rows)]
     cm = {tl: {vl: 0 for vl in labels} for tl in truths}
     for r in rows:
-        cm[r["truth"]][r["verdict"] if r["verdict"] in labels else "inconclusive"] += 1
+        cm[r["truth"]][r["verdict"] if r["verdict"] in labels else "inconclusive"] += 1  # verdicts: contract names
     eff = [r for r in rows if r["truth"] != "none" and r["correct"]]
     shr = [r["shrink"] for r in rows if r["truth"] != "none"]
     two = [r for r in rows if r["truth_second"]]

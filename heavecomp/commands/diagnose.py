@@ -108,7 +108,9 @@ def run(args) -> int:
                         columns=columns, units=units, shown_dir=final(args))
     v = d.verdict_
     extra = f", second effect {v['second_effect']['effect']}" if v.get("second_effect") else ""
-    print(f"verdict: {v['effect']} (confidence {v['confidence']}), held-out shrink {v['shrink']:.2f} "
+    from heavecomp.diagnosis.verdict import label
+
+    print(f"verdict: {label(v)} (confidence {v['confidence']}), held-out shrink {v['shrink']:.2f} "
           f"on {v.get('shrink_channel', 'wob')}{extra} -> {Path(final(args)) / 'diagnosis.json'}, calibrated model "
           f"({len(cal.changes)} change{'s' if len(cal.changes) != 1 else ''}) -> {Path(final(args)) / 'calibrated.toml'}")
     return 0

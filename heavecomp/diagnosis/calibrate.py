@@ -10,6 +10,8 @@ verdict                           calibrated.toml
 ================================  ============================================================
 a plant effect (``string_damping``,  an ``[[effects]]`` entry with the fitted values (the plant
 ``dwell_stiction``, ...)            changes: ``simulate``, ``analyse``, the MPCs use it)
+a law of a family (``friction_lag``,  the fitted member's entry (``name = "friction_memory"``): the class
+``law = "distance"``)                 that was fitted, with its values (``verdict.member``)
 ``parameter_mismatch``            the refitted values in their tables (F_C clipped to F_S, as the fit),
                                   and ``[anchor]``: the values they were refitted from (kept from the
                                   file when it has one), the centre of a re-diagnosis' refit box
@@ -48,6 +50,7 @@ import numpy as np
 from heavecomp.diagnosis.estimator import GapDiagnoser
 from heavecomp.diagnosis.data import MeasuredRun, load_run
 from heavecomp.diagnosis import replay as R
+from heavecomp.diagnosis import verdict as V
 from heavecomp.effects.candidates import MISMATCH_KEYS, ParameterMismatch
 from heavecomp.effects.discovered_term import COMPONENT as DISCOVERED_COMPONENT
 from heavecomp.effects.discovered_term import FEATURES as DISCOVERED_FEATURES
@@ -163,8 +166,8 @@ def calibrate(nominal, diagnosis: dict) -> Calibrated:
     Calibrated
     """
     v = diagnosis["verdict"]
-    eff = v["effect"]
-    out = Calibrated(nominal, verdict=eff, expected_shrink=float(v.get("shrink", 0.0)))
+    eff = V.member(v)  # the effect fitted: a family's law is carried as its member class (friction_memory)
+    out = Calibrated(nominal, verdict=v["effect"], expected_shrink=float(v.get("shrink", 0.0)))
     if eff in ("none", "inconclusive"):
         out.why.append(_unchanged(v))
         out.expected_shrink = 0.0
@@ -187,7 +190,7 @@ def calibrate(nominal, diagnosis: dict) -> Calibrated:
     elif not _add_form(out, v, add):  # the named law (its open-search form, when that fits better)
         add(eff, v.get("parameters", {}))
         role = out.changes[-1]["role"]
-        out.why.append(f"diagnosis verdict: {eff} (confidence {v.get('confidence', '?')}) -- "
+        out.why.append(f"diagnosis verdict: {V.label(v)} (confidence {v.get('confidence', '?')}) -- "
                        + ("a sensor that misreads: the [[effects]] entry corrects how a log is read (the plant is "
                           "unchanged)" if role == "reading" else "the effect is added at its hook with the fitted "
                                                                  "values"))
@@ -347,14 +350,14 @@ def _add_form(out: Calibrated, v: dict, add) -> bool:
         ``add(name, values)``: adds an effect entry.
     """
     d = v.get("form") or {}
-    hooked = _plant_term(d) if d.get("replaces") == v["effect"] else None
+    hooked = _plant_term(d) if d.get("replaces") == V.member(v) else None
     if hooked is None:
         return False
     named = d.get("named", {})
     return _carry(out, add, *hooked, d, lead=(
-        f"diagnosis verdict: {v['effect']} (confidence {v.get('confidence', '?')}), carried in the form the open "
+        f"diagnosis verdict: {V.label(v)} (confidence {v.get('confidence', '?')}), carried in the form the open "
         f"search gave its {d.get('component', '?')} residual (held-out shrink {d.get('shrink', 0.0):.2f} against "
-        f"{named.get('shrink', 0.0):.2f} for the {v['effect']} law; a lower fit-part BIC)"))
+        f"{named.get('shrink', 0.0):.2f} for the {V.member(v)} law; a lower fit-part BIC)"))
 
 
 def _carry(out: Calibrated, add, name: str, values: dict, what: str, d: dict, lead: str = "") -> bool:

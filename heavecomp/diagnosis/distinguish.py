@@ -50,6 +50,7 @@ from heavecomp.diagnosis.data import MeasuredRun, uniform
 from heavecomp.diagnosis.replay import CH
 from heavecomp.diagnosis.stepper import replay_dt
 from heavecomp.diagnosis.where import wave_band
+from heavecomp.effects.candidates import by_family, family_of
 from heavecomp.plants.cmc import plant_vectors
 from heavecomp.simulate.excitation import jonswap, spectral_hs_tp
 
@@ -282,8 +283,10 @@ def distinguish(ctx, fits, perturbed, policy, nominal_pert=None) -> Distinguisha
     """
     P = policy
     block = block_length(ctx.run, P)
-    lead = list(fits[:P.distinguish_leading])
-    lead += [f for f in fits[P.distinguish_leading:] if f.effect == "parameter_mismatch"]
+    # the leading families (two laws of one family count once: both are tested, neither crowds out a rival)
+    top = within_families([f.effect for f in fits], P.distinguish_leading)
+    lead = [f for f in fits if f.effect in top]
+    lead += [f for f in fits if f.effect not in top and f.effect == "parameter_mismatch"]
     # an explanation explains: a candidate under min_explained is no named verdict's rival (a short held-out
     # part has few blocks, and the test alone would keep it in the group)
     lead = [f for f in lead if f.pred is not None and math.isfinite(f.explained) and f.effect in perturbed
@@ -303,8 +306,24 @@ def distinguish(ctx, fits, perturbed, policy, nominal_pert=None) -> Distinguisha
     if nominal_pert is None:  # the nominal's draws the preparation replayed (not twice)
         nominal_pert = list(ctx.nominal_pert) or [ctx.simulate([], hs=hs) for hs in ctx.hs_pert]
     n, k = null_pairs(ctx, [nominal_pert, perturbed.get(best.effect, [])], P.distinguish_alpha, block)
-    return Distinguishability(pairs, tuple(together[:P.group_max]), P.distinguish_alpha, n, k, block,
-                              tuple(together[P.group_max:]))
+    inside = within_families(together, P.group_max)
+    return Distinguishability(pairs, inside, P.distinguish_alpha, n, k, block,
+                              tuple(m for m in together if m not in inside))
+
+
+def within_families(names, n) -> tuple:
+    """The first ``n`` families of ``names`` (best first), every member of each kept: two laws of one
+    contract class (``friction_lag`` in time and in distance) count once towards a group's size.
+
+    Parameters
+    ----------
+    names : sequence of str
+        Effect names, best first.
+    n : int
+        Families kept.
+    """
+    keep = {family_of(m) for m in by_family(names)[:n]}
+    return tuple(m for m in names if family_of(m) in keep)
 
 
 # ------------------------------------------------------------------ what would separate them
@@ -419,6 +438,7 @@ def separate_by(ctx, fits, group, policy, top=3, pairs=()) -> list:
     pairs : sequence of Pair
         The block tests of the group (the longer log's length the test would need).
     """
+    group = by_family(group)  # one member per family: two laws of one class are one answer, not to separate
     if len(group) < 2:
         return []
     P = policy
@@ -428,7 +448,7 @@ def separate_by(ctx, fits, group, policy, top=3, pairs=()) -> list:
     T = float(ctx.run.t[-1])
     hs0, tp = _sea(ctx.run)
     w0 = ctx.replay.nominal.operating_point.wob_setpoint
-    names = ", ".join(f"`{m}`" for m in members[:-1]) + f" and `{members[-1]}`"
+    names = ", ".join(f"`{family_of(m)}`" for m in members[:-1]) + f" and `{family_of(members[-1])}`"
 
     def run(label, text, **kw):
         rp = experiment_replay(ctx, **kw)

@@ -51,7 +51,7 @@ from heavecomp.diagnosis import where as W
 from heavecomp.diagnosis.fitting import at_bounds  # noqa: F401 - public here since issue 14.3
 from heavecomp.diagnosis.policy import VerdictPolicy
 from heavecomp.diagnosis.replay import CH
-from heavecomp.effects.candidates import CANDIDATES, get
+from heavecomp.effects.candidates import CANDIDATES, by_family, family_of, get, same_family
 from heavecomp.errors import InputError
 from heavecomp.estimator import GapEstimator
 from heavecomp.params.budget import check_diagnosis_memory
@@ -371,9 +371,11 @@ class GapDiagnoser(GapEstimator):
             if not ranked:
                 return False
             best_output = get(ranked[0]).kind == "output"
-            allowed = [n for n in ranked[1:] if not (best_output and get(n).kind == "output")]
-            read = ranked[:lead] + allowed[:self.second]
-            if len(ranked) < lead or len(allowed) < self.second:
+            allowed = [n for n in ranked[1:] if not (best_output and get(n).kind == "output")
+                       and not same_family(n, ranked[0])]
+            # the leading families (two laws of one family are no rivals: the runner-up is another family's)
+            read = list(D.within_families(ranked, lead)) + allowed[:self.second]
+            if len(by_family(ranked)) < lead or len(allowed) < self.second:
                 return False
             if min(final[n] for n in read) <= upper[nxt]:
                 return False
@@ -427,14 +429,15 @@ class GapDiagnoser(GapEstimator):
         verdict = V.decide(fits, self.gap_["channels"], self.noise_floor_, self.input_envelope_, P, evidence)
         self.warnings_ += list(verdict.warnings)
         out = verdict.to_json()
-        if len(out.get("group", ())) > 1:  # what would tell the group apart, computed (Box-Hill)
-            self.separate_ = D.separate_by(ctx, fits, out["group"], P, pairs=distinct.pairs if distinct else ())
+        if len(out.get("group", ())) > 1:  # what would tell the group apart, computed (Box-Hill), on its members
+            self.separate_ = D.separate_by(ctx, fits, list(verdict.members), P,
+                                           pairs=distinct.pairs if distinct else ())
             out["separate_by"] = [r["description"] for r in self.separate_]
             out["separate_by_experiments"] = self.separate_
         elif distinct is not None:
             out["separate_by"] = []
         # a named law that is not the plant's: the open search's form of its component, when it fits better
-        form = S.named_form(self.components_, out.get("effect", ""), ctx.fitmask, ctx.valmask) \
+        form = S.named_form(self.components_, V.member(out) or "", ctx.fitmask, ctx.valmask) \
             if P.named_form else None
         if form is not None:
             out["form"] = form
@@ -508,9 +511,11 @@ class GapDiagnoser(GapEstimator):
         named = v.get("effect")
         if named in ("none", "inconclusive", "discovered", None):
             return None
+        named = V.member(v)  # the effect fitted (a law of a family: its member), the table's name
         channel = (v.get("parameters") or {}).get("channel")
         group = ST.group_of(f"{named}:{channel}" if channel else named, self.isolability() if iso is None else iso)
-        return group if group else [named]
+        # in the contract's names: two laws of one family are one entry (issue 30 item 4)
+        return [family_of(m) for m in by_family(group)] if group else [family_of(named)]
 
     def to_json(self) -> dict:
         """The ``diagnosis.json`` content (contract schema 4: ``verdict.group`` tested on the log,

@@ -7,7 +7,7 @@ import math
 
 from heavecomp.diagnosis import fitting as F
 from heavecomp.diagnosis.screen import candidate_component
-from heavecomp.effects.candidates import get
+from heavecomp.effects.candidates import get, same_family
 
 
 @dataclasses.dataclass(frozen=True)
@@ -27,7 +27,8 @@ class SecondSearch:
 def partners(fits, shares, prescreened, n_second, policy) -> list:
     """The runners-up fitted jointly with the best: the ``n_second`` best-ranked, plus the best candidate
     of each other component holding ``second_share`` of the equation-error gap (``shares``).  Any pair
-    works except two output candidates (one transport delay per configuration).
+    works except two output candidates (one transport delay per configuration) and two laws of one
+    family (``friction_lag`` in time and in distance: one answer, :func:`heavecomp.effects.candidates.family_of`).
 
     Parameters
     ----------
@@ -44,7 +45,9 @@ def partners(fits, shares, prescreened, n_second, policy) -> list:
     """
     best = fits[0]
     best_output = get(best.effect).kind == "output"
-    allowed = [r for r in fits[1:] if not (best_output and get(r.effect).kind == "output")]
+    # a second law of the best's own family is the same answer, not a second effect
+    allowed = [r for r in fits[1:] if not (best_output and get(r.effect).kind == "output")
+               and not same_family(r.effect, best.effect)]
     chosen = allowed[:n_second]
     # a second gap in another component: its best candidate, however it ranked alone
     have = {candidate_component(r.effect, r.values, prescreened) for r in [best] + chosen}

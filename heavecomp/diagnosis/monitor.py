@@ -1441,6 +1441,7 @@ def diagnose_segments(result, run, params, *, candidates=None, n_jobs=1, span=DI
         v = d.verdict_
         seg["verdict"] = {"effect": v["effect"], "confidence": v.get("confidence"), "component": v.get("component"),
                           "shrink": v.get("shrink"), "span": [float(a), float(b)]}
+        seg["verdict"].update({k: v[k] for k in ("law", "member") if k in v})  # a family's law and its fitted member
         out[i] = d.to_json()
         if each is not None:
             each(i, d, sub, (float(a), float(b)))

@@ -34,9 +34,11 @@ from heavecomp.diagnosis.screen import candidate_component
 from heavecomp.diagnosis.structure import entries
 from heavecomp.errors import InputError
 from heavecomp.effects.base import COMPONENTS
-from heavecomp.effects.candidates import get
+from heavecomp.effects.candidates import by_family, family_of, get, law_of, same_family
 
 CONFIDENCE = ("low", "medium", "high")
+#: verdicts that name no effect
+NOT_NAMED = ("none", "inconclusive", "discovered")
 
 
 @dataclasses.dataclass(frozen=True)
@@ -79,6 +81,9 @@ class Verdict:
 
     body: dict
     warnings: tuple = ()
+    #: the fitted effects that stand for the verdict's group, one per family, lead first (``body["group"]``
+    #: names their families): what :func:`heavecomp.diagnosis.distinguish.separate_by` simulates
+    members: tuple = ()
 
     @property
     def effect(self) -> str:
@@ -112,7 +117,7 @@ def assess(fits, gap, floors, envelope, policy) -> Assessment:
     """
     P = policy
     best = fits[0]
-    runner = fits[1] if len(fits) > 1 else None
+    runner = rival(fits)
     chans = [c for c in CH if c in gap]  # the channels the log has (the first is the primary)
     ratio = {c: gap[c]["rms_validate"] / max(floors[c], 1e-30) for c in chans}
     margin = best.score - runner.score if runner else 1.0
@@ -132,6 +137,12 @@ def assess(fits, gap, floors, envelope, policy) -> Assessment:
     quiet = input_ratio <= P.none_ratio or (input_ratio <= P.none_tail and best.explained < P.none_explained)
     return Assessment(max(ratio.values()), input_ratio, margin, spread, margin > spread, ch, predicts,
                       quiet and not predicts)
+
+
+def rival(fits):
+    """The runner-up of ``fits`` (best first): the best fit of another family than the best's (two laws of
+    one contract class, ``friction_lag`` in time and in distance, are one answer, never rivals); None."""
+    return next((f for f in fits[1:] if not same_family(f.effect, fits[0].effect)), None)
 
 
 def wants_second(fits, a: Assessment, policy) -> bool:
@@ -202,9 +213,11 @@ def decide(fits, gap, floors, envelope, policy, evidence: Evidence) -> Verdict:
         v = _named(v, fits, a, policy, evidence)
     if evidence.distinct is not None and v["effect"] not in ("inconclusive", "discovered"):
         v["distinguishable"] = evidence.distinct.to_json()
-        if len(group) > 1:
+        if len(by_family(group)) > 1:
             v["group"] = list(group)
             v["group_note"] = _group_note(group, fits, evidence.distinct)
+        if len(by_family(group)) < len(group):
+            v["law_note"] = _law_note(group, evidence.distinct)
         if fits[0] is not by_score:
             _test_lead(v, fits, a, policy, evidence.distinct, by_score)
             p = next((p for p in evidence.distinct.pairs if {p.a, p.b} == {fits[0].effect, by_score.effect}), None)
@@ -215,7 +228,62 @@ def decide(fits, gap, floors, envelope, policy, evidence: Evidence) -> Verdict:
     warnings = []
     _at_bound(v, fits, warnings)
     _component(v, fits, policy, evidence, warnings)
-    return Verdict(v, tuple(warnings))
+    members = tuple(by_family(v.get("group") or [best.effect])) if v["effect"] not in NOT_NAMED else ()
+    _as_family(v)
+    return Verdict(v, tuple(warnings), members)
+
+
+def _as_family(v) -> None:
+    """The verdict in the contract's names (issue 30 item 4): an effect that is one law of a broader class
+    (``fit.family``, ``fit.law``) is named by its family, with ``law`` and the fitted ``member`` beside it
+    (``friction_memory`` -> ``effect: friction_lag, law: distance, member: friction_memory``); its
+    ``parameters`` stay the member's.  A group keeps one name per family, each family's law the better
+    fit's (the first); a group of one family is a single name."""
+    name = v["effect"]
+    if name in NOT_NAMED:
+        return
+    if law_of(name):
+        v.update(effect=family_of(name), law=law_of(name), member=name)
+    if v.get("group"):
+        v["group_members"] = by_family(v["group"])
+        v["group"] = [family_of(m) for m in v["group_members"]]
+
+
+def label(v) -> str:
+    """A verdict's name in words: ``friction_lag (law: distance, fitted as friction_memory)`` for a law of a
+    family, else its ``effect``.
+
+    Parameters
+    ----------
+    v : dict
+        A verdict (``diagnosis.json``'s ``verdict``).
+    """
+    if v.get("law"):
+        return f"{v['effect']} (law: {v['law']}, fitted as {v.get('member', v['effect'])})"
+    return str(v.get("effect"))
+
+
+def member(v) -> str:
+    """The effect a verdict fitted (its class: ``calibrated.toml``'s entry, its parameters' units): the
+    ``member`` of a family's law, else the ``effect``.
+
+    Parameters
+    ----------
+    v : dict
+        A verdict, or a ``second_effect`` block.
+    """
+    return v.get("member") or v.get("effect")
+
+
+def _law_note(group, distinct) -> str:
+    """Why the verdict's family carries the law it does when the log cannot tell two of its laws apart."""
+    lead = group[0]
+    sib = [m for m in group[1:] if same_family(m, lead)]
+    stats = {p.b: p for p in distinct.pairs}
+    st = "; ".join(f"{m}: t = {stats[m].statistic:+.2f} (threshold {stats[m].threshold:.2f})" for m in sib if m in stats)
+    return (f"this log cannot tell the laws of {family_of(lead)} apart ({lead}, law {law_of(lead) or '-'}; "
+            + ", ".join(f"{m}, law {law_of(m) or '-'}" for m in sib) + f"): one answer, the law of the better fit"
+            + (f" ({st})" if st else ""))
 
 
 def _grouped(fits, gap, floors, envelope, P, distinct, a):
@@ -249,7 +317,8 @@ def _test_lead(v, fits, a, P, distinct, by_score) -> None:
     penalty) is not the evidence, the test is.  When the test sets it apart from every leading candidate,
     it is medium (never high: the test's preference, not a margin of ``high_margin``) if it explains
     ``medium_explained`` outside the stick-event-noise tail."""
-    if len(v.get("group") or [v["effect"]]) > 1 or any(not p.apart for p in distinct.pairs):
+    rivals = [p for p in distinct.pairs if not same_family(p.a, p.b)]  # two laws of one family are no rivals
+    if len(by_family(v.get("group") or [v["effect"]])) > 1 or any(not p.apart for p in rivals):
         return
     if fits[0].explained >= P.medium_explained and a.input_ratio > P.none_tail and v["confidence"] == "low":
         v["confidence"] = "medium"
@@ -258,15 +327,15 @@ def _test_lead(v, fits, a, P, distinct, by_score) -> None:
 
 
 def _group_note(group, fits, distinct) -> str:
-    """Why the verdict is a group, in words."""
-    others = ", ".join(f"`{m}`" for m in group[1:])
+    """Why the verdict is a group, in words (two laws of one family named once, by the better's)."""
+    others = ", ".join(f"`{family_of(m)}`" for m in by_family(group)[1:])
     stats = {p.b: p for p in distinct.pairs}
     st = "; ".join(f"{m}: t = {stats[m].statistic:+.2f} (threshold {stats[m].threshold:.2f})"
                    for m in group if m in stats)
     lead = group[0]
     why = (" (the refit of the nominal's own parameters explains as much: no new mechanism is needed)"
            if lead == "parameter_mismatch" else "")
-    return (f"this log cannot tell `{lead}` from {others}{why}; held-out block test at a "
+    return (f"this log cannot tell `{family_of(lead)}` from {others}{why}; held-out block test at a "
             f"{100 * distinct.alpha:g} % false-alarm rate: {st}; the confidence is the group's")
 
 
@@ -324,7 +393,7 @@ def _named(v, fits, a, P, evidence) -> dict:
     elif best.explained >= P.medium_explained and a.margin >= P.medium_margin and a.survives:
         v["confidence"] = "medium"
     if not a.survives:
-        v["note"] = (f"margin to {fits[1].effect} ({a.margin:.3f}) within the spread a heave-noise redraw makes "
+        v["note"] = (f"margin to {(rival(fits) or best).effect} ({a.margin:.3f}) within the spread a heave-noise redraw makes "
                      f"of the explained shares ({a.spread:.3f}): confidence low")
     if a.input_ratio <= P.none_tail and v["confidence"] != "low":
         v["confidence"] = "low"

@@ -96,6 +96,13 @@ class FitSpec:
     """Parameters held at their defaults while the others are fitted as before (coarse start grid and
     Nelder-Mead for two), then released together from that optimum by least squares: a parameter that
     refines the others' law never leaves the fit on the fit part worse than the fit without it."""
+    family: str = ""
+    """The contract's name the diagnosis reports this effect under (``diagnosis-contract.md``, the effect
+    table), when the effect is one law of a broader class: ``friction_memory`` (a memory over sliding
+    distance) is a law of ``friction_lag`` (frictional memory).  Empty: the effect's own ``name``."""
+    law: str = ""
+    """The law of the family this effect is (``"time"``, ``"distance"``): the verdict names the family and
+    carries the law (``verdict.law``) and the effect fitted (``verdict.member``).  Empty: no family of laws."""
 
 
 class Effect:

@@ -183,3 +183,63 @@ def get(name: str) -> type:
     except KeyError:
         raise ParameterError(f"unknown effect {name!r}{did_you_mean(name, known)}; known: "
                              f"{', '.join(known)}") from None
+
+
+# ------------------------------------------------------------------ families of laws (issue 30 item 4)
+def family_of(name) -> str:
+    """The contract's name an effect is reported under: its ``fit.family`` (``friction_memory`` ->
+    ``friction_lag``), else the name itself; a channel effect's ``name:channel`` keeps its channel; a name
+    that is no effect (``none``, ``inconclusive``, a truth label) is returned as it is.
+
+    Parameters
+    ----------
+    name : str
+        An effect name (``"friction_memory"``, ``"sensor_gain:wob"``) or a verdict word.
+    """
+    if not isinstance(name, str):
+        return name
+    base, sep, channel = name.partition(":")
+    cls = {**CANDIDATES, **library()}.get(base)
+    fam = (cls.fit.family if cls is not None else "") or base
+    return fam + sep + channel
+
+
+def law_of(name) -> str:
+    """The law an effect is of its family (``fit.law``: ``"time"``, ``"distance"``), "" when it has none.
+
+    Parameters
+    ----------
+    name : str
+        An effect name.
+    """
+    cls = {**CANDIDATES, **library()}.get(str(name).partition(":")[0])
+    return cls.fit.law if cls is not None else ""
+
+
+def same_family(a, b) -> bool:
+    """Two effect names of one contract class (:func:`family_of`): rivals never, two laws of one answer.
+
+    Parameters
+    ----------
+    a, b : str
+        Effect names.
+    """
+    return family_of(a) == family_of(b)
+
+
+def by_family(names) -> list:
+    """``names`` with only the first of each family kept, in order (the members that stand for their
+    family: the better law first where ``names`` is best first).
+
+    Parameters
+    ----------
+    names : iterable of str
+        Effect names.
+    """
+    seen, out = set(), []
+    for n in names:
+        f = family_of(n)
+        if f not in seen:
+            seen.add(f)
+            out.append(n)
+    return out

@@ -27,6 +27,9 @@ class FrictionLag(Effect):
     name = "friction_lag"
     fit = FitSpec(
         candidate=True,
+        # the contract's frictional memory; this law is the memory in time (friction_memory: in distance)
+        family="friction_lag",
+        law="time",
         # the top-mass balance is blind where the lag acts, at reversals (a lag of 6.5 x its floor on the
         # WOB left the friction residual no gap at all: docs/diagnosis.md, the verdict policy)
         screened=False,

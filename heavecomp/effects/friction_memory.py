@@ -1,7 +1,8 @@
 """``friction_memory``: the seal friction remembers the sliding *distance* since a reversal (seal friction hook).
 
 The distance form of ``friction_lag`` (a memory in time): the two compete in the diagnosis, the held-out
-fit picks.
+fit picks; the verdict names the contract's family ``friction_lag`` with ``law = "distance"`` and
+``member = "friction_memory"`` (``calibrated.toml`` carries this class and its parameters).
 """
 
 from __future__ import annotations
@@ -35,6 +36,11 @@ class FrictionMemory(Effect):
     name = "friction_memory"
     fit = FitSpec(
         candidate=True,
+        # reported as the contract's frictional memory (diagnosis-contract.md: friction_lag, "friction depends
+        # on the velocity history ... pre-sliding"), law "distance": a scorer reading the contract knows no
+        # other name for a LuGre/Dahl memory (issue 30 item 4)
+        family="friction_lag",
+        law="distance",
         # the memory acts in the first sigma after each reversal and breakaway, where the top-mass balance is
         # blind (as for friction_lag): on a generated LuGre bristle at 5 x its floor (scripts/third_set_logs.py,
         # seed 300001) the friction residual showed no gap and the screened candidate was never replayed;

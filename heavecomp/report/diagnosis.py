@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
+from heavecomp.diagnosis import verdict as V
 from heavecomp.diagnosis.where import residual_spectrum
 from heavecomp.report.figures import _plt, save
 from heavecomp.report.scenario import md_table
@@ -71,7 +72,7 @@ def write_json(diag, path) -> Path:
     d = copy.deepcopy(diag.to_json())  # the declarations go into the file, not into the diagnoser's own results
     for block in _parameter_blocks(d):  # the effect's own metadata, the channel's unit for a channel effect
         if isinstance(block.get("parameters"), dict) and isinstance(block.get("effect"), str):
-            units = _effect_units(block["effect"], block["parameters"])
+            units = _effect_units(V.member(block), block["parameters"])  # a family's law: its member's units
             own = {k: u for k, u in units.items() if k in block["parameters"]}
             if own:
                 declare_units(block["parameters"], own)
@@ -244,7 +245,7 @@ def overlay_title(v, best) -> str:
     if eff in ("inconclusive", "discovered"):
         return (f"Held-out data, verdict {eff}: the best named candidate ({best}, dashed) explains only "
                 f"{100 * v.get('explained', 0.0):.0f} % of the gap")
-    return (f"Before/after on held-out data: {eff} shrinks the {v.get('shrink_channel', 'wob')} gap by "
+    return (f"Before/after on held-out data: {V.label(v)} shrinks the {v.get('shrink_channel', 'wob')} gap by "
             f"{100 * v['shrink']:.0f} % (confidence {v['confidence']})")
 
 
@@ -351,8 +352,8 @@ def write_report(diag, out_dir, *, title="Sim-to-real gap diagnosis") -> dict:
     group = diag.verdict_group()
     tested = "distinguishable" in v
     named = (f"**Verdict: one of {', '.join(f'`{m}`' for m in group)}** "
-             f"({'this log' if tested else 'this sensor set'} cannot tell them apart; `{v['effect']}` "
-             f"{'leads' if tested else 'fitted best'})" if group and len(group) > 1 else f"**Verdict: `{v['effect']}`**")
+             f"({'this log' if tested else 'this sensor set'} cannot tell them apart; `{V.label(v)}` "
+             f"{'leads' if tested else 'fitted best'})" if group and len(group) > 1 else f"**Verdict: `{V.label(v)}`**")
     lines = [f"# {title}", "",
              f"{named} (confidence {v['confidence']}{', the group' + chr(39) + 's' if group and len(group) > 1 else ''}); "
              f"held-out shrink of the {v.get('shrink_channel', 'wob')} residual {v['shrink']:.2f}."]
@@ -362,7 +363,7 @@ def write_report(diag, out_dir, *, title="Sim-to-real gap diagnosis") -> dict:
     if v.get("parameters"):
         unc = v.get("uncertainty", {})
         lines.append("\nFitted parameters: " + ", ".join(
-            _with_unit(k, val, unc.get(k), _effect_units(v["effect"], v["parameters"])) for k, val in v["parameters"].items()) + ".")
+            _with_unit(k, val, unc.get(k), _effect_units(V.member(v), v["parameters"])) for k, val in v["parameters"].items()) + ".")
     if v.get("second_effect"):
         se = v["second_effect"]
         lines.append(f"\nSecond effect: `{se['effect']}` adds {100 * se['added_explained']:.0f} % of the held-out "
@@ -448,7 +449,7 @@ def _distinguish_lines(v) -> list:
     if not d:
         return []
     lines = []
-    for key in ("group_note", "lead_note"):
+    for key in ("group_note", "law_note", "lead_note"):
         if v.get(key):
             lines.append(f"\n{v[key]}.")
     fam = d.get("false_alarm_measured", {})

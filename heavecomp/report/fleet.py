@@ -9,6 +9,7 @@ from pathlib import Path
 
 from heavecomp.campaign.fleet import RESULTS, read_json, read_task, run_fleet
 from heavecomp.diagnosis.monitor import GAP_NOTABLE, gap_level
+from heavecomp.diagnosis.verdict import label
 from heavecomp.effects.base import COMPONENTS
 from heavecomp.io.arrays import fleet_dataset
 from heavecomp.report.figures import _plt, save
@@ -99,13 +100,13 @@ def collect(out_dir, keys) -> dict:
                              "WOB set-point [kN]": round(op["wob_setpoint"] * 1e-3, 2),
                              "static stroke [m]": round(op["static_stroke"], 4),
                              "static pressure [MPa]": round(op["static_pressure"] * 1e-6, 4),
-                             "verdict": v.get("effect", "-") if v else "-", "confidence": v.get("confidence") or "-",
+                             "verdict": label(v) if v else "-", "confidence": v.get("confidence") or "-",
                              "verdict component": v.get("component") or "-", "group": grp,
                              "shrink [-]": "-" if v.get("shrink") is None else round(v["shrink"], 3),
                              "diagnosed span [s]": "-" if not v.get("span") else
                              f"{v['span'][0]:.0f}-{v['span'][1]:.0f}", **gap_cells(s.get("gap_to_noise"))})
             if v:
-                verdicts.append(f"{i}: {v['effect']}" + ("" if v["effect"] == "not_diagnosed" else
+                verdicts.append(f"{i}: {label(v)}" + ("" if v["effect"] == "not_diagnosed" else
                                                          f", {v.get('confidence')}, {grp}"))
         for c in mon["changes"]:
             changes.append({"log": key, "kind": c["kind"], "t [s]": round(c["t"], 1), "onset [s]": round(c["onset"], 1),

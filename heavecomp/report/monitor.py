@@ -9,6 +9,7 @@ import numpy as np
 
 from heavecomp.diagnosis.components import UNITS
 from heavecomp.diagnosis.monitor import block_gap
+from heavecomp.diagnosis.verdict import label
 from heavecomp.effects.base import COMPONENTS
 from heavecomp.report.commands import command, span_text
 from heavecomp.report.figures import _plt, save
@@ -220,7 +221,7 @@ def _verdict(segment) -> str:
         return "-"
     if v["effect"] == "not_diagnosed":
         return f"not diagnosed ({v['reason']})"
-    return f"{v['effect']} ({v.get('confidence')}; {v.get('component') or '-'})"
+    return f"{label(v)} ({v.get('confidence')}; {v.get('component') or '-'})"
 
 
 def write_report(res, out, *, source="", extra=None, diagnosed=()) -> Path:
