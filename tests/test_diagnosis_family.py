@@ -90,6 +90,7 @@ def test_a_group_of_one_family_is_a_single_name_and_a_mixed_group_names_each_fam
     v = got.body
     assert v["group"] == ["friction_lag", "dwell_stiction"] and v["law"] == "distance"
     assert v["group_members"] == ["friction_memory", "dwell_stiction"]
+    assert v["group_laws"] == {"friction_lag": "distance"}
     assert got.members == ("friction_memory", "dwell_stiction")
     assert "`friction_memory`" not in v["group_note"]
 
@@ -125,7 +126,7 @@ SIZE = (4.5, 5.5)  #: the planted effect's largest channel gap over the noise fl
 FRICTION = "friction_memory,friction_lag,dwell_stiction,parameter_mismatch"
 
 
-def _diagnosed(tmp, case):
+def _diagnosed(tmp, case, candidates=FRICTION):
     """``heavecomp diagnose`` on a generated log (the benchmark's truth law, never the candidate's equation),
     as a user runs it, among the frictional candidates and the refit of the nominal."""
     import json as _json
@@ -137,7 +138,7 @@ def _diagnosed(tmp, case):
     tr = generate(case)
     log, nom = tr.to_csv(tmp / "run.csv"), tmp / "nominal.toml"
     nom.write_text(dumps(tr.nominal))
-    assert main(["diagnose", str(log), "--params", str(nom), "--out", str(tmp / "d"), "--candidates", FRICTION,
+    assert main(["diagnose", str(log), "--params", str(nom), "--out", str(tmp / "d"), "--candidates", candidates,
                  "--jobs", "1", "--quiet"]) == 0
     return log, nom, _json.loads((tmp / "d" / "diagnosis.json").read_text())
 
@@ -169,9 +170,13 @@ def test_a_lugre_bristle_reads_friction_lag_law_distance_and_its_calibrated_file
 
 @pytest.mark.slow
 def test_a_time_lag_reads_friction_lag_law_time(tmp_path):
-    """The generator's frictional lag in time (its own truth law): friction_lag, law time."""
+    """The generator's frictional lag in time (its own truth law) among the frictional laws: friction_lag, law
+    time, fitted as friction_lag (the distance law explains 0.12 of it).  The refit of the nominal is left
+    out: on this seed the log cannot tell it from the lag and it leads their group as the simpler model
+    (item 3), which is not what this test is about."""
     from heavecomp.benchmark import Case
 
-    _, _, d = _diagnosed(tmp_path, Case("friction_lag", 300104, "named", duration=300.0, size=SIZE))
+    _, _, d = _diagnosed(tmp_path, Case("friction_lag", 300104, "named", duration=300.0, size=SIZE),
+                         "friction_memory,friction_lag,dwell_stiction")
     v = d["verdict"]
     assert (v["effect"], v.get("law"), v.get("member")) == ("friction_lag", "time", "friction_lag"), v

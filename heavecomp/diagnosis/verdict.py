@@ -246,6 +246,9 @@ def _as_family(v) -> None:
         v.update(effect=family_of(name), law=law_of(name), member=name)
     if v.get("group"):
         v["group_members"] = by_family(v["group"])
+        laws = {family_of(m): law_of(m) for m in v["group_members"] if law_of(m)}
+        if laws:  # the law each family of the group stands with (its better fit's)
+            v["group_laws"] = laws
         v["group"] = [family_of(m) for m in v["group_members"]]
 
 
