@@ -37,7 +37,7 @@ import math
 import numpy as np
 
 from heavecomp.effects.base import Effect
-from heavecomp.effects.candidates import CANDIDATES, get
+from heavecomp.effects.candidates import CANDIDATES, family_of, get, law_of
 from heavecomp.errors import ParameterError
 from heavecomp.diagnosis.equation_error import fit_columns, open_search
 from heavecomp.estimator import GapEstimator
@@ -332,6 +332,8 @@ class ResidualDiagnoser(GapEstimator):
                          "changes": best["changes"] if best else {},
                          "units": best["units"] if best else {},
                          "discovered": self.discovered_}
+        if best and law_of(best["effect"]):  # a law of a family: the contract's name, its law and the member fitted
+            self.verdict_.update(effect=family_of(best["effect"]), law=law_of(best["effect"]), member=best["effect"])
         log.info("residual diagnosis (%s): best single %s (shrink %.3f); forward selection %s", pl.name,
                  self.results_[0]["effect"] if self.results_ else "none",
                  self.results_[0]["shrink"] if self.results_ else 0.0,

@@ -351,7 +351,8 @@ def write_report(diag, out_dir, *, title="Sim-to-real gap diagnosis") -> dict:
     pu, ps = CH_UNITS[pc]
     group = diag.verdict_group()
     tested = "distinguishable" in v
-    named = (f"**Verdict: one of {', '.join(f'`{m}`' for m in group)}** "
+    laws = v.get("group_laws") or {}  # a family of laws in the group: its law
+    named = (f"**Verdict: one of {', '.join(f'`{m}`' + (f' (law: {laws[m]})' if m in laws else '') for m in group)}** "
              f"({'this log' if tested else 'this sensor set'} cannot tell them apart; `{V.label(v)}` "
              f"{'leads' if tested else 'fitted best'})" if group and len(group) > 1 else f"**Verdict: `{V.label(v)}`**")
     lines = [f"# {title}", "",
