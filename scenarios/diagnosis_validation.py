@@ -50,6 +50,8 @@ from heavecomp.diagnosis.data import check_run
 from heavecomp.effects.candidates import family_of, same_family
 from heavecomp.errors import InputError
 from heavecomp.benchmark import Case, corruption, generate, NEAR_NOISE, parameter_sets, validation_cases
+from heavecomp.benchmark.case import SCORING_SEED0
+from heavecomp.benchmark.seeds import spent as spent_ranges
 from heavecomp.params import load
 from heavecomp.report.provenance import write_params
 from heavecomp.report.scenario import (ROOT, frozen_check, md_table, parse_args, run, run_cases, settings_hash,
@@ -795,11 +797,24 @@ def main(argv=None) -> int:
                                                      "a temporary folder, deleted)")
         p.add_argument("--allow-unfrozen", action="store_true",
                        help="score even if the settings differ from the tuning report's (flagged in the report)")
+        p.add_argument("--seed-base", type=int, default=None,
+                       help="with --set scoring: first seed of a fresh scoring set (never a spent range of "
+                            "heavecomp/benchmark/seeds.py); default: the committed report's seeds "
+                            f"({SCORING_SEED0}+, spent: a reproduction, not a score)")
 
     args = parse_args(argv, "diagnosis_validation", __doc__, extra)
     if args.jobs < 1:
         print(f"--jobs must be >= 1, got {args.jobs}", file=sys.stderr)
         return 2
+    if args.seed_base is not None:
+        if args.which != "scoring":
+            print(f"--seed-base is for --set scoring only (the {args.which} set's seeds are fixed)", file=sys.stderr)
+            return 2
+        taken = spent_ranges(c.seed for c in validation_cases("scoring", quick=args.quick, seed_base=args.seed_base))
+        if taken:
+            print(f"--seed-base {args.seed_base}: seeds in a spent range ({', '.join(taken)}); choose a fresh one",
+                  file=sys.stderr)
+            return 2
     if args.out == ROOT / "reports" / "diagnosis_validation":
         args.out = args.out / args.which
         args.out.mkdir(parents=True, exist_ok=True)
@@ -810,7 +825,7 @@ def main(argv=None) -> int:
         return main_corrupted(args, nominal, settings, digest)
     if args.which == "sensors":
         return main_sensors(args, nominal, settings, digest)
-    cases = validation_cases(args.which, quick=args.quick)
+    cases = validation_cases(args.which, quick=args.quick, seed_base=args.seed_base)
     ok, note = _settings_check(args.which, digest)
     if not ok and not args.allow_unfrozen:
         print(f"diagnosis_validation: {note} (--allow-unfrozen scores anyway, flagged)", file=sys.stderr)

@@ -14,6 +14,7 @@ The classes, each at about 5 x the noise floor (its largest channel's own gap, `
 - ``mru_heave``: the heave through an MRU's 2nd-order high-pass (corner ~100 s) plus a drift of ~2 cm
   (truth ``heave_reference``, variant ``mru_drift``);
 - ``hardening_formation``: the formation's stiffness doubled over 5 s half-way (``long_log``, ``hardening``, 150 s into the 300 s log);
+  diagnosed whole and, as ``monitor --diagnose`` does, per segment of the monitor (``segments``);
 - ``quantised_pressure``: a run without any plant effect whose pressure is read on a 0.25 bar grid with
   0.1 bar of mains hum aliased to 0.02 Hz (``corruption.quantised``).
 """
@@ -98,6 +99,16 @@ def diagnose(folder: Path, out: Path) -> None:
                       "quality": [i["kind"] + ":" + i["column"] for i in (q.issues if q is not None else [])],
                       "noise_floor": {c: g.get("noise_floor") for c, g in d.gap_["channels"].items()},
                       "wall_time_s": time.perf_counter() - t0}
+        if name == "hardening_formation":  # a change part-way: the monitor's segments, each diagnosed on its own
+            from heavecomp.diagnosis import monitor as M
+
+            res = M.monitor(run, nominal)
+            M.diagnose_segments(res, run, nominal, n_jobs=1)
+            rows[name]["monitor_changes"] = [{k: c.get(k) for k in ("t", "onset", "kind", "component")}
+                                             for c in res.changes]
+            rows[name]["segments"] = [{"start": s["start"], "end": s["end"], "verdict": s.get("verdict")}
+                                      for s in res.segments]
+            rows[name]["wall_time_s"] = time.perf_counter() - t0
         print(name, json.dumps(rows[name], default=str), flush=True)
     out.write_text(json.dumps(rows, indent=1, default=str))
 

@@ -3,6 +3,7 @@ and vessel model, the two disjoint sets, the scoring rules and the frozen-thresh
 
 from __future__ import annotations
 
+import dataclasses
 import importlib.util
 import json
 
@@ -119,6 +120,20 @@ def test_sets_are_disjoint_in_seeds_and_settings():
         assert new, c
     assert {c.label for c in sco if c.category == "out_of_library"} == set(B.OUT_OF_LIBRARY)
     assert {c.label for c in sco if c.category == "named"} >= set(B.CASES[1:] + B.NEW_EFFECTS)
+
+
+def test_a_fresh_scoring_set_is_the_same_cases_on_other_seeds_and_spent_seeds_are_refused(tmp_path, capsys):
+    """--seed-base makes the scoring set's cases again on fresh seeds; a spent range is refused before any
+    work (exit 2, one line), and the tuning set's seeds cannot be moved."""
+    from heavecomp.benchmark.seeds import spent
+    old, new = B.validation_cases("scoring"), B.validation_cases("scoring", seed_base=999_000)
+    assert [dataclasses.replace(c, seed=0) for c in old] == [dataclasses.replace(c, seed=0) for c in new]
+    assert spent(c.seed for c in old) and not spent(c.seed for c in new)
+    mod = _scenario()
+    assert mod.main(["--set", "scoring", "--quick", "--seed-base", "110000", "--out", str(tmp_path / "o")]) == 2
+    assert "spent range" in capsys.readouterr().err
+    assert mod.main(["--set", "tuning", "--quick", "--seed-base", "999000", "--out", str(tmp_path / "o")]) == 2
+    assert not (tmp_path / "o").exists() or not any((tmp_path / "o").iterdir())
 
 
 # --------------------------------------------------------------------------- scoring rules

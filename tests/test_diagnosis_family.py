@@ -45,6 +45,8 @@ def _dist(group, pairs=()):
 def test_the_families_of_the_library():
     assert family_of("friction_memory") == "friction_lag" and law_of("friction_memory") == "distance"
     assert family_of("friction_lag") == "friction_lag" and law_of("friction_lag") == "time"
+    assert family_of("gas_thermal") == "gas_heat_transfer" and law_of("gas_thermal") == "relaxation"
+    assert family_of("gas_heat_transfer") == "gas_heat_transfer" and law_of("gas_heat_transfer") == "effective_index"
     assert family_of("dwell_stiction") == "dwell_stiction" and law_of("dwell_stiction") == ""
     assert family_of("sensor_gain:wob") == "sensor_gain:wob" and family_of("none") == "none"
     assert same_family("friction_memory", "friction_lag") and not same_family("friction_lag", "dwell_stiction")

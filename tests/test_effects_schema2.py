@@ -244,23 +244,25 @@ class _Drifts(Effect):
 
 
 def test_a_composition_has_as_many_state_slots_as_its_effects():
-    """The library's four state effects plus one with two states: six effect states (the
-    stepper's state was once limited to three), laid out after the plant's four."""
+    """The library's state effects (five states today) plus one with two states: as many effect states as
+    they have together (the stepper's state was once limited to three), laid out after the plant's four."""
     from heavecomp.effects.compose import composition
     from heavecomp.effects.model import casadi_model
     from heavecomp.effects.registry import library
 
     classes = tuple(c for c in library().values() if c.kind == "plant" and c.states) + (_Drifts,)
+    n_lib = sum(len(c.states) for c in classes[:-1])
+    assert n_lib >= 4
     comp = composition(classes)
-    assert comp.n_states == 6 and comp.slots["_drifts"] == (8, 9)
+    assert comp.n_states == n_lib + 2 and comp.slots["_drifts"] == (4 + n_lib, 5 + n_lib)
     plant = cmc.plant_vectors(paper_a())
     EP = comp.ep([_Drifts(rate=0.5)])
     X0 = comp.initial_state(plant.FP, plant.PP, EP)
-    assert X0.shape == (11,) and X0[9] == 1.0
+    assert X0.shape == (4 + n_lib + 3,) and X0[5 + n_lib] == 1.0
     fn = comp.functions
-    X = tuple(X0[:10])
+    X = tuple(X0[:6 + n_lib])
     k = fn["state_dot"](0.1, 0.2, 0.3, 0.4, 0.0, 0.1, 2e6, X, plant.PP, plant.FP, EP)
-    assert k == (0.1, 0.2, 0.3, 0.4, 0.0, 0.0, 0.0, 0.0, 0.5, 1.0)
+    assert k == (0.1, 0.2, 0.3, 0.4) + (0.0,) * n_lib + (0.5, 1.0)
     f = casadi_model(paper_a("none"), effects=[_Drifts(rate=0.5)])
     xd = np.asarray(f(np.r_[0.0, 0.1, 0.0, 0.0, 0.0, 1.0], np.zeros(4))[0]).ravel()
     assert xd.size == 6 and xd[4] == 0.5 and xd[5] == 1.0

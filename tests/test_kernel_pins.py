@@ -164,7 +164,9 @@ def test_compiled_effect_hooks_equal_python_originals():
         fc, fp = K.compiled_hooks(comp), comp.functions
         for s, v, yb, vb, zh, dzh, ddzh, u in _states(100, 5):
             x = (s, v, yb, vb, rng.uniform(0.9, 1.1), abs(v) * rng.uniform(0.5, 1.5), rng.uniform(0, 2e4),
-                 rng.uniform(-1.0, 1.0))  # the last: friction_memory's direction state (the library's fourth)
+                 rng.uniform(-1.0, 1.0),  # friction_memory's direction state (the library's fourth)
+                 rng.uniform(0.98, 1.02))  # gas_thermal's temperature ratio (the fifth)
+            assert len(x) >= 4 + comp.n_states
             tau = rng.uniform(0, 5)
             for a, b in zip(fc["plant_fx"](s, v, yb, vb, x, zh, dzh, ddzh, u, 1.0, PP, EP),
                             fp["plant_fx"](s, v, yb, vb, x, zh, dzh, ddzh, u, 1.0, PP, EP)):

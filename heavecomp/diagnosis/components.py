@@ -66,7 +66,7 @@ from heavecomp.effects.spec import plant_effects
 from heavecomp.effects.features import rest_durations
 from heavecomp.errors import DataError
 from heavecomp.friction.laws import friction_cont, friction_jump
-from heavecomp.plants.cmc import CF, D0, KF, MB, MC, G, gas_pressure, net_force, plant_vectors, tension
+from heavecomp.plants.cmc import CF, D0, KF, MB, MC, G, P0ABS, PATM, gas_pressure, net_force, plant_vectors, tension
 
 CUTOFF = 1.0  #: zero-phase low-pass of every channel before the equations [Hz]
 STUCK_SPEED = 2e-3  #: below this filtered stroke speed the seal is at rest (friction set-valued) [m/s]
@@ -182,7 +182,10 @@ def equations(t, heave, stroke, pressure, wob, params, heave_reference=0.0, cuto
     dwell, rest = rest_durations(t, ~sliding)
     sig = {"t": t, "x": s, "v": v, "a": a, "p": p, "dp": dp, "wob": W, "dwob": dW, "zh": zh, "dzh": dzh,
            "ddzh": ddzh, "rel": zh + s - yb, "vrel": dzh + v - vb, "dwell": dwell, "rest": rest,
-           "still": ~sliding}
+           "still": ~sliding,
+           # the gas effects' equation-error inputs (Effect.features): the nominal gas's absolute pressure at
+           # the measured stroke, its absolute pre-charge and the plant vector (geometry for a gas state's rates)
+           "p_gas_abs": gas_pressure(s, PP) + PP[PATM], "p_charge_abs": float(PP[P0ABS]), "PP": PP}
     return res, sig, sliding
 
 

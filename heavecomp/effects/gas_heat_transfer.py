@@ -30,6 +30,10 @@ class GasHeatTransfer(Effect):
     name = "gas_heat_transfer"
     fit = FitSpec(
         candidate=True,
+        # the contract's heat exchange; this law is an effective index with a dashpot loss (gas_thermal: the
+        # gas temperature relaxing to the wall)
+        family="gas_heat_transfer",
+        law="effective_index",
         log=("loss_coefficient", "warming", "warming_time"),
         # units of the equation-error coefficients (``features``)
         feature_units={"index": "-", "loss": "Pa s/m", "warming": "s^2/m^2"},

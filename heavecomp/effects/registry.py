@@ -27,6 +27,7 @@ MODULES = (
     "sensor_offset",
     "heave_reference",
     "friction_memory",
+    "gas_thermal",
 )
 
 _LIBRARY: dict = {}

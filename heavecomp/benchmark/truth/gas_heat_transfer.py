@@ -1,13 +1,19 @@
 """gas_heat_transfer, as generated: a thermal state theta = T/T_0, adiabatic compression with a fixed
-gamma and Newton heat exchange with time constant tau_th.
+gamma and heat exchange to the wall by conduction and natural convection: the heat-transfer coefficient
+grows with the temperature difference as Nu = Nu_0 + c Ra^(1/3) (turbulent natural convection in a gas
+accumulator: Pourmovahed and Otis 1990), so the exchange's time constant depends on how far the gas is
+from the wall's temperature.
 
-The candidate (fitted, :mod:`heavecomp.effects`) is an effective polytropic index n_eff plus a
-linear loss c_g v.
+The candidates (fitted, :mod:`heavecomp.effects`) are an effective polytropic index n_eff plus a
+linear loss c_g v (``gas_heat_transfer``) and the thermal-time-constant law with one constant heat-transfer
+coefficient (``gas_thermal``): neither is this law.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+
+import numpy as np
 
 from heavecomp.benchmark.truth.base import Draw, TruthLaw
 from heavecomp.effects.base import Effect
@@ -16,12 +22,16 @@ from heavecomp.plants.cmc import A, P0ABS, PATM, V0
 
 
 class TruthThermalGas(Effect):
-    """Ideal gas with a temperature state theta = T/T_0: adiabatic compression, Newton heat exchange.
+    """Ideal gas with a temperature state theta = T/T_0: adiabatic compression, heat exchange by
+    conduction and natural convection.
 
     Notes
     -----
     p_abs = (p_0 + p_atm) theta V_0 / (V_0 + A s);
-    dtheta/dt = -(gamma - 1) theta A v / (V_0 + A s) + (1 - theta) / tau_th.
+    dtheta/dt = -(gamma - 1) theta A v / (V_0 + A s)
+                + (1 - theta) (K0 + (1 - K0) (|1 - theta| / DTHETA)^(1/3)) / tau_th:
+    tau_th is the exchange's time constant at a temperature difference DTHETA = 0.01 (3 K at 300 K); near
+    the wall's temperature conduction alone is left, K0 = 0.25 of it.
     """
 
     name = "gas_heat_transfer"
@@ -39,7 +49,9 @@ class TruthThermalGas(Effect):
 
     @staticmethod
     def rates(s, v, p, x, PP, FP, gamma, tau_th):
-        return (-(gamma - 1.0) * x[0] * PP[A] * v / (PP[V0] + PP[A] * s) + (1.0 - x[0]) / tau_th,)
+        d = 1.0 - x[0]
+        return (-(gamma - 1.0) * x[0] * PP[A] * v / (PP[V0] + PP[A] * s)
+                + d * (0.25 + 0.75 * (np.abs(d) / 0.01) ** (1.0 / 3.0)) / tau_th,)
 
     @staticmethod
     def initial(FP, PP, gamma, tau_th):
