@@ -96,6 +96,11 @@ class FitSpec:
     """Parameters held at their defaults while the others are fitted as before (coarse start grid and
     Nelder-Mead for two), then released together from that optimum by least squares: a parameter that
     refines the others' law never leaves the fit on the fit part worse than the fit without it."""
+    probes: tuple = ()
+    """Parameter sets (tuples of (name, value) pairs) the diagnosis's score test replays an unscreened
+    candidate at before a full fit (:mod:`heavecomp.diagnosis.score_test`): a moderate amplitude at two or
+    three values of its shape parameter (a lag time, a relaxation length, an exponent), each a secant
+    column of the replay's Jacobian from the null; empty: no score test (the candidate is always fitted)."""
 
 
 class Effect:
