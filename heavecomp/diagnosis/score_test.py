@@ -13,7 +13,8 @@ amplitude at that shape.  The Gauss-Newton step from the null, fitted on the fit
 decimated: the full fit's own objective) with non-negative amplitudes (an effect's amplitude is >= 0;
 a mixture of shapes stands for any shape between them), predicts the candidate's held-out channels;
 their explained share of the held-out gap above the noise floor is the verdict's own measure
-(:meth:`heavecomp.diagnosis.replay.ReplayContext.explained`).  A candidate whose predicted share is
+(:meth:`heavecomp.diagnosis.replay.ReplayContext.explained`); so are the fit part's and the best probe's
+own, and the largest of the three is tested (:func:`predicted`).  A candidate whose predicted share is
 under ``VerdictPolicy.score_test_explained`` is not replayed in full; its prescreen entry keeps the
 evidence (``score_test``).  The probes are secants from the null to a physical configuration, so the
 linear model includes each probe's own replay (amplitude 1, and its fit-part cost is never above the
@@ -70,8 +71,14 @@ def _channels(ctx, pred, mask) -> dict:
 def predicted(ctx, preds) -> dict:
     """The Gauss-Newton prediction from the nominal of the probes' replays ``preds`` (whole, one per probe):
     the amplitudes (>= 0) fitted on the fit part's weighted, decimated residual
-    (:meth:`~heavecomp.diagnosis.replay.ReplayContext.resid_vec`), and the held-out explained share of the
-    predicted channels (``explained``) and of the best probe alone (``explained_probe``) [-].
+    (:meth:`~heavecomp.diagnosis.replay.ReplayContext.resid_vec`), and the explained share of the gap
+    above noise (:meth:`~heavecomp.diagnosis.replay.ReplayContext.explained`) of the predicted channels
+    held out (``held_out``) and on the fit part itself (``fit_part``), and the best probe's own held out
+    (``probe``) [-].  ``explained``, the figure tested, is the largest of the three: where the replay
+    responds far from linearly (a dwell-grown static force flips stick events) the linear prediction
+    held out can be worse than the nominal even for the effect that is there (the tuning set's planted
+    dwell stiction: -1.29 held out, while its fit explains 0.96), but its fit part then says how much
+    the probes' directions can take out.
 
     Parameters
     ----------
@@ -86,23 +93,26 @@ def predicted(ctx, preds) -> dict:
     J = np.column_stack([ctx.resid_vec(p) - r0 for p in preds])
     ok = np.all(np.isfinite(J), axis=1)
     a, _ = nnls(J[ok], -r0[ok]) if ok.any() and np.any(J[ok]) else (np.zeros(len(preds)), 0.0)
-    v0 = _channels(ctx, ctx.nominal_pred, ctx.valmask)
-    cols = [_channels(ctx, p, ctx.valmask) for p in preds]
-    # a probe the fit gave no amplitude adds nothing (its replay may have diverged: not finite held out)
-    mse_lin = {c: float(np.mean((v0[c] + sum(ak * (col[c] - v0[c]) for ak, col in zip(a, cols) if ak > 0)) ** 2))
+
+    def share(mask):
+        v0 = _channels(ctx, ctx.nominal_pred, mask)
+        cols = [_channels(ctx, p, mask) for p in preds]
+        # a probe the fit gave no amplitude adds nothing (its replay may have diverged: not finite)
+        lin = {c: float(np.mean((v0[c] + sum(ak * (col[c] - v0[c]) for ak, col in zip(a, cols) if ak > 0)) ** 2))
                for c in ctx.channels}
+        e = ctx.explained(ctx.mse(ctx.nominal_pred, mask), lin)
+        return float(e) if math.isfinite(e) else math.inf
+
     e_probe = max((e for e in (ctx.explained(ctx.mse_before, ctx.mse(p, ctx.valmask)) for p in preds)
                    if math.isfinite(e)), default=-math.inf)
-    e = ctx.explained(ctx.mse_before, mse_lin)
-    return {"explained": float(e) if math.isfinite(e) else math.inf,
-            "explained_probe": float(e_probe) if math.isfinite(e_probe) else math.inf,
-            "amplitudes": [float(x) for x in a]}
+    got = {"held_out": share(ctx.valmask), "fit_part": share(ctx.fitmask), "probe": float(e_probe)}
+    return dict(got, explained=max(got.values()), amplitudes=[float(x) for x in a])
 
 
 def run(ctx, prescreened, names, policy, progress=None) -> dict:
     """The score test of the candidates ``names`` (their :func:`needs_test` holds), their probes replayed
     on ``ctx.n_jobs`` threads; each prescreen entry gets ``score_test`` (the probes, the prediction, the
-    threshold) and ``replay`` False when the predicted held-out explained share is under
+    threshold) and ``replay`` False when its predicted explained share (the largest of held out, fit part and best probe) is under
     ``policy.score_test_explained``.  Returns ``prescreened`` (updated in place).
 
     Parameters
@@ -131,10 +141,11 @@ def run(ctx, prescreened, names, policy, progress=None) -> dict:
         entry["wall_time"] = entry.get("wall_time", 0.0) + wall
         if not keep:
             entry["replay"] = False
-            entry["reason"] = (f"score test: its probes' Gauss-Newton step from the null predicts "
-                               f"{100 * got['explained']:.1f} % of the held-out gap above noise explained "
-                               f"(under {100 * policy.score_test_explained:g} %; the equation error is blind to it "
-                               f"and its component {entry['component']} shows no gap)")
+            entry["reason"] = (f"score test: its probes' Gauss-Newton step from the null explains at most "
+                               f"{100 * got['explained']:.1f} % of the gap above noise (held out "
+                               f"{100 * got['held_out']:.1f} %, fit part {100 * got['fit_part']:.1f} %, best probe "
+                               f"{100 * got['probe']:.1f} %; under {100 * policy.score_test_explained:g} %; the "
+                               f"equation error is blind to it and its component {entry['component']} shows no gap)")
         if progress is not None:
             progress(f"{n}: score test predicts {100 * got['explained']:.0f} % explained "
                      f"({'replayed' if keep else 'not replayed'})")
