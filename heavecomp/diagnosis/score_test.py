@@ -112,8 +112,9 @@ def predicted(ctx, preds) -> dict:
 def run(ctx, prescreened, names, policy, progress=None) -> dict:
     """The score test of the candidates ``names`` (their :func:`needs_test` holds), their probes replayed
     on ``ctx.n_jobs`` threads; each prescreen entry gets ``score_test`` (the probes, the prediction, the
-    threshold) and ``replay`` False when its predicted explained share (the largest of held out, fit part and best probe) is under
-    ``policy.score_test_explained``.  Returns ``prescreened`` (updated in place).
+    threshold) and ``replay`` False when its predicted explained share (the largest of held out, fit part
+    and best probe) is under ``policy.score_test_explained``, unless no candidate at all would then be fitted
+    (then every one tested is, as the pre-screen does).  Returns ``prescreened`` (updated in place).
 
     Parameters
     ----------
@@ -149,5 +150,10 @@ def run(ctx, prescreened, names, policy, progress=None) -> dict:
         if progress is not None:
             progress(f"{n}: score test predicts {100 * got['explained']:.0f} % explained "
                      f"({'replayed' if keep else 'not replayed'})")
+    if not any(o["replay"] for o in prescreened.values()):  # the verdict needs a fit: as the pre-screen, all
+        for n in names:
+            prescreened[n]["replay"] = True
+            prescreened[n].pop("reason", None)
+            prescreened[n]["score_test"]["overridden"] = "no candidate would be fitted: every one is"
     return prescreened
 
