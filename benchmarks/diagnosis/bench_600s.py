@@ -24,6 +24,18 @@ import sys
 import time
 
 
+def by_configuration(ledger, peer_steps) -> dict:
+    """Replays and their work in foundation simulations per configuration (its effect names joined by
+    '+'; 'nominal' for none), costliest first."""
+    out = {}
+    for _key, n, cost, names in ledger.rows:
+        row = out.setdefault("+".join(names) or "nominal", {"replays": 0, "foundation_simulations": 0.0})
+        row["replays"] += 1
+        row["foundation_simulations"] += n * cost / peer_steps
+    return dict(sorted(((k, dict(v, foundation_simulations=round(v["foundation_simulations"], 1)))
+                        for k, v in out.items()), key=lambda kv: -kv[1]["foundation_simulations"]))
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser()
     ap.add_argument("--effect", default="flow_loss")
@@ -60,6 +72,7 @@ def main(argv=None) -> int:
            "diagnosis_cpu_s": cpu_diag, "load_average_1min": os.getloadavg()[0], "goal_s": 4.0, "ratio_to_goal": t_diag / 4.0,
            "goal_cpu_s": 6.0, "goal_foundation_simulations": 200,
            "foundation_simulate_600s_wall_s": t_sim, "diagnosis_in_foundation_simulations": t_diag / t_sim,
+           "replays_by_configuration": by_configuration(ledger, peer_steps),
            "withheld": args.effect, "verdict": d.verdict_["effect"], "shrink": d.verdict_["shrink"],
            "component": d.verdict_.get("component"), "where_components": d.where_["components"],
            "replayed": [n for n, p in d.prescreen_.items() if p["replay"]],

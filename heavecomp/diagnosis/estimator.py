@@ -17,7 +17,9 @@ Method
    residual) on the *fit* part [settle, t_split] and scored on the held-out part [t_split, end].  Every
    channel the log has enters (heave required; any of stroke, pressure, WOB may be missing: docs/diagnosis.md
    "Sensor sets"), each weighted by 1/rms_before_c^2 on the fit part.  Candidates whose model component
-   shows no equation-error gap are not replayed (:mod:`heavecomp.diagnosis.screen`).
+   shows no equation-error gap are not replayed (:mod:`heavecomp.diagnosis.screen`), and those the
+   equation error is blind to only when a score test on a few replays at their null predicts they
+   explain part of the gap (:mod:`heavecomp.diagnosis.score_test`).
 4. Explained share of the held-out gap above the noise floor, per channel
    ``e_c = (mse_before - mse_after) / (mse_before - sigma_c^2)``, averaged with the channels'
    gap-over-noise as weights (:meth:`heavecomp.diagnosis.replay.ReplayContext.explained`); the smaller
@@ -44,6 +46,7 @@ from heavecomp.diagnosis import distinguish as D
 from heavecomp.diagnosis import fitting as F
 from heavecomp.diagnosis import joint as J
 from heavecomp.diagnosis import replay as R
+from heavecomp.diagnosis import score_test as T
 from heavecomp.diagnosis import screen as S
 from heavecomp.diagnosis import structure as ST
 from heavecomp.diagnosis import verdict as V
@@ -245,6 +248,11 @@ class GapDiagnoser(GapEstimator):
         # ---- pre-screen: candidates whose component shows no gap are not replayed
         self.prescreen_ = S.prescreen(self.components_, self.where_["components"], ctx.fitmask, ctx.valmask,
                                       fitted, P)
+        # ---- score test: the candidates the equation error is blind to, asked on the replay at their null
+        tested = [n for n in fitted if self.prescreen_[n].get("score_test") == "pending"]
+        if tested:
+            self._report(0.045, f"score test of {', '.join(tested)}")
+            T.run(ctx, self.prescreen_, tested, P, progress=lambda m: self._report(0.05, m))
         names = [n for n in fitted if self.prescreen_[n]["replay"]]
         self.fits_ = self._fit_candidates(ctx, names)
         self._report(0.9, "verdict")

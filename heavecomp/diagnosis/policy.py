@@ -99,6 +99,21 @@ class VerdictPolicy:
     prescreen_share: float = 0.02
     """A component with less than this share of the equation-error gap shows only what the others
     leak into it (its screened candidates are not replayed)."""
+    score_test_explained: float = 0.1
+    """Least explained share (of the gap above noise, the verdict's measure: the largest of held out, fit
+    part and best probe) the score test predicts for a candidate the equation error is blind to (``FitSpec.screened`` False) and whose
+    component shows no gap, for it to be fitted in full (:mod:`heavecomp.diagnosis.score_test`: the
+    Gauss-Newton step from the null on its probes' replays); 0: no test, every such candidate fitted.
+    What it guards against: full fits (~40 replays each) of friction and string candidates on a log
+    whose gap is all in the flow line.  Set at ``second_gain``, a priori: a candidate that explains
+    less than that alone can neither be named (``none_explained``, ``min_explained``) nor, as a rule,
+    add a named second effect, and as a runner-up it leaves any confident verdict's margin (>= 0.6
+    explained) far above ``high_margin``.  Measured (the tested share, the largest of held out, fit part
+    and best probe, against the full fit's explained share): on the 600 s bench log (flow loss)
+    friction_lag 0.076 against 0.099, friction_memory 0.050 against 0.059, dwell_stiction 0.000 against
+    0.000 (left out), string_damping 0.118 against 0.135 (fitted); on the tuning set's planted dwell
+    stiction dwell_stiction 1.00 against 0.96 (its held-out linear step alone: -1.29) and friction_lag
+    0.63 against 0.71; every verdict of the tuning report unchanged (docs/diagnosis.md, "The score test")."""
     confirm_share: float = 0.5
     """Share of the equation-error gap the best candidate's component must hold for its own
     equation-error fit to name it (low) when its replay explains under ``min_explained``."""

@@ -20,6 +20,7 @@ import numpy as np
 
 from heavecomp.diagnosis import components as CR
 from heavecomp.diagnosis import equation_error as EE
+from heavecomp.diagnosis.score_test import needs_test
 from heavecomp.effects.base import COMPONENTS
 from heavecomp.effects.candidates import MISMATCH_KEYS, ParameterMismatch, get
 from heavecomp.errors import ParameterError
@@ -78,6 +79,8 @@ def prescreen(cr, shares, fitmask, valmask, names, policy) -> dict:
         replay = not (cls.kind in ("plant", "heave") and quiet)
         out[n] = {"component": comp, "component_gap": float(gap.get(comp, math.nan)), "replay": replay,
                   "equation_error": ee, "wall_time": time.perf_counter() - t0}
+        if replay and needs_test(cls, comp, gap, shares, seen, ee, policy):
+            out[n]["score_test"] = "pending"  # blind here: the replay's score test decides (score_test.run)
     if not any(o["replay"] for o in out.values()):
         for o in out.values():
             o["replay"] = True
@@ -172,10 +175,10 @@ def skipped_row(name, pre, shares, rms_before, n_params, policy) -> dict:
     return {"effect": name, "parameters": {}, "rms_before": rms_before, "rms_after": rms_before, "shrink": 0.0,
             "score": -policy.penalty * n_params, "explained": 0.0, "n_params": n_params,
             "at_bound": [], "fit_wall_time": pre["wall_time"],
-            "skipped": f"pre-screen: its component {pre['component']} shows no gap of its own "
-                       f"(gap {pre['component_gap']:.3g} noise variances, "
-                       f"{100 * shares.get(pre['component'], 0.0):.1f} % of the whole; "
-                       f"equation-error shrink under {EE.MIN_SHRINK:g})",
+            "skipped": pre.get("reason") or (f"pre-screen: its component {pre['component']} shows no gap of its own "
+                                             f"(gap {pre['component_gap']:.3g} noise variances, "
+                                             f"{100 * shares.get(pre['component'], 0.0):.1f} % of the whole; "
+                                             f"equation-error shrink under {EE.MIN_SHRINK:g})"),
             "equation_error": pre["equation_error"]}
 
 

@@ -103,6 +103,11 @@ class FitSpec:
     law: str = ""
     """The law of the family this effect is (``"time"``, ``"distance"``): the verdict names the family and
     carries the law (``verdict.law``) and the effect fitted (``verdict.member``).  Empty: no family of laws."""
+    probes: tuple = ()
+    """Parameter sets (tuples of (name, value) pairs) the diagnosis's score test replays an unscreened
+    candidate at before a full fit (:mod:`heavecomp.diagnosis.score_test`): a moderate amplitude at two or
+    three values of its shape parameter (a lag time, a relaxation length, an exponent), each a secant
+    column of the replay's Jacobian from the null; empty: no score test (the candidate is always fitted)."""
 
 
 class Effect:

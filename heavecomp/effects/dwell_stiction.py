@@ -25,6 +25,9 @@ class DwellStiction(Effect):
         candidate=True,
         # the top-mass balance is blind at breakaway (the static force is whatever holds the piston)
         screened=False,
+        # the score test's probes (diagnosis.score_test): half the tuning set's planted 10 kN excess, at
+        # three exponents over the range
+        probes=tuple((("gain", 5e3), ("exponent", b)) for b in (0.25, 0.5, 1.0)),
         log=("gain",),
         # exponents beta [-] searched by the equation-error fit
         feature_grid=(0.25, 0.5, 0.75, 1.0),

