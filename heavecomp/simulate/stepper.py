@@ -135,7 +135,8 @@ def plant_stepper(plant, effects=()):
     point and its :class:`Plant` (effect parameters bound).
 
     Without effects the nominal stepper (:func:`nominal`), with effects the stepper of their
-    composition (:func:`heavecomp.effects.compose.composition_for`).
+    composition (:func:`heavecomp.effects.compose.composition_for`: the superset compiled at install
+    for registered effects and hook terms).
 
     Parameters
     ----------
@@ -274,8 +275,10 @@ def compile_all(progress=None) -> list[str]:
     """Compile the steppers the commands use into numba's cache (``setup.py`` runs it at install,
     with the campaign's batch: :func:`heavecomp.campaign.batch.compile_batch`).
 
-    The nominal stepper (simulate, closed loop), :func:`heave_at` and the stepper of the library's
-    effect composition (``simulate(effects=...)``, the diagnosis).  Returns the names compiled.
+    The nominal stepper (simulate, closed loop), :func:`heave_at` and the stepper of the superset
+    composition (:func:`heavecomp.effects.compose.library_composition`: every registered plant effect
+    and the open search's hook terms; ``simulate(effects=...)``, a calibrated file, the diagnosis).
+    Returns the names compiled.
 
     Parameters
     ----------
@@ -292,7 +295,9 @@ def compile_all(progress=None) -> list[str]:
 
 def install_steps() -> dict:
     """The install-time compiles of :func:`compile_all`, by name: each fills its own cache folder, so
-    ``setup.py`` runs each in a process of its own, on every core."""
+    ``setup.py`` runs each in a process of its own, on every core.  ``"library effects stepper"`` is the
+    superset composition's (:func:`heavecomp.effects.compose.library_composition`), which serves every
+    set of registered effects and hook terms: a calibrated file's new mix of them compiles nothing."""
     from heavecomp.simulate import _kernel
 
     def nominal():
