@@ -101,6 +101,8 @@ def test_the_superset_stepper_runs_the_files_effects_as_their_own_composition_do
     a = simulate_fx(p, 30.0, eff, rate=50.0, dt=0.025)
     b = simulate_fx(p, 30.0, eff, rate=50.0, dt=0.025, comp=exact)
     assert a["stuck"].min() == 0.0 and a["stuck"].max() == 1.0  # it slides and sticks
+    nominal = simulate_fx(p, 30.0, [], rate=50.0, dt=0.025)
+    assert np.max(np.abs(a["wob"] - nominal["wob"])) > 1e4  # the terms are on: 10 kN and more at the bit
     for ch in ("stroke", "pressure", "wob", "tension", "friction"):
         scale = np.max(np.abs(b[ch])) + 1e-9
         assert np.max(np.abs(a[ch] - b[ch])) <= 1e-9 * scale, ch
