@@ -223,7 +223,8 @@ def _ensure_compiled(fn, comp=None) -> None:
 
 
 #: CPU seconds to compile the nominal stepper, and more per effect of a composition (measured:
-#: 34 s and 73 s for the library's 10 effects, numba 0.68; the notice quotes their sum)
+#: 34 s and 73 s for the library's 10 effects, numba 0.68; 90 s for the superset's 15 classes and 50 s for
+#: 3 effects, benchmarks/simulate/install_compile.json and composition.json; the notice quotes their sum)
 COMPILE_S = 35
 COMPILE_S_PER_EFFECT = 4
 
