@@ -35,6 +35,8 @@ import numpy as np
 from heavecomp.errors import ParameterError
 from heavecomp.friction import laws as _laws
 from heavecomp.plants import cmc as _cmc
+from heavecomp.effects.discovered_term import DiscoveredTerm
+from heavecomp.effects.hook_term import GasTerm, LineTerm, StringTerm
 from heavecomp.effects.registry import library
 
 #: index of the first effect state in the stepper's state X (after s, v, y_b, v_b)
@@ -245,9 +247,6 @@ def hook_terms() -> tuple:
     """The open search's terms at the plant's hooks (not registered effects, not diagnosis candidates):
     ``discovered_term`` (seal friction, :mod:`heavecomp.effects.discovered_term`), ``gas_term``,
     ``line_term`` and ``string_term`` (:mod:`heavecomp.effects.hook_term`), in that order."""
-    from heavecomp.effects.discovered_term import DiscoveredTerm
-    from heavecomp.effects.hook_term import GasTerm, LineTerm, StringTerm
-
     return DiscoveredTerm, GasTerm, LineTerm, StringTerm
 
 
