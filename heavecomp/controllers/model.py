@@ -37,7 +37,7 @@ import dataclasses
 
 import numpy as np
 
-from heavecomp.effects.compose import composition
+from heavecomp.effects.compose import composition, hook_order
 from heavecomp.effects.model import casadi_model, heave_map, initial_effect_states, seen_heave, smooth_seal_friction
 from heavecomp.effects.registry import resolve, split_effects
 from heavecomp.friction.laws import FORCE_KEYS
@@ -239,7 +239,7 @@ class ControllerFriction:
         self.code, self.FP, self.PP = plant.code, plant.FP, plant.PP
         self.eps = float(eps)
         fx = split_effects(resolve(effects))[0]
-        self.comp = composition(tuple(dict.fromkeys(type(e) for e in fx)))
+        self.comp = composition(hook_order(type(e) for e in fx))  # as the stepper applies them
         self.EP = self.comp.ep(fx)
         self.effects = fx
         #: indices into the model state x of the effect states the seal friction reads

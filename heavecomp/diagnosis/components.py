@@ -118,7 +118,7 @@ def file_hooks(params):
         log.debug("component residuals: effects with a state of their own left out of the equations: %s", skipped)
     if not use:
         return None
-    comp = composition_for(use)  # as the stepper and the replay compose them (the file's order at a hook)
+    comp = composition_for(use)  # as the stepper and the replay compose them (hook terms first at a hook)
     return comp.functions, comp.ep(use), skipped
 
 

@@ -10,7 +10,8 @@ same source (:func:`heavecomp.effects.model.casadi_model`), so ``simulate``, ``l
 MPCs and the diagnosis accept any effect.
 
 Hooks (:data:`HOOKS`).  Every method gets the value so far at its hook and returns the
-new one (effects at one hook are chained in registry order); ``x`` is the tuple of the
+new one (effects at one hook are chained in the composition's order: the open search's hook
+terms first, then registry order, :func:`heavecomp.effects.compose.hook_order`); ``x`` is the tuple of the
 effect's own states, ``*prm`` its parameters in the order of the ``Params`` fields:
 
 =============  =================================================  ======================================

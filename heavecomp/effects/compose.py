@@ -5,7 +5,7 @@
 in :attr:`Composition.offsets`), gives the effects' states the slots after the plant's four in
 the stepper's state ``X = (s, v, y_b, v_b, X[4], ..., X[3 + n_states])`` (as many as the
 composition's effects have: none for the plain CMC) and writes the plant's hook functions as
-Python source that calls each effect's own methods in registry order, behind its on/off slot:
+Python source that calls each effect's own methods in the composition's order, behind its on/off slot:
 
 ``gas_fx, cylinder_pressure_fx, tension_fx, plant_fx, jump_fx, sliding_friction_fx,
 static_limit_fx, effect_rates``
@@ -17,6 +17,12 @@ The same generated functions are compiled by numba into the stepper
 (:func:`heavecomp.simulate._kernel.kernel_for`) and called with casadi symbols by
 :func:`heavecomp.effects.model.casadi_model`.  With no effect they are the CMC of
 :mod:`heavecomp.plants.cmc` and the laws of :mod:`heavecomp.friction.laws` exactly.
+
+One composition serves almost every run: the superset (:func:`library_composition`: the open
+search's hook terms, then every registered plant effect), compiled once at install.
+:func:`composition_for` picks it for any set of those effects, each switched on by its slot of EP,
+so a calibrated file with a new mix of effects compiles nothing; only an effect outside it (the
+benchmark generator's truth laws) gets a composition, and a compile, of its own.
 """
 
 from __future__ import annotations
@@ -29,6 +35,8 @@ import numpy as np
 from heavecomp.errors import ParameterError
 from heavecomp.friction import laws as _laws
 from heavecomp.plants import cmc as _cmc
+from heavecomp.effects.discovered_term import DiscoveredTerm
+from heavecomp.effects.hook_term import GasTerm, LineTerm, StringTerm
 from heavecomp.effects.registry import library
 
 #: index of the first effect state in the stepper's state X (after s, v, y_b, v_b)
@@ -44,13 +52,14 @@ GENERATED = ("gas_fx", "cylinder_pressure_fx", "tension_fx", "plant_fx", "jump_f
 
 
 class Composition:
-    """The hook functions of the CMC for the effect classes ``classes`` (registry order).
+    """The hook functions of the CMC for the effect classes ``classes`` (in the order given).
 
     Parameters
     ----------
     classes : sequence of Effect classes
         The plant effects of the composition (``kind == "plant"``), each once, in the order their
-        hooks are applied (registry order).
+        hooks are applied (:func:`hook_order` for a file's effects; the superset's is
+        :func:`library_composition`).
 
     Attributes
     ----------
@@ -234,15 +243,49 @@ def composition(classes=()) -> Composition:
     return _CACHE[key]
 
 
-def library_composition() -> Composition:
-    """The composition of every registered plant effect (one compiled stepper serves them all)."""
+def hook_terms() -> tuple:
+    """The open search's terms at the plant's hooks (not registered effects, not diagnosis candidates):
+    ``discovered_term`` (seal friction, :mod:`heavecomp.effects.discovered_term`), ``gas_term``,
+    ``line_term`` and ``string_term`` (:mod:`heavecomp.effects.hook_term`), in that order."""
+    return DiscoveredTerm, GasTerm, LineTerm, StringTerm
 
-    return composition(tuple(c for c in library().values() if c.kind == "plant"))
+
+def hook_order(classes) -> tuple:
+    """``classes`` (each once) in the order their hooks are applied: the hook terms (:func:`hook_terms`)
+    first, then the others in the order given.
+
+    A hook term was fitted on its hook's nominal signals (the open search's residual of the nominal
+    model at that hook), and :class:`heavecomp.effects.hook_term.StringTerm` recovers the stretch from
+    the tension it is handed by the nominal string law: applied first at its hook it sees the nominal
+    value, whatever other effect the file adds there and wherever the file lists it.  Every
+    composition of a file's effects (the stepper's, the casadi model's, the component equations')
+    applies them in this order.
+
+    Parameters
+    ----------
+    classes : iterable of Effect classes
+        Plant effect classes.
+    """
+    classes = tuple(dict.fromkeys(classes))
+    terms = hook_terms()
+    return tuple(c for c in classes if c in terms) + tuple(c for c in classes if c not in terms)
+
+
+def library_composition() -> Composition:
+    """The superset composition: the hook terms (:func:`hook_terms`, first at their hooks, see
+    :func:`hook_order`) and every registered plant effect (registry order).  One compiled stepper
+    (compiled at install, :func:`heavecomp.simulate.stepper.install_steps`) serves every set of them:
+    the diagnosis' candidates and a calibrated file's effects with the open search's terms, each
+    behind its on/off slot of EP (off: the CMC exactly)."""
+
+    return composition(hook_terms() + tuple(c for c in library().values() if c.kind == "plant"))
 
 
 def composition_for(effects) -> Composition:
-    """The library composition when every effect in ``effects`` (instances) is registered,
-    else the composition of exactly their classes (e.g. the benchmark generator's truth laws).
+    """The superset composition (:func:`library_composition`) when every effect in ``effects``
+    (instances) is a registered effect or a hook term (no compile: it is compiled at install), else
+    the composition of exactly their classes (e.g. the benchmark generator's truth laws), in
+    :func:`hook_order`.
 
     Parameters
     ----------
@@ -251,6 +294,7 @@ def composition_for(effects) -> Composition:
     """
 
     lib = library()
-    if all(lib.get(e.name) is type(e) for e in effects):
+    terms = hook_terms()
+    if all(lib.get(e.name) is type(e) or type(e) in terms for e in effects):
         return library_composition()
-    return composition(tuple(dict.fromkeys(type(e) for e in effects)))
+    return composition(hook_order(type(e) for e in effects))

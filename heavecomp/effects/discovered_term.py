@@ -18,9 +18,11 @@ parameter       open-search feature     unit         term added to J (F_f = J si
 ==============  =====================  ===========  ==========================================
 
 J stays >= 0 (a negative sum is clipped: friction never pushes).  Not a diagnosis candidate and
-not in the registry's library composition (the diagnosis' compiled stepper stays as it is): a
-parameter file names it in ``[[effects]]`` (:mod:`heavecomp.effects.spec`), and a simulation
-that uses it compiles the composition of its own effects.
+not registered: a parameter file names it in ``[[effects]]`` (:mod:`heavecomp.effects.spec`).  It is
+part of the superset composition compiled at install
+(:func:`heavecomp.effects.compose.library_composition`), applied first at the seal-friction hook (on
+the law's J, the nominal friction its features were fitted on, :func:`heavecomp.effects.compose.hook_order`),
+so a simulation that uses it compiles nothing.
 """
 
 from __future__ import annotations

@@ -23,7 +23,10 @@ effect              hook         residual (unit)              features carried (
 
 A feature the hook cannot compute (time, lags, stroke bands, the stretch's dead band and saturation, whose
 widths are not recorded) is not carried:
-:func:`carried` says which.  Not diagnosis candidates and not in the registry's library composition.
+:func:`carried` says which.  Not diagnosis candidates and not registered; part of the superset composition
+compiled at install (:func:`heavecomp.effects.compose.library_composition`), each applied *first* at its
+hook (:func:`heavecomp.effects.compose.hook_order`): it sees the hook's nominal value, the value its
+features were fitted on, whatever other effect a file adds at the same hook.
 """
 
 from __future__ import annotations
@@ -159,8 +162,9 @@ class StringTerm(_Term):
     are taken of (:func:`heavecomp.diagnosis.equation_error.library`, centred on their median ``rel_m``).
     The hook is handed the tension, not the stretch: it recovers the stretch by inverting the nominal
     string law T = T_0 + k_ds rel + c_ds dv (:func:`heavecomp.plants.cmc.tension`), rel = (T - T_0 - c_ds
-    dv) / k_ds.  That is exact when no other string effect precedes this one at the hook (a calibrated
-    file adds one term there); a preceding one's tension is read as stretch.
+    dv) / k_ds.  That is exact when no other string effect precedes this one at the hook: every composition
+    applies the hook terms first at their hook (:func:`heavecomp.effects.compose.hook_order`), so the
+    tension it is handed is the nominal one, whatever order the file lists its effects in.
     """
 
     name = "string_term"

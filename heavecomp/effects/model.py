@@ -12,7 +12,7 @@ import logging
 
 import numpy as np
 
-from heavecomp.effects.compose import composition
+from heavecomp.effects.compose import composition, hook_order
 from heavecomp.effects.registry import resolve, split_effects
 from heavecomp.errors import ParameterError
 from heavecomp.friction.laws import friction_cont
@@ -57,7 +57,7 @@ def casadi_model(params, *, eps: float | None = None, sym: str = "SX", effects=(
     ca = casadi()
     plant = plant_vectors(params)
     effects, heave_fx, sensor_fx = split_effects(resolve(effects))
-    comp = composition(tuple(dict.fromkeys(type(e) for e in effects)))
+    comp = composition(hook_order(type(e) for e in effects))
     EP = comp.ep(effects)
     if friction and (plant.has_stiction or comp.adds_stiction(EP)) and not (eps and eps > 0):
         what = ", ".join([f"the friction law {params.friction.model!r}"] * plant.has_stiction
@@ -216,6 +216,6 @@ def initial_effect_states(params, effects=()) -> np.ndarray:
     """
     plant = plant_vectors(params)
     effects = split_effects(resolve(effects))[0]
-    comp = composition(tuple(dict.fromkeys(type(e) for e in effects)))
+    comp = composition(hook_order(type(e) for e in effects))
     n_eff = comp.n_states
     return comp.initial_state(plant.FP, plant.PP, comp.ep(effects))[4:4 + n_eff]

@@ -42,7 +42,7 @@ from heavecomp.params.core import check_value
 
 def classes() -> dict:
     """name -> effect class of every effect a parameter file may name: the registry's, plus
-    the open search's terms (not candidates, not in the library composition): ``discovered_term`` at the
+    the open search's terms (not candidates, not registered; in the superset composition compiled at install): ``discovered_term`` at the
     seal-friction hook, ``line_term``, ``gas_term``, ``string_term`` at the line, gas-spring and string
     hooks (:mod:`heavecomp.effects.hook_term`) and ``sensor_term`` on a channel's reading; and the calibrated
     model's ``sensor_lag`` (a reading with its own dynamics, :mod:`heavecomp.effects.sensor_lag`)."""

@@ -135,7 +135,8 @@ def plant_stepper(plant, effects=()):
     point and its :class:`Plant` (effect parameters bound).
 
     Without effects the nominal stepper (:func:`nominal`), with effects the stepper of their
-    composition (:func:`heavecomp.effects.compose.composition_for`).
+    composition (:func:`heavecomp.effects.compose.composition_for`: the superset compiled at install
+    for registered effects and hook terms).
 
     Parameters
     ----------
@@ -222,7 +223,8 @@ def _ensure_compiled(fn, comp=None) -> None:
 
 
 #: CPU seconds to compile the nominal stepper, and more per effect of a composition (measured:
-#: 34 s and 73 s for the library's 10 effects, numba 0.68; the notice quotes their sum)
+#: 34 s and 73 s for the library's 10 effects, numba 0.68; 90 s for the superset's 15 classes and 50 s for
+#: 3 effects, benchmarks/simulate/install_compile.json and composition.json; the notice quotes their sum)
 COMPILE_S = 35
 COMPILE_S_PER_EFFECT = 4
 
@@ -274,8 +276,10 @@ def compile_all(progress=None) -> list[str]:
     """Compile the steppers the commands use into numba's cache (``setup.py`` runs it at install,
     with the campaign's batch: :func:`heavecomp.campaign.batch.compile_batch`).
 
-    The nominal stepper (simulate, closed loop), :func:`heave_at` and the stepper of the library's
-    effect composition (``simulate(effects=...)``, the diagnosis).  Returns the names compiled.
+    The nominal stepper (simulate, closed loop), :func:`heave_at` and the stepper of the superset
+    composition (:func:`heavecomp.effects.compose.library_composition`: every registered plant effect
+    and the open search's hook terms; ``simulate(effects=...)``, a calibrated file, the diagnosis).
+    Returns the names compiled.
 
     Parameters
     ----------
@@ -292,7 +296,9 @@ def compile_all(progress=None) -> list[str]:
 
 def install_steps() -> dict:
     """The install-time compiles of :func:`compile_all`, by name: each fills its own cache folder, so
-    ``setup.py`` runs each in a process of its own, on every core."""
+    ``setup.py`` runs each in a process of its own, on every core.  ``"library effects stepper"`` is the
+    superset composition's (:func:`heavecomp.effects.compose.library_composition`), which serves every
+    set of registered effects and hook terms: a calibrated file's new mix of them compiles nothing."""
     from heavecomp.simulate import _kernel
 
     def nominal():
