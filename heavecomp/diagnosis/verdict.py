@@ -141,7 +141,13 @@ def assess(fits, gap, floors, envelope, policy) -> Assessment:
 
 def rival(fits):
     """The runner-up of ``fits`` (best first): the best fit of another family than the best's (two laws of
-    one contract class, ``friction_lag`` in time and in distance, are one answer, never rivals); None."""
+    one contract class, ``friction_lag`` in time and in distance, are one answer, never rivals); None.
+
+    Parameters
+    ----------
+    fits : list of heavecomp.diagnosis.fitting.CandidateFit
+        The replayed candidates' fits, best score first.
+    """
     return next((f for f in fits[1:] if not same_family(f.effect, fits[0].effect)), None)
 
 
