@@ -1,7 +1,8 @@
 """Install-time builds of the compiled stepper (see heavecomp/simulate/stepper.py); metadata in pyproject.toml.
 
 1. Warm numba's cache: the JIT steppers the commands use (the nominal stepper, the stepper of the
-   library's effect composition, the campaign's parallel batch) are compiled into
+   library's effect composition, the campaign's parallel batch, the stick-slip map's pneumatic
+   batch) are compiled into
    ``heavecomp/_numba_cache`` beside the sources (:mod:`heavecomp.simulate.cache`), so the first
    ``heavecomp diagnose`` / ``simulate`` / ``campaign`` after ``pip install -e .`` loads machine
    code instead of compiling it (about 2 minutes of CPU here, once).  Each is compiled in a process
@@ -32,7 +33,8 @@ _LOG = "import logging; logging.basicConfig(level=logging.WARNING, format='%(mes
 WARM = {"library effects stepper": _LOG + "from heavecomp.simulate import stepper; "
                                           "stepper.install_steps()['library effects stepper']()",
         "nominal stepper": _LOG + "from heavecomp.simulate import stepper; stepper.install_steps()['nominal stepper']()",
-        "campaign batch": _LOG + "from heavecomp.campaign import batch; batch.compile_batch()"}
+        "campaign batch": _LOG + "from heavecomp.campaign import batch; batch.compile_batch()",
+        "pneumatic stepper": _LOG + "from heavecomp.pneumatic import stepper; stepper.compile_many()"}
 
 
 class AOTExtension(Extension):
