@@ -1,7 +1,8 @@
 """Install-time builds of the compiled stepper (see heavecomp/simulate/stepper.py); metadata in pyproject.toml.
 
 1. Warm numba's cache: the JIT steppers the commands use (the nominal stepper, the stepper of the
-   library's effect composition, the campaign's parallel batch) are compiled into
+   library's effect composition, the campaign's parallel batch, the stick-slip map's pneumatic
+   batch, and the benchmark generator's truth stepper the scenarios and the fast tests run) are compiled into
    ``heavecomp/_numba_cache`` beside the sources (:mod:`heavecomp.simulate.cache`), so the first
    ``heavecomp diagnose`` / ``simulate`` / ``campaign`` after ``pip install -e .`` loads machine
    code instead of compiling it (about 2 minutes of CPU here, once).  Each is compiled in a process
@@ -31,8 +32,11 @@ HERE = Path(__file__).resolve().parent
 _LOG = "import logging; logging.basicConfig(level=logging.WARNING, format='%(message)s'); "
 WARM = {"library effects stepper": _LOG + "from heavecomp.simulate import stepper; "
                                           "stepper.install_steps()['library effects stepper']()",
+        "benchmark truth stepper": _LOG + "from heavecomp.benchmark.truth import truth_composition; "
+                                          "from heavecomp.simulate import stepper; stepper.kernel_for(truth_composition())",
         "nominal stepper": _LOG + "from heavecomp.simulate import stepper; stepper.install_steps()['nominal stepper']()",
-        "campaign batch": _LOG + "from heavecomp.campaign import batch; batch.compile_batch()"}
+        "campaign batch": _LOG + "from heavecomp.campaign import batch; batch.compile_batch()",
+        "pneumatic stepper": _LOG + "from heavecomp.pneumatic import stepper; stepper.compile_many()"}
 
 
 class AOTExtension(Extension):

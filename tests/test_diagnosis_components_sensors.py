@@ -1,43 +1,28 @@
 """Sensors in the component residuals (heavecomp.diagnosis.components.channel_search): a channel that
 misreads shows in every equation that reads it, a string that stiffens only in the lower-mass
 balance.  Runs simulated by the project's own plant; the misreading is a generic clip of the reading
-and the string's stiffening a cubic in its stretch, neither a candidate nor a truth law."""
-
-from dataclasses import dataclass
+and the string's stiffening a cubic in its stretch, which no candidate fits: the benchmark's
+``stiffening_string``, run in its truth stepper (compiled once for the suite, which
+``tests/test_benchmark_truth.py`` compiles anyway; a test-only effect class cost a compile of its own,
+about 50 s of CPU, 103 s at load 8)."""
 
 import numpy as np
 import pytest
 
+from heavecomp.benchmark.truth import truth_composition
+from heavecomp.benchmark.truth.stiffening_string import TruthStiffeningString
 from heavecomp.diagnosis import components as CR
 from heavecomp.diagnosis import equation_error as EE
 from heavecomp.diagnosis.data import check_run
-from heavecomp.effects.base import Effect
-from heavecomp.params.core import q
+from heavecomp.diagnosis.stepper import simulate_fx
 from heavecomp.params.sets import paper_a
-from heavecomp.plants.cmc import KDS, T0
 from heavecomp.simulate import simulate
 
-pytestmark = pytest.mark.slow  # compiles an effect composition (~1-2 min on 2 busy cores)
+pytestmark = pytest.mark.slow  # loads (or compiles) the out-of-library truth stepper and simulates 2 x 240 s
 
 NOISE = {"heave": 0.002, "stroke": 0.002, "pressure": 2e3, "wob": 400.0}
 T = 240.0
 CUT = 160.0  # fit before, held out after [s]
-
-
-class CubicString(Effect):
-    """Test-only: a drill string that stiffens with its stretch, T += k3 ((T - T_0) / k_ds)^3."""
-
-    name = "test_cubic_string"
-    hook = "string"
-
-    @dataclass(frozen=True)
-    class Params:
-        k3: float = q(0.0, "N/m^3", bounds=(0.0, 1e12), symbol="k_3", doc="cubic stiffening")
-
-    @staticmethod
-    def string(dv, T, x, PP, k3):
-        e = (T - PP[T0]) / PP[KDS]
-        return T + k3 * e * e * e
 
 
 @pytest.fixture(scope="module")
@@ -54,7 +39,7 @@ def _residuals(p, cols):
 
 
 def _columns(sim):
-    return {"t": sim.t, **{c: np.asarray(sim[c], float) for c in NOISE}}
+    return {"t": np.asarray(sim["t"], float), **{c: np.asarray(sim[c], float) for c in NOISE}}
 
 
 def test_a_clipped_wob_reading_is_a_sensor(plant):
@@ -75,7 +60,7 @@ def test_a_stiffening_string_stays_in_string_formation(plant):
     """A string that stiffens (cubic in its stretch): the WOB reads it right, so the top-mass balance
     holds; no channel explains two equations, and the open search on the string residual finds a power
     of the relative displacement."""
-    sim = simulate(plant, T, rate=50.0, effects=[CubicString(k3=3e9)])
+    sim = simulate_fx(plant, T, [TruthStiffeningString(k3=3e9)], rate=50.0, comp=truth_composition("stiffening_string"))
     cr, fit, val = _residuals(plant, _columns(sim))
     sh = cr.shares()
     assert max(sh, key=sh.get) == "string_formation"

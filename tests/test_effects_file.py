@@ -150,6 +150,7 @@ def test_a_campaign_refuses_plant_effects_it_would_not_simulate(tmp_path):
         campaign.loads(text, base_dir=tmp_path).base_params()
 
 
+@pytest.mark.slow  # compiles the stepper of a discovered_term composition (about 40 s of CPU once, 78 s at load 8)
 def test_discovered_term_is_the_open_search_term_it_carries():
     """Round trip: a plant with discovered_term, its friction residual (simulated friction minus the
     nominal law at the same v and p, the friction component's residual) is exactly the term, and the

@@ -283,6 +283,13 @@ def run_many(states, t_ends, h, PPs, FPBs, moved, stop_at_stick):
     return res
 
 
+def compile_many() -> None:
+    """Compile :func:`run_many` for the argument types the stick-slip map passes
+    (:func:`heavecomp.pneumatic.stickslip.grid_map`), or load it from numba's cache: a call over
+    no run (``setup.py`` runs it at install, so the first ``heavecomp stickslip --map`` compiles nothing)."""
+    run_many(np.zeros((0, 4)), np.zeros(0), 1e-3, np.zeros((0, 12)), np.zeros((0, 6)), 1, 1)
+
+
 def default_step(p, position: float = 0.0) -> float:
     """RK4 step [s]: h * lambda <= 0.3 for the fastest linear mode, at most 1 ms.
 
