@@ -337,6 +337,11 @@ def fit(ctx, name, start=None, fixed=(), *, search=Search(), hint=None, room=Non
 #: effect kinds that correct a reading (a measured channel, the heave input): fitted with re-weighting
 READING_KINDS = ("output", "heave")
 
+#: Nelder-Mead's first simplex step [share of each parameter's search range] from a start the grid or the
+#: defaults picked (the optimum may be a fair part of the range away); a start next to the optimum takes
+#: ``VerdictPolicy.start_step``
+NM_STEP = 0.08
+
 
 def _fit_once(ctx, cls, start, fixed, search, hint, channel=None, room=None) -> Fit:
     """One fit of ``cls`` with the strategy its kind asks for (``channel``: an output effect's channel
@@ -420,12 +425,14 @@ def fit_replayed(ctx, cls, start=None, fixed=(), *, search=Search(), hint=None, 
         return Fit(cls.from_x(r.x), sigma(cls, r), int(r.nfev), float(2 * r.cost), n_params=moved)
     later = np.array([f.name in cls.fit.released_last for f in cls.fields()])
     if start is None and later.any():
-        r = _fit_then_release(fun, x0, lo, hi, ~later, budget, t_grid, search, hint)
+        r = _fit_then_release(fun, x0, lo, hi, ~later, budget, t_grid, search, hint, P.start_step)
         return Fit(cls.from_x(r.x), sigma(cls, r), int(r.nfev), float(2 * r.cost))
+    # a start next to the optimum (the equation error's): a small first simplex (VerdictPolicy.start_step)
+    near = False
     if start is None:
-        x0 = _start(cls, fun, x0, lo, hi, t_grid, search.grid, hint)
+        x0, near = _start(cls, fun, x0, lo, hi, t_grid, search.grid, hint)
     if x0.size <= 2:
-        r = nelder_mead(fun, x0, lo, hi, budget)
+        r = nelder_mead(fun, x0, lo, hi, budget, P.start_step if near else NM_STEP)
     else:
         r = least_squares(fun, x0, lo, hi, budget, search.n_jobs)
         if start is None:
@@ -433,7 +440,7 @@ def fit_replayed(ctx, cls, start=None, fixed=(), *, search=Search(), hint=None, 
     return Fit(cls.from_x(r.x), sigma(cls, r), int(r.nfev), float(2 * r.cost))
 
 
-def _fit_then_release(fun, x0, lo, hi, keep, budget, t_grid, search, hint):
+def _fit_then_release(fun, x0, lo, hi, keep, budget, t_grid, search, hint, start_step=None):
     """The fit of the parameters ``keep`` with the others held at ``x0`` (as :func:`fit_replayed` fits
     that smaller candidate: coarse start grid, Nelder-Mead for up to two), then every parameter
     released by least squares from that optimum (``cls.fit.released_last``).  Least squares only takes
@@ -457,6 +464,9 @@ def _fit_then_release(fun, x0, lo, hi, keep, budget, t_grid, search, hint):
         Search effort (``grid``, ``n_jobs``).
     hint : numpy.ndarray or None
         Equation-error start as a full fit vector.
+    start_step : float, optional
+        First simplex step (share of the range) from the equation-error start (``VerdictPolicy.start_step``;
+        None: :data:`NM_STEP`).
     """
     def part(xs, *t_stop):
         x = x0.copy()
@@ -464,9 +474,10 @@ def _fit_then_release(fun, x0, lo, hi, keep, budget, t_grid, search, hint):
         return fun(x, *t_stop)
 
     x1 = x0.copy()
-    x1[keep] = _start(None, part, x0[keep], lo[keep], hi[keep], t_grid, search.grid,
-                      None if hint is None else hint[keep])
-    r1 = _refit_subset(fun, x1, np.flatnonzero(keep), lo, hi, budget, search.n_jobs)
+    x1[keep], near = _start(None, part, x0[keep], lo[keep], hi[keep], t_grid, search.grid,
+                            None if hint is None else hint[keep])
+    r1 = _refit_subset(fun, x1, np.flatnonzero(keep), lo, hi, budget, search.n_jobs,
+                       start_step if near and start_step is not None else NM_STEP)
     r = least_squares(fun, np.clip(r1.x, lo + 1e-9, hi - 1e-9), lo, hi, budget, search.n_jobs)
     r.nfev = int(r.nfev) + int(r1.nfev)
     return r
@@ -795,10 +806,11 @@ def _lin_fit(J, r, act):
     return float(left @ left), dx
 
 
-def _refit_subset(fun, x, act, lo, hi, budget, n_jobs):
+def _refit_subset(fun, x, act, lo, hi, budget, n_jobs, step=None):
     """The fit vector ``x`` with its entries ``act`` refitted (Nelder-Mead up to two, else least squares;
     ``budget`` evaluations) and the rest held: a result with ``x``, ``fun``, ``jac`` (zero columns for the
-    held entries), ``nfev`` and ``cost`` (half the sum of squares)."""
+    held entries), ``nfev`` and ``cost`` (half the sum of squares).  ``step``: Nelder-Mead's first simplex
+    step (share of the range; None: :data:`NM_STEP`)."""
     act = np.asarray(act, dtype=int)
 
     def f(z, t_stop=None):
@@ -807,7 +819,7 @@ def _refit_subset(fun, x, act, lo, hi, budget, n_jobs):
         return fun(xx) if t_stop is None else fun(xx, t_stop)
 
     z0 = np.clip(x[act], lo[act] + 1e-9, hi[act] - 1e-9)
-    r = nelder_mead(f, z0, lo[act], hi[act], budget) if act.size <= 2 else \
+    r = nelder_mead(f, z0, lo[act], hi[act], budget, NM_STEP if step is None else step) if act.size <= 2 else \
         least_squares(f, z0, lo[act], hi[act], budget, n_jobs)
     xx = x.copy()
     xx[act] = r.x
@@ -839,13 +851,13 @@ def _start(cls, fun, x0, lo, hi, t_grid, grid, hint):
     residual, blind to stick timing) when it costs less on the first ``t_grid`` s than the default, and
     then no grid (issue 32: start where the equations point); else, with <= 2 parameters, the best point
     of a coarse grid (stick-slip makes the cost rough) when it costs less still (the grid only picks the
-    start)."""
+    start).  Returns the start and whether it is the equation-error one (next to the optimum)."""
     if hint is not None:
         # the component residual's fit as a start, where it fixes every parameter and its cost on the
         # grid span is lower
         x_ee = np.clip(hint, lo + 1e-9, hi - 1e-9)
         if float(np.sum(fun(x_ee, t_grid) ** 2)) < float(np.sum(fun(x0, t_grid) ** 2)):
-            return x_ee
+            return x_ee, True
     k = x0.size
     if k <= 2:
         axes = [_grid_axis(lo[i], hi[i], grid if k == 1 else max(3, (grid + 3) // 2)) for i in range(k)]
@@ -854,7 +866,7 @@ def _start(cls, fun, x0, lo, hi, t_grid, grid, hint):
         c0 = float(np.sum(fun(x0, t_grid) ** 2))
         if min(costs) < c0:
             x0 = pts[int(np.argmin(costs))]
-    return x0
+    return x0, False
 
 
 @functools.cache
@@ -942,7 +954,7 @@ def rescan(cls, fun, r, lo, hi, nominal, search=Search()):
     return best
 
 
-def nelder_mead(fun, x0, lo, hi, budget):
+def nelder_mead(fun, x0, lo, hi, budget, step=None):
     """Derivative-free refinement (Nelder-Mead on the clipped parameters; stick-slip costs are
     piecewise smooth, so finite-difference gradients mislead), then a forward-difference
     Jacobian at the optimum for the uncertainty.  Returns an object like least_squares'.
@@ -957,6 +969,9 @@ def nelder_mead(fun, x0, lo, hi, budget):
         Bounds of the fit vector (the parameters are clipped to them).
     budget : int
         Maximum number of cost evaluations of the simplex search.
+    step : float, optional
+        First simplex step as a share of each parameter's range (None: :data:`NM_STEP`, a start from a
+        grid or the defaults; ``VerdictPolicy.start_step`` from a start next to the optimum).
     """
     from scipy.optimize import minimize
 
@@ -964,7 +979,7 @@ def nelder_mead(fun, x0, lo, hi, budget):
         r = fun(np.clip(x, lo, hi))
         return float(r @ r)
 
-    step = 0.08 * (hi - lo)
+    step = (NM_STEP if step is None else step) * (hi - lo)
     simplex = np.vstack([x0] + [x0 + np.where(np.arange(x0.size) == i, np.where(x0 + step <= hi, step, -step), 0.0)
                                 for i in range(x0.size)])
     res = minimize(cost, x0, method="Nelder-Mead",

@@ -166,6 +166,14 @@ class VerdictPolicy:
     # ---------------------------------------------------------------- search budget
     joint_nfev: float = 0.5
     """Share of ``max_nfev`` a joint second-effect fit gets (it starts from the candidate's own fit)."""
+    start_step: float = 0.01
+    """Nelder-Mead's first simplex step [share of each parameter's search range] from the equation-error
+    start (:meth:`heavecomp.effects.base.Effect.from_equation_error`), where it costs less than the default
+    start (issue 32: start where the equations point); from a grid or the defaults the step is
+    :data:`heavecomp.diagnosis.fitting.NM_STEP` (0.08).  Evidence: on the 600 s flow-loss benchmark
+    (seed 11) the equation error's resistance is 2.7 % off the replay's optimum, 0.2 % of the search
+    range in the fit vector (its log); a simplex too small for a start further off grows by
+    expansion, one replay per doubling."""
     grid_span: float = 150.0
     """Span of the fit part [s] on which the coarse start grid of a candidate is scored."""
     delay_scan: int = 61

@@ -219,6 +219,18 @@ class Effect:
         return None
 
     @classmethod
+    def coefficient_value(cls, fit, feature, param) -> float | None:
+        """Parameter ``param`` [SI] read as the equation-error coefficient of ``feature`` itself (a
+        feature whose coefficient is that parameter, in its unit), inside the parameter's bounds (a
+        coefficient of the wrong sign sits at the bound); None when the fit has no such coefficient.
+        The helper of :meth:`from_equation_error` where one coefficient is one parameter."""
+        coef = (fit or {}).get("coefficients") or {}
+        if feature not in coef or not np.isfinite(coef[feature]):
+            return None
+        lo, hi = cls.Params.__dataclass_fields__[param].metadata["bounds"]
+        return float(min(max(float(coef[feature]), lo), hi))
+
+    @classmethod
     def null(cls, plant) -> dict | None:
         """Parameter values at which the effect reproduces the nominal plant bit for bit
         (``plant``: :class:`heavecomp.plants.cmc.PlantVectors`), or None when it has none

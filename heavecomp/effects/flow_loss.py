@@ -38,6 +38,13 @@ class FlowLoss(Effect):
             return None
         return {"flow_loss": -np.asarray(sig["v"], dtype=float)}
 
+    @classmethod
+    def from_equation_error(cls, fit, sig):
+        """The resistance R [Pa s/m]: the ``flow_loss`` coefficient itself (the feature is the kernel's
+        drop per unit -v), inside its bounds."""
+        r = cls.coefficient_value(fit, "flow_loss", "resistance")
+        return None if r is None else {"resistance": r}
+
     @staticmethod
     def line(v, p, x, PP, resistance):
         return p - resistance * v

@@ -47,6 +47,12 @@ class GasLeak(Effect):
             return None
         return {"gas_leak": np.asarray(sig["t"], dtype=float) * np.asarray(sig["p_gas_abs"], dtype=float)}
 
+    @classmethod
+    def from_equation_error(cls, fit, sig):
+        """r [1/s]: the ``gas_leak`` coefficient itself, inside its bounds."""
+        r = cls.coefficient_value(fit, "gas_leak", "leak_rate")
+        return None if r is None else {"leak_rate": r}
+
     @staticmethod
     def gas(s, v, p, x, PP, leak_rate):
         return p + x[0] * (p + PP[PATM])

@@ -70,8 +70,7 @@ class PositionFriction(Effect):
         x = np.asarray(sig["x"], dtype=float)
         x0, span = float(np.nanmin(x)), float(np.nanmax(x) - np.nanmin(x))
         c, w = fit["shape"]
-        low = cls.Params.__dataclass_fields__["extra_force"].metadata["bounds"][0]
-        return {"extra_force": max(float(fit["coefficients"]["position_friction"]), low),
+        return {"extra_force": cls.coefficient_value(fit, "position_friction", "extra_force"),
                 "centre": x0 + float(c) * span, "width": float(w) * span}
 
     @staticmethod

@@ -37,6 +37,12 @@ class PressureFriction(Effect):
             return None
         return {"pressure_friction": np.sign(sig["v"]) * np.abs(sig["p"])}
 
+    @classmethod
+    def from_equation_error(cls, fit, sig):
+        """dC_p [N/Pa]: the ``pressure_friction`` coefficient itself, inside its bounds."""
+        c = cls.coefficient_value(fit, "pressure_friction", "extra_pressure_coefficient")
+        return None if c is None else {"extra_pressure_coefficient": c}
+
     @staticmethod
     def jump(code, a, p, J, s, d, x, FP, extra_pressure_coefficient):
         return J + extra_pressure_coefficient * np.abs(p)

@@ -67,6 +67,16 @@ class StringDamping(Effect):
         n = 1.0 if shape is None else float(shape)
         return {"string_damping": -r * np.maximum(np.abs(r) / V_REF, 1e-6) ** (n - 1.0)}
 
+    @classmethod
+    def from_equation_error(cls, fit, sig):
+        """The damping c [N s/m]: the ``string_damping`` coefficient (the force at the reference speed
+        over v_r, as in the kernel: :data:`V_REF` makes it nearly independent of n), inside its bounds;
+        the exponent n: the grid value the fit picked (``shape``; 1 when it has none)."""
+        c = cls.coefficient_value(fit, "string_damping", "damping")
+        if c is None:
+            return None
+        return {"damping": c, "exponent": 1.0 if fit.get("shape") is None else float(fit["shape"])}
+
     @staticmethod
     def string(dv, T, x, PP, damping, exponent):
         # c dv |dv / v_r|^(n - 1): at n = 1 exactly the linear dashpot c dv (x^0 = 1), and its slope at dv = 0
