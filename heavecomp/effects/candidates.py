@@ -177,12 +177,17 @@ def get(name: str) -> type:
     name : str
         Effect name (e.g. ``"dwell_stiction"``, ``"parameter_mismatch"``).
     """
-    known = {**CANDIDATES, **library()}
+    known = _known()
     try:
         return known[name]
     except KeyError:
         raise ParameterError(f"unknown effect {name!r}{did_you_mean(name, known)}; known: "
                              f"{', '.join(known)}") from None
+
+
+def _known() -> dict:
+    """name -> class of every effect :func:`get` knows: the candidates and the registered effects."""
+    return {**CANDIDATES, **library()}
 
 
 # ------------------------------------------------------------------ families of laws (issue 30 item 4)
@@ -199,7 +204,7 @@ def family_of(name) -> str:
     if not isinstance(name, str):
         return name
     base, sep, channel = name.partition(":")
-    cls = {**CANDIDATES, **library()}.get(base)
+    cls = _known().get(base)
     fam = (cls.fit.family if cls is not None else "") or base
     return fam + sep + channel
 
@@ -212,7 +217,7 @@ def law_of(name) -> str:
     name : str
         An effect name.
     """
-    cls = {**CANDIDATES, **library()}.get(str(name).partition(":")[0])
+    cls = _known().get(str(name).partition(":")[0])
     return cls.fit.law if cls is not None else ""
 
 
