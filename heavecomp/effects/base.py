@@ -104,6 +104,10 @@ class FitSpec:
     law: str = ""
     """The law of the family this effect is (``"time"``, ``"distance"``): the verdict names the family and
     carries the law (``verdict.law``) and the effect fitted (``verdict.member``).  Empty: no family of laws."""
+    coefficients: dict = dataclasses.field(default_factory=dict)
+    """Equation-error columns whose coefficient is a parameter itself, in its unit (column name -> parameter
+    name): the default :meth:`Effect.from_equation_error` reads each (:meth:`Effect.coefficient_value`) as
+    the replay fit's start; empty: the effect writes its own, or has none."""
     probes: tuple = ()
     """Parameter sets (tuples of (name, value) pairs) the diagnosis's score test replays an unscreened
     candidate at before a full fit (:mod:`heavecomp.diagnosis.score_test`): a moderate amplitude at two or
@@ -215,8 +219,11 @@ class Effect:
         """Parameter values [SI] that the equation-error fit ``fit`` (a row of
         :func:`heavecomp.diagnosis.equation_error.rank_effects`: ``coefficients``, ``shape``) of this
         effect's :meth:`features` on signals ``sig`` stands for: a start for the replay's fit; None
-        when the features do not fix every parameter (the default)."""
-        return None
+        when the features do not fix every parameter.  The default reads ``fit.coefficients`` (each
+        listed column's coefficient as its parameter, inside its bounds): None when it lists none or the
+        fit lacks one of them."""
+        values = {param: cls.coefficient_value(fit, col, param) for col, param in cls.fit.coefficients.items()}
+        return values if values and None not in values.values() else None
 
     @classmethod
     def coefficient_value(cls, fit, feature, param) -> float | None:

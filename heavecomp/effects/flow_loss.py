@@ -19,6 +19,9 @@ class FlowLoss(Effect):
     name = "flow_loss"
     fit = FitSpec(
         candidate=True,
+        # the replay fit's start: the resistance R [Pa s/m] is the ``flow_loss`` coefficient itself (the
+        # feature is the kernel's drop per unit -v)
+        coefficients={"flow_loss": "resistance"},
         log=("resistance",),
         # units of the equation-error coefficients (``features``)
         feature_units={"flow_loss": "Pa s/m"},
@@ -37,13 +40,6 @@ class FlowLoss(Effect):
         if "v" not in sig:
             return None
         return {"flow_loss": -np.asarray(sig["v"], dtype=float)}
-
-    @classmethod
-    def from_equation_error(cls, fit, sig):
-        """The resistance R [Pa s/m]: the ``flow_loss`` coefficient itself (the feature is the kernel's
-        drop per unit -v), inside its bounds."""
-        r = cls.coefficient_value(fit, "flow_loss", "resistance")
-        return None if r is None else {"resistance": r}
 
     @staticmethod
     def line(v, p, x, PP, resistance):

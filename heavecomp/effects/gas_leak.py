@@ -27,6 +27,8 @@ class GasLeak(Effect):
     name = "gas_leak"
     fit = FitSpec(
         candidate=True,
+        # the replay fit's start: r [1/s] is the ``gas_leak`` coefficient itself
+        coefficients={"gas_leak": "leak_rate"},
         # units of the equation-error coefficients (``features``)
         feature_units={"gas_leak": "1/s"},
     )
@@ -46,12 +48,6 @@ class GasLeak(Effect):
         if not all(k in sig for k in ("t", "p_gas_abs")):
             return None
         return {"gas_leak": np.asarray(sig["t"], dtype=float) * np.asarray(sig["p_gas_abs"], dtype=float)}
-
-    @classmethod
-    def from_equation_error(cls, fit, sig):
-        """r [1/s]: the ``gas_leak`` coefficient itself, inside its bounds."""
-        r = cls.coefficient_value(fit, "gas_leak", "leak_rate")
-        return None if r is None else {"leak_rate": r}
 
     @staticmethod
     def gas(s, v, p, x, PP, leak_rate):

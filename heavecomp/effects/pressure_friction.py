@@ -17,6 +17,8 @@ class PressureFriction(Effect):
     name = "pressure_friction"
     fit = FitSpec(
         candidate=True,
+        # the replay fit's start: dC_p [N/Pa] is the ``pressure_friction`` coefficient itself
+        coefficients={"pressure_friction": "extra_pressure_coefficient"},
         log=("extra_pressure_coefficient",),
         # units of the feature coefficients [SI]
         feature_units={"pressure_friction": "N/Pa"},
@@ -36,12 +38,6 @@ class PressureFriction(Effect):
         if not need(sig, "v", "p"):
             return None
         return {"pressure_friction": np.sign(sig["v"]) * np.abs(sig["p"])}
-
-    @classmethod
-    def from_equation_error(cls, fit, sig):
-        """dC_p [N/Pa]: the ``pressure_friction`` coefficient itself, inside its bounds."""
-        c = cls.coefficient_value(fit, "pressure_friction", "extra_pressure_coefficient")
-        return None if c is None else {"extra_pressure_coefficient": c}
 
     @staticmethod
     def jump(code, a, p, J, s, d, x, FP, extra_pressure_coefficient):
