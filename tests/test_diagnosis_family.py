@@ -72,6 +72,19 @@ def test_a_time_lag_is_named_friction_lag_with_law_time():
     assert v["confidence"] == "high"
 
 
+def test_a_warning_names_the_family_and_its_law_not_only_the_member():
+    """A warning written before the verdict takes its family's name still says it: a friction_memory fit at
+    its search bound reads ``friction_lag (law: distance, fitted as friction_memory)`` in the warning."""
+    import dataclasses
+
+    hit = {"parameter": "relaxation_length", "value": 0.2, "side": "upper", "bound": 0.2}
+    fits = [dataclasses.replace(_fit("friction_memory", 0.95), at_bound=(hit,)), _fit("flow_loss", 0.4, n=1)]
+    got = decide(fits, GAP, ONES, ONES, VerdictPolicy(), Evidence(_shares(friction=0.9)))
+    said = [w for w in got.warnings if "search bound" in w]
+    assert got.body["confidence"] == "low" and len(said) == 1
+    assert said[0].startswith("verdict friction_lag (law: distance, fitted as friction_memory): fitted relaxation_length")
+
+
 def test_a_group_of_one_family_is_a_single_name_and_a_mixed_group_names_each_family_once():
     """The block test cannot tell the two laws apart: one answer, friction_lag, its law the better fit's
     (distance), no group; with dwell_stiction also inside, the group is [friction_lag, dwell_stiction]."""

@@ -272,6 +272,21 @@ def label(v) -> str:
     return str(v.get("effect"))
 
 
+def said(name: str) -> str:
+    """An effect's name as the verdict reports it, for the words of a warning written before the verdict
+    takes its family's name (:func:`_as_family`): ``friction_lag (law: distance, fitted as friction_memory)``
+    for a law of a family, else ``name``.
+
+    Parameters
+    ----------
+    name : str
+        The fitted effect (a family's member, or any other name).
+    """
+    if name in NOT_NAMED or not law_of(name):
+        return name
+    return label({"effect": family_of(name), "law": law_of(name), "member": name})
+
+
 def member(v) -> str:
     """The effect a verdict fitted (its class: ``calibrated.toml``'s entry, its parameters' units): the
     ``member`` of a family's law, else the ``effect``.
@@ -427,7 +442,7 @@ def _at_bound(v, fits, warnings) -> None:
     v["confidence"] = "low"
     where = ", ".join(f"{h['parameter']} = {h['value']:.4g} at its {h['side']} search bound {h['bound']:.4g}"
                       for h in hits)
-    warnings.append(f"verdict {v['effect']}: fitted {where}; the effect may stand in for another "
+    warnings.append(f"verdict {said(v['effect'])}: fitted {where}; the effect may stand in for another "
                     f"(e.g. a channel with the wrong sign or unit) -- confidence lowered from {was} to low")
 
 
@@ -506,7 +521,7 @@ def _table_check(v, shares, largest, P, not_observable=(), warnings=None) -> Non
         was = v["confidence"]
         v["confidence"] = "low"
         if warnings is not None:
-            warnings.append(f"verdict {v['effect']}: its component {comp.replace('_', ' ')} holds "
+            warnings.append(f"verdict {said(v['effect'])}: its component {comp.replace('_', ' ')} holds "
                             f"{100 * shares.get(comp, 0.0):.0f} % of the equation-error gap, "
                             f"{largest.replace('_', ' ')} {100 * shares[largest]:.0f} % ({reason}) -- confidence "
                             f"lowered from {was} to low")
