@@ -269,8 +269,9 @@ def test_a_composition_has_as_many_state_slots_as_its_effects():
 
 
 @pytest.mark.slow
-def test_a_five_state_composition_compiles_and_integrates():
-    """The stepper compiled for five effect states integrates them (constant rates: exact)."""
+def test_every_stateful_effect_composed_with_a_two_state_one_compiles_and_integrates():
+    """The stepper compiled for every stateful library effect plus a two-state test effect (seven effect
+    states today; the count grows with the library) integrates them (constant rates: exact)."""
     from heavecomp.effects.compose import composition
     from heavecomp.effects.registry import library
     from heavecomp.diagnosis.stepper import simulate_fx
