@@ -18,7 +18,8 @@ own, and the largest of the three is tested (:func:`predicted`).  A candidate wh
 under ``VerdictPolicy.score_test_explained`` is not replayed in full; its prescreen entry keeps the
 evidence (``score_test``).  The probes are secants from the null to a physical configuration, so the
 linear model includes each probe's own replay (amplitude 1, and its fit-part cost is never above the
-best probe's).  Three probes cost about three replays, against ~40 for a full fit.
+best probe's).  Three probes cost about three replays, against ~40 for a full fit.  A smooth candidate's
+fit starts at the test's step (:func:`start`).
 """
 
 from __future__ import annotations
@@ -107,6 +108,36 @@ def predicted(ctx, preds) -> dict:
                    if math.isfinite(e)), default=-math.inf)
     got = {"held_out": share(ctx.valmask), "fit_part": share(ctx.fitmask), "probe": float(e_probe)}
     return dict(got, explained=max(got.values()), amplitudes=[float(x) for x in a])
+
+
+def start(cls, entry):
+    """The fit vector a smooth candidate's fit starts from after its score test (``FitSpec.smooth``:
+    its replay responds smoothly, so the test's Gauss-Newton step from the null stands for a point near
+    its optimum), or None (no test, not smooth, or a step of zero amplitude).  The probes are secant
+    columns in the effect's amplitude (``FitSpec.probes``: a moderate amplitude at several values of its
+    shape parameter): a parameter equal in every probe (the amplitude) is scaled by the sum of the fitted
+    amplitudes, one that differs (the shape) is their amplitude-weighted mean.
+
+    Parameters
+    ----------
+    cls : type
+        The candidate's effect class.
+    entry : dict or None
+        Its prescreen entry (``score_test``: the probes and their fitted amplitudes, :func:`run`).
+    """
+    test = (entry or {}).get("score_test")
+    if not cls.fit.smooth or not isinstance(test, dict) or not test.get("amplitudes"):
+        return None
+    a = np.asarray(test["amplitudes"], dtype=float)
+    if not np.all(np.isfinite(a)) or a.sum() <= 0:
+        return None
+    probes = [dict(p) for p in test["probes"]]
+    values = cls.from_x(cls.x0())
+    for name in probes[0]:
+        v = np.array([p[name] for p in probes], dtype=float)
+        values[name] = float(v[0] * a.sum() if np.all(v == v[0]) else a @ v / a.sum())
+    lo, hi = cls.bounds_x()
+    return np.clip(cls.to_x(values), lo, hi)
 
 
 def run(ctx, prescreened, names, policy, progress=None) -> dict:
