@@ -115,7 +115,7 @@ def search(ctx, fits, shares, prescreened, n_second, search=F.Search()) -> Secon
             lo, hi = cls.search_box(ctx.replay.nominal)
             x = cls.to_x(start)
             free = np.flatnonzero(x != cls.x0()) if cls.kind == "nominal" else np.arange(x.size)
-            got, start_pred = T.joint_prediction(ctx, fixed, r.effect, start, free, lo, hi)
+            got, start_pred = T.joint_prediction(ctx, fixed, cls, start, free, lo, hi)
             # what the joint adds by each of the prediction's measures, against the best's own by the same
             # measure (the fit part's share is in-sample: against the best's fit-part share)
             added = max(got["held_out"] - best.explained, got["probe"] - best.explained, got["fit_part"] - best_fit)

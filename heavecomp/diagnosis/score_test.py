@@ -126,7 +126,7 @@ def predicted(ctx, preds, null=None) -> dict:
     return dict(got, explained=max(got.values()), amplitudes=[float(x) for x in a])
 
 
-def joint_prediction(ctx, fixed, name, values, free, lo, hi):
+def joint_prediction(ctx, fixed, cls, values, free, lo, hi):
     """The score test of a joint fit before it is run: the configuration ``fixed`` plus candidate ``name``
     at its own fit ``values`` replayed whole, and once more with each of its ``free`` fit-vector entries
     moved by a secant of 10 % of its search range (inwards, as the stepwise refit's Jacobian,
@@ -140,8 +140,8 @@ def joint_prediction(ctx, fixed, name, values, free, lo, hi):
         The prepared run.
     fixed : list of (str, dict)
         The configuration held (the best candidate at its fit).
-    name : str
-        The partner candidate.
+    cls : type
+        The partner's effect class as fitted on this run (:func:`heavecomp.diagnosis.fitting.candidate_class`).
     values : dict
         Its own fit's parameter values [SI] (the joint fit's start).
     free : sequence of int
@@ -149,7 +149,7 @@ def joint_prediction(ctx, fixed, name, values, free, lo, hi):
     lo, hi : numpy.ndarray
         Its search box (fit vector).
     """
-    cls = get(name)
+    name = cls.name
     x = np.clip(cls.to_x(values), lo, hi)
     configs = [fixed + [(name, dict(values))]]
     for j in free:
