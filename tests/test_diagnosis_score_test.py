@@ -62,3 +62,20 @@ def test_only_blind_plant_candidates_with_probes_and_no_component_gap_are_tested
     assert not T.needs_test(flow, "flow_line", {"flow_line": 0.5}, {"flow_line": 0.001}, {}, None, P)  # screened
     off = VerdictPolicy(score_test_explained=0.0)
     assert not T.needs_test(fl, "friction", *quiet, None, off)
+
+
+def test_a_smooth_candidate_starts_at_its_score_tests_step():
+    """A smooth candidate (string damping: no stick event's timing jumps with it) fitted after its score
+    test starts at the test's Gauss-Newton step: the probes' common amplitude scaled by the fitted
+    amplitudes' sum, the shape their amplitude-weighted mean; a friction candidate (not smooth), a zero
+    step or no test gives no start."""
+    sd, fl = get("string_damping"), get("friction_lag")
+    probes = [dict(p) for p in sd.fit.probes]  # damping 1e5 at exponents 0.5, 1 and 2
+    entry = {"score_test": {"amplitudes": [0.0, 0.5, 1.5], "probes": probes}}
+    got = sd.from_x(T.start(sd, entry))
+    assert got["damping"] == pytest.approx(2e5)
+    assert got["exponent"] == pytest.approx((0.5 * 1.0 + 1.5 * 2.0) / 2.0)
+    assert T.start(sd, {"score_test": {"amplitudes": [0.0, 0.0, 0.0], "probes": probes}}) is None
+    assert T.start(sd, {"score_test": "pending"}) is None and T.start(sd, None) is None
+    lag = {"score_test": {"amplitudes": [1.0, 0.0, 0.0], "probes": [dict(p) for p in fl.fit.probes]}}
+    assert T.start(fl, lag) is None

@@ -408,6 +408,8 @@ class GapDiagnoser(GapEstimator):
         hint = None
         if cls.kind != "output" and start is None:
             hint = S.equation_error_start(self.components_, self.prescreen_.get(name), cls)
+            if hint is None:  # a smooth candidate the equation error is blind to: its score test's step
+                hint = T.start(cls, self.prescreen_.get(name))
         room = (self.prescreen_.get(name) or {}).get("room") if cls.kind == "nominal" and start is None else None
         return F.fit(ctx, name, start, fixed, search=self._search(), hint=hint, room=room)
 

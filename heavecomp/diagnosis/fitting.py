@@ -5,7 +5,8 @@ effect class (optionally jointly after ``fixed`` configurations already fitted):
 
 - :func:`fit_replayed` -- a plant or nominal candidate through the replay: a coarse start grid
   (<= 2 parameters) or the equation-error start, then Nelder-Mead (<= 2 parameters: stick-slip costs are
-  piecewise smooth) or bounded least squares with a rescan of the rugged parameters;
+  piecewise smooth) or bounded least squares with a rescan of the rugged parameters; a smooth law
+  (``FitSpec.smooth``: a string damping) by least squares (Gauss-Newton) from its start, no grid;
 - :func:`fit_linear_output` -- a channel reading affine in its parameters (sensor_gain, sensor_offset):
   linear least squares per channel, refined through the replay on stroke and WOB;
 - :func:`fit_delay_output` -- a channel delay (sensor_delay): a scan refined by a bounded scalar search.
@@ -319,7 +320,8 @@ def fit(ctx, name, start=None, fixed=(), *, search=Search(), hint=None, room=Non
     search : Search
         Search effort (evaluations, grid and scan points, threads).
     hint : numpy.ndarray, optional
-        Equation-error start as a fit vector (``cls.to_x``); None: none.
+        Equation-error start as a fit vector (``cls.to_x``; a smooth candidate the equation error is blind
+        to: its score test's step, :func:`heavecomp.diagnosis.score_test.start`); None: none.
     room : sequence of int, optional
         A nominal candidate's parameters the equation error leaves room for (the stepwise refit releases
         only those, :func:`heavecomp.diagnosis.screen.mismatch_room`); None: every one.
@@ -395,7 +397,8 @@ def fit_replayed(ctx, cls, start=None, fixed=(), *, search=Search(), hint=None, 
     search : Search
         Search effort (evaluations, grid and scan points, threads).
     hint : numpy.ndarray, optional
-        Equation-error start as a fit vector (``cls.to_x``); None: none.
+        Equation-error start as a fit vector (``cls.to_x``; a smooth candidate the equation error is blind
+        to: its score test's step, :func:`heavecomp.diagnosis.score_test.start`); None: none.
     room : sequence of int, optional
         A nominal candidate's parameters its stepwise refit may release (:func:`stepwise`'s ``eligible``).
     """
@@ -424,8 +427,14 @@ def fit_replayed(ctx, cls, start=None, fixed=(), *, search=Search(), hint=None, 
         moved = int(np.count_nonzero(np.abs(np.asarray(r.x) - cls.x0()) > 1e-12))
         return Fit(cls.from_x(r.x), sigma(cls, r), int(r.nfev), float(2 * r.cost), n_params=moved)
     later = np.array([f.name in cls.fit.released_last for f in cls.fields()])
+    smooth = bool(cls.fit.smooth)
     if start is None and later.any():
-        r = _fit_then_release(fun, x0, lo, hi, ~later, budget, t_grid, search, hint, P.start_step)
+        r = _fit_then_release(fun, x0, lo, hi, ~later, budget, t_grid, search, hint, P.start_step, smooth)
+        return Fit(cls.from_x(r.x), sigma(cls, r), int(r.nfev), float(2 * r.cost))
+    if smooth:  # a smooth law (FitSpec.smooth): Gauss-Newton from its start (the equation error's where it costs less)
+        if start is None:
+            x0, _ = _start(cls, fun, x0, lo, hi, t_grid, 0, hint)
+        r = least_squares(fun, x0, lo, hi, budget, search.n_jobs)
         return Fit(cls.from_x(r.x), sigma(cls, r), int(r.nfev), float(2 * r.cost))
     # a start next to the optimum (the equation error's): a small first simplex (VerdictPolicy.start_step)
     near = False
@@ -440,11 +449,12 @@ def fit_replayed(ctx, cls, start=None, fixed=(), *, search=Search(), hint=None, 
     return Fit(cls.from_x(r.x), sigma(cls, r), int(r.nfev), float(2 * r.cost))
 
 
-def _fit_then_release(fun, x0, lo, hi, keep, budget, t_grid, search, hint, start_step=None):
+def _fit_then_release(fun, x0, lo, hi, keep, budget, t_grid, search, hint, start_step=None, smooth=False):
     """The fit of the parameters ``keep`` with the others held at ``x0`` (as :func:`fit_replayed` fits
-    that smaller candidate: coarse start grid, Nelder-Mead for up to two), then every parameter
-    released by least squares from that optimum (``cls.fit.released_last``).  Least squares only takes
-    steps that lower the cost, so the result costs no more on the fit part than the smaller fit.
+    that smaller candidate: coarse start grid, Nelder-Mead for up to two; a ``smooth`` law by least
+    squares from its start, no grid), then every parameter released by least squares from that optimum
+    (``cls.fit.released_last``).  Least squares only takes steps that lower the cost, so the result
+    costs no more on the fit part than the smaller fit.
 
     Parameters
     ----------
@@ -467,6 +477,8 @@ def _fit_then_release(fun, x0, lo, hi, keep, budget, t_grid, search, hint, start
     start_step : float, optional
         First simplex step (share of the range) from the equation-error start (``VerdictPolicy.start_step``;
         None: :data:`NM_STEP`).
+    smooth : bool
+        The law is smooth (``FitSpec.smooth``): no grid, the first stage by least squares too.
     """
     def part(xs, *t_stop):
         x = x0.copy()
@@ -474,10 +486,10 @@ def _fit_then_release(fun, x0, lo, hi, keep, budget, t_grid, search, hint, start
         return fun(x, *t_stop)
 
     x1 = x0.copy()
-    x1[keep], near = _start(None, part, x0[keep], lo[keep], hi[keep], t_grid, search.grid,
+    x1[keep], near = _start(None, part, x0[keep], lo[keep], hi[keep], t_grid, 0 if smooth else search.grid,
                             None if hint is None else hint[keep])
     r1 = _refit_subset(fun, x1, np.flatnonzero(keep), lo, hi, budget, search.n_jobs,
-                       start_step if near and start_step is not None else NM_STEP)
+                       start_step if near and start_step is not None else NM_STEP, smooth)
     r = least_squares(fun, np.clip(r1.x, lo + 1e-9, hi - 1e-9), lo, hi, budget, search.n_jobs)
     r.nfev = int(r.nfev) + int(r1.nfev)
     return r
@@ -806,11 +818,11 @@ def _lin_fit(J, r, act):
     return float(left @ left), dx
 
 
-def _refit_subset(fun, x, act, lo, hi, budget, n_jobs, step=None):
-    """The fit vector ``x`` with its entries ``act`` refitted (Nelder-Mead up to two, else least squares;
-    ``budget`` evaluations) and the rest held: a result with ``x``, ``fun``, ``jac`` (zero columns for the
-    held entries), ``nfev`` and ``cost`` (half the sum of squares).  ``step``: Nelder-Mead's first simplex
-    step (share of the range; None: :data:`NM_STEP`)."""
+def _refit_subset(fun, x, act, lo, hi, budget, n_jobs, step=None, smooth=False):
+    """The fit vector ``x`` with its entries ``act`` refitted (Nelder-Mead up to two, else, or ``smooth``,
+    least squares; ``budget`` evaluations) and the rest held: a result with ``x``, ``fun``, ``jac`` (zero
+    columns for the held entries), ``nfev`` and ``cost`` (half the sum of squares).  ``step``: Nelder-Mead's
+    first simplex step (share of the range; None: :data:`NM_STEP`)."""
     act = np.asarray(act, dtype=int)
 
     def f(z, t_stop=None):
@@ -819,8 +831,8 @@ def _refit_subset(fun, x, act, lo, hi, budget, n_jobs, step=None):
         return fun(xx) if t_stop is None else fun(xx, t_stop)
 
     z0 = np.clip(x[act], lo[act] + 1e-9, hi[act] - 1e-9)
-    r = nelder_mead(f, z0, lo[act], hi[act], budget, NM_STEP if step is None else step) if act.size <= 2 else \
-        least_squares(f, z0, lo[act], hi[act], budget, n_jobs)
+    r = nelder_mead(f, z0, lo[act], hi[act], budget, NM_STEP if step is None else step) \
+        if act.size <= 2 and not smooth else least_squares(f, z0, lo[act], hi[act], budget, n_jobs)
     xx = x.copy()
     xx[act] = r.x
     J = np.zeros((r.fun.size, x.size))
@@ -851,7 +863,8 @@ def _start(cls, fun, x0, lo, hi, t_grid, grid, hint):
     residual, blind to stick timing) when it costs less on the first ``t_grid`` s than the default, and
     then no grid (issue 32: start where the equations point); else, with <= 2 parameters, the best point
     of a coarse grid (stick-slip makes the cost rough) when it costs less still (the grid only picks the
-    start).  Returns the start and whether it is the equation-error one (next to the optimum)."""
+    start; ``grid`` 0: no grid, a smooth law).  Returns the start and whether it is the equation-error one
+    (next to the optimum)."""
     if hint is not None:
         # the component residual's fit as a start, where it fixes every parameter and its cost on the
         # grid span is lower
@@ -859,7 +872,7 @@ def _start(cls, fun, x0, lo, hi, t_grid, grid, hint):
         if float(np.sum(fun(x_ee, t_grid) ** 2)) < float(np.sum(fun(x0, t_grid) ** 2)):
             return x_ee, True
     k = x0.size
-    if k <= 2:
+    if k <= 2 and grid > 0:  # grid 0: none (a smooth law, FitSpec.smooth)
         axes = [_grid_axis(lo[i], hi[i], grid if k == 1 else max(3, (grid + 3) // 2)) for i in range(k)]
         pts = np.array(np.meshgrid(*axes)).reshape(k, -1).T
         costs = [float(np.sum(fun(x, t_grid) ** 2)) for x in pts]

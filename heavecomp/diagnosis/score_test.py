@@ -19,6 +19,10 @@ under ``VerdictPolicy.score_test_explained`` is not replayed in full; its prescr
 evidence (``score_test``).  The probes are secants from the null to a physical configuration, so the
 linear model includes each probe's own replay (amplitude 1, and its fit-part cost is never above the
 best probe's).  Three probes cost about three replays, against ~40 for a full fit.
+
+The same Gauss-Newton step asks a joint second-effect fit before it is run (:func:`joint_prediction`,
+from the partner's own fit instead of the null), and a smooth candidate's fit starts at the test's step
+(:func:`start`).
 """
 
 from __future__ import annotations
@@ -68,7 +72,7 @@ def _channels(ctx, pred, mask) -> dict:
     return out
 
 
-def predicted(ctx, preds) -> dict:
+def predicted(ctx, preds, null=None) -> dict:
     """The Gauss-Newton prediction from the nominal of the probes' replays ``preds`` (whole, one per probe):
     the amplitudes (>= 0) fitted on the fit part's weighted, decimated residual
     (:meth:`~heavecomp.diagnosis.replay.ReplayContext.resid_vec`), and the explained share of the gap
@@ -80,33 +84,111 @@ def predicted(ctx, preds) -> dict:
     dwell stiction: -1.29 held out, while its fit explains 0.96), but its fit part then says how much
     the probes' directions can take out.
 
+    With ``null`` (a replay other than the nominal's: a joint fit's start, :func:`joint_prediction`) the
+    columns are secants from it, their steps signed (unbounded least squares), the shares still of the
+    nominal's gap, and ``null``'s own held-out share counts among the probes'.
+
     Parameters
     ----------
     ctx : heavecomp.diagnosis.replay.ReplayContext
         The prepared run.
     preds : list of dict
         The probes' whole replays (:meth:`ReplayContext.simulate`).
+    null : dict, optional
+        The whole replay the columns are secants from (None: the nominal's, amplitudes >= 0).
     """
     from scipy.optimize import nnls
 
-    r0 = ctx.resid_vec(ctx.nominal_pred)
-    J = np.column_stack([ctx.resid_vec(p) - r0 for p in preds])
-    ok = np.all(np.isfinite(J), axis=1)
-    a, _ = nnls(J[ok], -r0[ok]) if ok.any() and np.any(J[ok]) else (np.zeros(len(preds)), 0.0)
+    base = ctx.nominal_pred if null is None else null
+    r0 = ctx.resid_vec(base)
+    J = np.column_stack([ctx.resid_vec(p) - r0 for p in preds]) if preds else np.zeros((r0.size, 0))
+    ok = np.all(np.isfinite(J), axis=1) & np.isfinite(r0)
+    if not (ok.any() and np.any(J[ok])):
+        a = np.zeros(len(preds))
+    elif null is None:
+        a, _ = nnls(J[ok], -r0[ok])
+    else:
+        a = np.linalg.lstsq(J[ok], -r0[ok], rcond=None)[0]
 
     def share(mask):
-        v0 = _channels(ctx, ctx.nominal_pred, mask)
+        v0 = _channels(ctx, base, mask)
         cols = [_channels(ctx, p, mask) for p in preds]
         # a probe the fit gave no amplitude adds nothing (its replay may have diverged: not finite)
-        lin = {c: float(np.mean((v0[c] + sum(ak * (col[c] - v0[c]) for ak, col in zip(a, cols) if ak > 0)) ** 2))
+        lin = {c: float(np.mean((v0[c] + sum(ak * (col[c] - v0[c]) for ak, col in zip(a, cols) if ak != 0)) ** 2))
                for c in ctx.channels}
         e = ctx.explained(ctx.mse(ctx.nominal_pred, mask), lin)
         return float(e) if math.isfinite(e) else math.inf
 
-    e_probe = max((e for e in (ctx.explained(ctx.mse_before, ctx.mse(p, ctx.valmask)) for p in preds)
+    e_probe = max((e for e in (ctx.explained(ctx.mse_before, ctx.mse(p, ctx.valmask))
+                               for p in list(preds) + ([] if null is None else [null]))
                    if math.isfinite(e)), default=-math.inf)
     got = {"held_out": share(ctx.valmask), "fit_part": share(ctx.fitmask), "probe": float(e_probe)}
     return dict(got, explained=max(got.values()), amplitudes=[float(x) for x in a])
+
+
+def joint_prediction(ctx, fixed, cls, values, free, lo, hi):
+    """The score test of a joint fit before it is run: the configuration ``fixed`` plus candidate ``name``
+    at its own fit ``values`` replayed whole, and once more with each of its ``free`` fit-vector entries
+    moved by a secant of 10 % of its search range (inwards, as the stepwise refit's Jacobian,
+    :func:`heavecomp.diagnosis.fitting.stepwise`); the Gauss-Newton step from the start predicts the
+    joint explained share (:func:`predicted`: the largest of held out, fit part and the replays' own).
+    Returns (that prediction, the start's whole replay).
+
+    Parameters
+    ----------
+    ctx : heavecomp.diagnosis.replay.ReplayContext
+        The prepared run.
+    fixed : list of (str, dict)
+        The configuration held (the best candidate at its fit).
+    cls : type
+        The partner's effect class as fitted on this run (:func:`heavecomp.diagnosis.fitting.candidate_class`).
+    values : dict
+        Its own fit's parameter values [SI] (the joint fit's start).
+    free : sequence of int
+        The fit-vector entries the joint fit moves.
+    lo, hi : numpy.ndarray
+        Its search box (fit vector).
+    """
+    name = cls.name
+    x = np.clip(cls.to_x(values), lo, hi)
+    configs = [fixed + [(name, dict(values))]]
+    for j in free:
+        h = 0.1 * (hi[j] - lo[j]) * (1 if x[j] + 0.1 * (hi[j] - lo[j]) <= hi[j] else -1)
+        xx = x.copy()
+        xx[j] += h
+        configs.append(fixed + [(name, {**values, **cls.from_x(xx)})])
+    preds = ctx.map(ctx.simulate, configs)
+    return predicted(ctx, preds[1:], null=preds[0]), preds[0]
+
+
+def start(cls, entry):
+    """The fit vector a smooth candidate's fit starts from after its score test (``FitSpec.smooth``:
+    its replay responds smoothly, so the test's Gauss-Newton step from the null stands for a point near
+    its optimum), or None (no test, not smooth, or a step of zero amplitude).  The probes are secant
+    columns in the effect's amplitude (``FitSpec.probes``: a moderate amplitude at several values of its
+    shape parameter): a parameter equal in every probe (the amplitude) is scaled by the sum of the fitted
+    amplitudes, one that differs (the shape) is their amplitude-weighted mean.
+
+    Parameters
+    ----------
+    cls : type
+        The candidate's effect class.
+    entry : dict or None
+        Its prescreen entry (``score_test``: the probes and their fitted amplitudes, :func:`run`).
+    """
+    test = (entry or {}).get("score_test")
+    if not cls.fit.smooth or not isinstance(test, dict) or not test.get("amplitudes"):
+        return None
+    a = np.asarray(test["amplitudes"], dtype=float)
+    if not np.all(np.isfinite(a)) or a.sum() <= 0:
+        return None
+    probes = [dict(p) for p in test["probes"]]
+    values = cls.from_x(cls.x0())
+    for name in probes[0]:
+        v = np.array([p[name] for p in probes], dtype=float)
+        values[name] = float(v[0] * a.sum() if np.all(v == v[0]) else a @ v / a.sum())
+    lo, hi = cls.bounds_x()
+    return np.clip(cls.to_x(values), lo, hi)
 
 
 def run(ctx, prescreened, names, policy, progress=None) -> dict:

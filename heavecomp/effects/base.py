@@ -108,6 +108,11 @@ class FitSpec:
     """Equation-error columns whose coefficient is a parameter itself, in its unit (column name -> parameter
     name): the default :meth:`Effect.from_equation_error` reads each (:meth:`Effect.coefficient_value`) as
     the replay fit's start; empty: the effect writes its own, or has none."""
+    smooth: bool = False
+    """The replay responds smoothly to every parameter (no stick event's timing jumps with it: a damping,
+    not a friction force): the diagnosis fits it by Gauss-Newton (bounded least squares) from its start,
+    with no coarse grid and no Nelder-Mead, and a fit from the score test starts at the test's step
+    (:func:`heavecomp.diagnosis.score_test.start`)."""
     probes: tuple = ()
     """Parameter sets (tuples of (name, value) pairs) the diagnosis's score test replays an unscreened
     candidate at before a full fit (:mod:`heavecomp.diagnosis.score_test`): a moderate amplitude at two or

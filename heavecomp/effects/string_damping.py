@@ -36,6 +36,9 @@ class StringDamping(Effect):
         # replay is near-linear in it) at a friction-like, a linear and a quadratic law
         probes=tuple((("damping", 1e5), ("exponent", n)) for n in (0.5, 1.0, 2.0)),
         log=("damping",),
+        # a smooth term (no stick event's timing jumps with c or n): fitted by Gauss-Newton, not by a grid and
+        # Nelder-Mead (bench_600s: 50 replays of its configuration, 2 per fit-part replay on the library stepper)
+        smooth=True,
         # the law's shape refines the linear dashpot: fitted from its optimum, never worse on the fit part
         released_last=("exponent",),
         # a file written before the exponent existed reads a linear dashpot (n = 1)
