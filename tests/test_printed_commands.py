@@ -54,8 +54,9 @@ def shell(cmd, home, env):
 
 
 def printed(*texts) -> list[str]:
-    """The ``heavecomp ...`` command lines of reports and terminal output."""
-    return [ln.strip() for t in texts for ln in t.splitlines() if ln.strip().startswith("heavecomp ")]
+    """The distinct ``heavecomp ...`` command lines of reports and terminal output, in the order printed (a line
+    both the report and the terminal print runs once: the same line runs the same command)."""
+    return list(dict.fromkeys(ln.strip() for t in texts for ln in t.splitlines() if ln.strip().startswith("heavecomp ")))
 
 
 def named_paths(stdout: str) -> list[str]:
