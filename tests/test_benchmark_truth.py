@@ -140,6 +140,35 @@ def test_plant_truth_classes_are_the_benchmarks_own(name):
     assert cls in comp.classes and not set(comp.classes) & set(lib.values())
 
 
+@pytest.mark.parametrize("name", [n for n, law in LAWS.items() if law.plant is not None
+                                  and law.plant.hook == "seal_friction"])
+def test_a_seal_truths_static_limit_holds_the_friction_the_motion_starts_against(name):
+    """The stepper's ordering (tests/test_conformance.py, for the candidates) holds for the truth laws too, at
+    their drawn parameters: at rest the static limit in a direction is at least the sliding friction at v = 0
+    in that direction.  The LuGre bristle once scaled its static limit by its share twice (its ``static`` on
+    top of its ``jump``): a generated run hit the stepper's event cap (207 steps in 120 s, 83 samples
+    F_f v < 0)."""
+    from heavecomp.plants.cmc import plant_vectors
+    from test_conformance import _memory_states
+
+    cls = LAWS[name].plant
+    comp = truth_composition(name)
+    fn = comp.functions
+    plant = plant_vectors(NOMINAL)
+    slots = [k - 4 for k in comp.slots[cls.name]]
+    for _, draw in _draws(name, n=4):
+        e = cls(**{k: v for k, v in draw.parameters.items() if k in {f.name for f in cls.fields()}})
+        EP = comp.ep([e])
+        for mem in _memory_states(cls, plant, e.prm):
+            x = np.zeros(comp.n_states)
+            x[slots] = mem
+            for p, s, d in ((0.0, 0.0, 1.0), (2.4e6, 0.5, -1.0), (2.4e6, -0.5, 1.0), (4e6, 0.0, -1.0)):
+                X = (s, 0.0, 0.0, 0.0) + tuple(x)
+                lim = fn["static_limit_fx"](plant.code, p, s, d, X, 0.0, plant.FP, EP)
+                kinetic = fn["sliding_friction_fx"](plant.code, d, 0.0, p, s, X, plant.FP, EP) * d
+                assert lim >= kinetic, (draw.parameters, mem, p, s, d, lim, kinetic)
+
+
 def test_diagnosis_never_imports_the_benchmark():
     """The benchmark checks the diagnosis: the diagnosis does not know it (same layer, one way)."""
     for f in sorted((ROOT / "heavecomp" / "diagnosis").rglob("*.py")):

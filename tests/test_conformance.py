@@ -111,6 +111,43 @@ def test_seal_effects_dissipate(model, name):
                 assert fn["static_limit_fx"](plant.code, p, s, np.sign(v), X, 3.0, plant.FP, EP) >= 0.0
 
 
+def _memory_states(cls, plant, prm):
+    """States a seal effect's memory reaches (its own slots): its value at rest, its steady values sliding
+    at 1 mm/s to 1 m/s either way, and the points half-way between any two of them."""
+    if not cls.states:
+        return [()]
+    FP, PP = plant.FP, plant.PP
+    ends = [np.asarray(cls.initial(FP, PP, *prm), dtype=float)]
+    ends += [np.asarray(cls.steady(v, FP, PP, *prm), dtype=float) for v in np.r_[-np.logspace(-3, 0, 4),
+                                                                                  np.logspace(-3, 0, 4)]]
+    return [tuple(0.5 * (a + b)) for a, b in itertools.product(ends, ends)]
+
+
+@pytest.mark.parametrize("model", ["stribeck", "rotating_eq6", "rotating_eq7"])
+@pytest.mark.parametrize("name", [n for n in PLANT_EFFECTS if library()[n].hook == "seal_friction"])
+def test_static_limit_holds_the_friction_the_motion_starts_against(model, name):
+    """At rest the static limit in a direction is at least the sliding friction at v = 0 in that direction
+    (with the effect's memory as it stands): else a holding force between the two neither sticks (it
+    exceeds the limit) nor moves the stroke that way (the friction it would slide against is larger), and
+    the stepper reverses at every stop until its event cap (friction_memory once scaled its static limit
+    by its factor twice: tests/test_effects_friction_memory.py).  At the stop, tau = 0."""
+    plant = cmc.plant_vectors(paper_a(model))
+    cls = library()[name]
+    e = _effect(name)
+    comp = library_composition()
+    EP = comp.ep([e])
+    fn = comp.functions
+    slots = [k - 4 for k in comp.slots[name]]
+    for mem in _memory_states(cls, plant, e.prm):
+        x = np.zeros(comp.n_states)
+        x[slots] = mem
+        for p, s, d in itertools.product((0.0, 2.4e6, 4e6), np.linspace(-1.5, 1.5, 5), (-1.0, 1.0)):
+            X = (s, 0.0, 0.0, 0.0) + tuple(x)
+            lim = fn["static_limit_fx"](plant.code, p, s, d, X, 0.0, plant.FP, EP)
+            kinetic = fn["sliding_friction_fx"](plant.code, d, 0.0, p, s, X, plant.FP, EP) * d
+            assert lim >= kinetic, (mem, p, s, d, lim, kinetic)
+
+
 # ------------------------------------------------------------ zero size = nominal
 def _with_null():
     out = []

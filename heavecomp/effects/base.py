@@ -22,6 +22,9 @@ line           ``line(v, p, x, PP, *prm) -> p_cyl [Pa]``          lossless, p_cy
 string         ``string(dv, T, x, PP, *prm) -> T_ds [N]``         spring + dashpot (dv = dz_h + v - v_b)
 seal friction  ``jump(code, a, p, J, s, d, x, FP, *prm) -> J``    the friction law's J [N] (paper A eq. 4/6/7)
                ``static(code, p, lim, tau, s, d, x, FP, *prm)``   static limit J(0, p) [N]; tau = dwell time
+                                                                  (``lim`` is J at v = 0 in direction d
+                                                                  through the ``jump`` hooks: add to it,
+                                                                  never lower it, see below)
 states         ``rates(s, v, p, x, PP, FP, *prm) -> dx/dt``       (no extra states)
                ``initial(FP, PP, *prm) -> x`` at rest,
                ``steady(v, FP, PP, *prm) -> x`` sliding at v
@@ -34,6 +37,13 @@ heave input    ``seen(t, z, *prm) -> z`` (:class:`HeaveEffect`)    measured = se
 At the seal-friction hook ``s`` is the stroke [m] and ``d`` the direction of the (impending) motion:
 +1 while the stroke grows (v > 0, extending), -1 while it shrinks (retracting); at rest the sign of
 the holding force that would start the motion; in the smooth casadi model tanh(v / eps).
+
+The static limit an effect's ``static`` receives already has every ``jump`` hook applied at v = 0 in the
+direction ``d``: an effect that scales J scales the static limit through its ``jump`` alone.  ``static``
+adds what rest alone brings (``dwell_stiction``'s gain with the dwell time) and must not lower the limit
+below that J: at a stop the stepper reverses the stroke when the holding force exceeds the limit, and the
+motion can only start if the sliding friction at v = 0 is no larger (``tests/test_conformance.py``,
+``test_static_limit_holds_the_friction_the_motion_starts_against``).
 
 A method must use ``np.*`` only and branch on parameters or the law ``code``, never on a
 state (casadi traces it).  ``PP`` / ``FP`` are indexed by the named constants of

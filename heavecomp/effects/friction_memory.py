@@ -27,8 +27,12 @@ class FrictionMemory(Effect):
     independent, as the bristles of Dahl's and the LuGre model; ``friction_lag`` is a memory in time).
     After a reversal m d = -1 and the share delta of the friction J is missing; it comes back over a few
     sigma of sliding (the pre-sliding displacement of a seal, 3-6 cm in the maintainers' held-back set).
-    The static limit is scaled the same way in the direction of the impending motion: a stroke stopped
-    after a slide breaks away more easily backwards.  With 0 <= delta <= 1 and |m| <= 1 the factor lies
+    The static limit is scaled the same way in the direction of the impending motion (a stroke stopped
+    after a slide breaks away more easily backwards), by the ``jump`` hook alone: the static limit is J at
+    v = 0 in that direction, through every ``jump`` hook, so it stays the sliding friction the motion starts
+    against (a ``static`` hook scaling it again, as this effect once had, put the limit below that friction:
+    at each stop after a slide the stroke neither stuck nor moved back, and the stepper hit its event cap;
+    ``tests/test_effects_friction_memory.py``).  With 0 <= delta <= 1 and |m| <= 1 the factor lies
     in [1 - delta, 1]: the friction keeps its sign (F v >= 0), the bristle's stored force is not modelled
     as pushing (that would not dissipate).  delta = 0 is the nominal law bit for bit.
     """
@@ -90,10 +94,6 @@ class FrictionMemory(Effect):
     @staticmethod
     def jump(code, a, p, J, s, d, x, FP, relaxation_length, depth):
         return J * (1.0 - depth * np.minimum(np.maximum(1.0 - x[0] * d, 0.0), 2.0) * 0.5)
-
-    @staticmethod
-    def static(code, p, lim, tau, s, d, x, FP, relaxation_length, depth):
-        return lim * (1.0 - depth * np.minimum(np.maximum(1.0 - x[0] * d, 0.0), 2.0) * 0.5)
 
     @staticmethod
     def rates(s, v, p, x, PP, FP, relaxation_length, depth):
