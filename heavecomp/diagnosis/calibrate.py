@@ -12,7 +12,8 @@ a plant effect (``string_damping``,  an ``[[effects]]`` entry with the fitted va
 ``dwell_stiction``, ...)            changes: ``simulate``, ``analyse``, the MPCs use it)
 a law of a family (``friction_lag``,  the fitted member's entry (``name = "friction_memory"``): the class
 ``law = "distance"``)                 that was fitted, with its values (``verdict.member``)
-``parameter_mismatch``            the refitted values in their tables (F_C clipped to F_S, as the fit),
+``parameter_mismatch``            the refitted values in their tables (F_C clipped to F_S, as the fit;
+                                  a moved top mass with the gas stiffness of the same gas bank),
                                   and ``[anchor]``: the values they were refitted from (kept from the
                                   file when it has one), the centre of a re-diagnosis' refit box
 a sensor effect (``sensor_gain``,   an ``[[effects]]`` entry that corrects how a log is read

@@ -28,6 +28,26 @@ from heavecomp.errors import ParameterError
 #: component of each parameter table of parameter_mismatch
 TABLE_COMPONENT = {"compensator": "gas_spring", "friction": "friction", "drill_string": "string_formation",
                    "formation": "string_formation"}
+#: parameters of parameter_mismatch that enter more than their table's component's equation, the verdict's
+#: component first.  The top mass M_c enters the top-mass balance (its weight and inertia: the ``friction``
+#: rest of that equation, :data:`heavecomp.diagnosis.components.OWN`) and, through the charge that holds the
+#: WOB set-point (p_0 A = (M_c + m_b) g - W_0), the gas law as a pre-charge offset (``gas_spring``).  The
+#: verdict names ``gas_spring``: the top-mass residual reads the pressure too (p A) and so carries at least
+#: the gas law's noise times A, so a mass error's share is always the larger in the gas law (a 90 s planted
+#: 18 % heavier mass: gas_spring 0.88, friction 0.12 of the equation-error gap)
+KEY_COMPONENTS = {"compensator.moving_mass": ("gas_spring", "friction")}
+
+
+def parameter_components(key) -> tuple:
+    """The components whose equation residuals a ``parameter_mismatch`` parameter (``"table.key"``) enters,
+    the one a verdict names first (:data:`KEY_COMPONENTS`, else its table's, :data:`TABLE_COMPONENT`).
+
+    Parameters
+    ----------
+    key : str
+        The parameter's name in the report (``"compensator.moving_mass"``).
+    """
+    return KEY_COMPONENTS.get(key) or (TABLE_COMPONENT[key.split(".")[0]],)
 #: parameter_mismatch parameters no equation-error residual sees: the static friction force acts at
 #: breakaway, where the top-mass balance is blind (as dwell_stiction and friction_lag: always released)
 UNSEEN = ("static_force",)
@@ -43,7 +63,7 @@ def prescreen(cr, shares, fitmask, valmask, names, policy) -> dict:
     leaks into it; only components in :data:`heavecomp.diagnosis.components.SCREENED` and candidates
     their residual sees, ``Effect.fit.screened``) and whose equation-error columns shrink nothing held out
     (< :data:`heavecomp.diagnosis.equation_error.MIN_SHRINK`) is not.  Output and nominal candidates
-    (a channel delay, the six-parameter refit) are always replayed, and so is every candidate when
+    (a channel delay, the refit of the nominal's parameters) are always replayed, and so is every candidate when
     none would be; the refit releases only the parameters the equation error leaves room for
     (:func:`mismatch_room`: ``room``, ``left_out``).  ``shares``: the equation-error shares of the gap
     (``where.components``).
@@ -93,14 +113,15 @@ def prescreen(cr, shares, fitmask, valmask, names, policy) -> dict:
 def mismatch_room(gap, shares, seen, screened, policy) -> dict:
     """Which parameters of ``parameter_mismatch`` its stepwise refit may release: those whose component's
     equation error leaves room for them (``room``, indices in field order) and, for the others, the
-    evidence that left them out (``left_out``: {parameter: why}).  A parameter is left out when its
-    component is screened (:data:`heavecomp.diagnosis.components.SCREENED`, observable) and shows no gap
-    of its own, by the pre-screen's own test (gap <= ``prescreen_gap`` noise variances or under
-    ``prescreen_share`` of the whole; no candidate of the component, ``screened``, shrinks its held-out
-    residual by :data:`heavecomp.diagnosis.equation_error.MIN_SHRINK`): a gas stiffness that is off shows in
-    the gas law's residual, a string stiffness in the lower-mass balance, a Coulomb or viscous force in the
-    sliding top-mass balance.  The static friction force (:data:`UNSEEN`) acts at breakaway, which no
-    residual sees: it is always released.
+    evidence that left them out (``left_out``: {parameter: why}).  A parameter is left out when each of its
+    components (:func:`parameter_components`) is screened (:data:`heavecomp.diagnosis.components.SCREENED`,
+    observable) and shows no gap of its own, by the pre-screen's own test (gap <= ``prescreen_gap`` noise
+    variances or under ``prescreen_share`` of the whole; no candidate of the component, ``screened``, shrinks
+    its held-out residual by :data:`heavecomp.diagnosis.equation_error.MIN_SHRINK`): a gas stiffness that is
+    off shows in the gas law's residual, a string stiffness in the lower-mass balance, a Coulomb or viscous
+    force in the sliding top-mass balance, a top mass in the gas law (the charge it sets) and the top-mass
+    balance.  The static friction force (:data:`UNSEEN`) acts at breakaway, which no residual sees: it is
+    always released.
 
     Parameters
     ----------
@@ -115,17 +136,19 @@ def mismatch_room(gap, shares, seen, screened, policy) -> dict:
     policy : heavecomp.diagnosis.policy.VerdictPolicy
         Decision thresholds (``prescreen_gap``, ``prescreen_share``).
     """
-    room, left = [], {}
-    for i, (f, (key, table, _)) in enumerate(zip(ParameterMismatch.fields(), MISMATCH_KEYS)):
-        comp = TABLE_COMPONENT[table]
+    def quiet(comp):
         small = gap.get(comp, 0.0) <= policy.prescreen_gap or shares.get(comp, 0.0) < policy.prescreen_share
         ee = [o["equation_error"]["shrink"] for n, o in screened.items()
               if o["component"] == comp and o["equation_error"] is not None and get(n).fit.screened]
-        if (f.name not in UNSEEN and comp in CR.SCREENED and seen.get(comp, True) and small
-                and all(x < EE.MIN_SHRINK for x in ee)):
-            left[key] = (f"its component {comp} shows no gap of its own (gap {gap.get(comp, 0.0):.3g} noise "
-                         f"variances, {100 * shares.get(comp, 0.0):.1f} % of the whole; equation-error shrink "
-                         f"under {EE.MIN_SHRINK:g})")
+        return comp in CR.SCREENED and seen.get(comp, True) and small and all(x < EE.MIN_SHRINK for x in ee)
+
+    room, left = [], {}
+    for i, (f, (key, _, _)) in enumerate(zip(ParameterMismatch.fields(), MISMATCH_KEYS)):
+        comps = parameter_components(key)
+        if f.name not in UNSEEN and all(quiet(c) for c in comps):
+            left[key] = "; ".join(f"its component {c} shows no gap of its own (gap {gap.get(c, 0.0):.3g} noise "
+                                  f"variances, {100 * shares.get(c, 0.0):.1f} % of the whole; equation-error "
+                                  f"shrink under {EE.MIN_SHRINK:g})" for c in comps)
         else:
             room.append(i)
     return {"room": room, "left_out": left}
@@ -190,9 +213,9 @@ def moved_most(values) -> str:
     values : dict
         Fitted parameter_mismatch multipliers [-] by parameter.
     """
-    names = {f.name: table for f, (_, table, _) in zip(ParameterMismatch.fields(), MISMATCH_KEYS)}
+    names = {f.name: key for f, (key, _, _) in zip(ParameterMismatch.fields(), MISMATCH_KEYS)}
     k = max(values, key=lambda n: abs(math.log(max(values[n], 1e-12))))
-    return TABLE_COMPONENT.get(names.get(k, ""), "")
+    return parameter_components(names[k])[0] if k in names else ""
 
 
 def candidate_component(effect, values, prescreened) -> str:

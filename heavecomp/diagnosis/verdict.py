@@ -548,7 +548,7 @@ def _refit_disagrees(moved, shares, largest, P) -> bool:
 
 
 def _refit_check(v, shares, largest, P, warnings) -> None:
-    """The six-parameter refit can bend any gap into the nominal's parameters; when the parameter it
+    """The refit of the nominal's parameters can bend any gap into the nominal's parameters; when the parameter it
     moved most is of a component where the equation error sees (almost) no gap, while another holds
     most of it, the two readings disagree: the gap lives where the equations put it, and the refit is a
     stand-in (confidence low, the component the equation error's).  A mismatch in two components

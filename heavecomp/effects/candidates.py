@@ -27,7 +27,8 @@ MISMATCH_KEYS = (("compensator.gas_stiffness", "compensator", "gas_stiffness"),
                  ("friction.coulomb_force", "friction", "coulomb_force"),
                  ("friction.viscous_coefficient", "friction", "viscous_coefficient"),
                  ("drill_string.stiffness", "drill_string", "stiffness"),
-                 ("formation.stiffness", "formation", "stiffness"))
+                 ("formation.stiffness", "formation", "stiffness"),
+                 ("compensator.moving_mass", "compensator", "moving_mass"))
 
 
 @dataclass(frozen=True)
@@ -38,14 +39,21 @@ class MismatchParams:
     viscous_coefficient: float = q(1.0, "x nominal", bounds=(0.05, 20.0))
     drill_string_stiffness: float = q(1.0, "x nominal", bounds=(0.05, 5.0))
     formation_stiffness: float = q(1.0, "x nominal", bounds=(0.1, 10.0))
+    # a top mass is known to maybe +-30 % (crown block, travelling block, top drive, what hangs on them)
+    moving_mass: float = q(1.0, "x nominal", bounds=(0.5, 2.0))
 
 
 class ParameterMismatch(Effect):
     """``parameter_mismatch``: no missing physics; the nominal parameters are off.
 
-    Refits multipliers of six nominal parameters (:data:`MISMATCH_KEYS`), releasing them
+    Refits multipliers of the nominal parameters in :data:`MISMATCH_KEYS`, releasing them
     stepwise (:func:`heavecomp.diagnosis.fitting.stepwise`: those not released stay at 1); the
     report gives the refitted values and names those that moved.
+
+    The top mass M_c is refitted as a rig runs a heavier one: at the driller's WOB set-point (the
+    parameter set derives the charge p_0 = ((M_c + m_b) g - W_0) / A from the masses) in the same gas
+    bank (:meth:`bank_held`: the gas volume V_0 is the file's, so k_gas rises with the absolute charge).
+    The gas stiffness's multiplier scales the bank alone (V_0 / m).
     """
 
     name = "parameter_mismatch"
@@ -85,9 +93,20 @@ class ParameterMismatch(Effect):
         return {"friction.coulomb_force": np.sign(v), "friction.viscous_coefficient": v,
                 "friction.static_force": stribeck_excess(np.abs(v), 1.0, 0.0, float(shape)) * np.sign(v)}
 
+    @staticmethod
+    def bank_held(params, mass) -> float:
+        """The factor on k_gas that holds ``params``' gas volume V_0 when the top mass is ``mass`` [kg]
+        at the same WOB set-point: k_gas = n (p_0 + p_atm) A^2 / V_0 with p_0 following the mass
+        (:attr:`heavecomp.params.CMCParams.gas_volume`), i.e. (p_0' + p_atm) / (p_0 + p_atm) [-]; 1 at
+        the file's mass."""
+        if mass == params.compensator.moving_mass:
+            return 1.0
+        return params.replace(compensator={"moving_mass": mass}).gas_volume / params.gas_volume
+
     @classmethod
     def apply(cls, params, values):
-        """The nominal parameter set with the multipliers applied (F_C clipped to <= F_S)."""
+        """The nominal parameter set with the multipliers applied (F_C clipped to <= F_S; a moved top
+        mass in the same gas bank, :meth:`bank_held`)."""
         mult = list(values.values())
         ch: dict = {}
         for (label, table, key), m in zip(MISMATCH_KEYS, mult):
@@ -95,6 +114,9 @@ class ParameterMismatch(Effect):
             if base is None:
                 continue
             ch.setdefault(table, {})[key] = base * m
+        comp = ch.setdefault("compensator", {})
+        if "gas_stiffness" in comp:
+            comp["gas_stiffness"] *= cls.bank_held(params, comp.get("moving_mass", params.compensator.moving_mass))
         fr = ch.get("friction", {})
         if "static_force" in fr and "coulomb_force" in fr:
             fr["coulomb_force"] = min(fr["coulomb_force"], fr["static_force"])
@@ -150,12 +172,15 @@ class ParameterMismatch(Effect):
 
     @classmethod
     def named_values(cls, params, values) -> dict:
-        """Refitted values under their parameter-file names [SI]."""
+        """Refitted values under their parameter-file names [SI] (a moved top mass's gas stiffness in
+        the same gas bank, as :meth:`apply`)."""
         out = {}
         for (label, table, key), m in zip(MISMATCH_KEYS, values.values()):
             base = getattr(getattr(params, table), key)
             if base is not None:
                 out[label] = float(base * m)
+        if out.get("compensator.moving_mass", params.compensator.moving_mass) != params.compensator.moving_mass:
+            out["compensator.gas_stiffness"] *= cls.bank_held(params, out["compensator.moving_mass"])
         return out
 
 

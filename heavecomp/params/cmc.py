@@ -494,6 +494,8 @@ class Anchor:
                                       doc="drill_string.stiffness of the first file")
     formation_stiffness: float = q(None, "N/m", bounds=(5e3, 1e8), symbol="k_F,0",
                                    doc="formation.stiffness of the first file")
+    moving_mass: float = q(None, "kg", bounds=(1e3, 1e6), symbol="M_c,0",
+                           doc="compensator.moving_mass of the first file")
 
 
 OPTIONAL_EXTRA["anchor"] = lambda table: from_table(Anchor, table, "anchor")

@@ -17,7 +17,7 @@ gas_heat_transfer       gas_spring         thermal state, gamma = 1.4, tau_th   
 flow_loss               flow_line          orifice K v|v|                                laminar R v
 string_damping          string_formation   quadratic drag c_q dv|dv|                     linear dashpot c dv
 sensor_delay            sensors            first-order sensor lag (causal IIR)           pure transport delay
-parameter_mismatch      -                  nominal law, 2 parameters shifted             6 multipliers refitted
+parameter_mismatch      -                  nominal law, 2 parameters shifted             7 multipliers refitted
 asymmetric_friction     friction           J (1 + alpha d), d a lagged direction
 position_friction       friction           J (1 + beta parabolic bump in the stroke)
 gas_leak                gas_spring         laminar leak of the gas mass fraction
