@@ -423,7 +423,7 @@ def fit_replayed(ctx, cls, start=None, fixed=(), *, search=Search(), hint=None, 
         release = None if start is None else np.flatnonzero(x0 != cls.x0())
         r = stepwise(fun, x0 if start else cls.x0(), lo, hi, budget, t_grid, P.refit_release, search, release,
                      noise_cost(ctx), P.refit_f, room)
-        # parsimony counts what moved (issue 30 item 3): the parameters released, not all six it could release
+        # parsimony counts what moved (issue 30 item 3): the parameters released, not all it could release
         moved = int(np.count_nonzero(np.abs(np.asarray(r.x) - cls.x0()) > 1e-12))
         return Fit(cls.from_x(r.x), sigma(cls, r), int(r.nfev), float(2 * r.cost), n_params=moved)
     later = np.array([f.name in cls.fit.released_last for f in cls.fields()])
