@@ -222,11 +222,11 @@ def _ensure_compiled(fn, comp=None) -> None:
         fn.compile(sig)
 
 
-#: CPU seconds to compile the nominal stepper, and more per effect of a composition (measured:
-#: 34 s and 73 s for the library's 10 effects, numba 0.68; 90 s for the superset's 15 classes and 50 s for
-#: 3 effects, benchmarks/simulate/install_compile.json and composition.json; the notice quotes their sum)
-COMPILE_S = 35
-COMPILE_S_PER_EFFECT = 4
+#: CPU seconds to compile the nominal stepper, and more per effect of a composition (measured, numba 0.68,
+#: once rk4 is compiled for one signature, not three: 9.4 s and 38.8 s for the superset's 16 classes,
+#: benchmarks/install/compiles.json; before, 35 s and 90-105 s; the notice quotes their sum)
+COMPILE_S = 10
+COMPILE_S_PER_EFFECT = 2
 
 
 class compiling:
