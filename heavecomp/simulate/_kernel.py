@@ -192,7 +192,6 @@ static_limit_fx = _ENV["static_limit_fx"]
 effect_rates = _ENV["effect_rates"]
 state_axpy = _ENV["state_axpy"]
 state_rest = _ENV["state_rest"]
-state_rk4 = _ENV["state_rk4"]
 state_dot = _ENV["state_dot"]
 state_load = _ENV["state_load"]
 state_store = _ENV["state_store"]
@@ -287,12 +286,32 @@ def rhs(t, X, mode, d, cm, plant, drive):
 
 @_jit
 def rk4(t, h, X, mode, d, cm, plant, drive):
-    k1 = rhs(t, X, mode, d, cm, plant, drive)
+    """One classical RK4 step of :func:`rhs` from ``X`` at ``t`` over ``h``.
+
+    The four stages are one loop around one call of :func:`rhs`, so its inlined copy of the plant's hook
+    functions is compiled once, not four times (issue 32: the superset stepper's compile 39 s -> 17 s of CPU,
+    the run time unchanged); the sums are the classical ones in the same order,
+    ``X + h/6 (((k1 + 2 k2) + 2 k3) + k4)``, so the step is bit for bit the unrolled one."""
     h2 = 0.5 * h
-    k2 = rhs(t + h2, state_axpy(X, h2, k1), mode, d, cm, plant, drive)
-    k3 = rhs(t + h2, state_axpy(X, h2, k2), mode, d, cm, plant, drive)
-    k4 = rhs(t + h, state_axpy(X, h, k3), mode, d, cm, plant, drive)
-    return state_rk4(X, h / 6.0, k1, k2, k3, k4)
+    acc = X
+    Xs = X
+    ts = t
+    for stage in range(4):
+        k = rhs(ts, Xs, mode, d, cm, plant, drive)
+        if stage == 0:
+            acc = k
+            Xs = state_axpy(X, h2, k)
+            ts = t + h2
+        elif stage == 1:
+            acc = state_axpy(acc, 2.0, k)
+            Xs = state_axpy(X, h2, k)
+        elif stage == 2:
+            acc = state_axpy(acc, 2.0, k)
+            Xs = state_axpy(X, h, k)
+            ts = t + h
+        else:
+            acc = state_axpy(acc, 1.0, k)
+    return state_axpy(X, h / 6.0, acc)
 
 
 @_jit
