@@ -5,7 +5,7 @@
    pneumatic batch, and the benchmark generator's truth stepper the scenarios and the fast tests run) are
    compiled into ``heavecomp/_numba_cache`` beside the sources (:mod:`heavecomp.simulate.cache`), so the first
    ``heavecomp diagnose`` / ``simulate`` / ``campaign`` after ``pip install -e .`` loads machine
-   code instead of compiling it (about 70 s of CPU here, once: benchmarks/install/compiles.json).  Each is
+   code instead of compiling it (about 45 s of CPU here, once: benchmarks/install/compiles.json).  Each is
    compiled in a process of its own, on every core, while step 2 runs (issue 32); one line says what and how long.  Done for an editable
    install (or ``build_ext --inplace``), where the runtime imports these very sources; a wheel
    copied elsewhere compiles on first use, with a notice.  HEAVECOMP_NO_WARM=1 skips it.
@@ -102,7 +102,7 @@ class Warming:
         self.t0, self.r0 = time.perf_counter(), resource.getrusage(resource.RUSAGE_CHILDREN)
         self.t1 = self.t0
         print(f"heavecomp: compiling the steppers ({', '.join(WARM)}) into numba's cache, {self.cores} at a time, "
-              "once: about 70 s of CPU (under a minute on 2 cores)", file=sys.stderr, flush=True)
+              "once: about 45 s of CPU (20-30 s on 2 cores)", file=sys.stderr, flush=True)
         self.thread = threading.Thread(target=self._run, daemon=True)
         self.thread.start()
 

@@ -673,7 +673,7 @@ def kernel_for(comp):
     The stepper's functions that call the plant's hooks are compiled again from their own source,
     with the composition's hook functions (the effects' methods, inlined) bound in their place;
     numba's disk cache keeps each under a name and in a folder keyed to what it is compiled from
-    (:func:`heavecomp.simulate.cache.composition_key`; about 30 s of CPU to compile once per
+    (:func:`heavecomp.simulate.cache.composition_key`; about 10-20 s of CPU to compile once per
     composition, then loaded in a fraction of a second).  The composition of no effect is this
     module's :func:`advance`.
     """

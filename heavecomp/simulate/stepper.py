@@ -223,10 +223,10 @@ def _ensure_compiled(fn, comp=None) -> None:
 
 
 #: CPU seconds to compile the nominal stepper, and more per effect of a composition (measured, numba 0.68,
-#: once rk4 is compiled for one signature, not three: 9.4 s and 38.8 s for the superset's 16 classes,
-#: benchmarks/install/compiles.json; before, 35 s and 90-105 s; the notice quotes their sum)
-COMPILE_S = 10
-COMPILE_S_PER_EFFECT = 2
+#: with rk4 one loop compiled for one signature: 6.4 s, and 17.0 s for the superset's 16 classes,
+#: benchmarks/install/compiles.json; before issue 32's cut, 23-35 s and 90-105 s; the notice quotes their sum)
+COMPILE_S = 6
+COMPILE_S_PER_EFFECT = 1
 
 
 class compiling:
