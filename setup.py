@@ -1,12 +1,12 @@
 """Install-time builds of the compiled stepper (see heavecomp/simulate/stepper.py); metadata in pyproject.toml.
 
-1. Warm numba's cache: the JIT steppers the commands use (the nominal stepper, the stepper of the
-   library's effect composition, the campaign's parallel batch, the stick-slip map's pneumatic
-   batch, and the benchmark generator's truth stepper the scenarios and the fast tests run) are compiled into
-   ``heavecomp/_numba_cache`` beside the sources (:mod:`heavecomp.simulate.cache`), so the first
+1. Warm numba's cache: the JIT steppers the commands use (the stepper of the library's effect
+   composition, the campaign's parallel batch with the nominal stepper it calls, the stick-slip map's
+   pneumatic batch, and the benchmark generator's truth stepper the scenarios and the fast tests run) are
+   compiled into ``heavecomp/_numba_cache`` beside the sources (:mod:`heavecomp.simulate.cache`), so the first
    ``heavecomp diagnose`` / ``simulate`` / ``campaign`` after ``pip install -e .`` loads machine
-   code instead of compiling it (about 2 minutes of CPU here, once).  Each is compiled in a process
-   of its own, on every core, while step 2 runs (issue 32); one line says what and how long.  Done for an editable
+   code instead of compiling it (about 45 s of CPU here, once: benchmarks/install/compiles.json).  Each is
+   compiled in a process of its own, on every core, while step 2 runs (issue 32); one line says what and how long.  Done for an editable
    install (or ``build_ext --inplace``), where the runtime imports these very sources; a wheel
    copied elsewhere compiles on first use, with a notice.  HEAVECOMP_NO_WARM=1 skips it.
 2. The optional ahead-of-time build of the nominal stepper (numba.pycc; heavecomp/simulate/_aot.py).
@@ -28,13 +28,15 @@ from setuptools.command.build_ext import build_ext
 HERE = Path(__file__).resolve().parent
 
 #: the install-time compiles, each in a process of its own (each fills its own cache folder), the longest
-#: first: {name: python source}; stepper.install_steps() names the steppers'
+#: first: {name: python source}; stepper.install_steps() names the steppers'.  The JIT nominal stepper is not
+#: a step of its own: the campaign batch calls it from compiled code, so its compile fills the nominal
+#: stepper's cache folder too (and heave_at's); a step of its own compiled the same code twice at once
+#: (benchmarks/install/compiles.json)
 _LOG = "import logging; logging.basicConfig(level=logging.WARNING, format='%(message)s'); "
 WARM = {"library effects stepper": _LOG + "from heavecomp.simulate import stepper; "
                                           "stepper.install_steps()['library effects stepper']()",
         "benchmark truth stepper": _LOG + "from heavecomp.benchmark.truth import truth_composition; "
                                           "from heavecomp.simulate import stepper; stepper.kernel_for(truth_composition())",
-        "nominal stepper": _LOG + "from heavecomp.simulate import stepper; stepper.install_steps()['nominal stepper']()",
         "campaign batch": _LOG + "from heavecomp.campaign import batch; batch.compile_batch()",
         "pneumatic stepper": _LOG + "from heavecomp.pneumatic import stepper; stepper.compile_many()"}
 
@@ -100,7 +102,7 @@ class Warming:
         self.t0, self.r0 = time.perf_counter(), resource.getrusage(resource.RUSAGE_CHILDREN)
         self.t1 = self.t0
         print(f"heavecomp: compiling the steppers ({', '.join(WARM)}) into numba's cache, {self.cores} at a time, "
-              "once: about 2 minutes of CPU (1-2 min on 2 cores)", file=sys.stderr, flush=True)
+              "once: about 45 s of CPU (20-30 s on 2 cores)", file=sys.stderr, flush=True)
         self.thread = threading.Thread(target=self._run, daemon=True)
         self.thread.start()
 

@@ -159,3 +159,46 @@ figures = false
     assert set(K.kernel_for(comp).overloads) == {S._signature(comp)}
     assert len(batch._batch.overloads) == 1
     assert len(K.heave_at.overloads) == 1
+
+
+_HOOK_COMPILES = """
+import collections, json
+from numba.core import event
+compiled = collections.Counter()
+class Count(event.Listener):
+    def on_start(self, ev):
+        pass
+    def on_end(self, ev):
+        compiled[ev.data["dispatcher"].py_func.__qualname__] += 1
+event.register("numba:compile", Count())
+import numpy as np
+from heavecomp.effects.compose import GENERATED, composition
+from heavecomp.effects.registry import library
+from heavecomp.params import paper_a
+from heavecomp.plants import cmc
+from heavecomp.simulate import _kernel as K
+comp = composition((library()["charge_drift"],))
+plant = cmc.plant_vectors(paper_a("stribeck"))
+EP = comp.ep([library()["charge_drift"](charge_error=0.1)])
+p = K.compiled_hooks(comp)["cylinder_pressure_fx"](0.2, 0.01, (0.2, 0.01, 0.0, 0.0), plant.PP, EP)
+print(json.dumps([float(p), sum(n for f, n in compiled.items() if f in GENERATED)]))
+"""
+
+
+def test_generated_hook_functions_compile_once_per_cache(tmp_path):
+    """The hook functions a composition generates are kept in numba's disk cache like the stepper (their
+    source is a file in the composition's cache folder): a second process calling them compiles none of
+    them (the pins and the conformance battery call them from Python; they compiled in every process)."""
+    import json
+    import os
+    import subprocess
+    import sys
+
+    env = {**os.environ, "HEAVECOMP_CACHE_DIR": str(tmp_path), "PYTHONPATH": str(ROOT.parent)}
+    env.pop("NUMBA_CACHE_DIR", None)
+    runs = [json.loads(subprocess.run([sys.executable, "-c", _HOOK_COMPILES], env=env, capture_output=True,
+                                      text=True, check=True).stdout.splitlines()[-1]) for _ in range(2)]
+    (p1, first), (p2, second) = runs
+    assert first >= 1 and second == 0
+    assert p1 == p2
+    assert list(tmp_path.glob("numba-*/hooks_*.py"))

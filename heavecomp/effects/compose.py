@@ -11,7 +11,7 @@ Python source that calls each effect's own methods in the composition's order, b
 static_limit_fx, effect_rates``
 
 and the stepper's state arithmetic for that state size (``state_axpy``, ``state_rest``,
-``state_rk4``, ``state_dot``, ``state_load``, ``state_store``, ``state_record``).
+``state_dot``, ``state_load``, ``state_store``, ``state_record``).
 
 The same generated functions are compiled by numba into the stepper
 (:func:`heavecomp.simulate._kernel.kernel_for`) and called with casadi symbols by
@@ -47,7 +47,7 @@ PLANT_FUNCTIONS = {"gas_pressure": _cmc.gas_pressure, "tension": _cmc.tension, "
                    "friction_cont": _laws.friction_cont}
 #: names of the generated functions, callees first
 GENERATED = ("gas_fx", "cylinder_pressure_fx", "tension_fx", "plant_fx", "jump_fx", "sliding_friction_fx",
-             "static_limit_fx", "effect_rates", "state_axpy", "state_rest", "state_rk4", "state_dot", "state_load",
+             "static_limit_fx", "effect_rates", "state_axpy", "state_rest", "state_dot", "state_load",
              "state_store", "state_record")
 
 
@@ -158,9 +158,6 @@ class Composition:
         every = range(f + n)
         L += ["def state_axpy(X, h, k):", "    return (" + ", ".join(f"X[{i}] + h * k[{i}]" for i in every) + ")", ""]
         L += ["def state_rest(X):", "    return (X[0], 0.0, " + "".join(f"X[{i}], " for i in range(2, f + n)) + ")", ""]
-        L += ["def state_rk4(X, h6, k1, k2, k3, k4):",
-              "    return (" + ", ".join(f"X[{i}] + h6 * (k1[{i}] + 2 * k2[{i}] + 2 * k3[{i}] + k4[{i}])"
-                                        for i in every) + ")", ""]
         L += ["def state_dot(ds, dv, dyb, dvb, s, v, p, X, PP, FP, EP):",
               '    """dX/dt: the plant\'s four derivatives, then the effects\' rates."""']
         if n:

@@ -58,6 +58,7 @@ samples they are interpolated with quintic Hermite polynomials.
 
 from __future__ import annotations
 
+import sys
 import threading
 import types
 
@@ -102,7 +103,7 @@ def _compile(func, inline=False, env=None, *, cache=True, name=None, nogil=False
     ``inline=True`` inlines it into its callers in numba's IR (no call, no array
     reference counting: LLVM leaves larger functions out of line).  ``env`` (default the
     module's ``_ENV``) receives it under ``name`` (default its own); ``cache=False`` for
-    generated source, which has no file for numba's cache.  ``key``: the cache key
+    source without a file for numba's cache (generated source where no cache folder is writable).  ``key``: the cache key
     (:mod:`heavecomp.simulate.cache`; default :data:`KERNEL_KEY`)."""
     env = _ENV if env is None else env
     g = dict(func.__globals__)
@@ -148,6 +149,24 @@ contact_switch = _compile(_cmc.contact_switch)
 # and for the pins (tests/test_kernel_pins.py): numba compiles them on first use only.
 
 
+def _generated(comp, key):
+    """``(functions, cacheable)``: the generated hook functions of ``comp`` (name -> Python function), from a
+    file in the cache folder of ``key`` (:func:`heavecomp.simulate.cache.source_file`), so numba's disk cache
+    keeps them too when they are compiled on their own (the pins call them from Python: ~4 compiles per
+    composition, in every fresh process); ``cacheable`` False (the source exec'd from memory, as
+    :class:`~heavecomp.effects.compose.Composition` does) when no cache folder is writable."""
+    path = _cache.source_file(key, f"hooks_{comp.key}.py", comp.source)
+    if path is None:
+        return comp.functions, False
+    name = f"_heavecomp_hooks_{key}_{comp.key}"
+    if name not in sys.modules:  # a module numba's cache finds again when it loads the compiled code
+        module = types.ModuleType(name)
+        module.__file__ = str(path)
+        exec(compile(comp.source, str(path), "exec"), module.__dict__)
+        sys.modules[name] = module
+    return vars(sys.modules[name]), True
+
+
 def _compile_composition(comp, env, key=None):
     """Compile the effects' hook methods and the generated hook functions of ``comp`` into ``env``."""
     for i, c in enumerate(comp.classes):
@@ -155,8 +174,10 @@ def _compile_composition(comp, env, key=None):
             f = getattr(c, m)
             _compile(f, inline=True, env=env, key=key)
             env[f"E{i}_{m}"] = env.pop(f.__name__)
+    key = KERNEL_KEY if key is None else key
+    functions, cacheable = _generated(comp, key)
     for fname in _compose.GENERATED:
-        _compile(comp.functions[fname], inline=True, env=env, cache=False)
+        _compile(functions[fname], inline=True, env=env, cache=cacheable, key=key)
 
 
 _NONE = _compose.composition(())
@@ -171,7 +192,6 @@ static_limit_fx = _ENV["static_limit_fx"]
 effect_rates = _ENV["effect_rates"]
 state_axpy = _ENV["state_axpy"]
 state_rest = _ENV["state_rest"]
-state_rk4 = _ENV["state_rk4"]
 state_dot = _ENV["state_dot"]
 state_load = _ENV["state_load"]
 state_store = _ENV["state_store"]
@@ -266,12 +286,48 @@ def rhs(t, X, mode, d, cm, plant, drive):
 
 @_jit
 def rk4(t, h, X, mode, d, cm, plant, drive):
-    k1 = rhs(t, X, mode, d, cm, plant, drive)
+    """One classical RK4 step of :func:`rhs` from ``X`` at ``t`` over ``h``.
+
+    The four stages are one loop around one call of :func:`rhs`, so its inlined copy of the plant's hook
+    functions is compiled once, not four times (issue 32: the superset stepper's compile 39 s -> 17 s of CPU,
+    the run time unchanged); the sums are the classical ones in the same order,
+    ``X + h/6 (((k1 + 2 k2) + 2 k3) + k4)``, so the step is bit for bit the unrolled one."""
     h2 = 0.5 * h
-    k2 = rhs(t + h2, state_axpy(X, h2, k1), mode, d, cm, plant, drive)
-    k3 = rhs(t + h2, state_axpy(X, h2, k2), mode, d, cm, plant, drive)
-    k4 = rhs(t + h, state_axpy(X, h, k3), mode, d, cm, plant, drive)
-    return state_rk4(X, h / 6.0, k1, k2, k3, k4)
+    acc = X
+    Xs = X
+    ts = t
+    for stage in range(4):
+        k = rhs(ts, Xs, mode, d, cm, plant, drive)
+        if stage == 0:
+            acc = k
+            Xs = state_axpy(X, h2, k)
+            ts = t + h2
+        elif stage == 1:
+            acc = state_axpy(acc, 2.0, k)
+            Xs = state_axpy(X, h2, k)
+        elif stage == 2:
+            acc = state_axpy(acc, 2.0, k)
+            Xs = state_axpy(X, h, k)
+            ts = t + h
+        else:
+            acc = state_axpy(acc, 1.0, k)
+    return state_axpy(X, h / 6.0, acc)
+
+
+@_jit
+def _sliding_accel(t, X, d, cm, plant, drive):
+    """dv/dt sliding in direction ``d`` (:func:`rhs`), for the velocity-zero location: a call, not
+    inlined, so the plant's hook functions are compiled once here rather than at each of its three
+    call sites in :func:`_advance` (issue 32: compile work; it runs only at a reversal or a stick)."""
+    return rhs(t, X, SLIDING, d, cm, plant, drive)[1]
+
+
+@_jit
+def _static_limit(code, p, s, d, X, tau, FP, EP):
+    """The static friction limit (the composition's ``static_limit_fx``) as a call, not inlined: compiled
+    once rather than at each of its four call sites in :func:`_advance` (issue 32: compile work; one call
+    per step while stuck, beside the four right-hand sides of :func:`rk4`)."""
+    return static_limit_fx(code, p, s, d, X, tau, FP, EP)
 
 
 @_jit
@@ -429,15 +485,15 @@ def _advance(X, tau, mode, d, t0, n_steps, h, plant, drive, out, out_every, out_
                         break
                     continue
                 # velocity reaches zero before the cut: locate it
-                a0 = rhs(tc, X, SLIDING, d, cm, plant, drive)[1]
-                a1 = rhs(tc + cut, X1, SLIDING, d, cm, plant, drive)[1]
+                a0 = _sliding_accel(tc, X, d, cm, plant, drive)
+                a1 = _sliding_accel(tc + cut, X1, d, cm, plant, drive)
                 tz = _cubic_root(X[1], a0, X1[1], a1, cut)
                 Xt = X1
                 for _n in range(4):
-                    Xt = rk4(tc, tz, X, SLIDING, d, cm, plant, drive)
+                    Xt = rk4(tc, tz, X, mode, d, cm, plant, drive)  # mode, not the constant SLIDING: one rk4
                     if abs(Xt[1]) < 1e-13:
                         break
-                    at = rhs(tc + tz, Xt, SLIDING, d, cm, plant, drive)[1]
+                    at = _sliding_accel(tc + tz, Xt, d, cm, plant, drive)
                     if at == 0.0:
                         break
                     nt = tz - Xt[1] / at
@@ -450,7 +506,7 @@ def _advance(X, tau, mode, d, t0, n_steps, h, plant, drive, out, out_every, out_
                 tc += tz
                 left -= tz
                 F, p = hold(tc, X, plant, drive)
-                if abs(F) <= static_limit_fx(code, p, X[0], 1.0 if F > 0 else -1.0, X, 0.0, FP, EP):
+                if abs(F) <= _static_limit(code, p, X[0], 1.0 if F > 0 else -1.0, X, 0.0, FP, EP):
                     mode = STUCK
                     tau = 0.0
                     stats[STAT_N_STICK] += 1.0
@@ -461,7 +517,7 @@ def _advance(X, tau, mode, d, t0, n_steps, h, plant, drive, out, out_every, out_
                     break
             else:  # STUCK
                 F1, p1 = hold(tc + cut, X1, plant, drive)
-                lim1 = static_limit_fx(code, p1, X1[0], 1.0 if F1 > 0 else -1.0, X1, tau + cut, FP, EP)
+                lim1 = _static_limit(code, p1, X1[0], 1.0 if F1 > 0 else -1.0, X1, tau + cut, FP, EP)
                 if abs(F1) <= lim1:
                     stats[STAT_STUCK_TIME] += cut
                     tau += cut
@@ -472,7 +528,7 @@ def _advance(X, tau, mode, d, t0, n_steps, h, plant, drive, out, out_every, out_
                 # breakaway before the cut: bracket [lo, hi] with margin(lo) >= 0 > margin(hi)
                 sg = 1.0 if F1 > 0 else -1.0
                 F0, p0 = hold(tc, X, plant, drive)
-                m_lo = static_limit_fx(code, p0, X[0], sg, X, tau, FP, EP) - sg * F0
+                m_lo = _static_limit(code, p0, X[0], sg, X, tau, FP, EP) - sg * F0
                 m_hi = lim1 - sg * F1
                 lo, hi = 0.0, cut
                 Xhi = X1
@@ -483,9 +539,9 @@ def _advance(X, tau, mode, d, t0, n_steps, h, plant, drive, out, out_every, out_
                     tt = lo + (hi - lo) * m_lo / (m_lo - m_hi) if m_lo != m_hi else 0.5 * (lo + hi)
                     if not (lo < tt < hi):
                         tt = 0.5 * (lo + hi)
-                    X2 = rk4(tc, tt, X, STUCK, d, cm, plant, drive)
+                    X2 = rk4(tc, tt, X, mode, d, cm, plant, drive)  # mode (STUCK here): one compiled rk4
                     F2, p2 = hold(tc + tt, X2, plant, drive)
-                    m = static_limit_fx(code, p2, X2[0], sg, X2, tau + tt, FP, EP) - sg * F2
+                    m = _static_limit(code, p2, X2[0], sg, X2, tau + tt, FP, EP) - sg * F2
                     if m >= 0.0:
                         lo, m_lo = tt, m
                         if side == -1:
@@ -594,7 +650,7 @@ def _record(out, pos, t, X, mode, d, cm, plant, drive):
 
 
 #: kernel functions that call the hook functions, callees first (cloned per composition)
-_PER_COMPOSITION = ("rhs", "rk4", "hold", "_contact_time", "_record", "_advance", "advance")
+_PER_COMPOSITION = ("rhs", "rk4", "_sliding_accel", "_static_limit", "hold", "_contact_time", "_record", "_advance", "advance")
 _KERNELS: dict = {}
 
 
@@ -617,7 +673,7 @@ def kernel_for(comp):
     The stepper's functions that call the plant's hooks are compiled again from their own source,
     with the composition's hook functions (the effects' methods, inlined) bound in their place;
     numba's disk cache keeps each under a name and in a folder keyed to what it is compiled from
-    (:func:`heavecomp.simulate.cache.composition_key`; about 30 s of CPU to compile once per
+    (:func:`heavecomp.simulate.cache.composition_key`; about 10-20 s of CPU to compile once per
     composition, then loaded in a fraction of a second).  The composition of no effect is this
     module's :func:`advance`.
     """

@@ -160,6 +160,34 @@ def cache_dir(key: str) -> Path:
     return base_dir() / f"numba-{key}"
 
 
+def source_file(key: str, name: str, text: str) -> Path | None:
+    """``text`` written to the file ``name`` in :func:`cache_dir` ``(key)`` (unless it already holds exactly
+    that): generated source that numba can then cache like any module's, since its cache needs a file
+    whose time stamp stays put.  Written to a temporary name and renamed, so processes compiling at once
+    (the install's, pytest's workers) never read half a file.  None when no cache folder is writable.
+
+    Parameters
+    ----------
+    key : str
+        A key of :func:`source_key` or :func:`composition_key` (the text is part of what it hashes).
+    name : str
+        File name (``hooks_<hash>.py``).
+    text : str
+        The source.
+    """
+    path = cache_dir(key) / name
+    try:
+        if path.exists() and path.read_text() == text:
+            return path
+        path.parent.mkdir(parents=True, exist_ok=True)
+        tmp = path.with_name(f"{name}.{os.getpid()}.tmp")
+        tmp.write_text(text)
+        os.replace(tmp, path)
+    except OSError:
+        return None
+    return path
+
+
 @contextlib.contextmanager
 def keyed(key: str):
     """numba's cache folder is :func:`cache_dir` ``(key)`` for the functions decorated inside.

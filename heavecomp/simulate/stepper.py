@@ -222,11 +222,11 @@ def _ensure_compiled(fn, comp=None) -> None:
         fn.compile(sig)
 
 
-#: CPU seconds to compile the nominal stepper, and more per effect of a composition (measured:
-#: 34 s and 73 s for the library's 10 effects, numba 0.68; 90 s for the superset's 15 classes and 50 s for
-#: 3 effects, benchmarks/simulate/install_compile.json and composition.json; the notice quotes their sum)
-COMPILE_S = 35
-COMPILE_S_PER_EFFECT = 4
+#: CPU seconds to compile the nominal stepper, and more per effect of a composition (measured, numba 0.68,
+#: with rk4 one loop compiled for one signature: 6.4 s, and 17.0 s for the superset's 16 classes,
+#: benchmarks/install/compiles.json; before issue 32's cut, 23-35 s and 90-105 s; the notice quotes their sum)
+COMPILE_S = 6
+COMPILE_S_PER_EFFECT = 1
 
 
 class compiling:
