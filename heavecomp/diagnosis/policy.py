@@ -189,7 +189,11 @@ class VerdictPolicy:
     (tolerance 0.26 at n_eff 952; fit cost 4739.33 against 4739.29, the resistance 0.1 % from the
     former stop's, 0.04 of its sigma), parameter_mismatch's static-force simplex after 26 instead of its
     whole 40 (tolerance 0.32; 26809.10 against 26809.06); the diagnosis 161 -> 140 replays, verdict
-    and shrink unchanged (benchmarks/diagnosis/README.md)."""
+    and shrink unchanged (benchmarks/diagnosis/README.md).  Tuning report: every verdict unchanged (26 of
+    26); the largest moves 20013's shrink 0.889 -> 0.867 (a high-pass least-squares stage after the
+    simplex that ends unconverged) and near-noise 20018's explained 0.920 -> 0.900.  A stop on the
+    Fisher scale instead (noise_cost / n_eff, a one-sigma parameter step: 0.06 on the benchmark) would
+    be tighter; not tried."""
     grid_span: float = 150.0
     """Span of the fit part [s] on which the coarse start grid of a candidate is scored."""
     delay_scan: int = 61
