@@ -273,3 +273,43 @@ def test_a_parameter_released_last_starts_from_the_smaller_fits_optimum_and_refi
     assert r.x[:2] == pytest.approx([0.8, 0.4], abs=0.03)
     assert r.x[2] == pytest.approx(2.0, abs=0.2)  # released from 1 (the wrapper's tolerances are loose)
     assert r.cost < plain.cost
+
+
+def _noisy_line(seed=6, n=4000, sigma=0.05, truth=0.3):
+    """A one-parameter residual: a response linear in ``x`` (optimum near ``truth``) plus white output
+    noise ``sigma``; its noise-only cost n sigma^2."""
+    rng = np.random.default_rng(seed)
+    t = np.linspace(0.0, 80.0, n)
+    b = np.sin(0.7 * t) + 0.5 * np.sign(np.sin(0.23 * t))
+    y = truth * b + rng.normal(0.0, sigma, n)
+    return (lambda x, t_stop=None: x[0] * b - y), n * sigma ** 2, float(b @ y / (b @ b)), sigma / math.sqrt(b @ b)
+
+
+def test_a_simplex_stops_where_the_noise_cannot_tell_its_steps_apart():
+    """``VerdictPolicy.search_resolution``: Nelder-Mead stops once its vertices' costs differ by less than
+    that share of the noise-only cost's chi-square spread; the absolute stop (costs within 1e-4) spends
+    more evaluations for a cost change the noise cannot resolve.  Both end within a fraction of the
+    least-squares sigma of the optimum."""
+    from heavecomp.diagnosis.fitting import cost_resolution, nelder_mead
+
+    fun, c_noise, x_opt, sd = _noisy_line()
+    lo, hi, x0 = np.array([-1.0]), np.array([1.0]), np.array([0.1])
+    share = VerdictPolicy().search_resolution
+    absolute = nelder_mead(fun, x0, lo, hi, 60, 0.08)
+    stopped = nelder_mead(fun, x0, lo, hi, 60, 0.08, share * c_noise)
+    assert stopped.nfev < absolute.nfev - 5
+    assert 2 * (stopped.cost - absolute.cost) <= cost_resolution(share * c_noise, absolute.fun)
+    assert abs(stopped.x[0] - x_opt) < 0.5 * sd and abs(absolute.x[0] - x_opt) < 0.5 * sd
+
+
+def test_a_simplex_that_straddles_the_optimum_is_not_taken_for_a_stop():
+    """A first simplex whose two vertices cost the same (they lie either side of the optimum, a step
+    apart) must not stop there: the stop also asks the simplex to have contracted under half its first
+    step, so it ends nearer the optimum than a quarter step."""
+    from heavecomp.diagnosis.fitting import nelder_mead
+
+    fun, c_noise, x_opt, _ = _noisy_line()
+    lo, hi, step = np.array([-1.0]), np.array([1.0]), 0.08
+    x0 = np.array([x_opt - 0.5 * step * 2.0])  # the vertices x0 and x0 + step (2 the range) straddle x_opt
+    r = nelder_mead(fun, x0, lo, hi, 60, step, VerdictPolicy().search_resolution * c_noise)
+    assert abs(r.x[0] - x_opt) < 0.25 * step * 2.0

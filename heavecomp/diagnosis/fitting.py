@@ -404,6 +404,7 @@ def fit_replayed(ctx, cls, start=None, fixed=(), *, search=Search(), hint=None, 
     """
     P = ctx.policy
     t_end = ctx.split["fit"][1]
+    noise = P.search_resolution * noise_cost(ctx)  # a search stops where the noise cannot tell its steps apart
     x0 = cls.to_x(start) if start else cls.x0()
     lo, hi = cls.search_box(ctx.replay.nominal)  # a refit of a calibrated file: about its [anchor]
     x0 = np.clip(x0, lo + 1e-9, hi - 1e-9)
@@ -422,14 +423,14 @@ def fit_replayed(ctx, cls, start=None, fixed=(), *, search=Search(), hint=None, 
     if cls.kind == "nominal":  # a nominal refit releases only the parameters the fit part asks for
         release = None if start is None else np.flatnonzero(x0 != cls.x0())
         r = stepwise(fun, x0 if start else cls.x0(), lo, hi, budget, t_grid, P.refit_release, search, release,
-                     noise_cost(ctx), P.refit_f, room)
+                     noise_cost(ctx), P.refit_f, room, noise)
         # parsimony counts what moved (issue 30 item 3): the parameters released, not all it could release
         moved = int(np.count_nonzero(np.abs(np.asarray(r.x) - cls.x0()) > 1e-12))
         return Fit(cls.from_x(r.x), sigma(cls, r), int(r.nfev), float(2 * r.cost), n_params=moved)
     later = np.array([f.name in cls.fit.released_last for f in cls.fields()])
     smooth = bool(cls.fit.smooth)
     if start is None and later.any():
-        r = _fit_then_release(fun, x0, lo, hi, ~later, budget, t_grid, search, hint, P.start_step, smooth)
+        r = _fit_then_release(fun, x0, lo, hi, ~later, budget, t_grid, search, hint, P.start_step, smooth, noise)
         return Fit(cls.from_x(r.x), sigma(cls, r), int(r.nfev), float(2 * r.cost))
     if smooth:  # a smooth law (FitSpec.smooth): Gauss-Newton from its start (the equation error's where it costs less)
         if start is None:
@@ -441,7 +442,7 @@ def fit_replayed(ctx, cls, start=None, fixed=(), *, search=Search(), hint=None, 
     if start is None:
         x0, near = _start(cls, fun, x0, lo, hi, t_grid, search.grid, hint)
     if x0.size <= 2:
-        r = nelder_mead(fun, x0, lo, hi, budget, P.start_step if near else NM_STEP)
+        r = nelder_mead(fun, x0, lo, hi, budget, P.start_step if near else NM_STEP, noise)
     else:
         r = least_squares(fun, x0, lo, hi, budget, search.n_jobs)
         if start is None:
@@ -449,7 +450,7 @@ def fit_replayed(ctx, cls, start=None, fixed=(), *, search=Search(), hint=None, 
     return Fit(cls.from_x(r.x), sigma(cls, r), int(r.nfev), float(2 * r.cost))
 
 
-def _fit_then_release(fun, x0, lo, hi, keep, budget, t_grid, search, hint, start_step=None, smooth=False):
+def _fit_then_release(fun, x0, lo, hi, keep, budget, t_grid, search, hint, start_step=None, smooth=False, noise=0.0):
     """The fit of the parameters ``keep`` with the others held at ``x0`` (as :func:`fit_replayed` fits
     that smaller candidate: coarse start grid, Nelder-Mead for up to two; a ``smooth`` law by least
     squares from its start, no grid), then every parameter released by least squares from that optimum
@@ -479,6 +480,8 @@ def _fit_then_release(fun, x0, lo, hi, keep, budget, t_grid, search, hint, start
         None: :data:`NM_STEP`).
     smooth : bool
         The law is smooth (``FitSpec.smooth``): no grid, the first stage by least squares too.
+    noise : float [-]
+        The first stage's stop: the search's share of the output noise's cost (:func:`nelder_mead`).
     """
     def part(xs, *t_stop):
         x = x0.copy()
@@ -489,7 +492,7 @@ def _fit_then_release(fun, x0, lo, hi, keep, budget, t_grid, search, hint, start
     x1[keep], near = _start(None, part, x0[keep], lo[keep], hi[keep], t_grid, 0 if smooth else search.grid,
                             None if hint is None else hint[keep])
     r1 = _refit_subset(fun, x1, np.flatnonzero(keep), lo, hi, budget, search.n_jobs,
-                       start_step if near and start_step is not None else NM_STEP, smooth)
+                       start_step if near and start_step is not None else NM_STEP, smooth, noise)
     r = least_squares(fun, np.clip(r1.x, lo + 1e-9, hi - 1e-9), lo, hi, budget, search.n_jobs)
     r.nfev = int(r.nfev) + int(r1.nfev)
     return r
@@ -535,8 +538,24 @@ def noise_cost(ctx) -> float:
     return float(total)
 
 
+def cost_resolution(noise, r) -> float:
+    """The fit-cost change [-] the output noise resolves at the residual ``r``: ``noise`` (a share of the
+    noise-only cost, :func:`noise_cost`) times the chi-square's relative spread sqrt(2 / n_eff), n_eff the
+    independent samples of ``r`` (:func:`effective_samples`).  A search step that changes the cost by less
+    cannot change a verdict (``VerdictPolicy.search_resolution``).
+
+    Parameters
+    ----------
+    noise : float [-]
+        ``VerdictPolicy.search_resolution`` times the noise-only fit cost.
+    r : array_like [-]
+        The weighted fit residual the spread is taken at.
+    """
+    return float(noise * math.sqrt(2.0 / effective_samples(r)))
+
+
 def stepwise(fun, x0, lo, hi, budget, t_grid, release_share, search=Search(), release=None, floor=0.0,
-             f_crit=0.0, eligible=None):
+             f_crit=0.0, eligible=None, noise=0.0):
     """Forward stepwise refit of a nominal parameter set (``parameter_mismatch``): from the nominal
     ``x0``, the parameters are released one at a time.  The first step scans each parameter alone
     (the others held; ``search.grid`` points over 10-90 % of its range, the cost on the first
@@ -610,9 +629,12 @@ def stepwise(fun, x0, lo, hi, budget, t_grid, release_share, search=Search(), re
     eligible : sequence of int, optional
         The parameters the search may release (the others stay at ``x0``: the equation error leaves no
         room for them, :func:`heavecomp.diagnosis.screen.mismatch_room`); None: every one.
+    noise : float [-]
+        The joint refits' stop: the search's share of the output noise's cost (:func:`nelder_mead`); 0:
+        the absolute stop.
     """
     S = _Stepwise(fun, np.asarray(x0, dtype=float).copy(), lo, hi, budget, search.n_jobs, release_share, floor,
-                  f_crit)
+                  f_crit, noise)
     x, best = S.x0, S.nominal()
     if release is not None:
         if len(release):
@@ -661,12 +683,12 @@ def stepwise(fun, x0, lo, hi, budget, t_grid, release_share, search=Search(), re
 
 class _Stepwise:
     """The evaluations of :func:`stepwise`: the residual ``fun`` of a fit vector, its bounds, the
-    joint refit's ``budget`` and threads, the partial F-test's ``release_share``, ``floor`` and
-    ``f_crit``, and the count of evaluations ``nfev`` (a refit's own count included)."""
+    joint refit's ``budget``, threads and stop (``noise``), the partial F-test's ``release_share``, ``floor``
+    and ``f_crit``, and the count of evaluations ``nfev`` (a refit's own count included)."""
 
-    def __init__(self, fun, x0, lo, hi, budget, n_jobs, release_share, floor, f_crit):
+    def __init__(self, fun, x0, lo, hi, budget, n_jobs, release_share, floor, f_crit, noise=0.0):
         self.fun, self.x0, self.lo, self.hi, self.budget, self.n_jobs = fun, x0, lo, hi, budget, n_jobs
-        self.release_share, self.floor, self.f_crit = release_share, floor, f_crit
+        self.release_share, self.floor, self.f_crit, self.noise = release_share, floor, f_crit, noise
         self.nfev = 0
         self.pool = list(range(x0.size))  # the parameters the search may release
 
@@ -685,7 +707,7 @@ class _Stepwise:
 
     def refit(self, x, act):
         """``x`` with its entries ``act`` refitted (:func:`_refit_subset`)."""
-        got = _refit_subset(self.fun, x, act, self.lo, self.hi, self.budget, self.n_jobs)
+        got = _refit_subset(self.fun, x, act, self.lo, self.hi, self.budget, self.n_jobs, noise=self.noise)
         self.nfev += got.nfev
         return got
 
@@ -818,11 +840,11 @@ def _lin_fit(J, r, act):
     return float(left @ left), dx
 
 
-def _refit_subset(fun, x, act, lo, hi, budget, n_jobs, step=None, smooth=False):
+def _refit_subset(fun, x, act, lo, hi, budget, n_jobs, step=None, smooth=False, noise=0.0):
     """The fit vector ``x`` with its entries ``act`` refitted (Nelder-Mead up to two, else, or ``smooth``,
     least squares; ``budget`` evaluations) and the rest held: a result with ``x``, ``fun``, ``jac`` (zero
     columns for the held entries), ``nfev`` and ``cost`` (half the sum of squares).  ``step``: Nelder-Mead's
-    first simplex step (share of the range; None: :data:`NM_STEP`)."""
+    first simplex step (share of the range; None: :data:`NM_STEP`); ``noise``: its stop (:func:`nelder_mead`)."""
     act = np.asarray(act, dtype=int)
 
     def f(z, t_stop=None):
@@ -831,7 +853,7 @@ def _refit_subset(fun, x, act, lo, hi, budget, n_jobs, step=None, smooth=False):
         return fun(xx) if t_stop is None else fun(xx, t_stop)
 
     z0 = np.clip(x[act], lo[act] + 1e-9, hi[act] - 1e-9)
-    r = nelder_mead(f, z0, lo[act], hi[act], budget, NM_STEP if step is None else step) \
+    r = nelder_mead(f, z0, lo[act], hi[act], budget, NM_STEP if step is None else step, noise) \
         if act.size <= 2 and not smooth else least_squares(f, z0, lo[act], hi[act], budget, n_jobs)
     xx = x.copy()
     xx[act] = r.x
@@ -967,7 +989,7 @@ def rescan(cls, fun, r, lo, hi, nominal, search=Search()):
     return best
 
 
-def nelder_mead(fun, x0, lo, hi, budget, step=None):
+def nelder_mead(fun, x0, lo, hi, budget, step=None, noise=0.0):
     """Derivative-free refinement (Nelder-Mead on the clipped parameters; stick-slip costs are
     piecewise smooth, so finite-difference gradients mislead), then a forward-difference
     Jacobian at the optimum for the uncertainty.  Returns an object like least_squares'.
@@ -985,6 +1007,12 @@ def nelder_mead(fun, x0, lo, hi, budget, step=None):
     step : float, optional
         First simplex step as a share of each parameter's range (None: :data:`NM_STEP`, a start from a
         grid or the defaults; ``VerdictPolicy.start_step`` from a start next to the optimum).
+    noise : float [-]
+        ``VerdictPolicy.search_resolution`` times the output noise's expected fit cost (:func:`noise_cost`):
+        the search stops once its simplex has contracted under half its first step and its vertices' costs
+        differ by less than the noise's resolution of the cost (:func:`cost_resolution` at the start's
+        residual): the noise can no longer tell its steps apart.  0: the absolute stop (costs within 1e-4,
+        vertices within 1e-3 of the fit vector).  Never tighter than the absolute stop.
     """
     from scipy.optimize import minimize
 
@@ -995,8 +1023,12 @@ def nelder_mead(fun, x0, lo, hi, budget, step=None):
     step = (NM_STEP if step is None else step) * (hi - lo)
     simplex = np.vstack([x0] + [x0 + np.where(np.arange(x0.size) == i, np.where(x0 + step <= hi, step, -step), 0.0)
                                 for i in range(x0.size)])
+    xatol, fatol = 1e-3, 1e-4
+    if noise > 0:
+        xatol = max(xatol, 0.5 * float(np.min(step)))
+        fatol = max(fatol, cost_resolution(noise, fun(np.clip(x0, lo, hi))))
     res = minimize(cost, x0, method="Nelder-Mead",
-                   options={"initial_simplex": simplex, "maxfev": budget, "xatol": 1e-3, "fatol": 1e-4})
+                   options={"initial_simplex": simplex, "maxfev": budget, "xatol": xatol, "fatol": fatol})
     x = np.clip(res.x, lo, hi)
     f0 = fun(x)
     J = np.empty((f0.size, x.size))
@@ -1152,7 +1184,8 @@ def _refine_reading(ctx, cls, fixed, t_end, c, got, used):
     (a stroke read 3 cm off: the pressure and WOB of the gas law and the string), not in the channel
     itself, which the start follows.  From the channel's linear fit ``got``, ``start_iterations``
     Gauss-Newton steps on the weighted fit residual of all channels (finite differences through the
-    replay; the parameters used by the linear fit only); the better of the two is kept."""
+    replay; the parameters used by the linear fit only), ending after a step that changed the cost by less
+    than the noise resolves (:func:`cost_resolution`); the better of the two is kept."""
     names = [f.name for f in cls.fields()]
     lo, hi = cls.bounds_x()
     idx = np.flatnonzero(used | (got[2] != 0.0))
@@ -1165,6 +1198,8 @@ def _refine_reading(ctx, cls, fixed, t_end, c, got, used):
     coef = np.array(got[2], dtype=float)
     r = resid(coef)
     best = (float(r @ r), coef.copy())
+    # a step that changes the cost by less than the noise resolves is the last (VerdictPolicy.search_resolution)
+    tol = cost_resolution(ctx.policy.search_resolution * noise_cost(ctx), r)
     for _ in range(ctx.policy.start_iterations):
         J = np.empty((r.size, idx.size))
         for j, i in enumerate(idx):
@@ -1173,9 +1208,12 @@ def _refine_reading(ctx, cls, fixed, t_end, c, got, used):
             x[i] += step
             J[:, j] = (resid(x) - r) / step
         coef[idx] = np.clip(coef[idx] - np.linalg.lstsq(J, r, rcond=None)[0], lo[idx], hi[idx])
+        c_before = float(r @ r)
         r = resid(coef)
         if float(r @ r) < best[0]:
             best = (float(r @ r), coef.copy())
+        if abs(c_before - float(r @ r)) < tol:
+            break
     if best[0] >= got[0]:
         return got
     return (best[0], c, best[1], got[3], got[4])

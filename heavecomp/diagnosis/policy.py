@@ -177,6 +177,26 @@ class VerdictPolicy:
     (seed 11) the equation error's resistance is 2.7 % off the replay's optimum, 0.2 % of the search
     range in the fit vector (its log); a simplex too small for a start further off grows by
     expansion, one replay per doubling."""
+    search_resolution: float = 0.1
+    """Share of the output noise's resolution of the fit cost under which a search can no longer tell its
+    steps apart, and stops: a Nelder-Mead simplex whose vertices' costs differ by less than this share of
+    the noise-only cost's chi-square spread, ``noise_cost`` x sqrt(2 / n_eff) (n_eff the independent
+    samples of the start's residual, :func:`heavecomp.diagnosis.fitting.effective_samples`), once it has
+    contracted under half its first step (so its vertices do not merely straddle the minimum); a reading's
+    Gauss-Newton refinement after a step that changed the cost by less
+    (:func:`heavecomp.diagnosis.fitting.cost_resolution`).  Never a tighter stop than the absolute one it
+    replaces (costs within 1e-4, vertices within 1e-3 of the fit vector), which on a fit cost of ~10^4
+    asked for digits the noise does not hold, so a simplex on a rough stick-slip cost spent its whole
+    budget.  A priori a tenth ("far below" what the noise resolves).  Measured on the 600 s flow-loss
+    benchmark (noise-only cost 57.4): the flow-loss simplex stops after 12 evaluations instead of 24
+    (tolerance 0.26 at n_eff 952; fit cost 4739.33 against 4739.29, the resistance 0.1 % from the
+    former stop's, 0.04 of its sigma), parameter_mismatch's static-force simplex after 26 instead of its
+    whole 40 (tolerance 0.32; 26809.10 against 26809.06); the diagnosis 161 -> 140 replays, verdict
+    and shrink unchanged (benchmarks/diagnosis/README.md).  Tuning report: every verdict unchanged (26 of
+    26); the largest moves 20013's shrink 0.889 -> 0.867 (a high-pass least-squares stage after the
+    simplex that ends unconverged) and near-noise 20018's explained 0.920 -> 0.900.  A stop on the
+    Fisher scale instead (noise_cost / n_eff, a one-sigma parameter step: 0.06 on the benchmark) would
+    be tighter; not tried."""
     grid_span: float = 150.0
     """Span of the fit part [s] on which the coarse start grid of a candidate is scored."""
     delay_scan: int = 61
