@@ -17,6 +17,8 @@ import ast
 import collections
 from pathlib import Path
 
+import pytest
+
 ROOT = Path(__file__).resolve().parents[1]
 PACKAGE = ROOT / "heavecomp"
 
@@ -120,7 +122,19 @@ def _parse():
     return modules, own, third
 
 
-MODULES, OWN, THIRD = _parse()
+#: the parsed package, filled by the first test of this module a process runs (not at collection: parsing
+#: every module costs each pytest-xdist worker ~1.5 s of CPU, also the worker that runs none of these tests)
+MODULES, OWN, THIRD = {}, [], []
+
+
+@pytest.fixture(scope="module", autouse=True)
+def _parsed():
+    if not MODULES:
+        modules, own, third = _parse()
+        MODULES.update(modules)
+        OWN.extend(own)
+        THIRD.extend(third)
+    assert MODULES and OWN and THIRD, "parsed no module: every check below would pass vacuously"
 
 
 def layer(module: str) -> str:
