@@ -32,6 +32,8 @@ import re
 
 import pytest
 
+from _source import tree as tree_of  # the package's files, parsed once per process
+
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 PACKAGE = ROOT / "heavecomp"
 
@@ -58,7 +60,7 @@ class _Parsed(dict):
     the paths: parsing them all there costs every pytest-xdist worker ~0.7 s of CPU)."""
 
     def __missing__(self, path):
-        tree = self[path] = ast.parse((ROOT / path).read_text(encoding="utf-8"))
+        tree = self[path] = tree_of(ROOT / path)
         return tree
 
 

@@ -19,6 +19,8 @@ from pathlib import Path
 
 import pytest
 
+from _source import tree as tree_of  # the package's files, parsed once per process
+
 ROOT = Path(__file__).resolve().parents[1]
 PACKAGE = ROOT / "heavecomp"
 
@@ -99,7 +101,7 @@ def _parse():
     modules = {_module_name(p): p for p in sorted(PACKAGE.rglob("*.py"))}
     own, third = [], []
     for name, path in modules.items():
-        tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
+        tree = tree_of(path)
         top = _top_level_nodes(tree)
         is_pkg = path.name == "__init__.py"
         for node in ast.walk(tree):
