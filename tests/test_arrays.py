@@ -16,7 +16,16 @@ from heavecomp.io.arrays import open_dataset
 from _cli import run
 from test_campaign_table import TINY
 
-xr = pytest.importorskip("xarray", reason="xarray not installed: pip install 'heavecomp[arrays]'")
+xr = None  #: xarray, imported by the first test of this module a process runs (below), not at collection
+
+
+@pytest.fixture(scope="module", autouse=True)
+def _xarray():
+    """Every test here needs xarray (skipped, saying why, without it). Imported here rather than at the
+    module's top: collection imports every test module in every pytest-xdist worker, and xarray with
+    pandas costs ~0.7 s of CPU each."""
+    global xr
+    xr = pytest.importorskip("xarray", reason="xarray not installed: pip install 'heavecomp[arrays]'")
 
 MAP = "t=Time,heave=MRU_heave,stroke=CMC_pos,pressure=P_main,wob=WOB"
 UNITS = "t=ms,pressure=bar,wob=kN,stroke=mm"

@@ -18,6 +18,8 @@ from heavecomp.benchmark.truth import Setting, truth_composition
 from heavecomp.effects.registry import library
 from heavecomp.errors import ParameterError
 
+from _source import tree as tree_of  # the package's files, parsed once per process
+
 ROOT = Path(__file__).resolve().parents[1]
 TRUTH_DIR = ROOT / "heavecomp" / "benchmark" / "truth"
 NOMINAL = parameter_sets()["paper_a"]
@@ -98,7 +100,7 @@ def test_zero_size_gives_back_the_nominal_run(name, bed):
 def _imports(path):
     """Every module a file imports from (``from X import a`` -> X and X.a; ``import X`` -> X)."""
     out = set()
-    for node in ast.walk(ast.parse(path.read_text())):
+    for node in ast.walk(tree_of(path)):
         if isinstance(node, ast.ImportFrom) and node.module:
             out.add(node.module)
             out.update(f"{node.module}.{a.name}" for a in node.names)

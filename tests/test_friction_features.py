@@ -7,7 +7,6 @@ import math
 
 import numpy as np
 import pytest
-from scipy.integrate import solve_ivp
 
 from heavecomp.effects.candidates import ParameterMismatch
 from heavecomp.effects.dwell_stiction import DwellStiction
@@ -30,6 +29,8 @@ def _signals(with_pressure=True):
 def test_first_order_lag_is_the_exact_solution_on_an_uneven_grid():
     t = np.cumsum(np.r_[0.0, np.random.default_rng(0).uniform(0.5e-3, 1.5e-3, 999)])
     y = first_order_lag(t, np.ones(t.size), 0.1)
+    from scipy.integrate import solve_ivp  # here, not at collection (scipy.integrate: ~0.4 s a worker)
+
     sol = solve_ivp(lambda s, z: (1.0 - z) / 0.1, (0.0, t[-1]), [0.0], t_eval=t, rtol=1e-11, atol=1e-12)
     assert np.max(np.abs(y - sol.y[0])) < 1e-8
     i = np.searchsorted(t, 0.1)

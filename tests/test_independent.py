@@ -17,6 +17,8 @@ import pytest
 from heavecomp.independent import laws
 from heavecomp.independent.plant import Heave, Plant, SampledHeave, simulate
 
+from _source import tree as tree_of  # the package's files, parsed once per process
+
 ROOT = Path(__file__).resolve().parents[1]
 FORBIDDEN = ("heavecomp.effects", "heavecomp.diagnosis", "heavecomp.benchmark", "heavecomp.plants",
              "heavecomp.friction", "heavecomp.simulate")
@@ -26,7 +28,7 @@ SEAL = dict(static_force=23e3, coulomb_force=12e3, stribeck_velocity=0.01, visco
 
 def _imports(path: Path) -> list[str]:
     names = []
-    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+    for node in ast.walk(tree_of(path)):
         if isinstance(node, ast.Import):
             names += [a.name for a in node.names]
         elif isinstance(node, ast.ImportFrom):

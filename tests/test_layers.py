@@ -17,6 +17,10 @@ import ast
 import collections
 from pathlib import Path
 
+import pytest
+
+from _source import tree as tree_of  # the package's files, parsed once per process
+
 ROOT = Path(__file__).resolve().parents[1]
 PACKAGE = ROOT / "heavecomp"
 
@@ -97,7 +101,7 @@ def _parse():
     modules = {_module_name(p): p for p in sorted(PACKAGE.rglob("*.py"))}
     own, third = [], []
     for name, path in modules.items():
-        tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
+        tree = tree_of(path)
         top = _top_level_nodes(tree)
         is_pkg = path.name == "__init__.py"
         for node in ast.walk(tree):
@@ -120,7 +124,19 @@ def _parse():
     return modules, own, third
 
 
-MODULES, OWN, THIRD = _parse()
+#: the parsed package, filled by the first test of this module a process runs (not at collection: parsing
+#: every module costs each pytest-xdist worker ~1.5 s of CPU, also the worker that runs none of these tests)
+MODULES, OWN, THIRD = {}, [], []
+
+
+@pytest.fixture(scope="module", autouse=True)
+def _parsed():
+    if not MODULES:
+        modules, own, third = _parse()
+        MODULES.update(modules)
+        OWN.extend(own)
+        THIRD.extend(third)
+    assert MODULES and OWN and THIRD, "parsed no module: every check below would pass vacuously"
 
 
 def layer(module: str) -> str:

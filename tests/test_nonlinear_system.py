@@ -1,6 +1,5 @@
 """Issue 13.5: a python-control nonlinear system of the CMC whose linearisation agrees with linearise()."""
 
-import control as ct
 import numpy as np
 import pytest
 
@@ -30,6 +29,7 @@ def test_named_signals_and_the_operating_point():
 
 @pytest.mark.parametrize("case", ["none", "sliding"])
 def test_linearize_agrees_with_linearise(case):
+    import control as ct  # here, not at collection: python-control imports scipy.signal and matplotlib
     if case == "none":
         p, v0, eps = paper_a("none"), None, None
         ref = L.linearise_details(p, friction="none")
@@ -59,6 +59,7 @@ def test_stiction_needs_a_smoothing_width():
 
 
 def test_simulates_with_input_output_response():
+    import control as ct  # here, not at collection: python-control imports scipy.signal and matplotlib
     p = paper_a("stribeck")
     sys = cmc_nlsys(p, eps=1e-3)
     t = np.linspace(0, 2.0, 201)
@@ -73,6 +74,8 @@ def test_simulates_with_input_output_response():
 def test_linearize_keeps_signal_names_with_copy_names():
     """The documented door: ``ct.linearize(..., copy_names=True)`` keeps the nlsys' signal names (without it
     python-control names them generically, which is why the docs say to pass it)."""
+    import control as ct
+
     p = paper_a("none")
     op = L.linearise_details(p, friction="none").op
     sys = cmc_nlsys(p)

@@ -6,6 +6,8 @@ from __future__ import annotations
 import ast
 from pathlib import Path
 
+from _source import tree as tree_of  # the package's files, parsed once per process
+
 PKG = Path(__file__).resolve().parents[1] / "heavecomp"
 
 #: layer of each wing module: physics 1, stepper 2, analysis 5 (the package's numbering:
@@ -21,7 +23,7 @@ OUTSIDE = {"heavecomp.errors": 0, "heavecomp.params": 0, "heavecomp.signals": 0,
 
 def _imports(path: Path):
     """(module imported, at module top?) for every ``heavecomp`` import of a file."""
-    tree = ast.parse(path.read_text())
+    tree = tree_of(path)
     top = {id(n) for n in tree.body}
     out = []
     for node in ast.walk(tree):
