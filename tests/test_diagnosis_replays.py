@@ -180,3 +180,42 @@ def test_a_joint_partner_the_score_test_leaves_out_would_not_have_been_named(joi
     gain = ctx.explained(ctx.mse_before, ctx.mse(pred, ctx.valmask)) - best.explained \
         - P.penalty * F.n_params(ctx, "string_damping", fitted)
     assert gain <= P.second_gain
+
+
+@pytest.mark.slow
+def test_a_reading_out_of_contention_is_not_refined_through_the_replay(diagnosed):
+    """A stroke or WOB reading is refined through the replay only where its first Gauss-Newton step's
+    linearised cost (or its linear fit) comes under the contention bar (``reading_contention``).  On a
+    withheld flow loss the offsets cannot: the row says so, and the refinement, run anyway, stays above
+    the bar too (the prediction was right), at more replays."""
+    from heavecomp.diagnosis import fitting as F
+
+    _, d = diagnosed
+    ctx, ledger = d.context_, d.context_.replay.ledger
+    row = next(r for r in d.candidates_ if r["effect"] == "sensor_offset")
+    for c in ("stroke", "wob"):
+        ev = row["refinement"][c]
+        assert not ev["refined"] and ev["predicted_cost"] > ev["bar_cost"]
+    cls = F.candidate_class(ctx, "sensor_offset")
+    n0 = ledger.count
+    stopped = F.fit_linear_output(ctx, cls)
+    n1 = ledger.count
+    always = dataclasses.replace(ctx, policy=dataclasses.replace(ctx.policy, reading_contention=0.0))
+    refined = F.fit_linear_output(always, cls)
+    n2 = ledger.count
+    assert all(ev["refined"] for ev in refined.refinement.values())
+    assert refined.cost > row["refinement"]["wob"]["bar_cost"]
+    assert refined.cost > row["refinement"]["stroke"]["bar_cost"]
+    assert n1 - n0 < n2 - n1
+
+
+@pytest.mark.slow
+def test_a_reading_in_contention_is_refined_through_the_replay():
+    """A planted sensor offset (120 s): its reading's first step is predicted under the contention bar, so it
+    is refined through the replay, and named."""
+    tr = generate(benchmark_case("sensor_offset", seed=11, duration=120.0, rate=50.0))
+    d = GapDiagnoser(tr.nominal, candidates=["sensor_offset", "flow_loss"], n_jobs=1).fit(tr.to_run())
+    assert d.verdict_["effect"] == "sensor_offset"
+    row = next(r for r in d.candidates_ if r["effect"] == "sensor_offset")
+    ev = row["refinement"][row["parameters"]["channel"]]
+    assert ev["refined"] and ev["predicted_cost"] < ev["bar_cost"]

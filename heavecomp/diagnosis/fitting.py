@@ -63,6 +63,8 @@ class Fit:
     cost: float
     wall_time: float = 0.0
     n_params: int | None = None
+    #: a stroke or WOB reading's refinement through the replay, per channel (:func:`_refine_reading`)
+    refinement: dict | None = None
 
 
 @dataclasses.dataclass(frozen=True)
@@ -88,6 +90,8 @@ class CandidateFit:
     values: dict
     pred: dict = dataclasses.field(repr=False, compare=False, default=None)
     at_bound: tuple = ()
+    #: a reading's refinement through the replay per channel (:attr:`Fit.refinement`; None: not a reading)
+    refinement: dict | None = None
 
     @property
     def primary(self) -> str:
@@ -112,7 +116,8 @@ class CandidateFit:
                 "rms_before": self.rms_before, "rms_after": self.rms_after, "shrink": self.shrink,
                 "channels": self.channels, "explained": self.explained, "explained_replay": self.explained_replay,
                 "explained_perturbed_heave": self.explained_perturbed, "n_params": self.n_params,
-                "score": self.score, "fit_wall_time": self.fit_wall_time, "at_bound": list(self.at_bound)}
+                "score": self.score, "fit_wall_time": self.fit_wall_time, "at_bound": list(self.at_bound),
+                **({} if self.refinement is None else {"refinement": self.refinement})}
 
 
 def public(nominal, name, values) -> dict:
@@ -222,7 +227,8 @@ def score(ctx, name, fitted: Fit, pred, pred_pert) -> CandidateFit:
                         channel_scores(ctx.mse_before, mse_a), float(expl), float(expl_plain),
                         None if expl_pert is None else float(expl_pert), k,
                         float(expl - P.penalty * k), fitted.wall_time, fitted.values, pred,
-                        tuple(at_bounds(name, fitted.values, tol=P.bound_tol, params=ctx.replay.nominal)))
+                        tuple(at_bounds(name, fitted.values, tol=P.bound_tol, params=ctx.replay.nominal)),
+                        fitted.refinement)
 
 
 def upper_score(ctx, name, fitted: Fit, pred) -> float:
@@ -1111,7 +1117,8 @@ def fit_linear_output(ctx, cls, fixed=(), channel=None) -> Fit:
     channel's fit residual by at least :data:`heavecomp.diagnosis.equation_error.MIN_SHRINK`;
     ``n_params`` counts the parameters used.  On stroke and WOB, which also set the replay's start
     (:meth:`~heavecomp.diagnosis.replay.Replay.start_for`), the fit is refined through the replay
-    (:func:`_refine_reading`).
+    (:func:`_refine_reading`) where it can contend (``VerdictPolicy.reading_contention``); ``refinement``
+    says per channel what the refinement predicted and whether it ran.
 
     Parameters
     ----------
@@ -1128,16 +1135,36 @@ def fit_linear_output(ctx, cls, fixed=(), channel=None) -> Fit:
     base0 = ctx.simulate(list(fixed), t_end)
     names = [f.name for f in cls.fields()]
     used = np.array([n not in cls.fit.optional for n in names])
-    best = None
+    r0 = ctx.resid_vec(base0)
+    bar = contention_bar(ctx, float(r0 @ r0))
+    best, refinement = None, {}
     for c in ctx.channels if channel is None else (channel,):
         got = _fit_channel(ctx, cls, base0, c, used)
         if c in ("stroke", "wob"):  # they also set the replay's start: Gauss-Newton on every channel
-            got = _refine_reading(ctx, cls, fixed, t_end, c, got, used)
+            got, refinement[c] = _refine_reading(ctx, cls, fixed, t_end, c, got, used, bar)
         if best is None or got[0] < best[0]:
             best = got
     cost, c, coef, sig, k_used = best
     values = {"channel": c, **{n: float(v) for n, v in zip(names, coef)}}
-    return Fit(values, {n: float(s) for n, s in zip(names, sig)}, 1, cost, n_params=k_used)
+    return Fit(values, {n: float(s) for n, s in zip(names, sig)}, 1, cost, n_params=k_used,
+               refinement=refinement or None)
+
+
+def contention_bar(ctx, cost_fixed) -> float:
+    """The fit cost [-] a reading must be predicted to reach for its refinement through the replay to run
+    (:func:`_refine_reading`): the cost of the model it is added to, ``cost_fixed`` (the nominal, or a joint
+    fit's partner), less ``VerdictPolicy.reading_contention`` of that model's gap above the output noise's
+    cost (:func:`noise_cost`); inf (always refine) where that model is within the noise or the share is 0.
+
+    Parameters
+    ----------
+    ctx : heavecomp.diagnosis.replay.ReplayContext
+        The prepared run.
+    cost_fixed : float [-]
+        The fit cost of the model the reading is added to.
+    """
+    gap, share = cost_fixed - noise_cost(ctx), ctx.policy.reading_contention
+    return float(cost_fixed - share * gap) if gap > 0 and share > 0 else math.inf
 
 
 def _fit_channel(ctx, cls, base, c, used):
@@ -1178,14 +1205,18 @@ def _fit_channel(ctx, cls, base, c, used):
     return float(rv @ rv), c, coef, sig, k_used
 
 
-def _refine_reading(ctx, cls, fixed, t_end, c, got, used):
+def _refine_reading(ctx, cls, fixed, t_end, c, got, used, bar=math.inf):
     """A stroke or WOB reading also sets the replay's start and heave reference
     (:meth:`~heavecomp.diagnosis.replay.Replay.start_for`), so a misreading there shows in every channel
     (a stroke read 3 cm off: the pressure and WOB of the gas law and the string), not in the channel
     itself, which the start follows.  From the channel's linear fit ``got``, ``start_iterations``
     Gauss-Newton steps on the weighted fit residual of all channels (finite differences through the
     replay; the parameters used by the linear fit only), ending after a step that changed the cost by less
-    than the noise resolves (:func:`cost_resolution`); the better of the two is kept."""
+    than the noise resolves (:func:`cost_resolution`); the better of the two is kept.  The first step's
+    linearised cost (its Jacobian's prediction, no replay) is the refinement's prediction: where neither it
+    nor the linear fit reaches ``bar`` (:func:`contention_bar`) the reading cannot contend and the
+    refinement stops there.  Returns the fit and its evidence (``predicted_cost``, ``bar_cost``,
+    ``refined``)."""
     names = [f.name for f in cls.fields()]
     lo, hi = cls.bounds_x()
     idx = np.flatnonzero(used | (got[2] != 0.0))
@@ -1200,14 +1231,22 @@ def _refine_reading(ctx, cls, fixed, t_end, c, got, used):
     best = (float(r @ r), coef.copy())
     # a step that changes the cost by less than the noise resolves is the last (VerdictPolicy.search_resolution)
     tol = cost_resolution(ctx.policy.search_resolution * noise_cost(ctx), r)
-    for _ in range(ctx.policy.start_iterations):
+    evidence = {"predicted_cost": None, "bar_cost": None if math.isinf(bar) else float(bar), "refined": True}
+    for it in range(ctx.policy.start_iterations):
         J = np.empty((r.size, idx.size))
         for j, i in enumerate(idx):
             step = 1e-3 * (scale if abs(coef[i]) < 1e-12 or names[i] == "offset" else abs(coef[i]))
             x = coef.copy()
             x[i] += step
             J[:, j] = (resid(x) - r) / step
-        coef[idx] = np.clip(coef[idx] - np.linalg.lstsq(J, r, rcond=None)[0], lo[idx], hi[idx])
+        step = np.clip(coef[idx] - np.linalg.lstsq(J, r, rcond=None)[0], lo[idx], hi[idx]) - coef[idx]
+        if it == 0:  # the step's linearised cost: what the refinement is predicted to reach
+            r_lin = r + J @ step
+            evidence["predicted_cost"] = float(r_lin @ r_lin)
+            if min(evidence["predicted_cost"], got[0]) > bar:  # out of contention (reading_contention)
+                evidence["refined"] = False
+                break
+        coef[idx] += step
         c_before = float(r @ r)
         r = resid(coef)
         if float(r @ r) < best[0]:
@@ -1215,5 +1254,5 @@ def _refine_reading(ctx, cls, fixed, t_end, c, got, used):
         if abs(c_before - float(r @ r)) < tol:
             break
     if best[0] >= got[0]:
-        return got
-    return (best[0], c, best[1], got[3], got[4])
+        return got, evidence
+    return (best[0], c, best[1], got[3], got[4]), evidence
