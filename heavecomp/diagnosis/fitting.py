@@ -829,11 +829,30 @@ def _jacobian(fun, best, rest, lo, hi):
     string-and-formation runs); the other columns ``best.jac``'s (the last fit's)."""
     J = np.array(best.jac, dtype=float)
     for j in rest:
-        h = 0.1 * (hi[j] - lo[j]) * (1 if best.x[j] + 0.1 * (hi[j] - lo[j]) <= hi[j] else -1)
+        h = secant_step(best.x, lo, hi, j, 0.1)
         xx = best.x.copy()
         xx[j] += h
         J[:, j] = (fun(xx) - best.fun) / h
     return J
+
+
+def secant_step(x, lo, hi, j, share) -> float:
+    """A finite-difference step of fit-vector entry ``j``: ``share`` of its search range [lo, hi], inwards
+    (backwards where a step forwards would leave the box).
+
+    Parameters
+    ----------
+    x : numpy.ndarray
+        The fit vector the step is taken from.
+    lo, hi : numpy.ndarray
+        Its bounds.
+    j : int
+        The entry stepped.
+    share : float [-]
+        The step's share of the entry's range.
+    """
+    h = share * (hi[j] - lo[j])
+    return h * (1 if x[j] + h <= hi[j] else -1)
 
 
 def _lin_fit(J, r, act):
@@ -1039,7 +1058,7 @@ def nelder_mead(fun, x0, lo, hi, budget, step=None, noise=0.0):
     f0 = fun(x)
     J = np.empty((f0.size, x.size))
     for i in range(x.size):
-        dx = 0.02 * (hi[i] - lo[i]) * (1 if x[i] + 0.02 * (hi[i] - lo[i]) <= hi[i] else -1)
+        dx = secant_step(x, lo, hi, i, 0.02)
         xi = x.copy()
         xi[i] += dx
         J[:, i] = (fun(xi) - f0) / dx
@@ -1239,14 +1258,14 @@ def _refine_reading(ctx, cls, fixed, t_end, c, got, used, bar=math.inf):
             x = coef.copy()
             x[i] += step
             J[:, j] = (resid(x) - r) / step
-        step = np.clip(coef[idx] - np.linalg.lstsq(J, r, rcond=None)[0], lo[idx], hi[idx]) - coef[idx]
+        dx = np.clip(coef[idx] - np.linalg.lstsq(J, r, rcond=None)[0], lo[idx], hi[idx]) - coef[idx]
         if it == 0:  # the step's linearised cost: what the refinement is predicted to reach
-            r_lin = r + J @ step
+            r_lin = r + J @ dx
             evidence["predicted_cost"] = float(r_lin @ r_lin)
             if min(evidence["predicted_cost"], got[0]) > bar:  # out of contention (reading_contention)
                 evidence["refined"] = False
                 break
-        coef[idx] += step
+        coef[idx] += dx
         c_before = float(r @ r)
         r = resid(coef)
         if float(r @ r) < best[0]:

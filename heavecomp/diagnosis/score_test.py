@@ -34,6 +34,7 @@ import numpy as np
 
 from heavecomp.diagnosis import components as CR
 from heavecomp.diagnosis import equation_error as EE
+from heavecomp.diagnosis import fitting as F
 from heavecomp.effects.candidates import get
 
 
@@ -153,7 +154,7 @@ def joint_prediction(ctx, fixed, cls, values, free, lo, hi):
     x = np.clip(cls.to_x(values), lo, hi)
     configs = [fixed + [(name, dict(values))]]
     for j in free:
-        h = 0.1 * (hi[j] - lo[j]) * (1 if x[j] + 0.1 * (hi[j] - lo[j]) <= hi[j] else -1)
+        h = F.secant_step(x, lo, hi, j, 0.1)
         xx = x.copy()
         xx[j] += h
         configs.append(fixed + [(name, {**values, **cls.from_x(xx)})])
