@@ -107,16 +107,11 @@ class ParameterMismatch(Effect):
     def apply(cls, params, values):
         """The nominal parameter set with the multipliers applied (F_C clipped to <= F_S; a moved top
         mass in the same gas bank, :meth:`bank_held`)."""
-        mult = list(values.values())
+        named = cls.named_values(params, values)
         ch: dict = {}
-        for (label, table, key), m in zip(MISMATCH_KEYS, mult):
-            base = getattr(getattr(params, table), key)
-            if base is None:
-                continue
-            ch.setdefault(table, {})[key] = base * m
-        comp = ch.setdefault("compensator", {})
-        if "gas_stiffness" in comp:
-            comp["gas_stiffness"] *= cls.bank_held(params, comp.get("moving_mass", params.compensator.moving_mass))
+        for label, table, key in MISMATCH_KEYS:
+            if label in named:
+                ch.setdefault(table, {})[key] = named[label]
         fr = ch.get("friction", {})
         if "static_force" in fr and "coulomb_force" in fr:
             fr["coulomb_force"] = min(fr["coulomb_force"], fr["static_force"])
