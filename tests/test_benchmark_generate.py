@@ -15,7 +15,8 @@ import pytest
 import heavecomp.benchmark as B
 from heavecomp.benchmark import benchmark_case, benchmark_cases, corrupt, generate
 from heavecomp.benchmark.truth import LAWS, TRUTH, truth_composition
-from heavecomp.diagnosis.stepper import CHANNELS as SC, replay_dt, run_fx
+from heavecomp.benchmark.testbed import truth_dt
+from heavecomp.diagnosis.stepper import CHANNELS as SC, run_fx
 from heavecomp.plants.cmc import plant_vectors
 from heavecomp.simulate import excitation
 
@@ -32,7 +33,7 @@ def _truth(name, prm):
 def _clean(tr, effects):
     """Clean truth channels of the recorded sea with the truth ``effects`` on the nominal parameters."""
     nominal, sea = tr.nominal, tr.truth["sea"]
-    h = replay_dt(nominal, 50.0)
+    h = truth_dt(nominal, 50.0)  # the generator's step
     n = int(math.ceil(DUR / h - 1e-9))
     hs = excitation.jonswap(sea["hs"], sea["tp"], 3.3, sea["phase_seed"], 2 * sea["tp"], n * h, 0.5 * h)
     comp = truth_composition()

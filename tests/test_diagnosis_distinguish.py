@@ -142,7 +142,8 @@ def _friction_high(duration, rate=25.0, factor=1.3, seed=3):
     """The nominal paper-A plant in a JONSWAP sea with the seal's static and Coulomb forces x ``factor``,
     logged at ``rate`` with the benchmark's noise (2 mm heave and stroke, 2 kPa, 400 N)."""
     from heavecomp.diagnosis.data import check_run
-    from heavecomp.diagnosis.stepper import CHANNELS as SC, replay_dt, run_fx
+    from heavecomp.benchmark.testbed import truth_dt
+    from heavecomp.diagnosis.stepper import CHANNELS as SC, run_fx
     from heavecomp.effects.compose import composition
     from heavecomp.params import paper_a
     from heavecomp.plants.cmc import plant_vectors
@@ -151,7 +152,7 @@ def _friction_high(duration, rate=25.0, factor=1.3, seed=3):
     nominal = paper_a()
     truth = nominal.replace(friction={"static_force": 23e3 * factor, "coulomb_force": 12e3 * factor})
     comp = composition(())
-    h = replay_dt(truth, rate)
+    h = truth_dt(truth, rate)  # the generator's finer step
     n = int(math.ceil(duration / h))
     hs = excitation.jonswap(2.5, 10.0, 3.3, seed, 24.0, n * h, 0.5 * h)
     out = run_fx(plant_vectors(truth), comp, comp.ep([]), hs, h, n, int(round(1.0 / rate / h)))

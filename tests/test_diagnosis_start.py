@@ -15,7 +15,8 @@ from heavecomp.diagnosis import start as S
 from heavecomp.diagnosis.data import check_run, heave_filtered
 from heavecomp.diagnosis import replay as R
 from heavecomp.diagnosis.estimator import GapDiagnoser
-from heavecomp.diagnosis.stepper import CHANNELS as SC, replay_dt, run_fx
+from heavecomp.benchmark.testbed import truth_dt
+from heavecomp.diagnosis.stepper import CHANNELS as SC, run_fx
 from heavecomp.effects.compose import composition
 from heavecomp.params import paper_a
 from heavecomp.plants.cmc import plant_vectors
@@ -27,7 +28,7 @@ NOISE = {"heave": 2e-3, "stroke": 2e-3, "pressure": 2e3, "wob": 400.0}
 def _truth_run(duration=200.0, hs=2.0, seed=3):
     """A nominal run from rest with the full truth state (50 Hz) and its noisy measurement."""
     p = paper_a()
-    h = replay_dt(p, 50.0)
+    h = truth_dt(p, 50.0)  # the generator's finer step
     n = int(math.ceil(duration / h))
     sea = excitation.jonswap(hs, 10.0, 3.3, seed, 20.0, n * h, 0.5 * h)
     comp = composition()  # the nominal plant: no effect

@@ -353,7 +353,8 @@ def grid(run, nominal) -> tuple:
     nominal : heavecomp.params.CMCParams
         Nominal parameters. (the replay step, :func:`heavecomp.diagnosis.stepper.replay_dt`).
     """
-    h = replay_dt(nominal)
+    # a uniformly sampled log's samples fall on the replay's grid (no interpolation between its steps)
+    h = replay_dt(nominal, 1.0 / run.dt if run.uniform and run.t.size > 1 else None)
     n_steps = int(math.ceil(run.t[-1] / h - 1e-9))
     if n_steps > MAX_REPLAY_STEPS:
         raise InputError(f"{run.source}: the log is {run.t[-1] / 3600:.3g} h long, {n_steps:.3g} replay steps of "

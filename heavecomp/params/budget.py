@@ -34,7 +34,7 @@ from heavecomp.errors import InputError
 MAX_STEPS = 200_000_000  #: largest number of RK4 steps of one run
 MAX_BYTES = 4 * 2 ** 30  #: largest memory for heave samples + output rows [bytes]
 HEAVE_BYTES_PER_STEP = 3 * 8 * 2  #: z, dz, ddz at every half step [bytes]
-#: longest replay the gap diagnosis takes (about 28 h at its 10 ms step; each replay ~3 s there, the
+#: longest replay the gap diagnosis takes (about 55 h at its 20 ms step on the paper-A plant; each replay ~1.5 s there, the
 #: diagnosis makes several hundred, and the replay grid of 1e7 steps x 8 channels is 0.6 GB per thread)
 MAX_REPLAY_STEPS = 10_000_000
 MIN_DEFAULT_STEP = 1e-5  #: a parameter set whose default step is shorter cannot run an hour within MAX_STEPS [s]
