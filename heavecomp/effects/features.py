@@ -39,18 +39,52 @@ def first_order_lag(t, x, tau: float, y0: float = 0.0) -> np.ndarray:
 
         d = float(np.exp(-dt.mean() / tau))
         return lfilter([0.0, 1.0 - d], [1.0, -d], x, zi=[float(y0)])[0]
-    return _lag_steps(x, np.exp(-dt / tau), y0)
+    return compiled(_lag_steps)(x, np.exp(-dt / tau), float(y0))
 
 
 def _lag_steps(x, decay, y0):
-    """y[i + 1] = x[i] + (y[i] - x[i]) decay[i] from y[0] = ``y0``: a first-order lag, x held over each step."""
+    """y[i + 1] = x[i] + (y[i] - x[i]) decay[i] from y[0] = ``y0``: a first-order lag, x held over each step
+    (run :func:`compiled`)."""
     y = np.empty(x.size)
-    yk = float(y0)
+    yk = y0
     for i in range(x.size):
         y[i] = yk
         if i < decay.size:
             yk = x[i] + (yk - x[i]) * decay[i]
     return y
+
+
+def euler_affine(c0, c1, dt, max_h, y0):
+    """y with dy/dt = c0[k] + c1[k] y over the k-th interval ``dt[k]`` [s] (coefficients held): explicit
+    Euler steps, ceil(dt[k] / ``max_h``) equal ones per interval, from y[0] = ``y0``; y has dt.size + 1
+    samples (run :func:`compiled`).  An effect whose state rate is affine in its state builds ``c0``
+    and ``c1`` from its own ``rates`` (:meth:`heavecomp.effects.gas_thermal.GasThermal.features`)."""
+    y = np.empty(dt.size + 1)
+    yk = y0
+    y[0] = yk
+    for k in range(dt.size):
+        sub = max(1, int(np.ceil(dt[k] / max_h)))
+        h = dt[k] / sub
+        for _ in range(sub):
+            yk = yk + h * (c0[k] + c1[k] * yk)
+        y[k + 1] = yk
+    return y
+
+
+_COMPILED = {}
+
+
+def compiled(fn):
+    """``fn``, a sample-by-sample loop of this module over float arrays, compiled by numba on first use
+    (cached on disk): the same source at machine speed.  The equation-error features run these loops
+    over every sample of a log, several times per diagnosis (a 600 s log at 50 Hz: 30 000 samples, ~2 us
+    each in the interpreter)."""
+    got = _COMPILED.get(fn.__name__)
+    if got is None:
+        from numba import njit
+
+        got = _COMPILED[fn.__name__] = njit(cache=True)(fn)
+    return got
 
 
 def rest_durations(t, still) -> tuple[np.ndarray, np.ndarray]:
@@ -156,4 +190,5 @@ def distance_lag(x, u, length: float, y0: float = 0.0) -> np.ndarray:
         ``y[i]`` is the state when ``u[i]`` is sampled (before ``u[i]`` acts), so ``y`` lags ``u``;
         at rest (no distance travelled) it holds.
     """
-    return _lag_steps(np.asarray(u, dtype=float), np.exp(-np.abs(np.diff(np.asarray(x, dtype=float))) / length), y0)
+    return compiled(_lag_steps)(np.asarray(u, dtype=float),
+                                np.exp(-np.abs(np.diff(np.asarray(x, dtype=float))) / length), float(y0))
