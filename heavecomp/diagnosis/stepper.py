@@ -127,8 +127,18 @@ def replay_dt(params, rate: float | None = None) -> float:
 
 def step_within(params, cap: float, rate: float | None = None) -> float:
     """The longest RK4 step [s] with h * lambda_max <= 0.25 and h <= ``cap``, made a divisor of the output
-    interval 1/rate when ``rate`` [Hz] is given (:func:`replay_dt`; the generator's truth step,
-    :func:`heavecomp.benchmark.testbed.truth_dt`)."""
+    interval 1/rate when ``rate`` is given (:func:`replay_dt`; the generator's truth step,
+    :func:`heavecomp.benchmark.testbed.truth_dt`).
+
+    Parameters
+    ----------
+    params : heavecomp.params.CMCParams
+        Parameter set (its fastest eigen-rate, :func:`heavecomp.plants.cmc.eigen_rate`, bounds the step).
+    cap : float [s]
+        Longest step.
+    rate : float [Hz], optional
+        Output rate the step must divide; None: any step.
+    """
     h = min(cap, 0.25 / eigen_rate(params))
     if rate:
         interval = 1.0 / rate

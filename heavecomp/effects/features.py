@@ -58,7 +58,19 @@ def euler_affine(c0, c1, dt, max_h, y0):
     """y with dy/dt = c0[k] + c1[k] y over the k-th interval ``dt[k]`` [s] (coefficients held): explicit
     Euler steps, ceil(dt[k] / ``max_h``) equal ones per interval, from y[0] = ``y0``; y has dt.size + 1
     samples (run :func:`compiled`).  An effect whose state rate is affine in its state builds ``c0``
-    and ``c1`` from its own ``rates`` (:meth:`heavecomp.effects.gas_thermal.GasThermal.features`)."""
+    and ``c1`` from its own ``rates`` (:meth:`heavecomp.effects.gas_thermal.GasThermal.features`).
+
+    Parameters
+    ----------
+    c0, c1 : numpy.ndarray
+        The rate's constant [unit/s] and its coefficient of y [1/s] over each interval.
+    dt : numpy.ndarray [s]
+        The intervals.
+    max_h : float [s]
+        Longest Euler step.
+    y0 : float
+        y at the start.
+    """
     y = np.empty(dt.size + 1)
     yk = y0
     y[0] = yk
@@ -78,7 +90,13 @@ def compiled(fn):
     """``fn``, a sample-by-sample loop of this module over float arrays, compiled by numba on first use
     (cached on disk): the same source at machine speed.  The equation-error features run these loops
     over every sample of a log, several times per diagnosis (a 600 s log at 50 Hz: 30 000 samples, ~2 us
-    each in the interpreter)."""
+    each in the interpreter).
+
+    Parameters
+    ----------
+    fn : callable
+        A loop of this module (:func:`_lag_steps`, :func:`euler_affine`).
+    """
     got = _COMPILED.get(fn.__name__)
     if got is None:
         from numba import njit
