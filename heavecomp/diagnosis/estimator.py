@@ -337,7 +337,8 @@ class GapDiagnoser(GapEstimator):
         pert = self._contention(ctx, names, results)
         fits = [F.score(ctx, n, *results[n], pert.get(n)) for n in names]
         # the replays on the heave-noise draws, kept for the distinguishability test (channels only)
-        self.perturbed_ = {n: [{c: p[c] for c in CH} for p in pert[n]] for n in pert}
+        # (the first perturbed_draws: the test pairs them with the nominal's replays on the same draws)
+        self.perturbed_ = {n: [{c: p[c] for c in CH} for p in pert[n][:len(ctx.hs_pert)]] for n in pert}
         return sorted(fits, key=lambda r: -r.score)
 
     def _contention(self, ctx, names, results) -> dict:
@@ -364,6 +365,8 @@ class GapDiagnoser(GapEstimator):
         def draw(n):
             cfg = [(n, results[n][0].values)]
             pert[n] = ctx.map(lambda hs, cfg=cfg: ctx.simulate(cfg, hs=hs), ctx.hs_pert)
+            if F.draws_disagree(ctx, results[n][1], pert[n]):  # a flip in some draws: the envelope's others settle it
+                pert[n] = pert[n] + ctx.map(lambda hs, cfg=cfg: ctx.simulate(cfg, hs=hs), ctx.more_draws.get())
             final[n] = F.score(ctx, n, *results[n], pert[n]).score
 
         if "parameter_mismatch" in results:

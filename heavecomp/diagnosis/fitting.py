@@ -92,6 +92,9 @@ class CandidateFit:
     at_bound: tuple = ()
     #: a reading's refinement through the replay per channel (:attr:`Fit.refinement`; None: not a reading)
     refinement: dict | None = None
+    #: heave-noise draws ``explained_perturbed`` is the median of (0: not drawn; more than
+    #: ``perturbed_draws`` where the first ones disagreed, :func:`draws_disagree`)
+    heave_draws: int = 0
 
     @property
     def primary(self) -> str:
@@ -116,8 +119,8 @@ class CandidateFit:
                 "rms_before": self.rms_before, "rms_after": self.rms_after, "shrink": self.shrink,
                 "channels": self.channels, "explained": self.explained, "explained_replay": self.explained_replay,
                 "explained_perturbed_heave": self.explained_perturbed, "n_params": self.n_params,
-                "score": self.score, "fit_wall_time": self.fit_wall_time, "at_bound": list(self.at_bound),
-                **({} if self.refinement is None else {"refinement": self.refinement})}
+                "heave_draws": self.heave_draws, "score": self.score, "fit_wall_time": self.fit_wall_time,
+                "at_bound": list(self.at_bound), **({} if self.refinement is None else {"refinement": self.refinement})}
 
 
 def public(nominal, name, values) -> dict:
@@ -228,7 +231,31 @@ def score(ctx, name, fitted: Fit, pred, pred_pert) -> CandidateFit:
                         None if expl_pert is None else float(expl_pert), k,
                         float(expl - P.penalty * k), fitted.wall_time, fitted.values, pred,
                         tuple(at_bounds(name, fitted.values, tol=P.bound_tol, params=ctx.replay.nominal)),
-                        fitted.refinement)
+                        fitted.refinement, 0 if pred_pert is None else len(pred_pert))
+
+
+def draws_disagree(ctx, pred, preds) -> bool:
+    """Whether the first heave-noise draws disagree on a candidate (``VerdictPolicy.draw_disagreement``):
+    one keeps less than that share of its replay's explained share ``pred`` and another at least as much,
+    and the input envelope has more draws to settle it (:attr:`ReplayContext.more_draws`).
+
+    Parameters
+    ----------
+    ctx : heavecomp.diagnosis.replay.ReplayContext
+        The prepared run.
+    pred : dict
+        The candidate's whole replay.
+    preds : list of dict
+        Its replays on the first draws (:attr:`ReplayContext.hs_pert`).
+    """
+    if not ctx.mse_before_more or ctx.more_draws is None:
+        return False
+    e_rep = ctx.explained(ctx.mse_before, ctx.mse(pred, ctx.valmask))
+    if not (math.isfinite(e_rep) and e_rep > 0.0):
+        return False
+    e = ctx.explained_draws(preds)
+    bar = ctx.policy.draw_disagreement * e_rep
+    return min(e) < bar <= max(e)
 
 
 def upper_score(ctx, name, fitted: Fit, pred) -> float:

@@ -32,6 +32,16 @@ class VerdictPolicy:
     """Heave-noise draws whose replays test a candidate's explained share (their median counts):
     guards against a gain that only lucky stick-event timing makes (one draw alone can flip an early
     stick event)."""
+    draw_disagreement: float = 0.5
+    """The first ``perturbed_draws`` draws disagree when one keeps less than this share of the
+    candidate's explained share on its replay and another keeps at least as much: a stick event that
+    flips in some draws and not in others.  The median is then taken over every draw of the input
+    envelope (``input_draws``, 8), whose nominal replays the envelope already made.  Guards against a
+    verdict decided by which draws flip: tuning seed 20001 replayed on a 20 ms step (a dwell stiction
+    explained 0.99 on its replay, 0.02 and 0.04 on the first two draws and 0.99 on the third, while 11 of
+    12 fresh draws kept 0.97-0.99; on its 10 ms step the first draw flips, 0.02, and the other two keep
+    0.96-0.99).  Half: any flip of that run falls below it (0.02-0.10), no unflipped draw of it comes near
+    (>= 0.96)."""
     gap_floor_share: float = 0.1
     """Smallest denominator of a channel's explained share, as a share of its held-out mean square:
     guards against dividing by a gap that sits at the noise floor."""

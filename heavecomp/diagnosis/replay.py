@@ -452,6 +452,10 @@ class ReplayContext:
     #: the nominal's replays on :attr:`hs_pert` (the distinguishability test's pairs equal by construction
     #: read them: kept, not replayed again)
     nominal_pert: tuple = ()
+    #: the input envelope's other heave-noise draws (:class:`MoreDraws`, made again when asked: a long log's
+    #: draws are not held) and the nominal's held-out mean squares on them (the envelope replayed them)
+    more_draws: object = None
+    mse_before_more: tuple = ()
 
     @property
     def run(self):
@@ -484,12 +488,16 @@ class ReplayContext:
             den += g
         return num / den if den > 0 else 0.0
 
-    def explained_perturbed(self, preds) -> float:
+    def explained_draws(self, preds) -> list:
         """Explained share of the held-out gap by replays driven by the heave redrawn within its noise
-        (``preds``, one per draw of :attr:`hs_pert`), each against the nominal replay with the same
-        draw: the median over the draws [-]."""
-        return float(np.median([self.explained(b, self.mse(a, self.valmask))
-                                for b, a in zip(self.mse_before_pert, preds)]))
+        (``preds``, one per draw: those of :attr:`hs_pert`, then those of :attr:`more_draws`), each
+        against the nominal replay with the same draw [-]."""
+        bases = list(self.mse_before_pert) + list(self.mse_before_more)
+        return [self.explained(b, self.mse(a, self.valmask)) for b, a in zip(bases, preds)]
+
+    def explained_perturbed(self, preds) -> float:
+        """The median of :meth:`explained_draws` [-]."""
+        return float(np.median(self.explained_draws(preds)))
 
     def held_out(self, config) -> tuple:
         """A configuration's whole replay and its replays on the heave-noise draws :attr:`hs_pert`."""
@@ -627,7 +635,38 @@ def prepare(run, nominal, *, split=0.67, settle=None, stuck_speed=S.STUCK_SPEED,
     return ReplayContext(rp, sp, y, fitmask, valmask, allmask, noise, fl["heave_noise"], fl["replay_floor"], floor,
                          envelope, weights, nom, mse(y, nom, valmask, chans), fl["hs_pert"],
                          [mse(y, a, valmask, chans) for a in fl["pert_preds"]], policy, max(1, int(decimate)),
-                         max(1, int(n_jobs)), chans, tuple(fl["pert_preds"]))
+                         max(1, int(n_jobs)), chans, tuple(fl["pert_preds"]), fl["more_draws"],
+                         tuple(mse(y, a, valmask, chans) for a in fl["more_preds"]))
+
+
+class MoreDraws:
+    """The input envelope's heave-noise draws after the first ``perturbed_draws``, made again (the same
+    noise, drawn in the same order from the same seed) the first time they are asked for, then kept.
+
+    Parameters
+    ----------
+    make : callable
+        Makes every draw of the envelope, in order (heave samples).
+    first : int
+        The first draw kept (the number of ``hs_pert``).
+    count : int
+        The draws kept.
+    """
+
+    def __init__(self, make, first, count):
+        self._make, self._first, self._count = make, first, count
+        self._draws = None
+        self._lock = threading.Lock()
+
+    def __len__(self):
+        return self._count
+
+    def get(self) -> list:
+        """The draws (heave samples)."""
+        with self._lock:
+            if self._draws is None:
+                self._draws = self._make()[self._first:]
+            return self._draws
 
 
 def _replay_floor(rp, nom, mask, val, input_draws, n_jobs, policy, chans=CH) -> dict:
@@ -644,10 +683,14 @@ def _replay_floor(rp, nom, mask, val, input_draws, n_jobs, policy, chans=CH) -> 
     (``pert_preds``) test the candidates."""
     run = rp.run
     sz = noise_floor(run["heave"], run.t if not run.uniform else None)
-    rng = np.random.default_rng(NOISE_SEED)
     ref = rp.hs.info["reference_m"]
+    n_draws = max(1, int(input_draws))
 
-    def perturbed():
+    def make_draws():
+        rng = np.random.default_rng(NOISE_SEED)
+        return [perturbed(rng) for _ in range(n_draws)]  # the noise drawn in order
+
+    def perturbed(rng):
         pert = MeasuredRun(run.t, {**{a: run[a] for a in ANGLES if a in run.columns},
                                    "heave": run["heave"] + rng.normal(0.0, sz, run.t.size)}, run.source)
         return heave_samples(pert, rp.h, rp.n_steps, reference=ref)
@@ -655,7 +698,7 @@ def _replay_floor(rp, nom, mask, val, input_draws, n_jobs, policy, chans=CH) -> 
     def ms(a, m):
         return {c: float(np.mean((a[c][m] - nom[c][m]) ** 2)) for c in chans}
 
-    draws = [perturbed() for _ in range(max(1, int(input_draws)))]  # the noise drawn in order, replayed concurrently
+    draws = make_draws()  # replayed concurrently
     n_pert = policy.perturbed_draws
     cut = heave_samples(run, rp.h, rp.n_steps, cutoff=policy.floor_cutoff_ratio * HEAVE_CUTOFF, reference=ref)
     alt, *others, alt2 = parallel_map(lambda hs: rp.simulate([], hs=hs), draws + [cut], n_jobs)
@@ -666,5 +709,6 @@ def _replay_floor(rp, nom, mask, val, input_draws, n_jobs, policy, chans=CH) -> 
     pre = ms(alt2, val)
     a, b = ms(alt, mask), ms(alt2, mask)
     return {"heave_noise": sz, "hs_pert": draws[:n_pert], "pert_preds": ([alt] + others)[:n_pert],
+            "more_draws": MoreDraws(make_draws, n_pert, max(0, n_draws - n_pert)), "more_preds": ([alt] + others)[n_pert:],
             "env_ms": {c: env[c] + pre[c] for c in chans},
             "replay_floor": {c: float(np.sqrt(a[c] + b[c])) for c in chans}}
