@@ -47,7 +47,7 @@ def test_draws_that_agree_are_not_extended():
         valmask = None
         mse_before_more = ({"wob": 4.0},)
         more_draws = object()
-        policy = type("P", (), {"draw_disagreement": 0.5})()
+        policy = type("P", (), {"draw_disagreement": 0.5, "none_explained": 0.25})()
 
         def mse(self, pred, mask):
             return {"wob": pred}
@@ -62,5 +62,6 @@ def test_draws_that_agree_are_not_extended():
     assert not F.draws_disagree(ctx, 0.0, [0.1, 0.2, 0.1])   # all keep ~all of the replay's share
     assert not F.draws_disagree(ctx, 0.0, [3.9, 3.8, 3.9])   # all flipped: the heave noise undoes it
     assert F.draws_disagree(ctx, 0.0, [3.9, 0.1, 3.8])       # one keeps it, two lose it
+    assert not F.draws_disagree(ctx, 3.2, [4.0, 3.5, 3.2])   # a replay that explains 0.2 < none_explained
     ctx.mse_before_more = ()
     assert not F.draws_disagree(ctx, 0.0, [3.9, 0.1, 3.8])   # no more draws to settle it

@@ -237,7 +237,9 @@ def score(ctx, name, fitted: Fit, pred, pred_pert) -> CandidateFit:
 def draws_disagree(ctx, pred, preds) -> bool:
     """Whether the first heave-noise draws disagree on a candidate (``VerdictPolicy.draw_disagreement``):
     one keeps less than that share of its replay's explained share ``pred`` and another at least as much,
-    and the input envelope has more draws to settle it (:attr:`ReplayContext.more_draws`).
+    and the input envelope has more draws to settle it (:attr:`ReplayContext.more_draws`).  A candidate
+    whose replay explains less than ``none_explained`` (the least any verdict reads) is not settled
+    further: its draws cannot change what the verdict reads.
 
     Parameters
     ----------
@@ -251,7 +253,7 @@ def draws_disagree(ctx, pred, preds) -> bool:
     if not ctx.mse_before_more or ctx.more_draws is None:
         return False
     e_rep = ctx.explained(ctx.mse_before, ctx.mse(pred, ctx.valmask))
-    if not (math.isfinite(e_rep) and e_rep > 0.0):
+    if not (math.isfinite(e_rep) and e_rep >= ctx.policy.none_explained):
         return False
     e = ctx.explained_draws(preds)
     bar = ctx.policy.draw_disagreement * e_rep
