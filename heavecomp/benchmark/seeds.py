@@ -39,7 +39,9 @@ SPENT = (
     (850000, 851000, "diagnosis validation: scoring (reports/diagnosis_validation/scoring/spent/850000/)"),
     (860000, 861000, "diagnosis validation: scoring (reports/diagnosis_validation/scoring/spent/860000/)"),
     (880000, 881000, "diagnosis validation: scoring (reports/diagnosis_validation/scoring/spent/880000/)"),
-    (890000, 891000, "diagnosis validation: scoring on the 20 ms replay step (reports/diagnosis_validation/scoring/)"),
+    (890000, 891000, "diagnosis validation: scoring on the 20 ms replay step (reports/diagnosis_validation/scoring/spent/890000/)"),
+    (900000, 901000, "diagnosis validation: scoring with the draws' disagreement rule (reports/diagnosis_validation/scoring/), "
+                     "then its misses replayed at the 10 ms step and without the rule, studied"),
     (870000, 871000, "independent truth: third scoring run (reports/independent_truth/)"),
     (9000000, 9000100, "independent truth: smoke runs while it was written"),
     (830000, 830100, "string_damping against a rate-independent (dry, F_y tanh(dv/eps)) string element, a scratch "
