@@ -24,7 +24,8 @@ Method
    ``e_c = (mse_before - mse_after) / (mse_before - sigma_c^2)``, averaged with the channels'
    gap-over-noise as weights (:meth:`heavecomp.diagnosis.replay.ReplayContext.explained`); the smaller
    of the one on the replay and the median of those on ``perturbed_draws`` replays with the heave
-   perturbed by its own noise level; score = e - ``penalty`` * (number of parameters).
+   perturbed by its own noise level (on every draw of the input envelope where those disagree,
+   ``draw_disagreement``); score = e - ``penalty`` * (number of parameters).
 5. The verdict (:func:`heavecomp.diagnosis.verdict.decide`, every threshold in the
    :class:`~heavecomp.diagnosis.policy.VerdictPolicy`): ``none``, ``inconclusive``, ``discovered``
    or the best candidate with a confidence, a ``second_effect`` from joint fits
