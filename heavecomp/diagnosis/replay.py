@@ -452,8 +452,8 @@ class ReplayContext:
     #: the nominal's replays on :attr:`hs_pert` (the distinguishability test's pairs equal by construction
     #: read them: kept, not replayed again)
     nominal_pert: tuple = ()
-    #: the input envelope's other heave-noise draws (:class:`MoreDraws`, made again when asked: a long log's
-    #: draws are not held) and the nominal's held-out mean squares on them (the envelope replayed them)
+    #: the input envelope's other heave-noise draws (:class:`MoreDraws`: made again the first time a candidate's
+    #: draws disagree, not held otherwise) and the nominal's held-out mean squares on them (the envelope replayed them)
     more_draws: object = None
     mse_before_more: tuple = ()
 
@@ -646,26 +646,21 @@ class MoreDraws:
     Parameters
     ----------
     make : callable
-        Makes every draw of the envelope, in order (heave samples).
+        ``make(first)``: the envelope's draws from the ``first`` on (heave samples), the noise drawn in order.
     first : int
         The first draw kept (the number of ``hs_pert``).
-    count : int
-        The draws kept.
     """
 
-    def __init__(self, make, first, count):
-        self._make, self._first, self._count = make, first, count
+    def __init__(self, make, first):
+        self._make, self._first = make, first
         self._draws = None
         self._lock = threading.Lock()
-
-    def __len__(self):
-        return self._count
 
     def get(self) -> list:
         """The draws (heave samples)."""
         with self._lock:
             if self._draws is None:
-                self._draws = self._make()[self._first:]
+                self._draws = self._make(self._first)
             return self._draws
 
 
@@ -686,13 +681,15 @@ def _replay_floor(rp, nom, mask, val, input_draws, n_jobs, policy, chans=CH) -> 
     ref = rp.hs.info["reference_m"]
     n_draws = max(1, int(input_draws))
 
-    def make_draws():
+    def make_draws(first=0):
+        """The draws from the ``first`` on: every noise drawn in order, the heave samples of those kept."""
         rng = np.random.default_rng(NOISE_SEED)
-        return [perturbed(rng) for _ in range(n_draws)]  # the noise drawn in order
+        noises = [rng.normal(0.0, sz, run.t.size) for _ in range(n_draws)]
+        return [perturbed(e) for e in noises[first:]]
 
-    def perturbed(rng):
+    def perturbed(noise):
         pert = MeasuredRun(run.t, {**{a: run[a] for a in ANGLES if a in run.columns},
-                                   "heave": run["heave"] + rng.normal(0.0, sz, run.t.size)}, run.source)
+                                   "heave": run["heave"] + noise}, run.source)
         return heave_samples(pert, rp.h, rp.n_steps, reference=ref)
 
     def ms(a, m):
@@ -709,6 +706,6 @@ def _replay_floor(rp, nom, mask, val, input_draws, n_jobs, policy, chans=CH) -> 
     pre = ms(alt2, val)
     a, b = ms(alt, mask), ms(alt2, mask)
     return {"heave_noise": sz, "hs_pert": draws[:n_pert], "pert_preds": ([alt] + others)[:n_pert],
-            "more_draws": MoreDraws(make_draws, n_pert, max(0, n_draws - n_pert)), "more_preds": ([alt] + others)[n_pert:],
+            "more_draws": MoreDraws(make_draws, n_pert), "more_preds": ([alt] + others)[n_pert:],
             "env_ms": {c: env[c] + pre[c] for c in chans},
             "replay_floor": {c: float(np.sqrt(a[c] + b[c])) for c in chans}}
