@@ -1,4 +1,4 @@
-"""Does ``string_damping`` (c dv |dv / v_r|^(n - 1), n in [0.5, 3]) carry a rate-independent string damping?
+"""Does ``string_damping`` (c dv |dv / v_r|^(n - 1), n in [0.1, 3]) carry a rate-independent string damping?
 (issue 30 item 4: "a string damping whose law's shape is carried, not only its slope").
 
     python scripts/string_damping_dry.py SEED OUT_DIR [--eps 0.02]

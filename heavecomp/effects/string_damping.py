@@ -44,7 +44,7 @@ class StringDamping(Effect):
         # a file written before the exponent existed reads a linear dashpot (n = 1)
         optional=("exponent",),
         # exponents n searched by the equation-error fit
-        feature_grid=(0.5, 1.0, 1.5, 2.0, 3.0),
+        feature_grid=(0.2, 0.5, 1.0, 1.5, 2.0, 3.0),
         # name and unit of the equation-error shape parameter
         feature_shape=("exponent", "-"),
         # units of the equation-error coefficients (``features``)
@@ -56,7 +56,7 @@ class StringDamping(Effect):
     class Params:
         damping: float = q(3e4, "N s/m", bounds=(10.0, 2e6), symbol="c",
                            doc="extra drill-string damping (the force at the reference speed v_r over v_r)")
-        exponent: float = q(1.0, "-", bounds=(0.5, 3.0), symbol="n",
+        exponent: float = q(1.0, "-", bounds=(0.1, 3.0), symbol="n",
                             doc="exponent of the damping law (1: a linear dashpot, 2: a quadratic drag)")
 
     @classmethod
