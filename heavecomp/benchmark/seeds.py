@@ -40,10 +40,13 @@ SPENT = (
     (860000, 861000, "diagnosis validation: scoring (reports/diagnosis_validation/scoring/spent/860000/)"),
     (880000, 881000, "diagnosis validation: scoring (reports/diagnosis_validation/scoring/spent/880000/)"),
     (890000, 891000, "diagnosis validation: scoring on the 20 ms replay step (reports/diagnosis_validation/scoring/spent/890000/)"),
-    (900000, 901000, "diagnosis validation: scoring with the draws' disagreement rule (reports/diagnosis_validation/scoring/), "
+    (900000, 901000, "diagnosis validation: scoring with the draws' disagreement rule (reports/diagnosis_validation/scoring/spent/900000/), "
                      "then its misses replayed at the 10 ms step and without the rule, studied"),
     (870000, 871000, "independent truth: third scoring run (reports/independent_truth/spent/870000/)"),
-    (910000, 911000, "independent truth: fourth scoring run, two per class (reports/independent_truth/)"),
+    (910000, 911000, "independent truth: fourth scoring run, two per class (reports/independent_truth/spent/910000/)"),
+    (920000, 921000, "diagnosis validation: scoring on the final tree of session 15 (reports/diagnosis_validation/scoring/), "
+                     "then its misses replayed at the 10 ms step and without the draws' rule, studied"),
+    (930000, 931000, "independent truth: fifth scoring run, two per class (reports/independent_truth/)"),
     (9000000, 9000100, "independent truth: smoke runs while it was written"),
     (830000, 830100, "string_damping against a rate-independent (dry, F_y tanh(dv/eps)) string element, a scratch "
                      "truth law of the family helper's (issue 30 item 4), studied"),
