@@ -78,10 +78,25 @@ def frozen_settings(nominal) -> dict:
     return {k: (list(v) if isinstance(v, tuple) else v) for k, v in p.items() if k not in NOT_FROZEN + ("policy",)}
 
 
+def search_ranges(nominal) -> dict:
+    """Every candidate's search box (each parameter's bounds) and its equation-error grid: settings as much
+    as the thresholds are (widening a law's range can change a verdict), so the frozen hash covers them."""
+    from heavecomp.effects import get
+
+    out = {}
+    for name in GapDiagnoser(nominal).candidates:
+        cls = get(name)
+        out[name] = {"bounds": {f.name: list(f.metadata["bounds"]) for f in cls.fields() if "bounds" in f.metadata},
+                     "feature_grid": list(cls.fit.feature_grid or ())}
+    return out
+
+
 def frozen_digest(nominal, settings: dict) -> str:
-    """The hash of the settings plus every field of the verdict policy the diagnoser decides with
-    (``GapDiagnoser.verdict_policy()``): a threshold changed anywhere changes it."""
-    return settings_hash({**settings, "policy": GapDiagnoser(nominal).verdict_policy().to_json()})
+    """The hash of the settings, every field of the verdict policy the diagnoser decides with
+    (``GapDiagnoser.verdict_policy()``) and every candidate's search ranges (:func:`search_ranges`): a
+    threshold or a range changed anywhere changes it."""
+    return settings_hash({**settings, "policy": GapDiagnoser(nominal).verdict_policy().to_json(),
+                          "search_ranges": search_ranges(nominal)})
 
 
 # ------------------------------------------------------------------------------ one run
