@@ -9,6 +9,8 @@ axis (EMPS) and the O-ring seal rig use the same columns.  The few signal operat
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 
@@ -83,26 +85,23 @@ def euler_affine(c0, c1, dt, max_h, y0):
     return y
 
 
-_COMPILED = {}
-
-
+@functools.cache
 def compiled(fn):
     """``fn``, a sample-by-sample loop of this module over float arrays, compiled by numba on first use
     (cached on disk): the same source at machine speed.  The equation-error features run these loops
     over every sample of a log, several times per diagnosis (a 600 s log at 50 Hz: 30 000 samples, ~2 us
-    each in the interpreter).
+    each in the interpreter).  numba's own disk cache, checked against this file, is enough here: the
+    loops call nothing from another file (the steppers, which inline physics from many files, need the
+    keyed folders of :mod:`heavecomp.simulate.cache`, a layer above this one).
 
     Parameters
     ----------
     fn : callable
         A loop of this module (:func:`_lag_steps`, :func:`euler_affine`).
     """
-    got = _COMPILED.get(fn.__name__)
-    if got is None:
-        from numba import njit
+    from numba import njit
 
-        got = _COMPILED[fn.__name__] = njit(cache=True)(fn)
-    return got
+    return njit(cache=True)(fn)
 
 
 def rest_durations(t, still) -> tuple[np.ndarray, np.ndarray]:
