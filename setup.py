@@ -45,7 +45,9 @@ class AOTExtension(Extension):
     """The numba.pycc-compiled stepper; built by OptionalBuildExt, not by distutils."""
 
     def __init__(self):
-        super().__init__("heavecomp.simulate._cmc_aot", sources=[])
+        # optional: when the build is skipped (HEAVECOMP_NO_AOT) or fails, setuptools copies no library into
+        # the sources instead of failing the install on the missing file
+        super().__init__("heavecomp.simulate._cmc_aot", sources=[], optional=True)
 
 
 class OptionalBuildExt(build_ext):
