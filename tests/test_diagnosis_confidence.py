@@ -121,3 +121,34 @@ def test_a_drifting_component_lowers_a_parameter_mismatch():
     steady = _decide(rows, evidence=Evidence(shares, stationarity=lambda c: dict(st, drifting=[])))
     assert drifting.confidence == "low" and "rel: 1 to 2 N/m" in drifting.warnings[0]
     assert steady.confidence == "high" and steady.body["stationarity"]["drifting"] == []
+
+
+@pytest.mark.parametrize("left, confidence", [(0.09, "high"), (0.25, "low")])
+def test_a_refit_that_leaves_a_gap_the_none_test_sees_is_not_confident(left, confidence):
+    """parameter_mismatch explains 90 % and leads by far, in the component the equation error names.  It
+    claims the nominal structure with other values explains the log; what it leaves held out must then
+    read `none` (within none_ratio x the input-noise envelope, here 1).  Leaving 0.09 of a gap of 10
+    (0.9 x the envelope) it keeps high; leaving 0.25 (2.5 x) it is low and says so."""
+    rows = [_row("parameter_mismatch", 0.9, 0.9, k=2, shrink=1.0 - left, values=MISMATCH),
+            _row("flow_loss", 0.3, 0.3)]
+    for r in rows:
+        for c in CH:
+            r.channels[c]["rms_after"] *= 10.0  # the rows' rms on the gap's scale (10 x the envelope)
+    ev = Evidence({**{c: 0.0 for c in COMPS}, "string_formation": 0.99})
+    got = _decide(rows, evidence=ev)
+    assert got.effect == "parameter_mismatch"
+    assert got.confidence == confidence
+    assert got.body["remainder_to_input_envelope"] == pytest.approx(10.0 * left)
+    assert any("does not explain the log" in w for w in got.warnings) == (confidence == "low")
+
+
+def test_a_named_mechanism_keeps_its_confidence_with_a_remainder():
+    """A mechanism's law may carry only part of its effect (a line loss's quadratic law): it claims the
+    mechanism, not that nothing is left, so the same remainder leaves a flow_loss verdict high."""
+    rows = [_row("flow_loss", 0.9, 0.9, k=1, shrink=0.75), _row("gas_heat_transfer", 0.3, 0.3)]
+    for r in rows:
+        for c in CH:
+            r.channels[c]["rms_after"] *= 10.0
+    got = _decide(rows, evidence=Evidence({**{c: 0.0 for c in COMPS}, "flow_line": 0.99}))
+    assert got.effect == "flow_loss" and got.confidence == "high"
+    assert got.body["remainder_to_input_envelope"] == pytest.approx(2.5)
