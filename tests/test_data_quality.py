@@ -273,3 +273,22 @@ def test_a_hum_in_one_channel_joins_its_noise_floor():
     assert h["amplitude"] == pytest.approx(3e3, rel=0.1) and run.quality.confidence_cap is None
     clean = output_noise(_checked(T0, C0))["pressure"]
     assert output_noise(run)["pressure"] == pytest.approx(math.hypot(clean, 3e3 / math.sqrt(2)), rel=0.1)
+
+
+@pytest.mark.parametrize("effect", ["none", "flow_loss"])
+def test_a_none_verdict_places_the_reading_artefacts_in_the_sensors(effect):
+    """The same grid and hum: once their reading error is in the floor, a `none` verdict says where the log still
+    departs from an ideal reading (component sensors, the artefacts listed); a named verdict keeps its own
+    component; a clean log's `none` has none."""
+    t, cols, _ = K.quantised(T0, C0, "pressure", 25e3, hum=10e3, hum_frequency=0.02)
+    run = _checked(t, cols)
+    v = Q.place_reading_artefacts({"effect": effect, "confidence": "high", "component": None}, run.quality)
+    if effect == "none":
+        assert v["component"] == "sensors"
+        assert {(a["kind"], a["column"]) for a in v["reading_artefacts"]} == {("quantised", "pressure"),
+                                                                               ("hum", "pressure")}
+        assert "pressure" in v["note"] and v["confidence"] == "high"
+    else:
+        assert v["component"] is None and "reading_artefacts" not in v
+    clean = Q.place_reading_artefacts({"effect": "none", "confidence": "high"}, _checked(T0, C0).quality)
+    assert "component" not in clean and "reading_artefacts" not in clean

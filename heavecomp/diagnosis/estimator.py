@@ -59,7 +59,7 @@ from heavecomp.effects.candidates import CANDIDATES, by_family, family_of, get, 
 from heavecomp.errors import InputError
 from heavecomp.estimator import GapEstimator
 from heavecomp.params.budget import check_diagnosis_memory
-from heavecomp.diagnosis.quality import apply_quality
+from heavecomp.diagnosis.quality import apply_quality, place_reading_artefacts
 
 log = logging.getLogger(__name__)
 
@@ -229,6 +229,8 @@ class GapDiagnoser(GapEstimator):
         # a log with corrupted stretches (heavecomp.diagnosis.quality, found by load_run): the verdict's
         # confidence at most the cap those problems set, and the verdict says why
         self.verdict_ = apply_quality(self.verdict_, getattr(run, "quality", None))
+        # a `none` on a log whose readings carry artefacts (a grid, a hum) places them: in the sensors
+        self.verdict_ = place_reading_artefacts(self.verdict_, getattr(run, "quality", None))
         return self
 
     def _fit(self, run):

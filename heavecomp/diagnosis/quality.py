@@ -799,6 +799,39 @@ def checked(run, params=None, *, rows=None):
     return cleaned(run, assess(run, params, rows=rows))
 
 
+#: the findings that are a channel's reading error, counted in its noise floor (not excluded, no cap)
+READING_ARTEFACTS = ("quantised", "hum")
+
+
+def place_reading_artefacts(verdict: dict, quality) -> dict:
+    """A ``none`` verdict on a log whose readings carry artefacts (:data:`READING_ARTEFACTS`: a coarse grid,
+    a hum line) names where what differs from an ideal reading lies: ``component: "sensors"`` and
+    ``reading_artefacts`` [{kind, column}] (a new dict; otherwise unchanged).  The nominal model explains the
+    log once those artefacts are counted as reading error; they are the log's only departure from it, and
+    they are in the sensors, not the plant (a pressure read on a 0.25 bar grid with an aliased hum read
+    ``inconclusive`` in the gas spring before its floor counted them, issue 30).
+
+    Parameters
+    ----------
+    verdict : dict
+        The diagnosis verdict.
+    quality : Quality or None
+        The run's quality (``run.quality``); None: unchanged.
+    """
+    found = [{"kind": i["kind"], "column": i["column"]} for i in getattr(quality, "issues", ()) or ()
+             if i.get("kind") in READING_ARTEFACTS]
+    if verdict.get("effect") != "none" or not found:
+        return verdict
+    v = dict(verdict)
+    v["component"] = "sensors"
+    v["reading_artefacts"] = found
+    what = ", ".join(f"{f['kind']} '{f['column']}'" for f in found)
+    v["note"] = (f"{v['note']}; " if v.get("note") else "") + (
+        f"with the readings' artefacts counted in the noise floor ({what}): the log departs from the nominal model "
+        "only in its sensors")
+    return v
+
+
 def apply_quality(verdict: dict, quality) -> dict:
     """The verdict with its confidence at most ``quality.confidence_cap`` (a new dict).
 
