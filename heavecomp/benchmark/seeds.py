@@ -46,7 +46,11 @@ SPENT = (
     (910000, 911000, "independent truth: fourth scoring run, two per class (reports/independent_truth/spent/910000/)"),
     (920000, 921000, "diagnosis validation: scoring on the final tree of session 15 (reports/diagnosis_validation/scoring/), "
                      "then its misses replayed at the 10 ms step and without the draws' rule, studied"),
-    (930000, 931000, "independent truth: fifth scoring run, two per class (reports/independent_truth/)"),
+    (930000, 931000, "independent truth: fifth scoring run, two per class (reports/independent_truth/spent/930000/), "
+                     "then its parameter_mismatch refits and quantised log studied"),
+    (940000, 941000, "diagnosis validation: scoring of session 16 (reports/diagnosis_validation/scoring/), and the same "
+                     "logs diagnosed by the code of 39b1208 (issue 32's A/B: benchmarks/diagnosis/scoring_ab.md)"),
+    (950000, 951000, "independent truth: sixth scoring run, two per class (reports/independent_truth/)"),
     (9000000, 9000100, "independent truth: smoke runs while it was written"),
     (830000, 830100, "string_damping against a rate-independent (dry, F_y tanh(dv/eps)) string element, a scratch "
                      "truth law of the family helper's (issue 30 item 4), studied"),
