@@ -140,3 +140,23 @@ def test_prescreen_skips_sliding_friction_candidates_only_without_a_friction_gap
     pre = prescreen(cr, cr.shares(), cr.t < 160.0, cr.t >= 160.0, sliding + always, VerdictPolicy())
     assert [pre[n]["replay"] for n in sliding] == [False] * 3
     assert [pre[n]["replay"] for n in always] == [True] * 3
+
+
+def test_a_heave_reading_is_replayed_where_a_logged_angle_leaves_the_split_blind(nominal):
+    """No effect: the heave_input residual shows no gap, so the heave reading is not replayed.  With a vessel
+    angle in the log the lever arm's L sin(theta) is in no column of the equation-error split (a 12.8 m lever
+    arm put 98 % of a scored log's gap in string_formation and 1.6 % in heave_input), so the split cannot rule
+    the reading out: it is replayed."""
+    import numpy as np
+
+    from heavecomp.diagnosis.policy import VerdictPolicy
+    from heavecomp.diagnosis.screen import prescreen
+
+    p, nom = nominal
+    cr = _components(p, nom, [])
+    names = ["heave_reference", "pressure_friction", "friction_lag"]  # friction_lag: always replayed
+    pre = prescreen(cr, cr.shares(), cr.t < 160.0, cr.t >= 160.0, names, VerdictPolicy())
+    assert [pre[n]["replay"] for n in names] == [False, False, True]
+    cr.signals["pitch"] = 0.01 * np.sin(2 * np.pi * cr.t / 9.0)
+    pre = prescreen(cr, cr.shares(), cr.t < 160.0, cr.t >= 160.0, names, VerdictPolicy())
+    assert [pre[n]["replay"] for n in names] == [True, False, True]

@@ -152,3 +152,17 @@ def test_a_named_mechanism_keeps_its_confidence_with_a_remainder():
     got = _decide(rows, evidence=Evidence({**{c: 0.0 for c in COMPS}, "flow_line": 0.99}))
     assert got.effect == "flow_loss" and got.confidence == "high"
     assert got.body["remainder_to_input_envelope"] == pytest.approx(2.5)
+
+
+@pytest.mark.parametrize("angle, confidence", [(False, "low"), (True, "high")])
+def test_a_lever_arm_the_split_cannot_see_is_not_lowered_by_the_table(angle, confidence):
+    """heave_reference explains 99 % and leads by far, while the equation-error table puts 98 % of the gap in
+    the string balance.  Without a vessel angle that is a disagreement (low); with one logged, the lever arm's
+    L sin(theta) is in no column of the split, which then can neither support nor contradict it: the verdict
+    keeps its confidence and component_table says why."""
+    rows = [_row("heave_reference", 0.99, 0.99, k=4, shrink=0.95), _row("string_damping", 0.3, 0.3)]
+    ev = Evidence({**{c: 0.0 for c in COMPS}, "string_formation": 0.98, "heave_input": 0.02}, angle=angle)
+    got = _decide(rows, evidence=ev)
+    assert got.effect == "heave_reference" and got.confidence == confidence
+    assert got.body["component"] == "heave_input"
+    assert ("vessel angle" in got.body["component_table"]["reason"]) == angle

@@ -42,6 +42,7 @@ import time
 
 import numpy as np
 
+from heavecomp.diagnosis.data import ANGLES
 from heavecomp.diagnosis import components as CR
 from heavecomp.diagnosis import distinguish as D
 from heavecomp.diagnosis import fitting as F
@@ -441,7 +442,8 @@ class GapDiagnoser(GapEstimator):
         if not a.is_none and len(fits) > 1 and max(f.explained for f in fits[:P.distinguish_leading]) >= P.min_explained:
             distinct = D.distinguish(ctx, fits, getattr(self, "perturbed_", {}), P)
         evidence = V.Evidence(shares, self.prescreen_, second, self.discovered_, stationarity,
-                              tuple(self.where_.get("not_observable", ())), distinct)
+                              tuple(self.where_.get("not_observable", ())), distinct,
+                              angle=any(a in self.components_.signals for a in ANGLES))
         verdict = V.decide(fits, self.gap_["channels"], self.noise_floor_, self.input_envelope_, P, evidence)
         self.warnings_ += list(verdict.warnings)
         out = verdict.to_json()

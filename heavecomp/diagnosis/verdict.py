@@ -58,6 +58,9 @@ class Evidence:
     #: the practical distinguishability of the leading candidates on this log
     #: (:class:`heavecomp.diagnosis.distinguish.Distinguishability`; None: not tested)
     distinct: object = None
+    #: the log carries a vessel angle (``pitch``): a heave reading's lever arm, L sin(theta), is in no column of
+    #: the equation-error split, so the component table can neither support nor contradict it
+    angle: bool = False
 
 
 @dataclasses.dataclass(frozen=True)
@@ -472,7 +475,7 @@ def _component(v, fits, P, evidence, warnings) -> None:
     if eff == "parameter_mismatch":
         _refit_check(v, shares, largest, P, warnings)
         _stationarity(v, evidence, warnings)
-    _table_check(v, shares, largest, P, evidence.not_observable, warnings)
+    _table_check(v, shares, largest, P, evidence.not_observable, warnings, angle=evidence.angle)
     if best.explained >= P.min_explained or evidence.discovered is None:
         return
     found = evidence.discovered
@@ -486,7 +489,7 @@ def _component(v, fits, P, evidence, warnings) -> None:
                       f"held-out {found['component']} residual by {100 * found['shrink']:.0f} %")
 
 
-def _table_check(v, shares, largest, P, not_observable=(), warnings=None) -> None:
+def _table_check(v, shares, largest, P, not_observable=(), warnings=None, angle=False) -> None:
     """One verdict, one component (issue 23 item 4): ``verdict.component`` is the component of the effect
     the held-out replay fit named (that fit is what was scored), while the component table
     (``where.components``) splits the equation residuals by their terms.  The two can disagree by the
@@ -506,6 +509,10 @@ def _table_check(v, shares, largest, P, not_observable=(), warnings=None) -> Non
     if comp in not_observable:
         reason = (f"{comp.replace('_', ' ')} is not observable with this log's channels (every equation that carries "
                   "it reads a channel the log does not have): the table cannot show it, the replay fit does")
+    elif named and angle and get(v["effect"]).kind == "heave":
+        reason = (f"the log carries a vessel angle, and {v['effect']}'s lever arm (L sin(theta)) is in no column of the "
+                  f"equation-error split: the table puts what it moves in {largest.replace('_', ' ')} and can neither "
+                  "support nor contradict it; the held-out replay fit places the gap in the heave input")
     elif named and not get(v["effect"]).fit.screened:
         reason = (f"the {comp.replace('_', ' ')} equation residual is blind to {v['effect']} (it acts where that "
                   f"equation is left out or hides in its noise); the held-out replay fit places the gap in "
@@ -522,7 +529,8 @@ def _table_check(v, shares, largest, P, not_observable=(), warnings=None) -> Non
                             "verdict_share": float(shares.get(comp, 0.0)), "reason": reason}
     # the confidence never outruns the evidence (issue 30 item 2): a named verdict the equation-error table
     # does not support is at most low, and says why
-    if named and comp not in not_observable and largest not in _lands_in(v) and v["confidence"] != "low":
+    blind = angle and named and get(v["effect"]).kind == "heave"
+    if named and not blind and comp not in not_observable and largest not in _lands_in(v) and v["confidence"] != "low":
         was = v["confidence"]
         v["confidence"] = "low"
         if warnings is not None:
