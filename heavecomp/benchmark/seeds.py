@@ -48,11 +48,13 @@ SPENT = (
                      "then its misses replayed at the 10 ms step and without the draws' rule, studied"),
     (930000, 931000, "independent truth: fifth scoring run, two per class (reports/independent_truth/spent/930000/), "
                      "then its parameter_mismatch refits and quantised log studied"),
-    (940000, 941000, "diagnosis validation: scoring of session 16 (reports/diagnosis_validation/scoring/), and the same "
+    (940000, 941000, "diagnosis validation: scoring of session 16 (reports/diagnosis_validation/scoring/spent/940000/), and the same "
                      "logs diagnosed by the code of 39b1208 (issue 32's A/B), then 940018's lever arm studied (spent/940000)"),
     (950000, 951000, "independent truth: sixth scoring run, two per class (reports/independent_truth/)"),
     (960000, 961000, "diagnosis validation: scored on 4ec47c9 and diagnosed by 39b1208 (issue 32's A/B), then two of "
                      "its runs studied (960024's string damping fit, 960029's warming seal); not committed"),
+    (970000, 971000, "diagnosis validation: scoring of session 16's final tree (reports/diagnosis_validation/scoring/), "
+                     "and the same logs diagnosed by 39b1208 (issue 32's A/B: benchmarks/diagnosis/scoring_ab.json)"),
     (9000000, 9000100, "independent truth: smoke runs while it was written"),
     (830000, 830100, "string_damping against a rate-independent (dry, F_y tanh(dv/eps)) string element, a scratch "
                      "truth law of the family helper's (issue 30 item 4), studied"),
