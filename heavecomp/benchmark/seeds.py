@@ -50,7 +50,9 @@ SPENT = (
                      "then its parameter_mismatch refits and quantised log studied"),
     (940000, 941000, "diagnosis validation: scoring of session 16 (reports/diagnosis_validation/scoring/spent/940000/), and the same "
                      "logs diagnosed by the code of 39b1208 (issue 32's A/B), then 940018's lever arm studied (spent/940000)"),
-    (950000, 951000, "independent truth: sixth scoring run, two per class (reports/independent_truth/)"),
+    (950000, 951000, "independent truth: sixth scoring run, two per class (reports/independent_truth/spent/950000/)"),
+    (980000, 981000, "independent truth: seventh scoring run on session 16's final tree, two per class "
+                     "(reports/independent_truth/)"),
     (960000, 961000, "diagnosis validation: scored on 4ec47c9 and diagnosed by 39b1208 (issue 32's A/B), then two of "
                      "its runs studied (960024's string damping fit, 960029's warming seal); not committed"),
     (970000, 971000, "diagnosis validation: scoring of session 16's final tree (reports/diagnosis_validation/scoring/), "
