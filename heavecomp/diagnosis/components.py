@@ -254,6 +254,13 @@ class ComponentResiduals:
     #: the equation its :attr:`residual` was taken from
     host: dict = dataclasses.field(default_factory=dict)
 
+    @property
+    def angle(self) -> bool:
+        """The log carries a vessel angle (:data:`~heavecomp.diagnosis.data.ANGLES`): a heave reading's lever arm,
+        L sin(theta), is in no column of the split (z_h, dz_h, d2z_h), which can then neither show nor rule
+        out such a reading (the pre-screen replays it; the verdict's table check does not lower it)."""
+        return any(a in self.signals for a in ANGLES)
+
     def observable(self) -> dict:
         """{component: whether an equation that carries a part of it is computable from the log's channels}."""
         return {c: any(e not in self.missing for e in self.parts.get(c, {})) for c in COMPONENTS}

@@ -42,7 +42,6 @@ import time
 
 import numpy as np
 
-from heavecomp.diagnosis.data import ANGLES
 from heavecomp.diagnosis import components as CR
 from heavecomp.diagnosis import distinguish as D
 from heavecomp.diagnosis import fitting as F
@@ -229,9 +228,10 @@ class GapDiagnoser(GapEstimator):
             self._fit(run)
         # a log with corrupted stretches (heavecomp.diagnosis.quality, found by load_run): the verdict's
         # confidence at most the cap those problems set, and the verdict says why
-        self.verdict_ = apply_quality(self.verdict_, getattr(run, "quality", None))
+        quality = getattr(run, "quality", None)
+        self.verdict_ = apply_quality(self.verdict_, quality)
         # a `none` on a log whose readings carry artefacts (a grid, a hum) places them: in the sensors
-        self.verdict_ = place_reading_artefacts(self.verdict_, getattr(run, "quality", None))
+        self.verdict_ = place_reading_artefacts(self.verdict_, quality)
         return self
 
     def _fit(self, run):
@@ -443,7 +443,7 @@ class GapDiagnoser(GapEstimator):
             distinct = D.distinguish(ctx, fits, getattr(self, "perturbed_", {}), P)
         evidence = V.Evidence(shares, self.prescreen_, second, self.discovered_, stationarity,
                               tuple(self.where_.get("not_observable", ())), distinct,
-                              angle=any(a in self.components_.signals for a in ANGLES))
+                              angle=self.components_.angle)
         verdict = V.decide(fits, self.gap_["channels"], self.noise_floor_, self.input_envelope_, P, evidence)
         self.warnings_ += list(verdict.warnings)
         out = verdict.to_json()

@@ -465,31 +465,31 @@ def fit_replayed(ctx, cls, start=None, fixed=(), *, search=Search(), hint=None, 
     later = np.array([f.name in cls.fit.released_last for f in cls.fields()])
     smooth = bool(cls.fit.smooth)
     if start is None and later.any():
-        r = _fit_then_release(fun, x0, lo, hi, ~later, budget, t_grid, search, hint, P.start_step, smooth, noise)
+        def release(by_least_squares):
+            return _fit_then_release(fun, x0, lo, hi, ~later, budget, t_grid, search, hint, P.start_step,
+                                     by_least_squares, noise)
+
+        r = release(smooth)
         if smooth and _worse_than_null(ctx, fixed, t_end, r):  # a local search lost on a rugged cost: the grid's way
-            r = _better(r, _fit_then_release(fun, x0, lo, hi, ~later, budget, t_grid, search, hint, P.start_step,
-                                             False, noise))
+            r = _better(r, release(False))
         return Fit(cls.from_x(r.x), sigma(cls, r), int(r.nfev), float(2 * r.cost))
+
+    def searched():
+        """The grid's start (or the equation error's, with a small first simplex, ``VerdictPolicy.start_step``),
+        then Nelder-Mead for up to two parameters, else least squares and the rugged parameters' rescan."""
+        x, near = (x0, False) if start is not None else _start(cls, fun, x0, lo, hi, t_grid, search.grid, hint)
+        if x.size <= 2:
+            return nelder_mead(fun, x, lo, hi, budget, P.start_step if near else NM_STEP, noise)
+        r = least_squares(fun, x, lo, hi, budget, search.n_jobs)
+        return rescan(cls, fun, r, lo, hi, ctx.replay.nominal, search) if start is None else r
+
     if smooth:  # a smooth law (FitSpec.smooth): Gauss-Newton from its start (the equation error's where it costs less)
         x1 = _start(cls, fun, x0, lo, hi, t_grid, 0, hint)[0] if start is None else x0
         r = least_squares(fun, x1, lo, hi, budget, search.n_jobs)
-        if start is not None or not _worse_than_null(ctx, fixed, t_end, r):
-            return Fit(cls.from_x(r.x), sigma(cls, r), int(r.nfev), float(2 * r.cost))
-        smooth_r = r  # a local search lost on a rugged cost: the grid's way below, the better kept
+        if start is None and _worse_than_null(ctx, fixed, t_end, r):  # lost on a rugged cost: the grid's way too
+            r = _better(r, searched())
     else:
-        smooth_r = None
-    # a start next to the optimum (the equation error's): a small first simplex (VerdictPolicy.start_step)
-    near = False
-    if start is None:
-        x0, near = _start(cls, fun, x0, lo, hi, t_grid, search.grid, hint)
-    if x0.size <= 2:
-        r = nelder_mead(fun, x0, lo, hi, budget, P.start_step if near else NM_STEP, noise)
-    else:
-        r = least_squares(fun, x0, lo, hi, budget, search.n_jobs)
-        if start is None:
-            r = rescan(cls, fun, r, lo, hi, ctx.replay.nominal, search)
-    if smooth_r is not None:
-        r = _better(smooth_r, r)
+        r = searched()
     return Fit(cls.from_x(r.x), sigma(cls, r), int(r.nfev), float(2 * r.cost))
 
 

@@ -20,7 +20,6 @@ import numpy as np
 
 from heavecomp.diagnosis import components as CR
 from heavecomp.diagnosis import equation_error as EE
-from heavecomp.diagnosis.data import ANGLES
 from heavecomp.diagnosis.score_test import needs_test
 from heavecomp.effects.base import COMPONENTS
 from heavecomp.effects.candidates import MISMATCH_KEYS, ParameterMismatch, get
@@ -100,7 +99,7 @@ def prescreen(cr, shares, fitmask, valmask, names, policy) -> dict:
         # a 12.8 m lever arm put 98 % of the gap in string_formation and 1.6 % in heave_input, under
         # prescreen_share; the reading was not replayed and the verdict was `discovered`, low, where the code
         # before the pre-screen read it heave_reference, high)
-        blind = cls.kind == "heave" and any(a in cr.signals for a in ANGLES)
+        blind = cls.kind == "heave" and cr.angle
         quiet = (comp in CR.SCREENED and seen.get(comp, True) and cls.fit.screened and small and not blind
                  and (ee is None or ee["shrink"] < EE.MIN_SHRINK))
         replay = not (cls.kind in ("plant", "heave") and quiet)

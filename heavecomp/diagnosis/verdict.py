@@ -506,10 +506,11 @@ def _table_check(v, shares, largest, P, not_observable=(), warnings=None, angle=
     if v["effect"] == "none" or not comp or not _refit_disagrees(comp, shares, largest, P):
         return
     named = v["effect"] not in ("inconclusive", "discovered")
+    blind = angle and named and get(v["effect"]).kind == "heave"  # the split has no column for the lever arm
     if comp in not_observable:
         reason = (f"{comp.replace('_', ' ')} is not observable with this log's channels (every equation that carries "
                   "it reads a channel the log does not have): the table cannot show it, the replay fit does")
-    elif named and angle and get(v["effect"]).kind == "heave":
+    elif blind:
         reason = (f"the log carries a vessel angle, and {v['effect']}'s lever arm (L sin(theta)) is in no column of the "
                   f"equation-error split: the table puts what it moves in {largest.replace('_', ' ')} and can neither "
                   "support nor contradict it; the held-out replay fit places the gap in the heave input")
@@ -529,7 +530,6 @@ def _table_check(v, shares, largest, P, not_observable=(), warnings=None, angle=
                             "verdict_share": float(shares.get(comp, 0.0)), "reason": reason}
     # the confidence never outruns the evidence (issue 30 item 2): a named verdict the equation-error table
     # does not support is at most low, and says why
-    blind = angle and named and get(v["effect"]).kind == "heave"
     if named and not blind and comp not in not_observable and largest not in _lands_in(v) and v["confidence"] != "low":
         was = v["confidence"]
         v["confidence"] = "low"
