@@ -101,6 +101,26 @@ def test_correct_undoes_what_each_sensor_effect_does():
     np.testing.assert_allclose(got["stroke"][ok], true["stroke"][ok], atol=1e-12)
 
 
+def test_correct_reads_a_files_heave_reference_by_name_high_pass_included():
+    """A calibrated file's MRU high-pass is undone when the log is read, whatever the order of its keys:
+    the heave the compensator saw, not the measured one (positionally a file's ``highpass`` was taken
+    for the lever arm, which the angle term applies, and the high-pass was dropped: the replay and the
+    re-diagnosis of a calibrated MRU file read the log as the nominal does)."""
+    from scipy.signal import butter, lfilter
+
+    t = np.arange(0.0, 600.0, 0.1)
+    true = 0.8 * np.sin(2 * np.pi * t / 11.0) + 0.3 * np.sin(2 * np.pi * t / 8.0 + 1.0)
+    b, a = butter(2, 0.01, btype="highpass", fs=10.0)  # the MRU's 2nd-order high-pass, 100 s
+    meas = lfilter(b, a, true)
+    for order in (("scale", "delay", "highpass", "lever_arm"), ("highpass", "lever_arm", "delay", "scale")):
+        values = {"scale": 1.0, "delay": 0.0, "highpass": 0.01, "lever_arm": 0.0}
+        fx = spec.check(paper_a().replace(effects=[("heave_reference", {k: values[k] for k in order})]))
+        got, notes = spec.correct(fx, t, {"heave": meas})
+        late = t > 100.0  # after the filter's start-up
+        err, before = (np.sqrt(np.mean((y - true)[late] ** 2)) for y in (got["heave"], meas))
+        assert len(notes) == 1 and err < 0.2 * before, (order, err, before)
+
+
 def test_discovered_term_adds_friction_by_direction_and_never_pushes():
     J = 5e3
     args = dict(sign_v_pos=1.9e3, sign_v_neg=-200.0, v=0.0, v_abs_v=0.0, p_sign_v=0.0)
