@@ -230,8 +230,8 @@ def correct(effects, t, columns: dict) -> tuple[dict, list]:
         elif isinstance(e, HeaveEffect):
             v = e.values
             z = np.asarray(cols["heave"], dtype=float)
-            # by name: a file lists the parameters in any order (positionally, a file's highpass was read
-            # as the lever arm, which ``seen`` leaves to the angle term: the MRU's high-pass was dropped)
+            # by name: the lever arm is left out here (the angle term below applies it), so passed by
+            # position the high-pass took its slot in ``seen`` and was dropped
             seen = e.seen(t, z, **{k: float(v[k]) for k in v if k not in e.angle_params})
             L = float(v.get("lever_arm", 0.0))
             if L:
