@@ -57,6 +57,9 @@ SPENT = (
                      "its runs studied (960024's string damping fit, 960029's warming seal); not committed"),
     (970000, 971000, "diagnosis validation: scoring of session 16's final tree (reports/diagnosis_validation/scoring/), "
                      "and the same logs diagnosed by 39b1208 (issue 32's A/B: benchmarks/diagnosis/scoring_ab.json)"),
+    (990000, 991000, "independent truth: a scoring run on e9d7c9c (session 17), then its param_friction 990000 (the "
+                     "stepwise refit stopped by the noise test in a stand-in's valley), string_boucwen 990001 and "
+                     "mru_filter studied; not committed"),
     (9000000, 9000100, "independent truth: smoke runs while it was written"),
     (830000, 830100, "string_damping against a rate-independent (dry, F_y tanh(dv/eps)) string element, a scratch "
                      "truth law of the family helper's (issue 30 item 4), studied"),
