@@ -173,7 +173,9 @@ def judge(row) -> dict:
 
     - named and two-effect runs: right when the verdict is the (dominant) withheld effect's class (its
       contract family: a ``friction_lag`` verdict of either law for a frictional-memory truth) and its
-      held-out shrink is real (>= :data:`SHRINK_REAL`);
+      held-out shrink is real (>= :data:`SHRINK_REAL`); confident wrong: another name at medium or high
+      confidence whose group (``verdict.group``, at most three) does not hold the truth (issue 30: a
+      group is the verdict where the log cannot tell its members apart);
     - no-effect runs: right when the verdict is ``none``;
     - out-of-library runs: a named effect with medium or high confidence is a failure; right when
       ``verdict.component`` is the true component (``inconclusive`` or ``discovered`` with the right
@@ -193,8 +195,11 @@ def judge(row) -> dict:
         out["right"] = hit and v["shrink"] >= SHRINK_REAL
         # issue 30: the right group (at most three members) where the log cannot tell them apart
         group = v.get("group") or []
-        out["group_right"] = out["right"] or (family_of(lab) in {family_of(g) for g in group} and len(group) <= 3
-                                              and v["shrink"] >= SHRINK_REAL)
+        in_group = family_of(lab) in {family_of(g) for g in group} and len(group) <= 3
+        out["group_right"] = out["right"] or (in_group and v["shrink"] >= SHRINK_REAL)
+        # and a confident wrong verdict is a single wrong name (issue 30's goal, as the independent truth's
+        # scorer counts it): a group that holds the truth is the answer, its confidence the group's
+        out["confident_wrong"] = out["confident_wrong"] and not in_group
     elif cat == "none":
         out["right"] = v["verdict"] == "none"
         out["confident_wrong"] = v["verdict"] != "none" and confident

@@ -154,6 +154,26 @@ def test_judge_counts_as_the_contract_says():
     assert not judge(_row("near_noise", "flow_loss", "none", "low"))["confident_wrong"]
 
 
+def test_a_group_that_holds_the_truth_is_not_a_confident_wrong_name():
+    """Issue 30: where the log cannot tell the leading explanations apart, the verdict is their group, with
+    the group's confidence; a confident wrong verdict is a single wrong name (scoring 1010009: an asymmetric
+    friction read sensor_offset, medium, in the group {sensor_offset, asymmetric_friction}).  A group of more
+    than three, or one without the truth, does not count."""
+    judge = _scenario().judge
+    row = _row("named", "asymmetric_friction", "sensor_offset", "medium")
+    assert judge(row)["confident_wrong"]  # a single name
+    row["full"]["group"] = ["sensor_offset", "asymmetric_friction"]
+    j = judge(row)
+    assert not j["confident_wrong"] and j["group_right"] and not j["right"]
+    row["full"]["group"] = ["sensor_offset", "sensor_gain"]
+    assert judge(row)["confident_wrong"]
+    row["full"]["group"] = ["sensor_offset", "sensor_gain", "gas_leak", "asymmetric_friction"]
+    assert judge(row)["confident_wrong"]
+    ool = _row("out_of_library", "seal_warming", "dwell_stiction", "medium", "friction")
+    ool["full"]["group"] = ["dwell_stiction", "friction_lag"]
+    assert judge(ool)["confident_wrong"]  # no group holds an effect outside every name
+
+
 def test_scoring_refuses_thresholds_changed_after_tuning(tmp_path, monkeypatch, capsys):
     mod = _scenario()
     fake = tmp_path / "metrics.json"

@@ -104,6 +104,8 @@ def main(argv=None) -> int:
     ap.add_argument("--metrics", default=str(ROOT / "reports" / "diagnosis_validation" / "scoring" / "metrics.json"),
                     help="this tree's scoring metrics.json of those runs")
     ap.add_argument("--jobs", type=int, default=2, help="diagnoses in parallel (default 2)")
+    ap.add_argument("--reuse", action="store_true",
+                    help="judge the older tree's verdicts already in RUNS/old_verdicts.json again (no diagnosis)")
     ap.add_argument("--diagnose-only", default=None, help=argparse.SUPPRESS)  # the worker side, in the old tree
     args = ap.parse_args(argv)
     if args.diagnose_only:
@@ -116,9 +118,10 @@ def main(argv=None) -> int:
     old_json = Path(args.runs) / "old_verdicts.json"
     env = dict(os.environ, PYTHONPATH=str(Path(args.old).resolve()))
     head = subprocess.run(["git", "-C", args.old, "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip()
-    print(f"diagnosing {args.runs} with {args.old} ({head}) ...", file=sys.stderr, flush=True)
-    subprocess.run([sys.executable, str(Path(__file__).resolve()), "--runs", args.runs, "--jobs", str(args.jobs),
-                    "--diagnose-only", str(old_json)], cwd=args.old, env=env, check=True)
+    if not (args.reuse and old_json.exists()):
+        print(f"diagnosing {args.runs} with {args.old} ({head}) ...", file=sys.stderr, flush=True)
+        subprocess.run([sys.executable, str(Path(__file__).resolve()), "--runs", args.runs, "--jobs", str(args.jobs),
+                        "--diagnose-only", str(old_json)], cwd=args.old, env=env, check=True)
     res = compare(metrics["runs"], json.loads(old_json.read_text()), _judge())
     here = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip()
     res.update(old_commit=head, new_commit=here, seed_base=metrics["runs"][0]["seed"],
