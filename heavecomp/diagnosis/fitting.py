@@ -641,13 +641,13 @@ def stepwise(fun, x0, lo, hi, budget, t_grid, release_share, search=Search(), re
     its start) for a parameter not released by the same linearised fit at a new Jacobian, probes
     each the same way, refits the best probed and keeps it only if its fit cost is lower, while that
     holds.  Where the search stops (a step's picks fail the test, or the noise test stops it) after a
-    release and above the noise's expected cost, it restarts once: the releases with each of two picks
-    refitted from the nominal ``x0``
-    (:meth:`_Stepwise.restart`), the lower kept if it passes, and the search goes on from it: a first
-    release that stood in for two parameters digs a valley that a refit from its point cannot leave
-    (the seal's static and Coulomb forces both x0.79: the static force alone at x0.45, then the viscous
-    force, the Coulomb force's probe third; restarted, both at x0.78-0.79).  The decisions are taken on
-    refitted costs; the predictions, probes and scans only choose what to refit.
+    release and above the noise's expected cost, it restarts once (:meth:`_Stepwise.restart`): the
+    releases with each of two picks refitted from the nominal ``x0``, the lower kept if it passes, and
+    the search goes on from it.  A first release that stood in for two parameters digs a valley that a
+    refit from its point cannot leave (the seal's static and Coulomb forces both x0.79: the static
+    force alone at x0.45, then the viscous force, the Coulomb force's probe third; restarted, both at
+    x0.78-0.79).  The decisions are taken on refitted costs; the predictions, probes and scans only
+    choose what to refit.
 
     Releasing all parameters at once lets near-collinear ones (a stiffer string against a softer gas
     spring, a viscous against a Coulomb force) trade off along a valley, and the local fit from the
