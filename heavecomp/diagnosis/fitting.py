@@ -732,13 +732,7 @@ def stepwise(fun, x0, lo, hi, budget, t_grid, release_share, search=Search(), re
             # predictions), each refitted jointly with the released ones; the lower kept if it passes
             share = S.share_of(best.fun)
             picks = S.probed_picks(best, active, rest, J) if active else S.scanned_picks(t_grid, search.grid)
-            trials = []
-            for j, start in picks:
-                got = S.refit(start, active + [j])
-                trials.append((got.cost, j, got))
-                log.debug("diagnose: stepwise refit: releasing %s with %d: fit cost %.4g -> %.4g", active, j,
-                          2 * best.cost, 2 * got.cost)
-            c, j, got = min(trials, key=lambda t: t[0])
+            c, j, got = S.best_release(best, active, picks)
             if S.passes(best.cost, c, share):
                 active.append(j)
                 best = got
@@ -858,11 +852,19 @@ class _Stepwise:
         the new (active, best), or None."""
         if picks is None:
             picks = self.probed_picks(best, active, rest, self.jacobian(best, rest))
-        trials = [(got.cost, j, got) for j, got in ((j, self.refit(self.x0, active + [j])) for j, _ in picks)]
-        c, j, got = min(trials, key=lambda t: t[0])
-        log.debug("diagnose: stepwise refit: restart of %s with %d from the nominal: fit cost %.4g -> %.4g",
-                  active, j, 2 * best.cost, 2 * c)
+        c, j, got = self.best_release(best, active, picks, origin=self.x0)
         return (active + [j], got) if self.passes(best.cost, c, self.share_of(best.fun)) else None
+
+    def best_release(self, best, active, picks, origin=None):
+        """Each pick ``(j, start)`` released with ``active`` and refitted jointly, from its ``start`` (or from
+        ``origin`` for every pick: the restart's nominal): (fit half-cost, j, result) of the lowest."""
+        trials = []
+        for j, start in picks:
+            got = self.refit(start if origin is None else origin, active + [j])
+            trials.append((got.cost, j, got))
+            log.debug("diagnose: stepwise refit: releasing %s with %d%s: fit cost %.4g -> %.4g", active, j,
+                      "" if origin is None else " from the nominal", 2 * best.cost, 2 * got.cost)
+        return min(trials, key=lambda t: t[0])
 
     def floating(self, best, active, rest, J):
         """The floating step: an earlier release may only have stood in for a parameter near-collinear
