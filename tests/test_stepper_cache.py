@@ -202,3 +202,31 @@ def test_generated_hook_functions_compile_once_per_cache(tmp_path):
     assert first >= 1 and second == 0
     assert p1 == p2
     assert list(tmp_path.glob("numba-*/hooks_*.py"))
+
+
+_HOLDER = """
+import json, sys, time
+from heavecomp.simulate import cache
+with cache.one_compiler("stepper-test"):
+    t0 = time.time()
+    time.sleep(0.4)
+    print(json.dumps([t0, time.time()]))
+"""
+
+
+def test_two_processes_compiling_the_same_stepper_take_turns(tmp_path):
+    """The cache's compile lock (:func:`heavecomp.simulate.cache.one_compiler`, held around a stepper's first
+    compile): two processes that need the same kernel at once hold it one after the other, so the second
+    loads what the first compiled instead of compiling it again (pytest's workers, a fleet's processes)."""
+    import json
+    import os
+    import subprocess
+    import sys
+
+    env = dict(os.environ, HEAVECOMP_CACHE_DIR=str(tmp_path))
+    procs = [subprocess.Popen([sys.executable, "-c", _HOLDER], env=env, stdout=subprocess.PIPE, text=True)
+             for _ in range(2)]
+    spans = sorted(json.loads(p.communicate(timeout=60)[0]) for p in procs)
+    assert all(p.returncode == 0 for p in procs)
+    assert spans[1][0] >= spans[0][1], spans  # the second began after the first had let go
+    assert (tmp_path / "stepper-test.lock").exists()

@@ -220,6 +220,39 @@ def keyed(key: str):
         config.CACHE_DIR = old
 
 
+@contextlib.contextmanager
+def one_compiler(name: str):
+    """Hold the cache's lock ``name`` (an exclusive ``flock`` on ``<where()>/<name>.lock``) for a compile: a
+    second process that needs the same kernel at the same moment (pytest's workers, a fleet's or a
+    campaign's processes) waits, then loads what the first one wrote, instead of compiling it again.
+
+    Where no lock can be taken (no ``fcntl``, a read-only cache) it does nothing: each process compiles
+    on its own, as numba would.
+
+    Parameters
+    ----------
+    name : str
+        The kernel's key (:func:`composition_key`, or any name of one compiled thing).
+    """
+    try:
+        import fcntl
+    except ImportError:  # Windows: no flock
+        yield
+        return
+    try:
+        d = where()
+        d.mkdir(parents=True, exist_ok=True)
+        fd = os.open(d / f"{name}.lock", os.O_RDWR | os.O_CREAT, 0o644)
+    except OSError:
+        yield
+        return
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX)
+        yield
+    finally:
+        os.close(fd)  # closing the descriptor releases the lock
+
+
 def jit(files=(), **options):
     """``numba.njit(cache=True, **options)`` cached under :func:`source_key` ``(files)``: for a
     compiled driver that calls the stepper (``files``: its own module, package-relative).

@@ -25,6 +25,7 @@ the first run loads machine code instead of compiling it).  Every call with the 
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import os
 import threading
@@ -110,8 +111,11 @@ def _jit_kernel(comp):
             what = "the stick-slip stepper" + (f" with {n} effect{'s' * (n > 1)}" if n else "")
             # loading from the cache can take seconds on a busy machine: no notice then (a late one if
             # the cache turns out not to hold this signature after all)
-            with compiling(what, notice_after=20.0 if _in_cache(fn) else 1.0,
-                           estimate_s=COMPILE_S + COMPILE_S_PER_EFFECT * n):
+            cached = _in_cache(fn)
+            with compiling(what, notice_after=20.0 if cached else 1.0,
+                           estimate_s=COMPILE_S + COMPILE_S_PER_EFFECT * n), contextlib.ExitStack() as stack:
+                if not cached:  # another process compiling the same stepper now: wait, then load its result
+                    stack.enter_context(cache.one_compiler(f"stepper-{'nominal' if comp is None else comp.key}"))
                 _ensure_compiled(fn, comp)
             _READY.add(fn)
     return fn
