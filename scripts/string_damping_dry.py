@@ -59,8 +59,7 @@ def main(argv) -> int:
         return Draw({"f_y": rng.uniform(5e3, 2e4), "eps": eps}, "f_y", 2e6)
 
     saved = TR.LAWS["string_damping"]
-    TR.LAWS["string_damping"] = TruthLaw("string_damping", "string_formation", draw, plant=TruthDryString,
-                                         group="study_dry_string")
+    TR.LAWS["string_damping"] = TruthLaw("string_damping", "string_formation", draw, plant=TruthDryString)
     try:
         tr = generate(Case("string_damping", seed, "named", duration=300.0, size=(4.5, 5.5)))
     finally:

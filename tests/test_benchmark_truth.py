@@ -142,6 +142,22 @@ def test_plant_truth_classes_are_the_benchmarks_own(name):
     assert cls in comp.classes and not set(comp.classes) & set(lib.values())
 
 
+def test_the_truth_stepper_with_every_law_off_is_the_plain_stepper_bit_for_bit(bed):
+    """One truth stepper holds every plant law (:func:`truth_composition`); a law that is off adds nothing, so
+    with all of them off it runs the plain stepper's run, bit for bit (a generated log with no truth effect,
+    or a law's own share of a run, does not depend on which other laws the stepper holds)."""
+    from heavecomp.diagnosis.stepper import run_fx
+    from heavecomp.effects.compose import composition
+    from heavecomp.plants.cmc import plant_vectors
+
+    comp = truth_composition()
+    assert {law.plant for law in LAWS.values() if law.plant is not None} == set(comp.classes)
+    runs = [run_fx(plant_vectors(NOMINAL), c, c.ep([]), bed.hs, bed.h, bed.n_steps, bed.out_every)
+            for c in (composition(()), comp)]
+    n = runs[0].shape[1]  # the plain stepper's channels (the truth stepper records its states after them)
+    assert np.array_equal(runs[0], runs[1][:, :n])
+
+
 @pytest.mark.parametrize("name", [n for n, law in LAWS.items() if law.plant is not None
                                   and law.plant.hook == "seal_friction"])
 def test_a_seal_truths_static_limit_holds_the_friction_the_motion_starts_against(name):

@@ -32,8 +32,10 @@ stroke_backlash         sensors            the stroke read through a play (outsi
 friction_memory         friction           LuGre bristle, length L_c g(v)/F_C, clipped   Dahl share delta, constant sigma
 ======================  =================  ===========================================  ===============================
 
-Plant laws are compiled in four truth steppers (``group``) of at most three extra states each (``laws30``:
-the laws added for issue 30, kept out of the other steppers so that their runs stay as they were).
+Every plant law is compiled into one truth stepper (:func:`truth_composition`), each switched on by its slot.
+A run with some of them on is bit for bit the run of a stepper holding those alone (the hooks of a law
+that is off add nothing, and its states move no other).  One compile serves every truth run and every mix
+of laws.
 """
 
 from __future__ import annotations
@@ -63,22 +65,21 @@ OUT_OF_LIBRARY = tuple(n for n, law in LAWS.items() if not law.named)
 
 
 def truth_composition(name=None):
-    """The compiled truth stepper holding the plant law ``name`` (any other name or None: the
-    benchmark's six, which also runs a plant with no truth effect).
+    """The compiled truth stepper: every plant law of :data:`LAWS`, in their order, each off until a
+    run's effects switch it on (it also runs a plant with no truth effect).
 
     Parameters
     ----------
     name : str or None
-        A truth law of :data:`LAWS`.
+        A truth law of :data:`LAWS` (any: one stepper holds them all; kept for the callers that name
+        the law they plant).
 
     Returns
     -------
     heavecomp.effects.compose.Composition
-        The compiled composition of the plant laws of that law's ``group``.
+        The composition of every plant law.
     """
-    law = LAWS.get(name)
-    group = law.group if law is not None and law.plant is not None else "benchmark"
-    return composition(tuple(x.plant for x in LAWS.values() if x.plant is not None and x.group == group))
+    return composition(tuple(x.plant for x in LAWS.values() if x.plant is not None))
 
 
 __all__ = ["LAWS", "TRUTH", "COMPONENT", "OUT_OF_LIBRARY", "truth_composition", "Draw", "Part", "Setting",

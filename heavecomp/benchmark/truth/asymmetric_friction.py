@@ -64,4 +64,4 @@ def draw(rng, setting):
                  "v_e": 2e-3}, "alpha", 0.8)
 
 
-LAW = TruthLaw("asymmetric_friction", "friction", draw, plant=TruthLaggedDirection, group="schema2")
+LAW = TruthLaw("asymmetric_friction", "friction", draw, plant=TruthLaggedDirection)

@@ -117,8 +117,6 @@ class TruthLaw:
     plant : type or None
         Its own :class:`heavecomp.effects.base.Effect` subclass at the plant's hooks (never a
         candidate's class or equation).
-    group : str or None
-        Which compiled truth stepper holds ``plant`` (:func:`heavecomp.benchmark.truth.truth_composition`).
     output : callable or None
         ``output(t, cols, **parameters) -> cols``: a law on the clean logged channels.
     on_heave : bool
@@ -139,7 +137,6 @@ class TruthLaw:
     component: str | None
     draw: Callable
     plant: type | None = None
-    group: str | None = None
     output: Callable | None = None
     on_heave: bool = False
     changes: Callable | None = None

@@ -56,4 +56,4 @@ def draw(rng, setting):
     return Draw({"dF": rng.uniform(0.35, 0.65) * fs, "tau_d": rng.uniform(0.5, 2.0)}, "dF", fs)
 
 
-LAW = TruthLaw("dwell_stiction", "friction", draw, plant=TruthDwell, group="benchmark", min_stuck_share=STICK_MIN)
+LAW = TruthLaw("dwell_stiction", "friction", draw, plant=TruthDwell, min_stuck_share=STICK_MIN)

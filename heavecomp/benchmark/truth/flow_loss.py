@@ -47,4 +47,4 @@ def draw(rng, setting):
     return Draw({"K": rng.uniform(1.5e5, 4e5)}, "K", 1e6)
 
 
-LAW = TruthLaw("flow_loss", "flow_line", draw, plant=TruthOrifice, group="benchmark")
+LAW = TruthLaw("flow_loss", "flow_line", draw, plant=TruthOrifice)

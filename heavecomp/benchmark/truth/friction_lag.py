@@ -67,4 +67,4 @@ def draw(rng, setting):
     return Draw({"lag_time_speed": rng.uniform(0.8, 3.0)}, "lag_time_speed", 8.0)
 
 
-LAW = TruthLaw("friction_lag", "friction", draw, plant=TruthSpeedLag, group="benchmark")
+LAW = TruthLaw("friction_lag", "friction", draw, plant=TruthSpeedLag)

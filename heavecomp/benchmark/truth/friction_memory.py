@@ -79,4 +79,4 @@ def draw(rng, setting):
     return Draw({"relaxation_length": rng.uniform(0.03, 0.06), "share": rng.uniform(0.6, 0.95)}, "share", 1.0)
 
 
-LAW = TruthLaw("friction_memory", "friction", draw, plant=TruthBristle, group="laws30")
+LAW = TruthLaw("friction_memory", "friction", draw, plant=TruthBristle)

@@ -80,4 +80,4 @@ def draw(rng, setting):
     return Draw({"gamma": 1.4, "tau_th": rng.uniform(2.0, 8.0)})
 
 
-LAW = TruthLaw("gas_heat_transfer", "gas_spring", draw, plant=TruthThermalGas, group="benchmark")
+LAW = TruthLaw("gas_heat_transfer", "gas_spring", draw, plant=TruthThermalGas)

@@ -61,4 +61,4 @@ def draw(rng, setting):
     return Draw({"leak_rate": rng.uniform(0.01, 0.03) / setting.duration}, "leak_rate", 0.15 / setting.duration)
 
 
-LAW = TruthLaw("gas_leak", "gas_spring", draw, plant=TruthLaminarLeak, group="schema2")
+LAW = TruthLaw("gas_leak", "gas_spring", draw, plant=TruthLaminarLeak)

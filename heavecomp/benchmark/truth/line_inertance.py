@@ -60,4 +60,4 @@ def draw(rng, setting):
     return Draw({"inertance": rng.uniform(1e5, 3e5), "t_i": 0.05}, "inertance", 5e6)
 
 
-LAW = TruthLaw("line_inertance", "flow_line", draw, plant=TruthLineInertance, group="out_of_library", named=False)
+LAW = TruthLaw("line_inertance", "flow_line", draw, plant=TruthLineInertance, named=False)

@@ -65,4 +65,4 @@ def draw(rng, setting):
                 "beta", 3.0)
 
 
-LAW = TruthLaw("position_friction", "friction", draw, plant=TruthWornBand, group="schema2")
+LAW = TruthLaw("position_friction", "friction", draw, plant=TruthWornBand)

@@ -51,4 +51,4 @@ def draw(rng, setting):
     return Draw({"k": rng.uniform(0.02, 0.04), "p_th": 0.9 * setting.nominal.p0}, "k", 0.1)
 
 
-LAW = TruthLaw("pressure_friction", "friction", draw, plant=TruthEnergisedSeal, group="benchmark")
+LAW = TruthLaw("pressure_friction", "friction", draw, plant=TruthEnergisedSeal)

@@ -61,4 +61,4 @@ def draw(rng, setting):
     return Draw({"beta": rng.uniform(0.15, 0.3), "v_ref": 0.3, "t_th": rng.uniform(60.0, 200.0)}, "beta", 0.8)
 
 
-LAW = TruthLaw("seal_warming", "friction", draw, plant=TruthSealWarming, group="out_of_library", named=False)
+LAW = TruthLaw("seal_warming", "friction", draw, plant=TruthSealWarming, named=False)

@@ -46,5 +46,5 @@ def draw(rng, setting):
     return Draw({"k3": rng.uniform(0.5e9, 2e9)}, "k3", 1e12)
 
 
-LAW = TruthLaw("stiffening_string", "string_formation", draw, plant=TruthStiffeningString, group="out_of_library",
+LAW = TruthLaw("stiffening_string", "string_formation", draw, plant=TruthStiffeningString,
                named=False)

@@ -48,4 +48,4 @@ def draw(rng, setting):
     return Draw({"c_q": rng.uniform(3e5, 8e5)}, "c_q", 4e6)
 
 
-LAW = TruthLaw("string_damping", "string_formation", draw, plant=TruthQuadraticDrag, group="benchmark")
+LAW = TruthLaw("string_damping", "string_formation", draw, plant=TruthQuadraticDrag)
