@@ -142,19 +142,24 @@ def test_plant_truth_classes_are_the_benchmarks_own(name):
     assert cls in comp.classes and not set(comp.classes) & set(lib.values())
 
 
-def test_the_truth_stepper_with_every_law_off_is_the_plain_stepper_bit_for_bit(bed):
-    """One truth stepper holds every plant law (:func:`truth_composition`); a law that is off adds nothing, so
-    with all of them off it runs the plain stepper's run, bit for bit (a generated log with no truth effect,
-    or a law's own share of a run, does not depend on which other laws the stepper holds)."""
+@pytest.mark.parametrize("name", [None, pytest.param("line_inertance", marks=pytest.mark.slow)])
+def test_a_truth_stepper_with_every_law_off_is_the_plain_stepper_bit_for_bit(name, bed):
+    """The truth laws live in two steppers (:func:`truth_composition`: the benchmark's six, installed, and every
+    other law); a law that is off adds nothing, so with all of them off each runs the plain stepper's run, bit for
+    bit (a law's run does not depend on which other laws its stepper holds)."""
+    from heavecomp.benchmark.truth import INSTALLED
     from heavecomp.diagnosis.stepper import run_fx
     from heavecomp.effects.compose import composition
     from heavecomp.plants.cmc import plant_vectors
 
-    comp = truth_composition()
-    assert {law.plant for law in LAWS.values() if law.plant is not None} == set(comp.classes)
+    comp = truth_composition(name)
+    both = set(truth_composition().classes) | set(truth_composition("line_inertance").classes)
+    assert both == {law.plant for law in LAWS.values() if law.plant is not None}
+    assert {c.name for c in comp.classes} == set(INSTALLED) if name is None else not set(INSTALLED) & {
+        c.name for c in comp.classes}
     runs = [run_fx(plant_vectors(NOMINAL), c, c.ep([]), bed.hs, bed.h, bed.n_steps, bed.out_every)
             for c in (composition(()), comp)]
-    n = runs[0].shape[1]  # the plain stepper's channels (the truth stepper records its states after them)
+    n = runs[0].shape[1]  # the plain stepper's channels (a truth stepper records its states after them)
     assert np.array_equal(runs[0], runs[1][:, :n])
 
 

@@ -94,7 +94,10 @@ class Testbed:
                 prm = prm.replace(**part.changes)
             elif part.output is not None:
                 post.append(part)
-        comp = truth_composition()  # one stepper holds every truth law
+        comps = {truth_composition(e.name) for e in effects}
+        if len(comps) > 1:
+            raise ValueError(f"truth laws {[e.name for e in effects]} live in different compositions")
+        comp = comps.pop() if comps else truth_composition()
         out = run_fx(plant_vectors(prm), comp, comp.ep(effects), self.hs if hs is None else hs, self.h,
                      self.n_steps, self.out_every)
         t = out[:, 0].copy()
