@@ -87,7 +87,7 @@ def run_fx(plant, comp, EP, hs, h, n_steps, out_every=1, *, u_active=0.0, progre
     """
     advance = S.kernel_for(comp)
     args = S.plant_args(plant, EP, smooth_fx(plant, comp, EP))
-    out = np.empty((n_steps // out_every + 1, NCH))
+    out = np.zeros((n_steps // out_every + 1, NCH))  # zeros: the columns of states a composition lacks read 0, not stale memory
     state = comp.initial_state(plant.FP, plant.PP, args.EP)
     mode_dir = np.array([float(STUCK), 1.0])
     stats = np.zeros(NSTATS)
