@@ -166,3 +166,32 @@ def test_a_lever_arm_the_split_cannot_see_is_not_lowered_by_the_table(angle, con
     assert got.effect == "heave_reference" and got.confidence == confidence
     assert got.body["component"] == "heave_input"
     assert ("vessel angle" in got.body["component_table"]["reason"]) == angle
+
+
+def _term(component, shrink):
+    return {"term": "1e4*v", "features": ["v"], "coefficients": {"v": 1e4}, "shrink": shrink,
+            "component": component, "unit": "N"}
+
+
+@pytest.mark.parametrize("shares, term, component", [
+    # a hardening formation (independent truth 1000000): the table a near tie, the term shrinks the string's
+    # held-out residual by 35 %: the held-out test decides, not the fit part's larger share
+    ({"heave_input": 0.49, "string_formation": 0.47, "friction": 0.04}, _term("string_formation", 0.35),
+     "string_formation"),
+    # a second string mode: the table empty, the best candidate (a sensor delay) explains 9 %: the term's
+    ({}, _term("string_formation", 0.19), "string_formation"),
+    # no term (nothing beat the noise): the table's largest share, as before
+    ({"heave_input": 0.49, "string_formation": 0.47}, None, "heave_input"),
+    # a table that holds the gap in one component (confirm_share) decides over the term (a stiffening string,
+    # scoring 1010030: string_formation 0.68, the term in heave_input)
+    ({"string_formation": 0.68, "heave_input": 0.32}, _term("heave_input", 0.31), "string_formation")])
+def test_an_inconclusive_verdicts_component_is_where_the_held_out_term_shrinks_the_residual(shares, term, component):
+    """No candidate explains a real part of the gap (under ``none_explained``), so none knows the component.
+    Where no component of the equation-error table holds ``confirm_share`` of the gap, the open search's term,
+    which shrinks its component's held-out residual (a held-out test over the components with an equation gap),
+    places it before the table's largest share of the fit part, and before a candidate that explains 9 %
+    (issue 30: a formation that hardens part-way was read in heave_input)."""
+    rows = [_row("sensor_delay", 0.09, 0.09), _row("friction_lag", 0.05, 0.05, k=2)]
+    v = _decide(rows, evidence=Evidence({c: shares.get(c, 0.0) for c in COMPS}, discovered=term))
+    assert v.effect == "inconclusive" and v.confidence == "low"
+    assert v.body["component"] == component

@@ -469,7 +469,16 @@ def _component(v, fits, P, evidence, warnings) -> None:
         # gas law's residual)
         if best.effect == "parameter_mismatch" and _refit_disagrees(best_comp, shares, largest, P):
             best_comp = largest  # the refit stands in (see _refit_check)
-        v["component"] = best_comp if best.explained >= P.none_explained and best_comp else largest or best_comp
+        # no candidate explains a real part of it: the equation-error table's largest component where it holds
+        # confirm_share of the gap; where none does, the component whose held-out residual the open search's
+        # term shrinks (a held-out test over the components with an equation gap), before the table's largest
+        # (a hardening formation: heave_input 0.49 against string_formation 0.47, the term shrank the string's
+        # held-out residual by 35 %) and before a candidate under none_explained (a second string mode: the
+        # table empty, a sensor delay explaining 9 %)
+        held = evidence.discovered["component"] if evidence.discovered else ""
+        table = largest if largest and shares[largest] >= P.confirm_share else ""
+        v["component"] = best_comp if best.explained >= P.none_explained and best_comp \
+            else table or held or largest or best_comp
     else:
         v["component"] = best_comp
     if eff == "parameter_mismatch":
