@@ -60,9 +60,13 @@ SPENT = (
     (990000, 991000, "independent truth: a scoring run on e9d7c9c (session 17), then its param_friction 990000 (the "
                      "stepwise refit stopped by the noise test in a stand-in's valley), string_boucwen 990001 and "
                      "mru_filter studied; not committed"),
-    (1000000, 1001000, "independent truth: ninth scoring run on session 17's final diagnosis (reports/independent_truth/)"),
+    (1000000, 1001000, "independent truth: ninth scoring run on session 17's final diagnosis "
+                       "(reports/independent_truth/spent/1000000/; its sensor_offset, string_second_mode and "
+                       "formation_hardening cases studied in session 18)"),
     (1010000, 1011000, "diagnosis validation: scoring of session 17's final diagnosis (reports/diagnosis_validation/"
                        "scoring/), and the same logs diagnosed by 39b1208 (benchmarks/diagnosis/scoring_ab.json)"),
+    (1020000, 1021000, "independent truth: tenth scoring run, session 18, on 486820a (an inconclusive verdict's "
+                       "component from the held-out term) (reports/independent_truth/)"),
     (9000000, 9000100, "independent truth: smoke runs while it was written"),
     (830000, 830100, "string_damping against a rate-independent (dry, F_y tanh(dv/eps)) string element, a scratch "
                      "truth law of the family helper's (issue 30 item 4), studied"),
