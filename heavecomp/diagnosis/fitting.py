@@ -472,6 +472,8 @@ def fit_replayed(ctx, cls, start=None, fixed=(), *, search=Search(), hint=None, 
         r = release(smooth)
         if smooth and _worse_than_null(ctx, fixed, t_end, r):  # a local search lost on a rugged cost: the grid's way
             r = _better(r, release(False))
+        if cls.fit.rugged:  # the rugged parameters' second start (rescan), as on the grid's way below
+            r = rescan(cls, fun, r, lo, hi, ctx.replay.nominal, search)
         return Fit(cls.from_x(r.x), sigma(cls, r), int(r.nfev), float(2 * r.cost))
 
     def searched():
