@@ -64,9 +64,12 @@ SPENT = (
                        "(reports/independent_truth/spent/1000000/; its sensor_offset, string_second_mode and "
                        "formation_hardening cases studied in session 18)"),
     (1010000, 1011000, "diagnosis validation: scoring of session 17's final diagnosis (reports/diagnosis_validation/"
-                       "scoring/), and the same logs diagnosed by 39b1208 (benchmarks/diagnosis/scoring_ab.json)"),
+                       "scoring/spent/1010000/), and the same logs diagnosed by 39b1208 "
+                       "(benchmarks/diagnosis/scoring_ab.json)"),
     (1020000, 1021000, "independent truth: tenth scoring run, session 18, on 486820a (an inconclusive verdict's "
                        "component from the held-out term) (reports/independent_truth/)"),
+    (1030000, 1031000, "diagnosis validation: scoring of session 18's diagnosis, 2eaae54 (reports/diagnosis_validation/"
+                       "scoring/)"),
     (9000000, 9000100, "independent truth: smoke runs while it was written"),
     (830000, 830100, "string_damping against a rate-independent (dry, F_y tanh(dv/eps)) string element, a scratch "
                      "truth law of the family helper's (issue 30 item 4), studied"),
