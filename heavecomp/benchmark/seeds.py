@@ -67,7 +67,10 @@ SPENT = (
                        "scoring/spent/1010000/), and the same logs diagnosed by 39b1208 "
                        "(benchmarks/diagnosis/scoring_ab.json)"),
     (1020000, 1021000, "independent truth: tenth scoring run, session 18, on 486820a (an inconclusive verdict's "
-                       "component from the held-out term) (reports/independent_truth/)"),
+                       "component from the held-out term) (reports/independent_truth/spent/1020000/; its mru_filter cases "
+                       "studied after scoring: the high-pass corner's rescan)"),
+    (1040000, 1041000, "independent truth: eleventh scoring run, session 18, on 2eaae54 (the corner's rescan) "
+                       "(reports/independent_truth/)"),
     (1030000, 1031000, "diagnosis validation: scoring of session 18's diagnosis, 2eaae54 (reports/diagnosis_validation/"
                        "scoring/)"),
     (9000000, 9000100, "independent truth: smoke runs while it was written"),
