@@ -232,7 +232,7 @@ def one_compiler(name: str):
     Parameters
     ----------
     name : str
-        The kernel's key (:func:`composition_key`, or any name of one compiled thing).
+        A file name for the one compiled thing (the stepper's: ``stepper-<its composition's key>``).
     """
     try:
         import fcntl

@@ -112,10 +112,11 @@ def _jit_kernel(comp):
             # loading from the cache can take seconds on a busy machine: no notice then (a late one if
             # the cache turns out not to hold this signature after all)
             cached = _in_cache(fn)
+            # not cached: another process compiling the same stepper now is waited for, and its result loaded
+            lock = contextlib.nullcontext() if cached else \
+                cache.one_compiler(f"stepper-{'nominal' if comp is None else comp.key}")
             with compiling(what, notice_after=20.0 if cached else 1.0,
-                           estimate_s=COMPILE_S + COMPILE_S_PER_EFFECT * n), contextlib.ExitStack() as stack:
-                if not cached:  # another process compiling the same stepper now: wait, then load its result
-                    stack.enter_context(cache.one_compiler(f"stepper-{'nominal' if comp is None else comp.key}"))
+                           estimate_s=COMPILE_S + COMPILE_S_PER_EFFECT * n), lock:
                 _ensure_compiled(fn, comp)
             _READY.add(fn)
     return fn
