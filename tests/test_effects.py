@@ -17,7 +17,9 @@ CONTRACT = ("friction_lag", "dwell_stiction", "pressure_friction", "gas_heat_tra
             "asymmetric_friction", "position_friction", "gas_leak", "sensor_gain", "sensor_offset", "heave_reference",
             # schema 4: the distance form of the frictional memory and the gas's thermal relaxation (issue 30
             # item 4): laws of the friction_lag and gas_heat_transfer classes
-            "friction_memory", "gas_thermal")
+            "friction_memory", "gas_thermal",
+            # the hysteretic law of the string_damping class (a Bouc-Wen share of the string's stiffness)
+            "string_hysteresis")
 
 
 def test_contract_names_exactly():

@@ -181,7 +181,7 @@ def equations(t, heave, stroke, pressure, wob, params, heave_reference=0.0, cuto
            "gas": p - (gas_pressure(s, PP) if hooks is None else fx["cylinder_pressure_fx"](s, v, X, PP, EP))}
     dwell, rest = rest_durations(t, ~sliding)
     sig = {"t": t, "x": s, "v": v, "a": a, "p": p, "dp": dp, "wob": W, "dwob": dW, "zh": zh, "dzh": dzh,
-           "ddzh": ddzh, "rel": zh + s - yb, "vrel": dzh + v - vb, "dwell": dwell, "rest": rest,
+           "ddzh": ddzh, "rel": zh + s - yb, "dz": zh + s - yb, "vrel": dzh + v - vb, "dwell": dwell, "rest": rest,
            "still": ~sliding,
            # the gas effects' equation-error inputs (Effect.features): the nominal gas's absolute pressure at
            # the measured stroke, its absolute pre-charge and the plant vector (geometry for a gas state's rates)

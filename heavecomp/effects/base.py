@@ -26,6 +26,8 @@ seal friction  ``jump(code, a, p, J, s, d, x, FP, *prm) -> J``    the friction l
                                                                   through the ``jump`` hooks: add to it,
                                                                   never lower it, see below)
 states         ``rates(s, v, p, x, PP, FP, *prm) -> dx/dt``       (no extra states)
+               ``string_rates(dv, x, PP, *prm) -> dx/dt``         (a string effect's states: dv the
+                                                                  string's stretch rate dz_h + v - v_b)
                ``initial(FP, PP, *prm) -> x`` at rest,
                ``steady(v, FP, PP, *prm) -> x`` sliding at v
                (None: a slow state, carried over a restart)
@@ -68,7 +70,7 @@ COMPONENTS = ("friction", "gas_spring", "flow_line", "string_formation", "sensor
 HOOK_COMPONENT = {"seal_friction": "friction", "gas_spring": "gas_spring", "line": "flow_line",
                   "string": "string_formation", "channel": "sensors", "heave": "heave_input"}
 #: the methods the stepper and the casadi model call, in the order they are composed
-METHODS = ("gas", "line", "string", "jump", "static", "rates")
+METHODS = ("gas", "line", "string", "jump", "static", "rates", "string_rates")
 #: measured channels a channel effect (:class:`ChannelEffect`) may act on
 SENSOR_CHANNELS = ("wob", "stroke", "pressure", "heave")
 
@@ -162,7 +164,7 @@ class Effect:
     #: them, :mod:`heavecomp.effects.sensor_lag`), never undone on the log
     model_side: bool = False
     # hook methods (staticmethods in subclasses); None: the effect does not act there
-    gas = line = string = jump = static = rates = initial = steady = None
+    gas = line = string = jump = static = rates = string_rates = initial = steady = None
 
     def __init_subclass__(cls, **kw):
         super().__init_subclass__(**kw)

@@ -144,24 +144,26 @@ class Composition:
         L += self._calls("static", "lim", "code, p, lim, tau, s, d, {x}, FP") + ["    return lim", ""]
         n, f = self.n_states, FIRST_SLOT
         idx = range(f, f + n)
-        L += ["def effect_rates(s, v, p, X, PP, FP, EP):"] + [f"    d{i} = 0.0 * v" for i in idx]
+        L += ["def effect_rates(s, v, p, dvs, X, PP, FP, EP):"] + [f"    d{i} = 0.0 * v" for i in idx]
         for i, c in enumerate(self.classes):
-            if c.rates is None:
+            if c.rates is None and c.string_rates is None:
                 continue
             o, sl = self.offsets[c.name], self.slots[c.name]
             x = "(" + "".join(f"X[{s}], " for s in sl) + ")"
             prm = "".join(f", EP[{o + 1 + j}]" for j in range(c.n_params()))
-            L += [f"    if EP[{o}] != 0.0:  # {c.name}", f"        r = E{i}_rates(s, v, p, {x}, PP, FP{prm})"]
+            call = (f"E{i}_rates(s, v, p, {x}, PP, FP{prm})" if c.rates is not None
+                    else f"E{i}_string_rates(dvs, {x}, PP{prm})")  # a string state moves with the stretch rate
+            L += [f"    if EP[{o}] != 0.0:  # {c.name}", f"        r = {call}"]
             L += [f"        d{s} = r[{j}]" for j, s in enumerate(sl)]
         L += ["    return (" + "".join(f"d{i}, " for i in idx) + ")", ""]
         # the stepper's state arithmetic for X of 4 + n entries (numba: tuples of a fixed size)
         every = range(f + n)
         L += ["def state_axpy(X, h, k):", "    return (" + ", ".join(f"X[{i}] + h * k[{i}]" for i in every) + ")", ""]
         L += ["def state_rest(X):", "    return (X[0], 0.0, " + "".join(f"X[{i}], " for i in range(2, f + n)) + ")", ""]
-        L += ["def state_dot(ds, dv, dyb, dvb, s, v, p, X, PP, FP, EP):",
-              '    """dX/dt: the plant\'s four derivatives, then the effects\' rates."""']
+        L += ["def state_dot(ds, dv, dyb, dvb, s, v, p, dvs, X, PP, FP, EP):",
+              '    """dX/dt: the plant\'s four derivatives, then the effects\' rates (dvs: the string\'s stretch rate)."""']
         if n:
-            L += ["    r = effect_rates(s, v, p, X, PP, FP, EP)",
+            L += ["    r = effect_rates(s, v, p, dvs, X, PP, FP, EP)",
                   "    return (ds, dv, dyb, dvb, " + "".join(f"r[{j}], " for j in range(n)) + ")", ""]
         else:
             L += ["    return (ds, dv, dyb, dvb)", ""]

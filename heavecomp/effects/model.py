@@ -78,7 +78,7 @@ def casadi_model(params, *, eps: float | None = None, sym: str = "SX", effects=(
     dvb = lower_accel_wob(T, yb, vb, PP)  # the clamped contact law (smooth model)
     Ff = smooth_seal_friction(fn, code, v, p, s, X, FP, EP, eps or 1.0) if friction else 0.0 * v
     dv = (hold - Ff) / PP[MC]
-    rates = fn["effect_rates"](s, v, p, X, PP, FP, EP)
+    rates = fn["effect_rates"](s, v, p, dzh + v - vb, X, PP, FP, EP)
     xdot = ca.vertcat(v, dv, vb, dvb, *rates)
     y = {"wob": wob(yb, vb, PP), "stroke": s, "pressure": p}
     for e in sensor_fx:  # a recorded channel that reads g y + o

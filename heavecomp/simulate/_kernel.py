@@ -276,12 +276,12 @@ def rhs(t, X, mode, d, cm, plant, drive):
     zh, dzh, ddzh = heave_at(t, sp, Z, DZ, DDZ)
     p, T, hold, dvb = plant_fx(s, v, yb, vb, X, zh, dzh, ddzh, u, cm, PP, EP)
     if mode == STUCK:
-        return state_dot(0.0, 0.0, vb, dvb, s, v, p, X, PP, FP, EP)
+        return state_dot(0.0, 0.0, vb, dvb, s, v, p, dzh + v - vb, X, PP, FP, EP)
     if smooth:
         Ff = friction_cont(code, v, p, FP)
     else:
         Ff = sliding_friction_fx(code, d, v, p, s, X, FP, EP)
-    return state_dot(v, (hold - Ff) / PP[MC], vb, dvb, s, v, p, X, PP, FP, EP)
+    return state_dot(v, (hold - Ff) / PP[MC], vb, dvb, s, v, p, dzh + v - vb, X, PP, FP, EP)
 
 
 @_jit
