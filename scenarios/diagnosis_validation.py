@@ -49,7 +49,7 @@ from heavecomp.diagnosis import GapDiagnoser, load_run, quality
 from heavecomp.diagnosis.data import check_run
 from heavecomp.effects.candidates import family_of, same_family
 from heavecomp.errors import InputError
-from heavecomp.benchmark import Case, corruption, generate, NEAR_NOISE, parameter_sets, validation_cases
+from heavecomp.benchmark import LAWS, Case, corruption, generate, NEAR_NOISE, parameter_sets, validation_cases
 from heavecomp.benchmark.case import SCORING_SEED0
 from heavecomp.benchmark.seeds import spent as spent_ranges
 from heavecomp.params import load
@@ -185,6 +185,7 @@ def judge(row) -> dict:
     """
     v = row["full"]
     lab, cat = row["label"], row["category"]
+    lab = LAWS[lab].answer or lab if lab in LAWS else lab  # the contract's class the truth's law belongs to
     named = v["verdict"] not in NOT_NAMED
     confident = v["confidence"] in ("medium", "high")
     # the contract's class: a verdict of a family (friction_lag, either law) is right for a truth of that class

@@ -196,7 +196,8 @@ def _kernel_xdot(hooks, n_eff, plant, EP, X, w, u):
     p, T, hold, dvb = hooks["plant_fx"](s, v, yb, vb, xe, zh, dzh, ddzh, u, cm, plant.PP, EP)
     Ff = hooks["sliding_friction_fx"](plant.code, float(np.sign(v)), v, p, s, xe, plant.FP, EP)
     rates = hooks["effect_rates"](s, v, p, dzh + v - vb, xe, plant.PP, plant.FP, EP)
-    return np.r_[v, (hold - Ff) / plant.PP[cmc.MC], vb, dvb, rates]
+    m = plant.PP[cmc.MC] + hooks["line_mass_fx"](s, v, xe, plant.PP, EP)  # the line's oil moves with the stroke
+    return np.r_[v, (hold - Ff) / m, vb, dvb, rates]
 
 
 @pytest.mark.parametrize("model", MODELS)

@@ -19,7 +19,9 @@ CONTRACT = ("friction_lag", "dwell_stiction", "pressure_friction", "gas_heat_tra
             # item 4): laws of the friction_lag and gas_heat_transfer classes
             "friction_memory", "gas_thermal",
             # the hysteretic law of the string_damping class (a Bouc-Wen share of the string's stiffness)
-            "string_hysteresis")
+            "string_hysteresis",
+            # the inertance law of the flow_loss class (the line's oil as a mass on the stroke)
+            "line_inertia")
 
 
 def test_contract_names_exactly():

@@ -273,7 +273,7 @@ def validation_cases(which, quick=False, seed_base=None):
             Case("flow_loss", next(s), "near_noise", sea="mixed", near=True, start=mid),
             Case("asymmetric_friction", next(s), "near_noise", sea="buoy", near=True, duration=600.0, start=mid),
             Case("sensor_gain", next(s), "near_noise", sea="mixed", variant="wob", near=True, start=mid),
-            Case("line_inertance", next(s), "out_of_library", sea="buoy", start=mid),
+            Case("line_inertance", next(s), "named", sea="buoy", start=mid),
             Case("seal_warming", next(s), "out_of_library", sea="mixed", duration=600.0, params="long_soft_string",
                  start=mid),
             Case("stiffening_string", next(s), "out_of_library", sea="buoy", duration=600.0, params="soft_rock",

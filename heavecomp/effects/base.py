@@ -19,6 +19,10 @@ hook (slot)    method                                             nominal ("none
 =============  =================================================  ======================================
 gas spring     ``gas(s, v, p, x, PP, *prm) -> p_gas [Pa]``        polytropic, fixed charge
 line           ``line(v, p, x, PP, *prm) -> p_cyl [Pa]``          lossless, p_cyl = p_gas
+               ``line_mass(v, m, x, PP, *prm) -> m [kg]``         no oil inertia, m = 0
+                                                                  (the oil's inertance I A^2: the stroke
+                                                                  accelerates as M_c + m, the cylinder
+                                                                  reads p_cyl - m a / A)
 string         ``string(dv, T, x, PP, *prm) -> T_ds [N]``         spring + dashpot (dv = dz_h + v - v_b)
 seal friction  ``jump(code, a, p, J, s, d, x, FP, *prm) -> J``    the friction law's J [N] (paper A eq. 4/6/7)
                ``static(code, p, lim, tau, s, d, x, FP, *prm)``   static limit J(0, p) [N]; tau = dwell time
@@ -62,7 +66,7 @@ from heavecomp.errors import ParameterError, did_you_mean
 
 #: hook slot -> the methods an effect defines there (kernel hooks first; ``channel`` and
 #: ``heave`` act outside the kernel)
-HOOKS = {"seal_friction": ("jump", "static"), "gas_spring": ("gas",), "line": ("line",),
+HOOKS = {"seal_friction": ("jump", "static"), "gas_spring": ("gas",), "line": ("line", "line_mass"),
          "string": ("string",), "channel": (), "heave": ()}
 #: model components of the gap diagnosis (contract schema 2, ``where.components``), in report order
 COMPONENTS = ("friction", "gas_spring", "flow_line", "string_formation", "sensors", "heave_input")
@@ -70,7 +74,7 @@ COMPONENTS = ("friction", "gas_spring", "flow_line", "string_formation", "sensor
 HOOK_COMPONENT = {"seal_friction": "friction", "gas_spring": "gas_spring", "line": "flow_line",
                   "string": "string_formation", "channel": "sensors", "heave": "heave_input"}
 #: the methods the stepper and the casadi model call, in the order they are composed
-METHODS = ("gas", "line", "string", "jump", "static", "rates", "string_rates")
+METHODS = ("gas", "line", "line_mass", "string", "jump", "static", "rates", "string_rates")
 #: measured channels a channel effect (:class:`ChannelEffect`) may act on
 SENSOR_CHANNELS = ("wob", "stroke", "pressure", "heave")
 
@@ -164,7 +168,7 @@ class Effect:
     #: them, :mod:`heavecomp.effects.sensor_lag`), never undone on the log
     model_side: bool = False
     # hook methods (staticmethods in subclasses); None: the effect does not act there
-    gas = line = string = jump = static = rates = string_rates = initial = steady = None
+    gas = line = line_mass = string = jump = static = rates = string_rates = initial = steady = None
 
     def __init_subclass__(cls, **kw):
         super().__init_subclass__(**kw)

@@ -46,7 +46,7 @@ PLANT_FUNCTIONS = {"gas_pressure": _cmc.gas_pressure, "tension": _cmc.tension, "
                    "lower_accel_tension": _cmc.lower_accel_tension, "friction_jump": _laws.friction_jump,
                    "friction_cont": _laws.friction_cont}
 #: names of the generated functions, callees first
-GENERATED = ("gas_fx", "cylinder_pressure_fx", "tension_fx", "plant_fx", "jump_fx", "sliding_friction_fx",
+GENERATED = ("gas_fx", "cylinder_pressure_fx", "line_mass_fx", "tension_fx", "plant_fx", "jump_fx", "sliding_friction_fx",
              "static_limit_fx", "effect_rates", "state_axpy", "state_rest", "state_dot", "state_load",
              "state_store", "state_record")
 
@@ -128,6 +128,10 @@ class Composition:
         L += self._calls("gas", "p", "s, v, p, {x}, PP") + ["    return p", ""]
         L += ["def cylinder_pressure_fx(s, v, X, PP, EP):", "    p = gas_fx(s, v, X, PP, EP)"]
         L += self._calls("line", "p", "v, p, {x}, PP") + ["    return p", ""]
+        L += ["def line_mass_fx(s, v, X, PP, EP):",
+              '    """The mass [kg] the line\'s oil adds to the stroke (its inertance times A^2; 0: none)."""',
+              "    m = 0.0 * v"]
+        L += self._calls("line_mass", "m", "v, m, {x}, PP") + ["    return m", ""]
         L += ["def tension_fx(s, v, yb, vb, zh, dzh, X, PP, EP):", "    T = tension(s, v, yb, vb, zh, dzh, PP)"]
         L += self._calls("string", "T", "dzh + v - vb, T, {x}, PP") + ["    return T", ""]
         L += ["def plant_fx(s, v, yb, vb, X, zh, dzh, ddzh, u, contact, PP, EP):",

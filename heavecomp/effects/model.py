@@ -16,7 +16,7 @@ from heavecomp.effects.compose import composition, hook_order
 from heavecomp.effects.registry import resolve, split_effects
 from heavecomp.errors import ParameterError
 from heavecomp.friction.laws import friction_cont
-from heavecomp.plants.cmc import MC, lower_accel_wob, plant_vectors, wob
+from heavecomp.plants.cmc import MC, A, lower_accel_wob, plant_vectors, wob
 from heavecomp.plants.symbolic import casadi
 
 log = logging.getLogger(__name__)
@@ -77,10 +77,11 @@ def casadi_model(params, *, eps: float | None = None, sym: str = "SX", effects=(
     p, T, hold, dvb = fn["plant_fx"](s, v, yb, vb, X, zh, dzh, ddzh, ua, 1.0, PP, EP)
     dvb = lower_accel_wob(T, yb, vb, PP)  # the clamped contact law (smooth model)
     Ff = smooth_seal_friction(fn, code, v, p, s, X, FP, EP, eps or 1.0) if friction else 0.0 * v
-    dv = (hold - Ff) / PP[MC]
+    m_line = fn["line_mass_fx"](s, v, X, PP, EP)  # the line's oil moves with the stroke
+    dv = (hold - Ff) / (PP[MC] + m_line)
     rates = fn["effect_rates"](s, v, p, dzh + v - vb, X, PP, FP, EP)
     xdot = ca.vertcat(v, dv, vb, dvb, *rates)
-    y = {"wob": wob(yb, vb, PP), "stroke": s, "pressure": p}
+    y = {"wob": wob(yb, vb, PP), "stroke": s, "pressure": p - m_line * dv / PP[A]}
     for e in sensor_fx:  # a recorded channel that reads g y + o
         if e.channel in y:
             g, o = _static_affine(e)

@@ -17,6 +17,7 @@ MODULES = (
     "pressure_friction",
     "gas_heat_transfer",
     "flow_loss",
+    "line_inertia",
     "string_hysteresis",
     "string_damping",
     "sensor_delay",

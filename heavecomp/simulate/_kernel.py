@@ -68,7 +68,7 @@ import numpy as np
 from heavecomp.effects import compose as _compose
 from heavecomp.friction import laws as _laws
 from heavecomp.plants import cmc as _cmc
-from heavecomp.plants.cmc import MC
+from heavecomp.plants.cmc import MC, A
 
 
 
@@ -184,6 +184,7 @@ _NONE = _compose.composition(())
 _compile_composition(_NONE, _ENV)
 gas_fx = _ENV["gas_fx"]
 cylinder_pressure_fx = _ENV["cylinder_pressure_fx"]
+line_mass_fx = _ENV["line_mass_fx"]
 tension_fx = _ENV["tension_fx"]
 plant_fx = _ENV["plant_fx"]
 jump_fx = _ENV["jump_fx"]
@@ -281,7 +282,9 @@ def rhs(t, X, mode, d, cm, plant, drive):
         Ff = friction_cont(code, v, p, FP)
     else:
         Ff = sliding_friction_fx(code, d, v, p, s, X, FP, EP)
-    return state_dot(v, (hold - Ff) / PP[MC], vb, dvb, s, v, p, dzh + v - vb, X, PP, FP, EP)
+    # the line's oil (its inertance) moves with the stroke: the stroke's mass is M_c + m_line
+    return state_dot(v, (hold - Ff) / (PP[MC] + line_mass_fx(s, v, X, PP, EP)), vb, dvb, s, v, p, dzh + v - vb, X,
+                     PP, FP, EP)
 
 
 @_jit
@@ -632,6 +635,9 @@ def _record(out, pos, t, X, mode, d, cm, plant, drive):
         Ff = friction_cont(code, v, p, FP)
     else:
         Ff = sliding_friction_fx(code, d, v, p, s, X, FP, EP)
+    m_line = line_mass_fx(s, v, X, PP, EP)
+    if m_line != 0.0:  # the cylinder reads the oil column's inertial drop, m a / A (0 while stuck)
+        p = p - m_line * (F - Ff) / (PP[MC] + m_line) / PP[A]
     out[pos, COL_T] = t
     out[pos, COL_HEAVE] = zh
     out[pos, COL_STROKE] = s

@@ -24,7 +24,7 @@ gas_leak                gas_spring         laminar leak of the gas mass fraction
 sensor_gain             sensors            g LP(y), 5 Hz bandwidth; g = -1 (sign flip)
 sensor_offset           sensors            absolute pressure, stroke zero, WOB warm-up drift
 heave_reference         heave_input        lever arm x synthetic pitch, or an MRU high-pass
-line_inertance          flow_line          oil column inertance (outside every name)
+line_inertance          flow_line          oil column inertance (a law of flow_loss)
 seal_warming            friction           J (1 - beta theta), seal temperature theta (outside)
 stiffening_string       string_formation   T += k_3 e^3 (outside every name)
 wob_saturation          sensors            the WOB load cell clips (outside every name)

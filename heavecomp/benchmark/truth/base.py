@@ -127,6 +127,9 @@ class TruthLaw:
         ``record(parameters, nominal) -> dict``: the parameters as the run's truth records them.
     named : bool
         A name of the contract (else an effect outside every name).
+    answer : str
+        The contract's class a verdict is judged against (empty: the law's own name): a law of a
+        broader class (the line's inertance is a law of ``flow_loss``).
     variants : tuple of str
         The variants its draw knows (a case's ``variant``; None: the default).
     min_stuck_share : float [-]
@@ -142,6 +145,7 @@ class TruthLaw:
     changes: Callable | None = None
     record: Callable = _as_recorded
     named: bool = True
+    answer: str = ""
     variants: tuple = ()
     min_stuck_share: float = 0.0
 
