@@ -7,10 +7,10 @@ A study, not a truth law of the generator: a dry-friction element in the string,
 (dv = dz_h + v - v_b; rate-independent for |dv| >> eps: the large-amplitude limit of a Bouc-Wen element),
 planted by the benchmark generator in place of its quadratic drag for this one run (``string_damping``'s
 truth law is restored afterwards), sized to 4.5-5.5 x its floor, and diagnosed with every candidate by
-``heavecomp diagnose`` as a user runs it.  A Bouc-Wen element itself cannot be written as an effect: its
-state follows the string's relative displacement, and an effect's ``rates`` get the stroke, its speed and
-the pressure only (``heavecomp.effects.compose``: ``E_rates(s, v, p, x, PP, FP, ...)``), not the heave
-speed nor the lower mass's.  Seeds 830000-830099 (``heavecomp.benchmark.seeds``).
+``heavecomp diagnose`` as a user runs it.  When this study was written a Bouc-Wen element could not be an
+effect (an effect's ``rates`` got the stroke, its speed and the pressure only); a string effect's
+``string_rates`` now get the stretch rate, and ``string_hysteresis`` is that element (the hysteretic law
+of ``string_damping``).  Seeds 830000-830099 (``heavecomp.benchmark.seeds``).
 """
 
 from __future__ import annotations
