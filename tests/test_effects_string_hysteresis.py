@@ -61,3 +61,28 @@ def test_zero_stiffness_is_the_nominal_string():
     PP[KDS], PP[T0] = 2e6, 1e5
     T = 1e5 + 2e6 * 0.003
     assert SH.string(0.1, T, (0.001,), PP, 0.0, 2e-3, 1.0) == T
+
+
+def test_its_equation_error_form_sees_the_loop_not_a_stiffness_that_is_off():
+    """On a string residual that is a stiffness error (a force along the stretch) the loop's column shrinks
+    nothing held out (that is parameter_mismatch's); on a Bouc-Wen residual it finds the loop's h and z_y."""
+    from heavecomp.diagnosis import equation_error as EE
+
+    rng = np.random.default_rng(3)
+    t = np.arange(6000) * 0.1
+    e = 0.006 * np.sin(2 * np.pi * t / 11.0) + 0.003 * np.sin(2 * np.pi * t / 7.3 + 1.0)
+    sig = {"t": t, "dz": e}
+    fit, validate = t < 400, t >= 400
+    noise = 400.0 * rng.normal(size=t.size)
+    stiff = EE.rank_effects(-2e5 * e + noise, sig, [SH], fit, validate)[0]
+    assert stiff["shrink"] < EE.MIN_SHRINK
+    h, zy = 5e5, 2e-3
+    loop = -h * (hysteretic_displacement(e, zy) - e)  # the WOB the element takes off: -h (z - e)
+    found = EE.rank_effects(loop + noise, sig, [SH], fit, validate)[0]
+    start = SH.from_equation_error(found, sig)
+    # what is left of the loop once a stiffness has taken its part along the stretch is all the column's
+    X = np.column_stack([np.ones(t.size), e])
+    rest = loop - X @ np.linalg.lstsq(X, loop, rcond=None)[0]
+    assert EE.rank_effects(rest + 0.1 * noise, sig, [SH], fit, validate)[0]["shrink"] > 0.9
+    assert start["yield_displacement"] == pytest.approx(zy, rel=0.5)
+    assert start["stiffness"] == pytest.approx(h, rel=0.3)

@@ -45,6 +45,9 @@ class LineInertia(Effect):
         family="flow_loss",
         law="inertance",
         log=("added_mass", "resistance"),
+        # a mass and a resistance move no stick event discontinuously: Gauss-Newton from the equation error's
+        # start (bench_600s: 34 replays by the grid and simplex, on a flow-line log)
+        smooth=True,
         # the resistance is fitted only when it pays (a short, wide line is all inertance)
         optional=("resistance",),
         feature_units={"line_mass": "kg", "line_resistance": "Pa s/m"},
