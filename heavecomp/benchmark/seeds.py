@@ -70,7 +70,12 @@ SPENT = (
                        "component from the held-out term) (reports/independent_truth/spent/1020000/; its mru_filter cases "
                        "studied after scoring: the high-pass corner's rescan)"),
     (1040000, 1041000, "independent truth: eleventh scoring run, session 18, on 2eaae54 (the corner's rescan) "
-                       "(reports/independent_truth/)"),
+                       "(reports/independent_truth/spent/1040000/; its string_boucwen and line_dynamics cases studied "
+                       "in session 19: the hysteretic and inertance laws)"),
+    (1050000, 1051000, "independent truth: twelfth scoring run, session 19, on aa19173 (the hysteretic and inertance "
+                       "laws) (reports/independent_truth/)"),
+    (1060000, 1061000, "diagnosis validation: scoring of session 19's diagnosis, aa19173 (reports/diagnosis_validation/"
+                       "scoring/)"),
     (1030000, 1031000, "diagnosis validation: scoring of session 18's diagnosis, 2eaae54 (reports/diagnosis_validation/"
                        "scoring/)"),
     (9000000, 9000100, "independent truth: smoke runs while it was written"),
