@@ -27,7 +27,8 @@ class VerdictPolicy:
     # ---------------------------------------------------------------- scoring a candidate
     penalty: float = 0.03
     """Parsimony penalty per fitted parameter on the explained share: guards against a candidate
-    with more parameters winning by fitting noise."""
+    with more parameters winning by fitting noise.  Also the share a new mechanism must explain beyond the
+    refit of the nominal's own parameters to lead it (``verdict._refit_first``; issue 30 item 3)."""
     perturbed_draws: int = 3
     """Heave-noise draws whose replays test a candidate's explained share (their median counts):
     guards against a gain that only lucky stick-event timing makes (one draw alone can flip an early

@@ -450,7 +450,7 @@ def _distinguish_lines(v) -> list:
     if not d:
         return []
     lines = []
-    for key in ("group_note", "law_note", "lead_note"):
+    for key in ("group_note", "law_note", "lead_note", "refit_note"):
         if v.get(key):
             lines.append(f"\n{v[key]}.")
     fam = d.get("false_alarm_measured", {})
