@@ -73,9 +73,14 @@ SPENT = (
                        "(reports/independent_truth/spent/1040000/; its string_boucwen and line_dynamics cases studied "
                        "in session 19: the hysteretic and inertance laws)"),
     (1050000, 1051000, "independent truth: twelfth scoring run, session 19, on aa19173 (the hysteretic and inertance "
-                       "laws) (reports/independent_truth/)"),
-    (1060000, 1061000, "diagnosis validation: scoring of session 19's diagnosis, aa19173 (reports/diagnosis_validation/"
-                       "scoring/)"),
+                       "laws) (reports/independent_truth/spent/1050000/; its param_gas cases studied: the refit-first "
+                       "rule)"),
+    (1060000, 1061000, "diagnosis validation: scoring of session 19's diagnosis before the refit-first rule, 0335925 "
+                       "(reports/diagnosis_validation/scoring/spent/1060000/)"),
+    (1070000, 1071000, "independent truth: thirteenth scoring run, session 19, on c32d315 (the refit-first rule) "
+                       "(reports/independent_truth/)"),
+    (1080000, 1081000, "diagnosis validation: scoring of session 19's final diagnosis, c32d315 "
+                       "(reports/diagnosis_validation/scoring/)"),
     (1030000, 1031000, "diagnosis validation: scoring of session 18's diagnosis, 2eaae54 (reports/diagnosis_validation/"
                        "scoring/)"),
     (9000000, 9000100, "independent truth: smoke runs while it was written"),
