@@ -76,7 +76,7 @@ def test_finite_outputs_at_sampled_states(model, name):
         p = vals[0]
         vals.append(fn["sliding_friction_fx"](plant.code, np.sign(v), v, p, s, X, plant.FP, EP))
         vals.append(fn["static_limit_fx"](plant.code, p, s, np.sign(v), X, 2.0, plant.FP, EP))
-        vals += list(fn["effect_rates"](s, v, p, 0.0 * v, X, plant.PP, plant.FP, EP))
+        vals += list(fn["effect_rates"](s, v, p, 0.0 * v, 0.0 * v, X, plant.PP, plant.FP, EP))
         assert np.all(np.isfinite(vals)), vals
 
 
@@ -195,7 +195,7 @@ def _kernel_xdot(hooks, n_eff, plant, EP, X, w, u):
     cm = 1.0 if K.contact_switch(yb, vb, plant.PP) > 0 else 0.0
     p, T, hold, dvb = hooks["plant_fx"](s, v, yb, vb, xe, zh, dzh, ddzh, u, cm, plant.PP, EP)
     Ff = hooks["sliding_friction_fx"](plant.code, float(np.sign(v)), v, p, s, xe, plant.FP, EP)
-    rates = hooks["effect_rates"](s, v, p, dzh + v - vb, xe, plant.PP, plant.FP, EP)
+    rates = hooks["effect_rates"](s, v, p, dzh + v - vb, zh + s - yb, xe, plant.PP, plant.FP, EP)
     m = plant.PP[cmc.MC] + hooks["line_mass_fx"](s, v, xe, plant.PP, EP)  # the line's oil moves with the stroke
     return np.r_[v, (hold - Ff) / m, vb, dvb, rates]
 

@@ -261,7 +261,7 @@ def test_a_composition_has_as_many_state_slots_as_its_effects():
     assert X0.shape == (4 + n_lib + 3,) and X0[5 + n_lib] == 1.0
     fn = comp.functions
     X = tuple(X0[:6 + n_lib])
-    k = fn["state_dot"](0.1, 0.2, 0.3, 0.4, 0.0, 0.1, 2e6, 0.0, X, plant.PP, plant.FP, EP)
+    k = fn["state_dot"](0.1, 0.2, 0.3, 0.4, 0.0, 0.1, 2e6, 0.0, 0.0, X, plant.PP, plant.FP, EP)
     assert k == (0.1, 0.2, 0.3, 0.4) + (0.0,) * n_lib + (0.5, 1.0)
     f = casadi_model(paper_a("none"), effects=[_Drifts(rate=0.5)])
     xd = np.asarray(f(np.r_[0.0, 0.1, 0.0, 0.0, 0.0, 1.0], np.zeros(4))[0]).ravel()

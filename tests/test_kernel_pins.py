@@ -180,8 +180,8 @@ def test_compiled_effect_hooks_equal_python_originals():
                               fp["sliding_friction_fx"](code, np.sign(v), v, pr, s, x, FP, EP), 1e5)
                 assert _close(fc["static_limit_fx"](code, pr, s, np.sign(v), x, tau, FP, EP),
                               fp["static_limit_fx"](code, pr, s, np.sign(v), x, tau, FP, EP), 1e5)
-            for a, b in zip(fc["effect_rates"](s, v, pr, 0.3 * v, x, PP, plant.FP, EP),
-                            fp["effect_rates"](s, v, pr, 0.3 * v, x, PP, plant.FP, EP)):
+            for a, b in zip(fc["effect_rates"](s, v, pr, 0.3 * v, 0.01 * s, x, PP, plant.FP, EP),
+                            fp["effect_rates"](s, v, pr, 0.3 * v, 0.01 * s, x, PP, plant.FP, EP)):
                 assert _close(a, b, 1e4)
 
 

@@ -34,6 +34,7 @@ keeps the plant's own coordinates (for comparison).
 from __future__ import annotations
 
 import dataclasses
+import logging
 
 import numpy as np
 
@@ -43,6 +44,8 @@ from heavecomp.effects.registry import resolve, split_effects
 from heavecomp.friction.laws import FORCE_KEYS
 from heavecomp.plants.cmc import plant_vectors
 from heavecomp.plants.symbolic import casadi
+
+log = logging.getLogger(__name__)
 
 OUT = ("wob", "stroke", "pressure")
 
@@ -164,8 +167,17 @@ def controller_model(params, *, eps=None, frame: str = "earth", effects=(), fric
     if frame not in FRAMES:
         raise ValueError(f"model frame {frame!r}: not one of {', '.join(FRAMES)}")
     effects = resolve(effects)
-    f = casadi_model(params, eps=eps, effects=effects, friction=friction)
-    return earth_frame(f, heave_map(effects)) if frame == "earth" else f
+    earth = frame == "earth"
+    oil = [e for e in effects if getattr(type(e), "line_mass", None) is not None]
+    if earth and oil:
+        # the oil is accelerated relative to the platform: in the earth frame its inertia needs the heave
+        # acceleration, which the earth-frame model must not read; the MPC predicts without that mass
+        log.warning("controller model: %s left out of the earth-frame model (the line's oil moves relative to "
+                    "the platform; its inertia would need the heave acceleration); the controller predicts "
+                    "without it", ", ".join(f"{e.name}'s oil mass ({e.values.get('added_mass', 0.0):.3g} kg)"
+                                             for e in oil))
+    f = casadi_model(params, eps=eps, effects=effects, friction=friction, line_mass=not (earth and oil))
+    return earth_frame(f, heave_map(effects)) if earth else f
 
 
 def discrete_model(params, Ts: float, frame: str = "earth", effects=()) -> DiscreteModel:

@@ -30,8 +30,9 @@ seal friction  ``jump(code, a, p, J, s, d, x, FP, *prm) -> J``    the friction l
                                                                   through the ``jump`` hooks: add to it,
                                                                   never lower it, see below)
 states         ``rates(s, v, p, x, PP, FP, *prm) -> dx/dt``       (no extra states)
-               ``string_rates(dv, x, PP, *prm) -> dx/dt``         (a string effect's states: dv the
-                                                                  string's stretch rate dz_h + v - v_b)
+               ``string_rates(dv, e, x, PP, *prm) -> dx/dt``      (a string effect's states: e the
+                                                                  string's stretch z_h + s - y_b from the
+                                                                  operating point, dv its rate)
                ``initial(FP, PP, *prm) -> x`` at rest,
                ``steady(v, FP, PP, *prm) -> x`` sliding at v
                (None: a slow state, carried over a restart)

@@ -148,7 +148,7 @@ class Composition:
         L += self._calls("static", "lim", "code, p, lim, tau, s, d, {x}, FP") + ["    return lim", ""]
         n, f = self.n_states, FIRST_SLOT
         idx = range(f, f + n)
-        L += ["def effect_rates(s, v, p, dvs, X, PP, FP, EP):"] + [f"    d{i} = 0.0 * v" for i in idx]
+        L += ["def effect_rates(s, v, p, dvs, es, X, PP, FP, EP):"] + [f"    d{i} = 0.0 * v" for i in idx]
         for i, c in enumerate(self.classes):
             if c.rates is None and c.string_rates is None:
                 continue
@@ -156,7 +156,7 @@ class Composition:
             x = "(" + "".join(f"X[{s}], " for s in sl) + ")"
             prm = "".join(f", EP[{o + 1 + j}]" for j in range(c.n_params()))
             call = (f"E{i}_rates(s, v, p, {x}, PP, FP{prm})" if c.rates is not None
-                    else f"E{i}_string_rates(dvs, {x}, PP{prm})")  # a string state moves with the stretch rate
+                    else f"E{i}_string_rates(dvs, es, {x}, PP{prm})")  # a string state: the stretch and its rate
             L += [f"    if EP[{o}] != 0.0:  # {c.name}", f"        r = {call}"]
             L += [f"        d{s} = r[{j}]" for j, s in enumerate(sl)]
         L += ["    return (" + "".join(f"d{i}, " for i in idx) + ")", ""]
@@ -164,10 +164,11 @@ class Composition:
         every = range(f + n)
         L += ["def state_axpy(X, h, k):", "    return (" + ", ".join(f"X[{i}] + h * k[{i}]" for i in every) + ")", ""]
         L += ["def state_rest(X):", "    return (X[0], 0.0, " + "".join(f"X[{i}], " for i in range(2, f + n)) + ")", ""]
-        L += ["def state_dot(ds, dv, dyb, dvb, s, v, p, dvs, X, PP, FP, EP):",
-              '    """dX/dt: the plant\'s four derivatives, then the effects\' rates (dvs: the string\'s stretch rate)."""']
+        L += ["def state_dot(ds, dv, dyb, dvb, s, v, p, dvs, es, X, PP, FP, EP):",
+              '    """dX/dt: the plant\'s four derivatives, then the effects\' rates (es, dvs: the string\'s stretch '
+              'from the operating point and its rate)."""']
         if n:
-            L += ["    r = effect_rates(s, v, p, dvs, X, PP, FP, EP)",
+            L += ["    r = effect_rates(s, v, p, dvs, es, X, PP, FP, EP)",
                   "    return (ds, dv, dyb, dvb, " + "".join(f"r[{j}], " for j in range(n)) + ")", ""]
         else:
             L += ["    return (ds, dv, dyb, dvb)", ""]

@@ -22,7 +22,8 @@ from heavecomp.plants.symbolic import casadi
 log = logging.getLogger(__name__)
 
 
-def casadi_model(params, *, eps: float | None = None, sym: str = "SX", effects=(), friction: bool = True):
+def casadi_model(params, *, eps: float | None = None, sym: str = "SX", effects=(), friction: bool = True,
+                 line_mass: bool = True):
     """The CMC as a casadi Function ``f(x, u) -> (xdot, y)`` with smooth friction.
 
     Parameters
@@ -47,6 +48,11 @@ def casadi_model(params, *, eps: float | None = None, sym: str = "SX", effects=(
         False: no seal friction at all, neither the law's nor the seal-hook effects' (the
         friction output is 0; ``eps`` is then not needed).  The linear MPC's model: it takes the
         friction as a force input (:func:`heavecomp.controllers.model.discrete_model`).
+    line_mass : bool
+        False: the mass a line effect's oil adds to the stroke (``line_mass``, e.g. ``line_inertia``) is
+        left out.  That oil is accelerated relative to the platform, so in the earth frame the model
+        would depend on the heave acceleration, which the controllers' earth-frame model may not
+        (:func:`heavecomp.controllers.model.earth_frame`); the controllers predict without it.
 
     Returns
     -------
@@ -77,9 +83,10 @@ def casadi_model(params, *, eps: float | None = None, sym: str = "SX", effects=(
     p, T, hold, dvb = fn["plant_fx"](s, v, yb, vb, X, zh, dzh, ddzh, ua, 1.0, PP, EP)
     dvb = lower_accel_wob(T, yb, vb, PP)  # the clamped contact law (smooth model)
     Ff = smooth_seal_friction(fn, code, v, p, s, X, FP, EP, eps or 1.0) if friction else 0.0 * v
-    m_line = fn["line_mass_fx"](s, v, X, PP, EP)  # the line's oil moves with the stroke
+    # the line's oil moves with the stroke (line_mass=False: left out, for a model in the earth frame)
+    m_line = fn["line_mass_fx"](s, v, X, PP, EP) if line_mass else 0.0 * v
     dv = (hold - Ff) / (PP[MC] + m_line)
-    rates = fn["effect_rates"](s, v, p, dzh + v - vb, X, PP, FP, EP)
+    rates = fn["effect_rates"](s, v, p, dzh + v - vb, zh + s - yb, X, PP, FP, EP)
     xdot = ca.vertcat(v, dv, vb, dvb, *rates)
     y = {"wob": wob(yb, vb, PP), "stroke": s, "pressure": p - m_line * dv / PP[A]}
     for e in sensor_fx:  # a recorded channel that reads g y + o

@@ -17,26 +17,27 @@ import numpy as np
 from heavecomp.effects.base import Effect, FitSpec
 from heavecomp.effects.features import hysteretic_displacement
 from heavecomp.params.core import q
-from heavecomp.plants.cmc import CDS, KDS, T0
 
 
 class StringHysteresis(Effect):
-    """T -> T + h (z - e): a share h [N/m] of the string's stiffness acts through a Bouc-Wen element.
+    """T -> T + h w: a share h [N/m] of the string's stiffness acts through a Bouc-Wen element, w = z - e.
 
     Notes
     -----
-    e is the string's stretch from the operating point, read back from the tension the hook is handed
-    by the nominal law, e = (T - T_0 - c_ds dv) / k_ds; z is the element's hysteretic displacement,
+    e is the string's stretch from the operating point (z_h + s - y_b) and z the element's hysteretic
+    displacement,
 
-        dz/dt = dv - (|dv| z |z|^(n-1) + dv |z|^n) / (2 z_y^n)
+        dz/dt = de/dt - (|de/dt| z |z|^(n-1) + de/dt |z|^n) / (2 z_y^n)
 
     (Bouc 1967, Wen 1976, with A = 1 and beta = gamma = 1 / (2 z_y^n)): while the stretch grows away
     from the loop's centre z follows it and saturates at the yield displacement z_y (its force at
-    h z_y), when the stretch turns back the element unloads elastically (dz/dt = dv).  The force
-    h (z - e) is 0 on the elastic branch near rest, and each closed stretch cycle beyond z_y dissipates
-    energy in proportion to h z_y per unit of stretch travelled, not to its rate: a hysteretic damping.
-    h = 0 is the nominal law bit for bit.  The exponent n sets how sharply the element yields
-    (n = 1 a smooth knee; large n an elastic-perfectly-plastic corner).
+    h z_y), when the stretch turns back the element unloads elastically (dz/dt = de/dt).  The state is
+    the element's lag behind the elastic spring, w = z - e, so the tension changes by h w: 0 on the
+    elastic branch, and each closed stretch cycle beyond z_y dissipates energy in proportion to h z_y per
+    unit of stretch travelled, not to its rate (a hysteretic damping).  Linearised at rest the element is
+    elastic: dw/dt has no first-order term, the linear model keeps w at 0 and is the nominal one.
+    h = 0 is the nominal law bit for bit.  The exponent n sets how sharply the element yields (n = 1 a
+    smooth knee; large n an elastic-perfectly-plastic corner).
     """
 
     name = "string_hysteresis"
@@ -63,7 +64,7 @@ class StringHysteresis(Effect):
         feature_units={"string_hysteresis": "N/m"},
     )
     hook = "string"
-    states = ("z",)
+    states = ("w",)
 
     @dataclass(frozen=True)
     class Params:
@@ -76,14 +77,16 @@ class StringHysteresis(Effect):
 
     @staticmethod
     def string(dv, T, x, PP, stiffness, yield_displacement, exponent):
-        e = (T - PP[T0] - PP[CDS] * dv) / PP[KDS]  # the stretch, by the nominal string law
-        return T + stiffness * (x[0] - e)
+        return T + stiffness * x[0]
 
     @staticmethod
-    def string_rates(dv, x, PP, stiffness, yield_displacement, exponent):
-        u = x[0] / yield_displacement
+    def string_rates(dv, e, x, PP, stiffness, yield_displacement, exponent):
+        # dw/dt = dz/dt - de/dt, z = w + e; |z| <= z_y is invariant under the law, so z / z_y is clipped to
+        # [-1, 1] (no change there): a replay restarted mid-log at w = 0 with |e| > z_y returns at the
+        # yield's rate instead of |e / z_y|^n times it (a stiff transient for the fixed-step stepper)
+        u = np.minimum(np.maximum((x[0] + e) / yield_displacement, -1.0), 1.0)
         au = np.abs(u)
-        return (dv - 0.5 * (np.abs(dv) * u * np.maximum(au, 1e-12) ** (exponent - 1.0) + dv * au ** exponent),)
+        return (-0.5 * (np.abs(dv) * u * np.maximum(au, 1e-12) ** (exponent - 1.0) + dv * au ** exponent),)
 
     @staticmethod
     def initial(FP, PP, stiffness, yield_displacement, exponent):
@@ -91,7 +94,7 @@ class StringHysteresis(Effect):
 
     @staticmethod
     def steady(v, FP, PP, stiffness, yield_displacement, exponent):
-        # a restart mid-log: the element starts on its elastic branch at the loop's centre
+        # a restart mid-log: the element starts on its elastic branch, with the spring (w = 0)
         return (0.0,)
 
     @classmethod

@@ -277,14 +277,14 @@ def rhs(t, X, mode, d, cm, plant, drive):
     zh, dzh, ddzh = heave_at(t, sp, Z, DZ, DDZ)
     p, T, hold, dvb = plant_fx(s, v, yb, vb, X, zh, dzh, ddzh, u, cm, PP, EP)
     if mode == STUCK:
-        return state_dot(0.0, 0.0, vb, dvb, s, v, p, dzh + v - vb, X, PP, FP, EP)
+        return state_dot(0.0, 0.0, vb, dvb, s, v, p, dzh + v - vb, zh + s - yb, X, PP, FP, EP)
     if smooth:
         Ff = friction_cont(code, v, p, FP)
     else:
         Ff = sliding_friction_fx(code, d, v, p, s, X, FP, EP)
     # the line's oil (its inertance) moves with the stroke: the stroke's mass is M_c + m_line
-    return state_dot(v, (hold - Ff) / (PP[MC] + line_mass_fx(s, v, X, PP, EP)), vb, dvb, s, v, p, dzh + v - vb, X,
-                     PP, FP, EP)
+    return state_dot(v, (hold - Ff) / (PP[MC] + line_mass_fx(s, v, X, PP, EP)), vb, dvb, s, v, p, dzh + v - vb,
+                     zh + s - yb, X, PP, FP, EP)
 
 
 @_jit
