@@ -57,7 +57,7 @@ def test_a_closed_stretch_cycle_dissipates_per_cycle_not_per_rate():
 
 def test_zero_stiffness_is_the_nominal_string():
     T = 1e5 + 2e6 * 0.003
-    assert SH.string(0.1, T, (0.001,), None, 0.0, 2e-3, 1.0) == T
+    assert SH.string(0.1, T, (0.001,), np.full(20, 2e6), 0.0, 2e-3, 1.0) == T
 
 
 def test_the_linear_model_at_rest_is_the_nominal_one():
@@ -68,7 +68,7 @@ def test_the_linear_model_at_rest_is_the_nominal_one():
     from heavecomp.params import paper_a
 
     p = paper_a("none")
-    sys = linearise(p, effects=[SH(stiffness=6e5, yield_displacement=2e-3)])
+    sys = linearise(p, effects=[SH(share=0.3, yield_displacement=2e-3)])
     assert drift_states(sys) == ["string_hysteresis.w"]
     assert dc_gain(sys, hold=drift_states(sys)) == pytest.approx(dc_gain(linearise(p, effects=[])), rel=1e-9)
 
@@ -81,7 +81,11 @@ def test_its_equation_error_form_sees_the_loop_not_a_stiffness_that_is_off():
     rng = np.random.default_rng(3)
     t = np.arange(6000) * 0.1
     e = 0.006 * np.sin(2 * np.pi * t / 11.0) + 0.003 * np.sin(2 * np.pi * t / 7.3 + 1.0)
-    sig = {"t": t, "dz": e}
+    from heavecomp.plants.cmc import KDS
+
+    PP = np.zeros(KDS + 1)
+    PP[KDS] = 2e6
+    sig = {"t": t, "dz": e, "PP": PP}
     fit, validate = t < 400, t >= 400
     noise = 400.0 * rng.normal(size=t.size)
     stiff = EE.rank_effects(-2e5 * e + noise, sig, [SH], fit, validate)[0]
@@ -95,4 +99,4 @@ def test_its_equation_error_form_sees_the_loop_not_a_stiffness_that_is_off():
     rest = loop - X @ np.linalg.lstsq(X, loop, rcond=None)[0]
     assert EE.rank_effects(rest + 0.1 * noise, sig, [SH], fit, validate)[0]["shrink"] > 0.9
     assert start["yield_displacement"] == pytest.approx(zy, rel=0.5)
-    assert start["stiffness"] == pytest.approx(h, rel=0.3)
+    assert start["share"] == pytest.approx(h / 2e6, rel=0.3)

@@ -17,10 +17,12 @@ import numpy as np
 from heavecomp.effects.base import Effect, FitSpec
 from heavecomp.effects.features import hysteretic_displacement
 from heavecomp.params.core import q
+from heavecomp.plants.cmc import KDS
 
 
 class StringHysteresis(Effect):
-    """T -> T + h w: a share h [N/m] of the string's stiffness acts through a Bouc-Wen element, w = z - e.
+    """T -> T + delta k_ds w: a share delta of the string's stiffness k_ds acts through a Bouc-Wen element,
+    w = z - e.
 
     Notes
     -----
@@ -32,9 +34,12 @@ class StringHysteresis(Effect):
     (Bouc 1967, Wen 1976, with A = 1 and beta = gamma = 1 / (2 z_y^n)): while the stretch grows away
     from the loop's centre z follows it and saturates at the yield displacement z_y (its force at
     h z_y), when the stretch turns back the element unloads elastically (dz/dt = de/dt).  The state is
-    the element's lag behind the elastic spring, w = z - e, so the tension changes by h w: 0 on the
-    elastic branch, and each closed stretch cycle beyond z_y dissipates energy in proportion to h z_y per
-    unit of stretch travelled, not to its rate (a hysteretic damping).  Linearised at rest the element is
+    the element's lag behind the elastic spring, w = z - e, so the tension changes by h w, h = delta k_ds:
+    0 on the elastic branch, and each closed stretch cycle beyond z_y dissipates energy in proportion to
+    h z_y per unit of stretch travelled, not to its rate (a hysteretic damping).  The share is at most 1
+    (Bouc-Wen's alpha k e + (1 - alpha) k z, 0 <= alpha): while the element yields the string's stiffness
+    is (1 - delta) k_ds, and a share above 1 would make it negative (a replay that diverged, 5e302, when
+    the fit was free to try h = 30 k_ds).  Linearised at rest the element is
     elastic: dw/dt has no first-order term, the linear model keeps w at 0 and is the nominal one.
     h = 0 is the nominal law bit for bit.  The exponent n sets how sharply the element yields (n = 1 a
     smooth knee; large n an elastic-perfectly-plastic corner).
@@ -52,7 +57,9 @@ class StringHysteresis(Effect):
         # the balance's noise): left out, with that evidence, when string_formation shows no gap (bench_600s:
         # replayed unscreened it cost 14 replays on a flow-line log)
         screened=True,
-        log=("stiffness", "yield_displacement"),
+        log=("yield_displacement",),
+        # a share of 0 or 1 is a physical answer (the search bounds are its range)
+        limits=("share",),
         # no stick event's timing jumps with h, z_y or n
         smooth=True,
         # the yield's sharpness refines the smooth knee: fitted from its optimum, never worse on the fit part
@@ -68,19 +75,19 @@ class StringHysteresis(Effect):
 
     @dataclass(frozen=True)
     class Params:
-        stiffness: float = q(4e5, "N/m", bounds=(1e3, 1e8), symbol="h",
-                             doc="share of the string's stiffness that acts through the hysteretic element")
+        share: float = q(0.2, "-", bounds=(0.0, 1.0), symbol="delta",
+                         doc="share of the string's stiffness k_ds that acts through the hysteretic element")
         yield_displacement: float = q(3e-3, "m", bounds=(5e-4, 0.2), symbol="z_y",
                                       doc="stretch at which the hysteretic element yields (its force h z_y)")
         exponent: float = q(1.0, "-", bounds=(0.5, 4.0), symbol="n",
                             doc="sharpness of the yield (1: a smooth knee; large: elastic-perfectly-plastic)")
 
     @staticmethod
-    def string(dv, T, x, PP, stiffness, yield_displacement, exponent):
-        return T + stiffness * x[0]
+    def string(dv, T, x, PP, share, yield_displacement, exponent):
+        return T + share * PP[KDS] * x[0]
 
     @staticmethod
-    def string_rates(dv, e, x, PP, stiffness, yield_displacement, exponent):
+    def string_rates(dv, e, x, PP, share, yield_displacement, exponent):
         # dw/dt = dz/dt - de/dt, z = w + e; |z| <= z_y is invariant under the law, so z / z_y is clipped to
         # [-1, 1] (no change there): a replay restarted mid-log at w = 0 with |e| > z_y returns at the
         # yield's rate instead of |e / z_y|^n times it (a stiff transient for the fixed-step stepper)
@@ -89,11 +96,11 @@ class StringHysteresis(Effect):
         return (-0.5 * (np.abs(dv) * u * np.maximum(au, 1e-12) ** (exponent - 1.0) + dv * au ** exponent),)
 
     @staticmethod
-    def initial(FP, PP, stiffness, yield_displacement, exponent):
+    def initial(FP, PP, share, yield_displacement, exponent):
         return (0.0,)
 
     @staticmethod
-    def steady(v, FP, PP, stiffness, yield_displacement, exponent):
+    def steady(v, FP, PP, share, yield_displacement, exponent):
         # a restart mid-log: the element starts on its elastic branch, with the spring (w = 0)
         return (0.0,)
 
@@ -121,18 +128,20 @@ class StringHysteresis(Effect):
 
     @classmethod
     def from_equation_error(cls, fit, sig):
-        """h: the ``string_hysteresis`` coefficient (inside its bounds); z_y: the grid value the fit
-        picked; n = 1."""
-        h = cls.coefficient_value(fit, "string_hysteresis", "stiffness")
-        if h is None:
+        """delta: the ``string_hysteresis`` coefficient h over k_ds (``sig["PP"]``), inside [0, 1]; z_y: the
+        grid value the fit picked; n = 1.  None without the plant vector."""
+        coef = (fit or {}).get("coefficients") or {}
+        h = coef.get("string_hysteresis")
+        if h is None or not np.isfinite(h) or "PP" not in sig:
             return None
         zy = fit.get("shape")
-        return {"stiffness": h, "yield_displacement": cls.Params().yield_displacement if zy is None else float(zy),
+        return {"share": float(min(max(h / float(sig["PP"][KDS]), 0.0), 1.0)),
+                "yield_displacement": cls.Params().yield_displacement if zy is None else float(zy),
                 "exponent": 1.0}
 
     @classmethod
     def null(cls, plant):
-        return {"stiffness": 0.0, "yield_displacement": 3e-3, "exponent": 1.0}
+        return {"share": 0.0, "yield_displacement": 3e-3, "exponent": 1.0}
 
 
 EFFECT = StringHysteresis
