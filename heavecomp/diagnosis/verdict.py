@@ -229,10 +229,10 @@ def decide(fits, gap, floors, envelope, policy, evidence: Evidence) -> Verdict:
     else:
         v = _named(v, fits, a, policy, evidence)
     if refit_note and v["confidence"] != "low":
-        # the held-out test preferred the mechanism (or did not group the two): the parsimony decides, not
-        # the evidence, so the name is not confident
+        # the mechanism led by score or by the held-out test: the parsimony decides, not the evidence, so the
+        # name is not confident
         v["confidence"] = "low"
-        v["refit_note"] += "; confidence low: the held-out block test set the mechanism first"
+        v["refit_note"] += "; confidence low: the parsimony decides here, not the evidence"
     if evidence.distinct is not None and v["effect"] not in ("inconclusive", "discovered"):
         v["distinguishable"] = evidence.distinct.to_json()
         if len(by_family(group)) > 1:

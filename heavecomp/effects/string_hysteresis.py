@@ -60,7 +60,7 @@ class StringHysteresis(Effect):
         log=("yield_displacement",),
         # a share of 0 or 1 is a physical answer (the search bounds are its range)
         limits=("share",),
-        # no stick event's timing jumps with h, z_y or n
+        # no stick event's timing jumps with delta, z_y or n
         smooth=True,
         # the yield's sharpness refines the smooth knee: fitted from its optimum, never worse on the fit part
         released_last=("exponent",),
@@ -78,7 +78,7 @@ class StringHysteresis(Effect):
         share: float = q(0.2, "-", bounds=(0.0, 1.0), symbol="delta",
                          doc="share of the string's stiffness k_ds that acts through the hysteretic element")
         yield_displacement: float = q(3e-3, "m", bounds=(5e-4, 0.2), symbol="z_y",
-                                      doc="stretch at which the hysteretic element yields (its force h z_y)")
+                                      doc="stretch at which the hysteretic element yields (its force delta k_ds z_y)")
         exponent: float = q(1.0, "-", bounds=(0.5, 4.0), symbol="n",
                             doc="sharpness of the yield (1: a smooth knee; large: elastic-perfectly-plastic)")
 
