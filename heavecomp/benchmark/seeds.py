@@ -79,8 +79,12 @@ SPENT = (
                        "(reports/diagnosis_validation/scoring/spent/1060000/)"),
     (1070000, 1071000, "independent truth: thirteenth scoring run, session 19, on c32d315 (the refit-first rule) "
                        "(reports/independent_truth/)"),
-    (1080000, 1081000, "diagnosis validation: scoring of session 19's final diagnosis, c32d315 "
+    (1080000, 1081000, "diagnosis validation: scoring of session 19's diagnosis, c32d315 "
                        "(reports/diagnosis_validation/scoring/)"),
+    (1090000, 1091000, "independent truth: a run on 82c2e60 stopped after 27 cases (the hysteretic law's unbounded "
+                       "stiffness diverged in the suite); its printed verdicts were seen, not committed"),
+    (1100000, 1101000, "independent truth: fourteenth scoring run, session 19, on 05f9518 (the share-bounded "
+                       "hysteretic law) (reports/independent_truth/)"),
     (1030000, 1031000, "diagnosis validation: scoring of session 18's diagnosis, 2eaae54 (reports/diagnosis_validation/"
                        "scoring/)"),
     (9000000, 9000100, "independent truth: smoke runs while it was written"),
