@@ -66,7 +66,8 @@ from heavecomp.effects.spec import plant_effects
 from heavecomp.effects.features import rest_durations
 from heavecomp.errors import DataError
 from heavecomp.friction.laws import friction_cont, friction_jump
-from heavecomp.plants.cmc import A, CF, D0, KF, MB, MC, G, P0ABS, PATM, gas_pressure, net_force, plant_vectors, tension
+from heavecomp.plants.cmc import (CF, D0, KF, MB, MC, G, P0ABS, PATM, cylinder_reading, gas_pressure, net_force,
+                                  plant_vectors, tension)
 
 CUTOFF = 1.0  #: zero-phase low-pass of every channel before the equations [Hz]
 STUCK_SPEED = 2e-3  #: below this filtered stroke speed the seal is at rest (friction set-valued) [m/s]
@@ -179,10 +180,12 @@ def equations(t, heave, stroke, pressure, wob, params, heave_reference=0.0, cuto
            "lower_mass": np.where(lifted, np.nan, T_meas - (tension(s, v, yb, vb, zh, dzh, PP) if hooks is None else
                                                             fx["tension_fx"](s, v, yb, vb, zh, dzh, X, PP, EP))),
            "gas": p - (gas_pressure(s, PP) if hooks is None else
-                       fx["cylinder_pressure_fx"](s, v, X, PP, EP) - fx["line_mass_fx"](s, v, X, PP, EP) * a / PP[A])}
+                       cylinder_reading(fx["cylinder_pressure_fx"](s, v, X, PP, EP),
+                                        fx["line_mass_fx"](s, v, X, PP, EP), a, PP))}
     dwell, rest = rest_durations(t, ~sliding)
+    rel = zh + s - yb  # the string's stretch from the operating point (the effects' features read it as dz)
     sig = {"t": t, "x": s, "v": v, "a": a, "p": p, "dp": dp, "wob": W, "dwob": dW, "zh": zh, "dzh": dzh,
-           "ddzh": ddzh, "rel": zh + s - yb, "dz": zh + s - yb, "vrel": dzh + v - vb, "dwell": dwell, "rest": rest,
+           "ddzh": ddzh, "rel": rel, "dz": rel, "vrel": dzh + v - vb, "dwell": dwell, "rest": rest,
            "still": ~sliding,
            # the gas effects' equation-error inputs (Effect.features): the nominal gas's absolute pressure at
            # the measured stroke, its absolute pre-charge and the plant vector (geometry for a gas state's rates)

@@ -16,7 +16,7 @@ from heavecomp.effects.compose import composition, hook_order
 from heavecomp.effects.registry import resolve, split_effects
 from heavecomp.errors import ParameterError
 from heavecomp.friction.laws import friction_cont
-from heavecomp.plants.cmc import MC, A, lower_accel_wob, plant_vectors, wob
+from heavecomp.plants.cmc import cylinder_reading, lower_accel_wob, plant_vectors, top_accel, wob
 from heavecomp.plants.symbolic import casadi
 
 log = logging.getLogger(__name__)
@@ -85,10 +85,10 @@ def casadi_model(params, *, eps: float | None = None, sym: str = "SX", effects=(
     Ff = smooth_seal_friction(fn, code, v, p, s, X, FP, EP, eps or 1.0) if friction else 0.0 * v
     # the line's oil moves with the stroke (line_mass=False: left out, for a model in the earth frame)
     m_line = fn["line_mass_fx"](s, v, X, PP, EP) if line_mass else 0.0 * v
-    dv = (hold - Ff) / (PP[MC] + m_line)
+    dv = top_accel(hold, Ff, m_line, PP)
     rates = fn["effect_rates"](s, v, p, dzh + v - vb, zh + s - yb, X, PP, FP, EP)
     xdot = ca.vertcat(v, dv, vb, dvb, *rates)
-    y = {"wob": wob(yb, vb, PP), "stroke": s, "pressure": p - m_line * dv / PP[A]}
+    y = {"wob": wob(yb, vb, PP), "stroke": s, "pressure": cylinder_reading(p, m_line, dv, PP)}
     for e in sensor_fx:  # a recorded channel that reads g y + o
         if e.channel in y:
             g, o = _static_affine(e)

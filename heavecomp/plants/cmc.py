@@ -196,6 +196,43 @@ def net_force(p, T, ddzh, u, PP):
     return p * PP[A] - PP[MC] * PP[G] - T + u - PP[MC] * ddzh
 
 
+def top_accel(hold, Ff, m_line, PP):
+    """Stroke acceleration dv/dt [m/s^2] while sliding: the holding force less the seal friction over the
+    moving mass, M_c plus ``m_line``, the mass a line's oil adds to the stroke (its inertance times A^2;
+    0 for a lossless or a purely resistive line).
+
+    Parameters
+    ----------
+    hold : float [N]
+        Net non-friction force on the top mass (:func:`net_force`).
+    Ff : float [N]
+        Seal friction.
+    m_line : float [kg]
+        Mass of the line's oil as the stroke feels it.
+    PP : (14,) array
+        Plant parameter vector [SI], layout :data:`PP_NAMES` (:func:`plant_vector`).
+    """
+    return (hold - Ff) / (PP[MC] + m_line)
+
+
+def cylinder_reading(p, m_line, a, PP):
+    """The cylinder pressure a sensor reads [Pa]: the line's quasi-static pressure ``p`` less the inertial
+    drop m a / A of the line's oil (``m_line`` [kg], accelerated with the stroke at ``a`` [m/s^2]).
+
+    Parameters
+    ----------
+    p : float [Pa]
+        Cylinder gauge pressure through the line's hooks, without the oil's inertia.
+    m_line : float [kg]
+        Mass of the line's oil as the stroke feels it.
+    a : float [m/s^2]
+        Stroke acceleration.
+    PP : (14,) array
+        Plant parameter vector [SI], layout :data:`PP_NAMES` (:func:`plant_vector`).
+    """
+    return p - m_line * a / PP[A]
+
+
 def holding_force(s, v, yb, vb, zh, dzh, ddzh, u, PP):
     """Net non-friction force on the top mass in the platform frame [N]:
     :func:`net_force` of the gas pressure and the tension.  While stuck the friction equals it.

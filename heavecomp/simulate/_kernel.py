@@ -68,7 +68,6 @@ import numpy as np
 from heavecomp.effects import compose as _compose
 from heavecomp.friction import laws as _laws
 from heavecomp.plants import cmc as _cmc
-from heavecomp.plants.cmc import MC, A
 
 
 
@@ -134,6 +133,8 @@ tension = _compile(_cmc.tension, inline=True)
 contact_force = _compile(_cmc.contact_force, inline=True)
 wob = _compile(_cmc.wob)
 net_force = _compile(_cmc.net_force, inline=True)
+top_accel = _compile(_cmc.top_accel, inline=True)
+cylinder_reading = _compile(_cmc.cylinder_reading, inline=True)
 holding_force = _compile(_cmc.holding_force)
 lower_accel_wob = _compile(_cmc.lower_accel_wob)
 lower_accel = _compile(_cmc.lower_accel)
@@ -283,7 +284,7 @@ def rhs(t, X, mode, d, cm, plant, drive):
     else:
         Ff = sliding_friction_fx(code, d, v, p, s, X, FP, EP)
     # the line's oil (its inertance) moves with the stroke: the stroke's mass is M_c + m_line
-    return state_dot(v, (hold - Ff) / (PP[MC] + line_mass_fx(s, v, X, PP, EP)), vb, dvb, s, v, p, dzh + v - vb,
+    return state_dot(v, top_accel(hold, Ff, line_mass_fx(s, v, X, PP, EP), PP), vb, dvb, s, v, p, dzh + v - vb,
                      zh + s - yb, X, PP, FP, EP)
 
 
@@ -637,7 +638,7 @@ def _record(out, pos, t, X, mode, d, cm, plant, drive):
         Ff = sliding_friction_fx(code, d, v, p, s, X, FP, EP)
     m_line = line_mass_fx(s, v, X, PP, EP)
     if m_line != 0.0:  # the cylinder reads the oil column's inertial drop, m a / A (0 while stuck)
-        p = p - m_line * (F - Ff) / (PP[MC] + m_line) / PP[A]
+        p = cylinder_reading(p, m_line, top_accel(F, Ff, m_line, PP), PP)
     out[pos, COL_T] = t
     out[pos, COL_HEAVE] = zh
     out[pos, COL_STROKE] = s
